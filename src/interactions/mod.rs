@@ -1,0 +1,308 @@
+//! The interaction registry: every mechanism is one registered interaction type.
+//!
+//! An interaction type declares its name (its force-field keyword, the stem of
+//! its `.rs`, `.md`, `.wgsl` and reference `.yaml` files), its [`Kind`], its
+//! parameter schema ([`ParamSpec`]: name, unit, allowed range, default, doc),
+//! and a [`Law`]: the evaluator that turns parameters and geometry into energy
+//! and forces. Loops over terms, periodic images, neighbour lists and force
+//! accumulation live once in the backend; an interaction file holds only its
+//! functional form (HOOMD-blue's evaluator pattern).
+//!
+//! Parameters reach an evaluator as a slice in schema order, already checked
+//! against the schema and by [`Interaction::validate`].
+//!
+//! Laws carry what later solvers need: [`Radial`] returns d²E/dr², from which
+//! the analytic pair Hessian `E''·ûûᵀ + (E'/r)(I − ûûᵀ)` follows; state that
+//! changes during a run (e.g. a rest length under kinetics) is a parameter
+//! value, so a stateful bond owns its own parameter copy.
+
+use glam::DVec3;
+
+use crate::units::Dim;
+
+pub mod testing;
+
+mod harmonic;
+
+/// Every registered interaction type. The parser, validator, `cellmd list`
+/// and the docs read this list; nothing else lists interaction names.
+pub static REGISTRY: &[&dyn Interaction] = &[
+    &harmonic::Harmonic,
+];
+
+/// Looks an interaction type up by its registered name.
+pub fn lookup(name: &str) -> Option<&'static dyn Interaction> {
+    REGISTRY.iter().copied().find(|i| i.name() == name)
+}
+
+/// Where an interaction type may be used in a force field or deck.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    /// Two-particle bonded term (`bond` lines).
+    Bond,
+    /// Three-particle bonded term (`angle` lines).
+    Angle,
+    /// Non-bonded pair term by type pair, within a cutoff (`pair` lines).
+    Pair,
+    /// One-particle external field on a group (deck `external` command).
+    External,
+}
+
+impl Kind {
+    /// The keyword that introduces this kind in a force-field file or deck.
+    pub fn keyword(self) -> &'static str {
+        match self {
+            Kind::Bond => "bond",
+            Kind::Angle => "angle",
+            Kind::Pair => "pair",
+            Kind::External => "external",
+        }
+    }
+}
+
+/// Energy and its radial derivatives for a law that depends only on the
+/// distance r between two particles.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Radial {
+    pub energy: f64,
+    /// dE/dr: positive when the pair pulls together (tension).
+    pub de_dr: f64,
+    /// d²E/dr², for analytic Jacobians.
+    pub d2e_dr2: f64,
+}
+
+impl Radial {
+    pub const ZERO: Radial = Radial { energy: 0.0, de_dr: 0.0, d2e_dr2: 0.0 };
+}
+
+/// Energy and the force on each of three particles.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ThreeBody {
+    pub energy: f64,
+    pub forces: [DVec3; 3],
+}
+
+/// Energy and force of a one-particle external field.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OneBody {
+    pub energy: f64,
+    pub force: DVec3,
+}
+
+/// The evaluator of an interaction type, by family.
+#[derive(Clone, Copy)]
+pub enum Law {
+    /// E(r) for bonds and pairs. `range` is the cutoff beyond which E ≡ 0
+    /// (used for pair neighbour lists; `f64::INFINITY` for bonds).
+    Radial { eval: fn(&[f64], f64) -> Radial, range: fn(&[f64]) -> f64 },
+    /// E(r_i, r_j, r_k) for angles; positions are made image-consistent
+    /// (r_i and r_k are placed at their minimum image around r_j).
+    ThreeBody(fn(&[f64], [DVec3; 3]) -> ThreeBody),
+    /// E(r) of one particle in an external field; r is the unwrapped position.
+    OneBody(fn(&[f64], DVec3) -> OneBody),
+}
+
+/// Inclusive/exclusive numeric bound of a parameter.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Bound {
+    None,
+    Inclusive(f64),
+    Exclusive(f64),
+}
+
+/// One named, documented parameter of an interaction type.
+#[derive(Clone, Copy, Debug)]
+pub struct ParamSpec {
+    pub name: &'static str,
+    pub dim: Dim,
+    pub min: Bound,
+    pub max: Bound,
+    /// `None` means the parameter is required.
+    pub default: Option<f64>,
+    pub doc: &'static str,
+}
+
+impl ParamSpec {
+    /// A required parameter with no bounds; refine with the builder methods.
+    pub const fn new(name: &'static str, dim: Dim, doc: &'static str) -> Self {
+        Self { name, dim, min: Bound::None, max: Bound::None, default: None, doc }
+    }
+    pub const fn positive(mut self) -> Self {
+        self.min = Bound::Exclusive(0.0);
+        self
+    }
+    pub const fn non_negative(mut self) -> Self {
+        self.min = Bound::Inclusive(0.0);
+        self
+    }
+    pub const fn at_most(mut self, max: f64) -> Self {
+        self.max = Bound::Inclusive(max);
+        self
+    }
+    pub const fn below(mut self, max: f64) -> Self {
+        self.max = Bound::Exclusive(max);
+        self
+    }
+    pub const fn default(mut self, value: f64) -> Self {
+        self.default = Some(value);
+        self
+    }
+
+    /// Checks a value against the range; the error says what was expected.
+    pub fn check(&self, value: f64) -> Result<(), String> {
+        if !value.is_finite() {
+            return Err(format!("a finite number for `{}`, found {value}", self.name));
+        }
+        let low_ok = match self.min {
+            Bound::None => true,
+            Bound::Inclusive(m) => value >= m,
+            Bound::Exclusive(m) => value > m,
+        };
+        let high_ok = match self.max {
+            Bound::None => true,
+            Bound::Inclusive(m) => value <= m,
+            Bound::Exclusive(m) => value < m,
+        };
+        if low_ok && high_ok {
+            Ok(())
+        } else {
+            Err(format!("`{}` {}, found {value}", self.name, self.range_text()))
+        }
+    }
+
+    /// The allowed range in words, e.g. `> 0` or `in [0, 1]`.
+    pub fn range_text(&self) -> String {
+        match (self.min, self.max) {
+            (Bound::None, Bound::None) => "any finite value".into(),
+            (Bound::Inclusive(a), Bound::None) => format!(">= {a}"),
+            (Bound::Exclusive(a), Bound::None) => format!("> {a}"),
+            (Bound::None, Bound::Inclusive(b)) => format!("<= {b}"),
+            (Bound::None, Bound::Exclusive(b)) => format!("< {b}"),
+            (lo, hi) => {
+                let (l, a) = match lo {
+                    Bound::Inclusive(a) => ('[', a),
+                    Bound::Exclusive(a) => ('(', a),
+                    Bound::None => unreachable!(),
+                };
+                let (r, b) = match hi {
+                    Bound::Inclusive(b) => (']', b),
+                    Bound::Exclusive(b) => (')', b),
+                    Bound::None => unreachable!(),
+                };
+                format!("in {l}{a}, {b}{r}")
+            }
+        }
+    }
+}
+
+/// A registered interaction type.
+pub trait Interaction: Sync + Send {
+    /// Force-field keyword and registry name (snake_case).
+    fn name(&self) -> &'static str;
+    fn kind(&self) -> Kind;
+    /// One line for `cellmd list`.
+    fn summary(&self) -> &'static str;
+    /// Markdown with the headings Potential, References, Example (the
+    /// module's own doc; the parameter table is generated from the schema).
+    fn doc(&self) -> &'static str;
+    fn params(&self) -> &'static [ParamSpec];
+    fn law(&self) -> Law;
+    /// Checks relations between parameters beyond per-parameter ranges.
+    fn validate(&self, _params: &[f64]) -> Result<(), String> {
+        Ok(())
+    }
+}
+
+/// Index of a parameter in an interaction's schema.
+pub fn param_index(interaction: &dyn Interaction, name: &str) -> Option<usize> {
+    interaction.params().iter().position(|p| p.name == name)
+}
+
+/// Full documentation page of an interaction type (what `cellmd list NAME` prints).
+pub fn documentation(interaction: &dyn Interaction, units: crate::units::UnitSystem) -> String {
+    let mut page = format!(
+        "# {} ({})\n\n{}\n\n## Parameters\n\n| name | unit | allowed | default | meaning |\n|---|---|---|---|---|\n",
+        interaction.name(),
+        interaction.kind().keyword(),
+        interaction.summary()
+    );
+    for p in interaction.params() {
+        let default = p.default.map_or("required".to_string(), |d| d.to_string());
+        page += &format!(
+            "| `{}` | {} | {} | {} | {} |\n",
+            p.name,
+            units.label(p.dim),
+            p.range_text(),
+            default,
+            p.doc
+        );
+    }
+    page += "\n";
+    page += interaction.doc();
+    page
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_are_unique_snake_case_and_have_their_doc_file() {
+        let mut seen = std::collections::HashSet::new();
+        for i in REGISTRY {
+            assert!(seen.insert(i.name()), "duplicate {}", i.name());
+            assert!(
+                i.name().chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_'),
+                "{} is not snake_case",
+                i.name()
+            );
+            let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/src/interactions/");
+            for ext in ["rs", "md"] {
+                let path = format!("{dir}{}.{ext}", i.name());
+                assert!(std::path::Path::new(&path).exists(), "missing {path}");
+            }
+        }
+        // and no interaction file without a registry entry
+        for entry in std::fs::read_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/src/interactions")).unwrap() {
+            let path = entry.unwrap().path();
+            let stem = path.file_stem().unwrap().to_str().unwrap().to_string();
+            if ["mod", "testing"].contains(&stem.as_str()) {
+                continue;
+            }
+            assert!(lookup(&stem).is_some(), "{} has no REGISTRY entry", path.display());
+        }
+    }
+
+    #[test]
+    fn every_doc_has_the_house_headings_and_params_have_docs() {
+        for i in REGISTRY {
+            for heading in ["## Potential", "## References", "## Example"] {
+                assert!(i.doc().contains(heading), "{} doc lacks {heading}", i.name());
+            }
+            assert!(!i.summary().is_empty());
+            for p in i.params() {
+                assert!(!p.doc.is_empty(), "{}.{} undocumented", i.name(), p.name);
+                if let Some(d) = p.default {
+                    p.check(d).unwrap_or_else(|e| panic!("{}: default violates range: {e}", i.name()));
+                }
+            }
+            // Kind and law agree.
+            match (i.kind(), i.law()) {
+                (Kind::Bond | Kind::Pair, Law::Radial { .. })
+                | (Kind::Angle, Law::ThreeBody(_))
+                | (Kind::External, Law::OneBody(_)) => {}
+                _ => panic!("{}: kind and law disagree", i.name()),
+            }
+        }
+    }
+
+    #[test]
+    fn range_check_rejects_nan_and_out_of_range() {
+        let p = ParamSpec::new("k", Dim::Stiffness, "spring constant").positive();
+        assert!(p.check(1.0).is_ok());
+        assert!(p.check(0.0).unwrap_err().contains("> 0"));
+        assert!(p.check(f64::NAN).is_err());
+        let q = ParamSpec::new("tau", Dim::Dimensionless, "x").non_negative().below(1.0);
+        assert_eq!(q.range_text(), "in [0, 1)");
+    }
+}

@@ -1,0 +1,7 @@
+//! Simulation state: the box and the per-particle arrays (f64, structure of arrays).
+
+mod sim_box;
+mod state;
+
+pub use self::sim_box::SimBox;
+pub use self::state::State;

@@ -1,0 +1,109 @@
+//! Orthorhombic simulation box, periodic or not per axis.
+//!
+//! Positions on periodic axes are kept wrapped into `[lo, hi)` after every step
+//! (with an image counter per particle, as LAMMPS does), so the stored
+//! coordinates — and therefore every force sum — are independent of when the
+//! neighbour list happened to be rebuilt. Separations use the minimum image
+//! convention `d − L·round(d/L)` on periodic axes.
+
+use glam::DVec3;
+
+/// An axis-aligned box `[lo, hi)` with a periodic flag per axis.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SimBox {
+    pub lo: DVec3,
+    pub hi: DVec3,
+    pub periodic: [bool; 3],
+}
+
+impl SimBox {
+    pub fn new(lo: DVec3, hi: DVec3, periodic: [bool; 3]) -> Self {
+        Self { lo, hi, periodic }
+    }
+
+    /// Edge lengths `hi − lo`.
+    pub fn lengths(&self) -> DVec3 {
+        self.hi - self.lo
+    }
+
+    /// Box volume (length³).
+    pub fn volume(&self) -> f64 {
+        let l = self.lengths();
+        l.x * l.y * l.z
+    }
+
+    /// Minimum-image form of a separation vector.
+    #[inline]
+    pub fn minimum_image(&self, mut d: DVec3) -> DVec3 {
+        let l = self.lengths();
+        for axis in 0..3 {
+            if self.periodic[axis] {
+                d[axis] -= l[axis] * (d[axis] / l[axis]).round();
+            }
+        }
+        d
+    }
+
+    /// Wraps a position into the box on periodic axes, updating its image counter.
+    #[inline]
+    pub fn wrap(&self, x: &mut DVec3, image: &mut [i32; 3]) {
+        let l = self.lengths();
+        for axis in 0..3 {
+            if !self.periodic[axis] {
+                continue;
+            }
+            while x[axis] >= self.hi[axis] {
+                x[axis] -= l[axis];
+                image[axis] += 1;
+            }
+            while x[axis] < self.lo[axis] {
+                x[axis] += l[axis];
+                image[axis] -= 1;
+            }
+        }
+    }
+
+    /// Unwrapped position from a wrapped one and its image counter.
+    #[inline]
+    pub fn unwrap(&self, x: DVec3, image: [i32; 3]) -> DVec3 {
+        let l = self.lengths();
+        x + DVec3::new(image[0] as f64 * l.x, image[1] as f64 * l.y, image[2] as f64 * l.z)
+    }
+
+    /// `p` for a periodic axis, `f` for a fixed one (LAMMPS boundary letters).
+    pub fn boundary_letter(&self, axis: usize) -> char {
+        if self.periodic[axis] {
+            'p'
+        } else {
+            'f'
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn periodic_box() -> SimBox {
+        SimBox::new(DVec3::ZERO, DVec3::new(10.0, 10.0, 10.0), [true, true, false])
+    }
+
+    #[test]
+    fn minimum_image_is_shorter_than_half_a_box() {
+        let b = periodic_box();
+        let d = b.minimum_image(DVec3::new(9.0, -7.0, 9.0));
+        assert_eq!(d, DVec3::new(-1.0, 3.0, 9.0));
+    }
+
+    #[test]
+    fn wrap_then_unwrap_round_trips() {
+        let b = periodic_box();
+        let original = DVec3::new(23.5, -0.5, 12.0);
+        let mut x = original;
+        let mut image = [0; 3];
+        b.wrap(&mut x, &mut image);
+        assert_eq!(image, [2, -1, 0]);
+        assert!(x.x >= 0.0 && x.x < 10.0 && x.y >= 0.0 && x.y < 10.0);
+        assert!((b.unwrap(x, image) - original).length() < 1e-12);
+    }
+}
