@@ -15,6 +15,9 @@
 //! | `backend` | the CPU reference force engine (f64, rayon, deterministic) |
 //! | `output` | thermo, MCAP, extended XYZ, LAMMPS dump, restart |
 
+pub mod forcefield;
+pub mod input;
 pub mod interactions;
 pub mod system;
+pub mod topology;
 pub mod units;

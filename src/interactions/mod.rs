@@ -58,6 +58,16 @@ impl Kind {
             Kind::External => "external",
         }
     }
+
+    /// "a bond", "an angle", … for messages.
+    pub fn with_article(self) -> &'static str {
+        match self {
+            Kind::Bond => "a bond",
+            Kind::Angle => "an angle",
+            Kind::Pair => "a pair",
+            Kind::External => "an external",
+        }
+    }
 }
 
 /// Energy and its radial derivatives for a law that depends only on the

@@ -1,0 +1,23 @@
+//! Force-field files (`*.ff`): particle types and the interaction types that act
+//! between them, each line naming a registered interaction and its parameters.
+//!
+//! ```text
+//! include common.ff                          # path relative to this file
+//! particle actin  drag 0.05                  # γ in pN·s/µm, optional radius (µm)
+//! particle bead   radius 0.05 viscosity 1e-3 # Stokes drag γ = 6πηa (η in Pa·s)
+//! bond  actin_segment  harmonic  k 400 r0 0.1
+//! angle actin_bend     wlc_bending kappa 0.07 l0 0.1
+//! pair  actin actin    soft_repulsion k 100 sigma 0.05
+//! ```
+//!
+//! Parameters are `name value` pairs in any order, checked against the
+//! interaction's schema (`cellmd list NAME`): unknown or repeated names,
+//! missing required values, non-finite or out-of-range values and an
+//! interaction of the wrong kind are errors at their `file:line:col`.
+//! Several `pair` lines for one type pair add up (like LAMMPS `hybrid/overlay`).
+
+mod params;
+mod parse;
+
+pub use self::params::{parse_params, TermType};
+pub use self::parse::{load_forcefield, ForceField, PairRule, ParticleType};

@@ -1,0 +1,197 @@
+//! Parser of force-field files, with `include`.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use crate::input::{lex, parse_f64, InputError, SourceFile, Statement, Token};
+use crate::interactions::Kind;
+use crate::units::UnitSystem;
+
+use super::params::{parse_params, TermType};
+
+/// A particle type: overdamped drag coefficient and radius.
+#[derive(Clone, Debug)]
+pub struct ParticleType {
+    pub name: Token,
+    /// γ (drag units): force = γ·velocity.
+    pub drag: f64,
+    /// Radius (length units), for Stokes drag, output and export; 0 if not given.
+    pub radius: f64,
+}
+
+/// A pair rule between two particle types.
+#[derive(Clone, Debug)]
+pub struct PairRule {
+    pub type_a: Token,
+    pub type_b: Token,
+    pub term: TermType,
+}
+
+/// Everything the force-field files of a deck define.
+#[derive(Clone, Debug, Default)]
+pub struct ForceField {
+    pub particle_types: Vec<ParticleType>,
+    pub bond_types: Vec<TermType>,
+    pub angle_types: Vec<TermType>,
+    pub pair_rules: Vec<PairRule>,
+}
+
+impl ForceField {
+    pub fn particle_type(&self, name: &str) -> Option<usize> {
+        self.particle_types.iter().position(|t| t.name.text == name)
+    }
+}
+
+fn check_unique<'a>(name: &Token, existing: impl Iterator<Item = &'a Token>, what: &str) -> Result<(), InputError> {
+    for other in existing {
+        if other.text == name.text {
+            return Err(name.error(format!(
+                "{what} `{}` is already defined at {}:{}:{}; expected a new name",
+                name.text, other.file.path, other.line, other.col
+            )));
+        }
+    }
+    Ok(())
+}
+
+fn particle(s: &Statement) -> Result<ParticleType, InputError> {
+    let t = &s.tokens;
+    let Some(name) = t.get(1) else {
+        return Err(t[0].error("expected `particle NAME drag G [radius A]` or `particle NAME radius A viscosity ETA`"));
+    };
+    let mut fields: HashMap<&str, (f64, &Token)> = HashMap::new();
+    for pair in t[2..].chunks(2) {
+        let key = &pair[0];
+        if !["drag", "radius", "viscosity"].contains(&key.text.as_str()) {
+            return Err(key.error(format!("found `{}`, expected `drag`, `radius` or `viscosity`", key.text)));
+        }
+        let Some(value) = pair.get(1) else {
+            return Err(key.error(format!("`{}` has no value; expected `{} VALUE`", key.text, key.text)));
+        };
+        let v = parse_f64(value, &format!("a value for `{}`", key.text))?;
+        if v < 0.0 || (v == 0.0 && key.text != "radius") {
+            return Err(value.error(format!("found {v}, expected `{}` > 0", key.text)));
+        }
+        if fields.insert(key.text.as_str(), (v, key)).is_some() {
+            return Err(key.error(format!("`{}` is given twice; expected it once", key.text)));
+        }
+    }
+    let radius = fields.get("radius").map_or(0.0, |f| f.0);
+    let drag = match (fields.get("drag"), fields.get("viscosity")) {
+        (Some(_), Some((_, key))) => return Err(key.error("give either `drag` or `radius` + `viscosity`, not both")),
+        (Some((g, _)), None) => *g,
+        (None, Some((eta, key))) => {
+            if radius <= 0.0 {
+                return Err(key.error("`viscosity` needs `radius` > 0 for the Stokes drag 6πηa"));
+            }
+            6.0 * std::f64::consts::PI * eta * radius
+        }
+        (None, None) => return Err(name.error(format!("particle type `{}` has no drag; expected `drag G` or `radius A viscosity ETA`", name.text))),
+    };
+    Ok(ParticleType { name: name.clone(), drag, radius })
+}
+
+/// Reads a force-field file (and its includes) into `ff`.
+///
+/// `requested_by` is the deck token naming the file (for a missing-file error);
+/// `stack` guards against include cycles.
+pub fn load_forcefield(path: &Path, requested_by: Option<&Token>, units: UnitSystem, ff: &mut ForceField, stack: &mut Vec<PathBuf>) -> Result<(), InputError> {
+    let file = SourceFile::read(path, requested_by)?;
+    let canonical = path.canonicalize().unwrap_or_else(|_| path.to_path_buf());
+    if stack.contains(&canonical) {
+        let message = format!("include cycle: `{}` includes itself; expected an acyclic include graph", path.display());
+        return Err(match requested_by {
+            Some(t) => t.error(message),
+            None => InputError::in_file(&file.path, message),
+        });
+    }
+    stack.push(canonical);
+    let dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+    for s in lex(&file)? {
+        let t = &s.tokens;
+        let kw = &t[0];
+        match kw.text.as_str() {
+            "include" => {
+                if t.len() != 2 {
+                    return Err(kw.error("expected `include FILE`"));
+                }
+                load_forcefield(&dir.join(&t[1].text), Some(&t[1]), units, ff, stack)?;
+            }
+            "particle" => {
+                let p = particle(&s)?;
+                check_unique(&p.name, ff.particle_types.iter().map(|x| &x.name), "particle type")?;
+                ff.particle_types.push(p);
+            }
+            "bond" | "angle" => {
+                if t.len() < 3 {
+                    return Err(kw.error(format!("expected `{} NAME INTERACTION [param value]...`", kw.text)));
+                }
+                let (kind, list) = if kw.text == "bond" { (Kind::Bond, &mut ff.bond_types) } else { (Kind::Angle, &mut ff.angle_types) };
+                check_unique(&t[1], list.iter().map(|x| &x.label), &format!("{} type", kw.text))?;
+                list.push(parse_params(&t[1], &t[2], &t[3..], kind, units)?);
+            }
+            "pair" => {
+                if t.len() < 4 {
+                    return Err(kw.error("expected `pair TYPE_A TYPE_B INTERACTION [param value]...`"));
+                }
+                let term = parse_params(&t[1], &t[3], &t[4..], Kind::Pair, units)?;
+                ff.pair_rules.push(PairRule { type_a: t[1].clone(), type_b: t[2].clone(), term });
+            }
+            other => return Err(kw.error(format!("found `{other}`, expected `include`, `particle`, `bond`, `angle` or `pair`"))),
+        }
+    }
+    stack.pop();
+    Ok(())
+}
+
+/// Checks that pair rules name defined particle types (after all files are read).
+pub(crate) fn check_pair_types(ff: &ForceField) -> Result<(), InputError> {
+    for rule in &ff.pair_rules {
+        for t in [&rule.type_a, &rule.type_b] {
+            if ff.particle_type(&t.text).is_none() {
+                let names: Vec<&str> = ff.particle_types.iter().map(|p| p.name.text.as_str()).collect();
+                return Err(t.error(format!("found particle type `{}`, expected a defined particle type: {}", t.text, names.join(", "))));
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn load(files: &[(&str, &str)]) -> Result<ForceField, String> {
+        let dir = tempfile::tempdir().unwrap();
+        for (name, text) in files {
+            std::fs::write(dir.path().join(name), text).unwrap();
+        }
+        let mut ff = ForceField::default();
+        load_forcefield(&dir.path().join(files[0].0), None, UnitSystem::Cell, &mut ff, &mut Vec::new())
+            .and_then(|_| check_pair_types(&ff))
+            .map(|_| ff)
+            .map_err(|e| e.to_string().replace(&format!("{}/", dir.path().display()), ""))
+    }
+
+    #[test]
+    fn reads_types_with_includes_and_stokes_drag() {
+        let ff = load(&[
+            ("main.ff", "include types.ff\nbond s harmonic k 1 r0 2\n"),
+            ("types.ff", "particle a drag 2\nparticle b radius 0.5 viscosity 1\n"),
+        ])
+        .unwrap();
+        assert_eq!(ff.particle_types[0].drag, 2.0);
+        assert!((ff.particle_types[1].drag - 3.0 * std::f64::consts::PI).abs() < 1e-12);
+        assert_eq!(ff.bond_types[0].params, vec![1.0, 2.0]);
+    }
+
+    #[test]
+    fn errors() {
+        assert_eq!(load(&[("m.ff", "particle a\n")]).unwrap_err(), "m.ff:1:10: particle type `a` has no drag; expected `drag G` or `radius A viscosity ETA`");
+        assert!(load(&[("m.ff", "particle a drag 1\nparticle a drag 2\n")]).unwrap_err().contains("already defined at"));
+        assert!(load(&[("m.ff", "include m.ff\n")]).unwrap_err().contains("include cycle"));
+        assert!(load(&[("m.ff", "include missing.ff\n")]).unwrap_err().starts_with("m.ff:1:9: cannot read"));
+        assert!(load(&[("m.ff", "angle x harmonic k 1 r0 1\n")]).unwrap_err().contains("is a bond interaction, expected an angle interaction"));
+        assert!(load(&[("m.ff", "bnd x harmonic\n")]).unwrap_err().contains("expected `include`, `particle`"));
+    }
+}

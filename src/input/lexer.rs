@@ -1,0 +1,212 @@
+//! nom grammar of the line-oriented input languages.
+//!
+//! ```text
+//! file       := physical_line*
+//! line       := blank* (token blank*)* ("#" any*)? EOL
+//! token      := quoted | bare
+//! quoted     := '"' [^"\n]* '"'
+//! bare       := [^ \t\r\n#"]+
+//! ```
+//! A statement ends at the end of a line unless its last token is `&`, in
+//! which case it continues on the next line.
+
+use std::sync::Arc;
+
+use miette::NamedSource;
+use nom::branch::alt;
+use nom::bytes::complete::{is_not, tag, take_while};
+use nom::character::complete::{char, line_ending, not_line_ending, space0};
+use nom::combinator::{eof, opt};
+use nom::multi::many0;
+use nom::sequence::{delimited, preceded, terminated};
+use nom::{IResult, Parser};
+use nom_locate::LocatedSpan;
+
+use super::error::{named_source, InputError};
+
+type Span<'a> = LocatedSpan<&'a str>;
+
+/// The text of an input file, shared by every token and error taken from it.
+#[derive(Debug)]
+pub struct SourceFile {
+    pub path: String,
+    pub text: String,
+    pub(crate) named: NamedSource<String>,
+}
+
+impl SourceFile {
+    pub fn new(path: impl Into<String>, text: impl Into<String>) -> Arc<Self> {
+        let path = path.into();
+        let text = text.into();
+        let named = named_source(&path, &text);
+        Arc::new(Self { path, text, named })
+    }
+
+    /// Reads a file; a missing or unreadable file is an error at `requested_by`.
+    pub fn read(path: &std::path::Path, requested_by: Option<&Token>) -> Result<Arc<Self>, InputError> {
+        let shown = path.display().to_string();
+        match std::fs::read_to_string(path) {
+            Ok(text) => Ok(Self::new(shown, text)),
+            Err(e) => {
+                let message = format!("cannot read `{shown}`: {e}; expected an existing, readable text file");
+                Err(match requested_by {
+                    Some(token) => InputError::at(token, message),
+                    None => InputError::in_file(&shown, message),
+                })
+            }
+        }
+    }
+
+    /// 1-based line and column (in characters) of a byte offset.
+    pub fn line_col(&self, offset: usize) -> (u32, u32) {
+        let before = &self.text[..offset.min(self.text.len())];
+        let line = before.matches('\n').count() as u32 + 1;
+        let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+        (line, before[line_start..].chars().count() as u32 + 1)
+    }
+}
+
+/// A word of input with its position.
+#[derive(Debug, Clone)]
+pub struct Token {
+    pub text: String,
+    pub line: u32,
+    pub col: u32,
+    pub(crate) offset: usize,
+    pub(crate) text_len: usize,
+    pub file: Arc<SourceFile>,
+}
+
+impl Token {
+    /// A copy of this token with replaced text (after `${var}` substitution);
+    /// it keeps pointing at the original position.
+    pub fn with_text(&self, text: String) -> Token {
+        Token { text, ..self.clone() }
+    }
+
+    pub fn error(&self, message: impl Into<String>) -> InputError {
+        InputError::at(self, message)
+    }
+}
+
+/// One logical statement: its tokens, never empty.
+#[derive(Debug, Clone)]
+pub struct Statement {
+    pub tokens: Vec<Token>,
+}
+
+impl Statement {
+    pub fn keyword(&self) -> &Token {
+        &self.tokens[0]
+    }
+}
+
+fn quoted(input: Span) -> IResult<Span, Span> {
+    delimited(char('"'), take_while(|c| c != '"' && c != '\n'), char('"')).parse(input)
+}
+
+fn bare(input: Span) -> IResult<Span, Span> {
+    is_not(" \t\r\n#\"").parse(input)
+}
+
+/// A token with a flag telling whether it was quoted.
+fn token(input: Span) -> IResult<Span, (Span, bool)> {
+    alt((quoted.map(|s| (s, true)), bare.map(|s| (s, false)))).parse(input)
+}
+
+/// Tokens of one physical line, then the optional comment (not the line end).
+fn physical_line(input: Span) -> IResult<Span, Vec<(Span, bool)>> {
+    terminated(
+        preceded(space0, many0(terminated(token, space0))),
+        opt(preceded(tag("#"), not_line_ending)),
+    )
+    .parse(input)
+}
+
+/// Splits a file into statements.
+pub fn lex(file: &Arc<SourceFile>) -> Result<Vec<Statement>, InputError> {
+    let mut statements = Vec::new();
+    let mut pending: Vec<Token> = Vec::new();
+    let mut input = Span::new(file.text.as_str());
+    while !input.fragment().is_empty() {
+        let (after, words) = physical_line(input)
+            .map_err(|_| InputError::at_offset(file, input.location_offset(), "unreadable line; expected blank-separated words"))?;
+        let (after, _) = alt((line_ending, eof)).parse(after).map_err(|_: nom::Err<nom::error::Error<Span>>| {
+            let found = after.fragment().chars().next().unwrap_or(' ');
+            let message = if found == '"' {
+                "unterminated quoted string; expected a closing `\"` on the same line".to_string()
+            } else {
+                format!("unexpected `{}`; expected a blank-separated word", found.escape_debug())
+            };
+            InputError::at_offset(file, after.location_offset(), message)
+        })?;
+        input = after;
+        let mut tokens: Vec<Token> = words
+            .into_iter()
+            .map(|(span, quoted)| {
+                let token_offset = span.location_offset() - usize::from(quoted);
+                let (line, col) = file.line_col(token_offset);
+                Token {
+                    text: span.fragment().to_string(),
+                    line,
+                    col,
+                    offset: token_offset,
+                    text_len: span.fragment().len() + 2 * usize::from(quoted),
+                    file: file.clone(),
+                }
+            })
+            .collect();
+        let continues = tokens.last().is_some_and(|t| t.text == "&");
+        if continues {
+            tokens.pop();
+        }
+        pending.extend(tokens);
+        if !continues && !pending.is_empty() {
+            statements.push(Statement { tokens: std::mem::take(&mut pending) });
+        }
+    }
+    if !pending.is_empty() {
+        statements.push(Statement { tokens: pending });
+    }
+    Ok(statements)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn words(text: &str) -> Vec<Vec<(String, u32, u32)>> {
+        let file = SourceFile::new("t.in", text);
+        lex(&file)
+            .unwrap()
+            .into_iter()
+            .map(|s| s.tokens.into_iter().map(|t| (t.text, t.line, t.col)).collect())
+            .collect()
+    }
+
+    #[test]
+    fn comments_blanks_quotes_and_continuations() {
+        let got = words("# header\nrun 100  # go\n\n  dump a every 10 &\n   xyz \"my file.xyz\"\n");
+        assert_eq!(
+            got,
+            vec![
+                vec![("run".into(), 2, 1), ("100".into(), 2, 5)],
+                vec![
+                    ("dump".into(), 4, 3),
+                    ("a".into(), 4, 8),
+                    ("every".into(), 4, 10),
+                    ("10".into(), 4, 16),
+                    ("xyz".into(), 5, 4),
+                    ("my file.xyz".into(), 5, 8),
+                ],
+            ]
+        );
+    }
+
+    #[test]
+    fn unterminated_quote_is_located() {
+        let file = SourceFile::new("t.in", "run 1\ndump \"oops\n");
+        let err = lex(&file).unwrap_err();
+        assert_eq!(err.to_string(), "t.in:2:6: unterminated quoted string; expected a closing `\"` on the same line");
+    }
+}

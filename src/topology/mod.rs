@@ -1,0 +1,32 @@
+//! Topology files (`*.top`): particles, bonds, angles, bodies and triangles.
+//!
+//! GROMACS-like sections, one record per line, `#` comments:
+//!
+//! ```text
+//! [ box ]              # optional; the deck's `box` command overrides it
+//! x  -5 5 p            # axis lo hi p|f   (periodic or fixed), length units
+//! y  -5 5 p
+//! z   0 10 f
+//! [ particles ]
+//! # id  type   x     y     z     [body]
+//! 1     actin  0.0   0.0   0.5
+//! 2     actin  0.1   0.0   0.5
+//! [ bonds ]
+//! # type           i  j          (particle ids)
+//! actin_segment    1  2
+//! [ angles ]
+//! # type           i  j  k       (j is the vertex)
+//! [ bodies ]
+//! # id  type                     (closed surfaces: a cell, a nucleus)
+//! [ triangles ]
+//! # body  i  j  k                (outward-wound face of that body)
+//! ```
+//!
+//! Particle ids are any distinct positive integers; types are names defined in
+//! the force field. Names of particle, bond and angle types are resolved
+//! against the force field when the deck is validated, so unknown names are
+//! reported at their position in this file.
+
+mod parse;
+
+pub use self::parse::{parse_topology, BoxAxis, Topology, TypedTerm};

@@ -1,0 +1,284 @@
+//! Parser of topology files (second phase after the shared lexer).
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use glam::DVec3;
+
+use crate::input::{lex, parse_f64, parse_u64, InputError, SourceFile, Statement, Token};
+
+/// One axis of a `[ box ]` section or deck `box` command.
+#[derive(Clone, Debug)]
+pub struct BoxAxis {
+    pub lo: f64,
+    pub hi: f64,
+    pub periodic: bool,
+}
+
+/// A bonded term: its type name (with position) and internal particle indices.
+#[derive(Clone, Debug)]
+pub struct TypedTerm<const N: usize> {
+    pub type_name: Token,
+    pub particles: [u32; N],
+}
+
+/// A parsed topology. Particle arrays are indexed by internal index (file order).
+#[derive(Clone, Debug, Default)]
+pub struct Topology {
+    pub path: String,
+    pub box_axes: Option<[BoxAxis; 3]>,
+    pub ids: Vec<u64>,
+    pub type_names: Vec<Token>,
+    pub positions: Vec<DVec3>,
+    pub body_of: Vec<Option<u64>>,
+    pub bonds: Vec<TypedTerm<2>>,
+    pub angles: Vec<TypedTerm<3>>,
+    /// (body id, body type name).
+    pub bodies: Vec<(u64, Token)>,
+    /// (body id, three particle indices).
+    pub triangles: Vec<(u64, [u32; 3])>,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum Section {
+    Box,
+    Particles,
+    Bonds,
+    Angles,
+    Bodies,
+    Triangles,
+}
+
+const SECTIONS: &str = "[ box ], [ particles ], [ bonds ], [ angles ], [ bodies ] or [ triangles ]";
+
+fn section_of(statement: &Statement) -> Option<Result<Section, InputError>> {
+    let first = statement.keyword();
+    if !first.text.starts_with('[') {
+        return None;
+    }
+    let joined: String = statement.tokens.iter().map(|t| t.text.as_str()).collect();
+    let section = match joined.as_str() {
+        "[box]" => Section::Box,
+        "[particles]" => Section::Particles,
+        "[bonds]" => Section::Bonds,
+        "[angles]" => Section::Angles,
+        "[bodies]" => Section::Bodies,
+        "[triangles]" => Section::Triangles,
+        _ => return Some(Err(first.error(format!("found section `{}`, expected {SECTIONS}", joined)))),
+    };
+    Some(Ok(section))
+}
+
+/// Checks the number of fields of a record.
+fn expect_fields(statement: &Statement, allowed: &[usize], layout: &str) -> Result<(), InputError> {
+    let n = statement.tokens.len();
+    if allowed.contains(&n) {
+        return Ok(());
+    }
+    let at = statement.tokens.get(allowed[0].min(n)).unwrap_or(statement.tokens.last().unwrap());
+    Err(at.error(format!("found {n} fields, expected `{layout}`")))
+}
+
+struct Parser {
+    topology: Topology,
+    index_of_id: HashMap<u64, (u32, Token)>,
+    body_ids: HashMap<u64, Token>,
+}
+
+impl Parser {
+    fn particle_index(&self, token: &Token) -> Result<u32, InputError> {
+        let id = parse_u64(token, "a particle id")?;
+        self.index_of_id.get(&id).map(|(index, _)| *index).ok_or_else(|| {
+            token.error(format!("found particle id {id}, expected the id of a particle listed in [ particles ] before it"))
+        })
+    }
+
+    fn axis(&mut self, s: &Statement, seen: &mut [bool; 3]) -> Result<(), InputError> {
+        expect_fields(s, &[4], "axis lo hi p|f")?;
+        let axes = self.topology.box_axes.get_or_insert_with(|| std::array::from_fn(|_| BoxAxis { lo: 0.0, hi: 0.0, periodic: false }));
+        let index = parse_box_axis(&s.tokens, &mut axes[..])?;
+        if seen[index] {
+            return Err(s.tokens[0].error(format!("axis `{}` given twice; expected each of x, y, z once", s.tokens[0].text)));
+        }
+        seen[index] = true;
+        Ok(())
+    }
+
+    fn particle(&mut self, s: &Statement) -> Result<(), InputError> {
+        expect_fields(s, &[5, 6], "id type x y z [body]")?;
+        let t = &s.tokens;
+        let id = parse_u64(&t[0], "a particle id")?;
+        if id == 0 {
+            return Err(t[0].error("found particle id 0, expected a positive integer"));
+        }
+        if let Some((_, first)) = self.index_of_id.get(&id) {
+            return Err(t[0].error(format!("particle id {id} is already used at line {}; expected unique ids", first.line)));
+        }
+        let x = parse_f64(&t[2], "the x coordinate")?;
+        let y = parse_f64(&t[3], "the y coordinate")?;
+        let z = parse_f64(&t[4], "the z coordinate")?;
+        let body = t.get(5).map(|b| parse_u64(b, "a body id")).transpose()?;
+        let index = self.topology.ids.len() as u32;
+        self.index_of_id.insert(id, (index, t[0].clone()));
+        self.topology.ids.push(id);
+        self.topology.type_names.push(t[1].clone());
+        self.topology.positions.push(DVec3::new(x, y, z));
+        self.topology.body_of.push(body);
+        Ok(())
+    }
+
+    fn term<const N: usize>(&self, s: &Statement, layout: &str) -> Result<TypedTerm<N>, InputError> {
+        expect_fields(s, &[N + 1], layout)?;
+        let mut particles = [0u32; N];
+        for (k, slot) in particles.iter_mut().enumerate() {
+            *slot = self.particle_index(&s.tokens[k + 1])?;
+        }
+        for a in 0..N {
+            for b in a + 1..N {
+                if particles[a] == particles[b] {
+                    return Err(s.tokens[b + 1].error(format!(
+                        "particle id {} appears twice in this term; expected {N} distinct particles",
+                        s.tokens[b + 1].text
+                    )));
+                }
+            }
+        }
+        Ok(TypedTerm { type_name: s.tokens[0].clone(), particles })
+    }
+
+    fn body(&mut self, s: &Statement) -> Result<(), InputError> {
+        expect_fields(s, &[2], "id type")?;
+        let id = parse_u64(&s.tokens[0], "a body id")?;
+        if let Some(first) = self.body_ids.get(&id) {
+            return Err(s.tokens[0].error(format!("body id {id} is already used at line {}; expected unique ids", first.line)));
+        }
+        self.body_ids.insert(id, s.tokens[0].clone());
+        self.topology.bodies.push((id, s.tokens[1].clone()));
+        Ok(())
+    }
+
+    fn triangle(&mut self, s: &Statement) -> Result<(), InputError> {
+        expect_fields(s, &[4], "body i j k")?;
+        let body = parse_u64(&s.tokens[0], "a body id")?;
+        if !self.body_ids.contains_key(&body) {
+            return Err(s.tokens[0].error(format!("found body id {body}, expected a body listed in [ bodies ] before it")));
+        }
+        let mut particles = [0u32; 3];
+        for (k, slot) in particles.iter_mut().enumerate() {
+            *slot = self.particle_index(&s.tokens[k + 1])?;
+        }
+        if particles[0] == particles[1] || particles[1] == particles[2] || particles[0] == particles[2] {
+            return Err(s.tokens[1].error("a triangle repeats a particle; expected three distinct particles"));
+        }
+        self.topology.triangles.push((body, particles));
+        Ok(())
+    }
+}
+
+/// Parses `x|y|z lo hi p|f` into `axes` and returns the axis index.
+pub fn parse_box_axis(t: &[Token], axes: &mut [BoxAxis]) -> Result<usize, InputError> {
+    let index = match t[0].text.as_str() {
+        "x" => 0,
+        "y" => 1,
+        "z" => 2,
+        other => return Err(t[0].error(format!("found `{other}`, expected an axis name x, y or z"))),
+    };
+    let lo = parse_f64(&t[1], "the lower bound")?;
+    let hi = parse_f64(&t[2], "the upper bound")?;
+    if hi <= lo {
+        return Err(t[2].error(format!("upper bound {hi} is not above lower bound {lo}; expected hi > lo")));
+    }
+    let periodic = match t[3].text.as_str() {
+        "p" => true,
+        "f" => false,
+        other => return Err(t[3].error(format!("found `{other}`, expected `p` (periodic) or `f` (fixed)"))),
+    };
+    axes[index] = BoxAxis { lo, hi, periodic };
+    Ok(index)
+}
+
+/// Reads and parses a topology file.
+pub fn parse_topology(file: &Arc<SourceFile>) -> Result<Topology, InputError> {
+    let statements = lex(file)?;
+    let mut parser = Parser { topology: Topology { path: file.path.clone(), ..Default::default() }, index_of_id: HashMap::new(), body_ids: HashMap::new() };
+    let mut section: Option<Section> = None;
+    let mut seen_sections: Vec<Section> = Vec::new();
+    let mut seen_axes = [false; 3];
+    for s in &statements {
+        if let Some(next) = section_of(s) {
+            let next = next?;
+            if seen_sections.contains(&next) {
+                return Err(s.keyword().error("this section appears twice; expected each section at most once"));
+            }
+            seen_sections.push(next);
+            section = Some(next);
+            continue;
+        }
+        match section {
+            None => return Err(s.keyword().error(format!("found `{}` before any section, expected a section header {SECTIONS}", s.keyword().text))),
+            Some(Section::Box) => parser.axis(s, &mut seen_axes)?,
+            Some(Section::Particles) => parser.particle(s)?,
+            Some(Section::Bonds) => {
+                let bond = parser.term::<2>(s, "type i j")?;
+                parser.topology.bonds.push(bond);
+            }
+            Some(Section::Angles) => {
+                let angle = parser.term::<3>(s, "type i j k")?;
+                parser.topology.angles.push(angle);
+            }
+            Some(Section::Bodies) => parser.body(s)?,
+            Some(Section::Triangles) => parser.triangle(s)?,
+        }
+    }
+    if parser.topology.box_axes.is_some() && seen_axes != [true; 3] {
+        return Err(InputError::in_file(&file.path, "the [ box ] section must give all three axes x, y and z"));
+    }
+    // Bodies referenced by particles must exist.
+    for (index, body) in parser.topology.body_of.iter().enumerate() {
+        if let Some(body) = body {
+            if !parser.body_ids.contains_key(body) && !parser.topology.bodies.is_empty() {
+                let id = parser.topology.ids[index];
+                let (_, token) = &parser.index_of_id[&id];
+                return Err(token.error(format!("particle {id} names body {body}, expected a body listed in [ bodies ]")));
+            }
+        }
+    }
+    Ok(parser.topology)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<Topology, String> {
+        parse_topology(&SourceFile::new("t.top", text)).map_err(|e| e.to_string())
+    }
+
+    #[test]
+    fn reads_all_sections() {
+        let top = parse(
+            "[ box ]\nx 0 10 p\ny 0 10 p\nz 0 5 f\n[ particles ]\n10 a 0 0 0\n20 a 1 0 0 1\n30 b 1 1 0\n[ bonds ]\ns 10 20\n[ angles ]\nbend 10 20 30\n[ bodies ]\n1 cell\n[ triangles ]\n1 10 20 30\n",
+        )
+        .unwrap();
+        assert_eq!(top.ids, vec![10, 20, 30]);
+        assert_eq!(top.bonds[0].particles, [0, 1]);
+        assert_eq!(top.angles[0].particles, [0, 1, 2]);
+        assert_eq!(top.triangles, vec![(1, [0, 1, 2])]);
+        assert_eq!(top.body_of[1], Some(1));
+        let axes = top.box_axes.unwrap();
+        assert!(axes[0].periodic && !axes[2].periodic && axes[2].hi == 5.0);
+    }
+
+    #[test]
+    fn errors_are_located_and_say_what_was_expected() {
+        assert_eq!(parse("[ particles ]\n1 a 0 0\n").unwrap_err(), "t.top:2:7: found 4 fields, expected `id type x y z [body]`");
+        assert_eq!(
+            parse("[ particles ]\n1 a 0 0 0\n[ bonds ]\ns 1 2\n").unwrap_err(),
+            "t.top:4:5: found particle id 2, expected the id of a particle listed in [ particles ] before it"
+        );
+        assert_eq!(parse("1 a 0 0 0\n").unwrap_err(), "t.top:1:1: found `1` before any section, expected a section header [ box ], [ particles ], [ bonds ], [ angles ], [ bodies ] or [ triangles ]");
+        assert!(parse("[ atoms ]\n").unwrap_err().starts_with("t.top:1:1: found section `[atoms]`"));
+        assert!(parse("[ particles ]\n1 a 0 0 0\n1 a 1 0 0\n").unwrap_err().contains("already used at line 2"));
+        assert!(parse("[ particles ]\n1 a 0 zero 0\n").unwrap_err().starts_with("t.top:2:7: found `zero`, expected the y coordinate"));
+    }
+}
