@@ -20,4 +20,4 @@ mod params;
 mod parse;
 
 pub use self::params::{parse_params, TermType};
-pub use self::parse::{load_forcefield, ForceField, PairRule, ParticleType};
+pub use self::parse::{check_pair_types, load_forcefield, ForceField, PairRule, ParticleType};

@@ -145,7 +145,7 @@ pub fn load_forcefield(path: &Path, requested_by: Option<&Token>, units: UnitSys
 }
 
 /// Checks that pair rules name defined particle types (after all files are read).
-pub(crate) fn check_pair_types(ff: &ForceField) -> Result<(), InputError> {
+pub fn check_pair_types(ff: &ForceField) -> Result<(), InputError> {
     for rule in &ff.pair_rules {
         for t in [&rule.type_a, &rule.type_b] {
             if ff.particle_type(&t.text).is_none() {

@@ -1,7 +1,9 @@
 //! Simulation state: the box and the per-particle arrays (f64, structure of arrays).
 
+mod model;
 mod sim_box;
 mod state;
 
+pub use self::model::{registry_index, External, Model, SpecialBonds};
 pub use self::sim_box::SimBox;
 pub use self::state::State;

@@ -1,0 +1,20 @@
+//! Input decks (`*.in`): one command per line, LAMMPS-style.
+//!
+//! A deck is read in two phases: the shared nom lexer ([`crate::input`]) turns
+//! it into statements with positions; [`validate`] then checks every command
+//! in order — loading the topology and force fields, resolving names, checking
+//! parameters against schemas — and produces a [`Plan`]. Nothing is written
+//! before the whole deck validates, so a bad deck never touches an output.
+//!
+//! Paths of inputs (`topology`, `forcefield`, `read_state`) are relative to the
+//! deck's directory; outputs (`dump`, `thermo_file`, `write_state`) are
+//! relative to the output directory (the working directory unless `cellmd run
+//! -o DIR`). See README.md for the command reference.
+
+mod plan;
+mod validate;
+mod variables;
+
+pub use self::plan::{Action, CoeffTarget, DumpSpec, Group, NeighborSettings, Plan, ThermoColumn};
+pub use self::validate::{validate, validate_file};
+pub use self::variables::Variables;

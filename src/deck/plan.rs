@@ -1,0 +1,105 @@
+//! The validated form of a deck: an initial system and a list of actions.
+
+use std::path::PathBuf;
+
+use crate::integrate::fire::FireSettings;
+use crate::integrate::overdamped::OverdampedSettings;
+use crate::output::DumpFormat;
+use crate::system::{External, Model, SimBox};
+
+/// `neighbor skin S every N check yes|no`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NeighborSettings {
+    /// Extra range beyond the largest pair cutoff (length units).
+    pub skin: f64,
+    /// Consider a rebuild every N steps.
+    pub every: u64,
+    /// Rebuild only when some particle moved more than skin/2.
+    pub check: bool,
+}
+
+impl Default for NeighborSettings {
+    fn default() -> Self {
+        Self { skin: 0.0, every: 1, check: true }
+    }
+}
+
+/// A thermo output column.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ThermoColumn {
+    Step,
+    Time,
+    /// Total potential energy.
+    Pe,
+    /// Potential energy of one registered interaction type (registry index).
+    PeOf(usize),
+    /// Largest |F| on a particle.
+    Fmax,
+    /// √(Σ|F|²).
+    Fnorm,
+    /// Pressure (trace/3 of the pressure tensor).
+    Press,
+    /// Pressure tensor component (0..6 = xx yy zz xy xz yz).
+    Pressure(usize),
+    /// Neighbour-list builds so far.
+    Nbuild,
+}
+
+/// A named trajectory output.
+#[derive(Clone, Debug)]
+pub struct DumpSpec {
+    pub name: String,
+    pub every: u64,
+    pub format: DumpFormat,
+    pub path: PathBuf,
+}
+
+/// A named particle group (deck `group`).
+#[derive(Clone, Debug)]
+pub struct Group {
+    pub name: String,
+    /// Internal indices, ascending.
+    pub members: Vec<u32>,
+}
+
+/// One executable step of a deck, in order.
+#[derive(Clone, Debug)]
+pub enum Action {
+    Temperature(f64),
+    Timestep(f64),
+    Seed(u64),
+    Integrator(OverdampedSettings),
+    Neighbor(NeighborSettings),
+    Thermo { every: u64, columns: Vec<ThermoColumn> },
+    ThermoFile(PathBuf),
+    Dump(DumpSpec),
+    Undump(String),
+    External(External),
+    Unexternal(String),
+    /// Changes one parameter of a bond type, angle type or pair rule.
+    Coeff { target: CoeffTarget, param: usize, value: f64 },
+    Minimize(FireSettings),
+    Run(u64),
+    WriteState(PathBuf),
+    ReadState(PathBuf),
+    Print(String),
+}
+
+/// What a `coeff` command changes: an index into the model's tables.
+#[derive(Clone, Debug, PartialEq)]
+pub enum CoeffTarget {
+    BondType(usize),
+    AngleType(usize),
+    PairRule(usize),
+}
+
+/// A validated deck.
+#[derive(Clone, Debug)]
+pub struct Plan {
+    pub deck_path: PathBuf,
+    pub model: Model,
+    pub sim_box: SimBox,
+    pub positions: Vec<glam::DVec3>,
+    pub actions: Vec<Action>,
+}
+

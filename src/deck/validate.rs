@@ -1,0 +1,565 @@
+//! Second phase of deck parsing: command-by-command validation into a [`Plan`].
+
+use std::collections::{HashMap, HashSet};
+use std::path::{Path, PathBuf};
+
+use glam::DVec3;
+
+use super::plan::{Action, CoeffTarget, DumpSpec, Group, NeighborSettings, Plan, ThermoColumn};
+use super::variables::Variables;
+use crate::forcefield::{load_forcefield, parse_params, ForceField};
+use crate::input::{lex, parse_f64, parse_u64, InputError, SourceFile, Statement, Token};
+use crate::integrate::fire::FireSettings;
+use crate::integrate::overdamped::OverdampedSettings;
+use crate::integrate::rng::Noise;
+use crate::interactions::{param_index, Kind, REGISTRY};
+use crate::output::DumpFormat;
+use crate::system::{External, Model, SimBox, SpecialBonds};
+use crate::topology::{parse_box_axis, parse_topology, BoxAxis, Topology};
+use crate::units::UnitSystem;
+
+/// The commands a deck understands (for "expected ..." messages).
+const COMMANDS: &str = "units, variable, topology, forcefield, box, special_bonds, temperature, timestep, seed, integrator, neighbor, thermo, thermo_file, dump, undump, group, external, unexternal, coeff, minimize, run, write_state, read_state, print";
+
+/// Commands that define the system and must come before it is first used.
+const SETUP: [&str; 5] = ["units", "topology", "forcefield", "box", "special_bonds"];
+
+struct Validator {
+    deck_dir: PathBuf,
+    vars: Variables,
+    units: UnitSystem,
+    topology: Option<Topology>,
+    forcefield: ForceField,
+    forcefield_seen: bool,
+    box_axes: Option<[BoxAxis; 3]>,
+    special_bonds: SpecialBonds,
+    /// The system as first built (the plan's starting point).
+    initial_model: Option<Model>,
+    /// A working copy that `coeff` edits, so each edit is validated against
+    /// the parameter values in force at that point of the deck.
+    model: Option<Model>,
+    positions: Vec<DVec3>,
+    sim_box: Option<SimBox>,
+    groups: HashMap<String, Group>,
+    dumps: HashMap<String, PathBuf>,
+    externals: HashSet<String>,
+    states_written: HashSet<PathBuf>,
+    timestep_set: bool,
+    actions: Vec<Action>,
+}
+
+fn expect_len(s: &[Token], range: std::ops::RangeInclusive<usize>, usage: &str) -> Result<(), InputError> {
+    let n = s.len() - 1;
+    if range.contains(&n) {
+        return Ok(());
+    }
+    let at = if n > *range.end() { &s[*range.end() + 1] } else { s.last().unwrap() };
+    let what = if n > *range.end() { "too many arguments" } else { "too few arguments" };
+    Err(at.error(format!("{what} ({n}); expected `{usage}`")))
+}
+
+fn yes_no(token: &Token) -> Result<bool, InputError> {
+    match token.text.as_str() {
+        "yes" => Ok(true),
+        "no" => Ok(false),
+        other => Err(token.error(format!("found `{other}`, expected `yes` or `no`"))),
+    }
+}
+
+fn positive(token: &Token, what: &str) -> Result<f64, InputError> {
+    let v = parse_f64(token, what)?;
+    if v > 0.0 {
+        Ok(v)
+    } else {
+        Err(token.error(format!("found {v}, expected {what} > 0")))
+    }
+}
+
+fn non_negative(token: &Token, what: &str) -> Result<f64, InputError> {
+    let v = parse_f64(token, what)?;
+    if v >= 0.0 {
+        Ok(v)
+    } else {
+        Err(token.error(format!("found {v}, expected {what} >= 0")))
+    }
+}
+
+/// `key value` options after a command; each key at most once.
+fn options<'a>(tokens: &'a [Token], allowed: &[&str], usage: &str) -> Result<HashMap<String, &'a Token>, InputError> {
+    let mut out = HashMap::new();
+    for pair in tokens.chunks(2) {
+        let key = &pair[0];
+        if !allowed.contains(&key.text.as_str()) {
+            return Err(key.error(format!("found option `{}`, expected one of: {} (`{usage}`)", key.text, allowed.join(", "))));
+        }
+        let value = pair.get(1).ok_or_else(|| key.error(format!("option `{}` has no value; expected `{} VALUE`", key.text, key.text)))?;
+        if out.insert(key.text.clone(), value).is_some() {
+            return Err(key.error(format!("option `{}` is given twice; expected it once", key.text)));
+        }
+    }
+    Ok(out)
+}
+
+impl Validator {
+    fn input_path(&self, token: &Token) -> PathBuf {
+        let p = Path::new(&token.text);
+        if p.is_absolute() {
+            p.to_path_buf()
+        } else {
+            self.deck_dir.join(p)
+        }
+    }
+
+    /// The model, built on first use from the setup commands seen so far.
+    fn model(&mut self, at: &Token) -> Result<&mut Model, InputError> {
+        if self.model.is_none() {
+            let topology = self.topology.as_ref().ok_or_else(|| at.error(format!("`{}` needs a system; expected a `topology FILE` command before it", at.text)))?;
+            if !self.forcefield_seen {
+                return Err(at.error(format!("`{}` needs a force field; expected a `forcefield FILE` command before it", at.text)));
+            }
+            let axes = self.box_axes.clone().or_else(|| topology.box_axes.clone()).ok_or_else(|| {
+                at.error(format!("no simulation box: expected a `box` command before `{}` or a [ box ] section in {}", at.text, topology.path))
+            })?;
+            let sim_box = SimBox::new(
+                DVec3::new(axes[0].lo, axes[1].lo, axes[2].lo),
+                DVec3::new(axes[0].hi, axes[1].hi, axes[2].hi),
+                [axes[0].periodic, axes[1].periodic, axes[2].periodic],
+            );
+            let model = Model::build(topology, &self.forcefield, self.units, self.special_bonds)?;
+            self.positions = topology.positions.clone();
+            self.sim_box = Some(sim_box);
+            self.groups.insert("all".into(), Group { name: "all".into(), members: (0..model.len() as u32).collect() });
+            self.initial_model = Some(model.clone());
+            self.model = Some(model);
+        }
+        Ok(self.model.as_mut().unwrap())
+    }
+
+    fn setup_command(&mut self, s: &[Token]) -> Result<(), InputError> {
+        let kw = &s[0];
+        if self.model.is_some() {
+            return Err(kw.error(format!("`{}` changes the system after it was first used; expected it before the first group, external, coeff, run, minimize or state command", kw.text)));
+        }
+        match kw.text.as_str() {
+            "units" => {
+                expect_len(s, 1..=1, "units cell|lj")?;
+                if self.topology.is_some() || self.forcefield_seen {
+                    return Err(kw.error("`units` must come before `topology` and `forcefield`"));
+                }
+                self.units = UnitSystem::from_keyword(&s[1].text).ok_or_else(|| s[1].error(format!("found `{}`, expected `cell` (µm, s, pN) or `lj`", s[1].text)))?;
+            }
+            "topology" => {
+                expect_len(s, 1..=1, "topology FILE")?;
+                if self.topology.is_some() {
+                    return Err(kw.error("a second `topology`; expected exactly one per deck"));
+                }
+                let file = SourceFile::read(&self.input_path(&s[1]), Some(&s[1]))?;
+                self.topology = Some(parse_topology(&file)?);
+            }
+            "forcefield" => {
+                expect_len(s, 1..=1, "forcefield FILE")?;
+                let path = self.input_path(&s[1]);
+                load_forcefield(&path, Some(&s[1]), self.units, &mut self.forcefield, &mut Vec::new())?;
+                self.forcefield_seen = true;
+            }
+            "box" => {
+                expect_len(s, 12..=12, "box x LO HI p|f y LO HI p|f z LO HI p|f")?;
+                let mut axes: [BoxAxis; 3] = std::array::from_fn(|_| BoxAxis { lo: 0.0, hi: 0.0, periodic: false });
+                let mut seen = [false; 3];
+                for chunk in s[1..].chunks(4) {
+                    let index = parse_box_axis(chunk, &mut axes)?;
+                    if seen[index] {
+                        return Err(chunk[0].error("axis given twice; expected x, y and z once each"));
+                    }
+                    seen[index] = true;
+                }
+                self.box_axes = Some(axes);
+            }
+            "special_bonds" => {
+                expect_len(s, 3..=3, "special_bonds W12 W13 W14   (each 0 = excluded or 1 = included)")?;
+                let mut exclude = [false; 3];
+                for (k, t) in s[1..].iter().enumerate() {
+                    exclude[k] = match parse_f64(t, "a weight")? {
+                        w if w == 0.0 => true,
+                        w if w == 1.0 => false,
+                        w => return Err(t.error(format!("found weight {w}, expected 0 (exclude) or 1 (include); fractional weights are not supported"))),
+                    };
+                }
+                self.special_bonds = SpecialBonds { exclude_12: exclude[0], exclude_13: exclude[1], exclude_14: exclude[2] };
+            }
+            _ => unreachable!(),
+        }
+        Ok(())
+    }
+
+    fn thermo_columns(&self, tokens: &[Token]) -> Result<Vec<ThermoColumn>, InputError> {
+        const FIXED: &str = "step, time, pe, pe/NAME, fmax, fnorm, press, pxx, pyy, pzz, pxy, pxz, pyz, nbuild";
+        tokens
+            .iter()
+            .map(|t| {
+                Ok(match t.text.as_str() {
+                    "step" => ThermoColumn::Step,
+                    "time" => ThermoColumn::Time,
+                    "pe" => ThermoColumn::Pe,
+                    "fmax" => ThermoColumn::Fmax,
+                    "fnorm" => ThermoColumn::Fnorm,
+                    "press" => ThermoColumn::Press,
+                    "pxx" => ThermoColumn::Pressure(0),
+                    "pyy" => ThermoColumn::Pressure(1),
+                    "pzz" => ThermoColumn::Pressure(2),
+                    "pxy" => ThermoColumn::Pressure(3),
+                    "pxz" => ThermoColumn::Pressure(4),
+                    "pyz" => ThermoColumn::Pressure(5),
+                    "nbuild" => ThermoColumn::Nbuild,
+                    other => match other.strip_prefix("pe/") {
+                        Some(name) => ThermoColumn::PeOf(REGISTRY.iter().position(|i| i.name() == name).ok_or_else(|| {
+                            t.error(format!("found `pe/{name}`, expected pe/ followed by a registered interaction name (see `cellmd list`)"))
+                        })?),
+                        None => return Err(t.error(format!("found thermo column `{other}`, expected one of: {FIXED}"))),
+                    },
+                })
+            })
+            .collect()
+    }
+
+    fn group(&mut self, s: &[Token]) -> Result<(), InputError> {
+        expect_len(s, 2..=usize::MAX, "group NAME type T... | id N|A:B ... | all")?;
+        let name = s[1].text.clone();
+        let model = self.model(&s[0])?;
+        let n = model.len();
+        let mut member = vec![false; n];
+        match s[2].text.as_str() {
+            "all" => member.iter_mut().for_each(|m| *m = true),
+            "type" => {
+                if s.len() < 4 {
+                    return Err(s[2].error("expected at least one particle type name after `type`"));
+                }
+                for t in &s[3..] {
+                    let ty = model.type_names.iter().position(|n| *n == t.text).ok_or_else(|| {
+                        t.error(format!("found particle type `{}`, expected one of: {}", t.text, model.type_names.join(", ")))
+                    })?;
+                    for (i, m) in member.iter_mut().enumerate() {
+                        *m |= model.types[i] as usize == ty;
+                    }
+                }
+            }
+            "id" => {
+                if s.len() < 4 {
+                    return Err(s[2].error("expected at least one id or id range A:B after `id`"));
+                }
+                for t in &s[3..] {
+                    let (lo, hi) = match t.text.split_once(':') {
+                        Some((a, b)) => {
+                            let a_tok = t.with_text(a.to_string());
+                            let b_tok = t.with_text(b.to_string());
+                            (parse_u64(&a_tok, "the first id of a range A:B")?, parse_u64(&b_tok, "the last id of a range A:B")?)
+                        }
+                        None => {
+                            let v = parse_u64(t, "a particle id or range A:B")?;
+                            (v, v)
+                        }
+                    };
+                    if hi < lo {
+                        return Err(t.error(format!("found range {lo}:{hi}, expected A <= B")));
+                    }
+                    let before = member.iter().filter(|m| **m).count();
+                    for (i, m) in member.iter_mut().enumerate() {
+                        *m |= (lo..=hi).contains(&model.ids[i]);
+                    }
+                    if member.iter().filter(|m| **m).count() == before && !(lo..=hi).any(|id| model.ids.contains(&id)) {
+                        return Err(t.error(format!("`{}` matches no particle; expected ids present in the topology", t.text)));
+                    }
+                }
+            }
+            other => return Err(s[2].error(format!("found `{other}`, expected `type`, `id` or `all`"))),
+        }
+        let members: Vec<u32> = (0..n as u32).filter(|&i| member[i as usize]).collect();
+        if members.is_empty() {
+            return Err(s[1].error(format!("group `{name}` is empty; expected a selection that matches particles")));
+        }
+        self.groups.insert(name.clone(), Group { name, members });
+        Ok(())
+    }
+
+    fn coeff(&mut self, s: &[Token]) -> Result<(), InputError> {
+        expect_len(s, 3..=usize::MAX, "coeff bond|angle NAME PARAM VALUE ... | coeff pair A B PARAM VALUE ...")?;
+        let units = self.units;
+        let model = self.model(&s[0])?;
+        let (targets, start): (Vec<CoeffTarget>, usize) = match s[1].text.as_str() {
+            "bond" | "angle" => {
+                let table = if s[1].text == "bond" { &model.bond_types } else { &model.angle_types };
+                let index = table.iter().position(|t| t.label.text == s[2].text).ok_or_else(|| {
+                    s[2].error(format!("found {} type `{}`, expected one defined in the force field", s[1].text, s[2].text))
+                })?;
+                (vec![if s[1].text == "bond" { CoeffTarget::BondType(index) } else { CoeffTarget::AngleType(index) }], 3)
+            }
+            "pair" => {
+                expect_len(s, 5..=usize::MAX, "coeff pair A B PARAM VALUE ...")?;
+                let (a, b) = (&s[2].text, &s[3].text);
+                let rules: Vec<CoeffTarget> = model
+                    .pair_rules
+                    .iter()
+                    .enumerate()
+                    .filter(|(k, _)| {
+                        let (ta, tb) = model.pair_rule_types[*k];
+                        let (ra, rb) = (&model.type_names[ta as usize], &model.type_names[tb as usize]);
+                        (ra == a && rb == b) || (ra == b && rb == a)
+                    })
+                    .map(|(k, _)| CoeffTarget::PairRule(k))
+                    .collect();
+                if rules.is_empty() {
+                    return Err(s[2].error(format!("no pair rule between `{a}` and `{b}`; expected a type pair with a `pair` line in the force field")));
+                }
+                (rules, 4)
+            }
+            other => return Err(s[1].error(format!("found `{other}`, expected `bond`, `angle` or `pair`"))),
+        };
+        if (s.len() - start) % 2 != 0 || s.len() == start {
+            return Err(s.last().unwrap().error("expected `PARAM VALUE` pairs"));
+        }
+        for target in targets {
+            let term = match &target {
+                CoeffTarget::BondType(k) => &mut model.bond_types[*k],
+                CoeffTarget::AngleType(k) => &mut model.angle_types[*k],
+                CoeffTarget::PairRule(k) => &mut model.pair_rules[*k],
+            };
+            for pair in s[start..].chunks(2) {
+                let index = param_index(term.interaction, &pair[0].text).ok_or_else(|| {
+                    let names: Vec<&str> = term.interaction.params().iter().map(|p| p.name).collect();
+                    pair[0].error(format!("found parameter `{}`, expected one of `{}`'s parameters: {}", pair[0].text, term.interaction.name(), names.join(", ")))
+                })?;
+                let spec = &term.interaction.params()[index];
+                let value = parse_f64(&pair[1], &format!("a value for `{}` in {}", spec.name, units.label(spec.dim)))?;
+                spec.check(value).map_err(|e| pair[1].error(format!("expected {e}")))?;
+                term.params[index] = value;
+                term.interaction.validate(&term.params).map_err(|e| pair[1].error(format!("invalid `{}` parameters: expected {e}", term.interaction.name())))?;
+                self.actions.push(Action::Coeff { target: target.clone(), param: index, value });
+            }
+        }
+        Ok(())
+    }
+
+    fn command(&mut self, s: &[Token]) -> Result<(), InputError> {
+        let kw = &s[0];
+        match kw.text.as_str() {
+            k if SETUP.contains(&k) => self.setup_command(s)?,
+            "temperature" => {
+                expect_len(s, 1..=1, "temperature T")?;
+                let what = match self.units {
+                    UnitSystem::Cell => "a temperature in K",
+                    UnitSystem::Lj => "a reduced temperature kT",
+                };
+                let t = non_negative(&s[1], what)?;
+                self.actions.push(Action::Temperature(self.units.kt(t)));
+            }
+            "timestep" => {
+                expect_len(s, 1..=1, "timestep DT")?;
+                self.actions.push(Action::Timestep(positive(&s[1], "a timestep")?));
+                self.timestep_set = true;
+            }
+            "seed" => {
+                expect_len(s, 1..=1, "seed N")?;
+                self.actions.push(Action::Seed(parse_u64(&s[1], "a random seed")?));
+            }
+            "integrator" => {
+                expect_len(s, 1..=5, "integrator overdamped [noise uniform|gaussian] [max_displacement D]")?;
+                if s[1].text != "overdamped" {
+                    return Err(s[1].error(format!("found integrator `{}`, expected `overdamped`", s[1].text)));
+                }
+                let opts = options(&s[2..], &["noise", "max_displacement"], "integrator overdamped [noise uniform|gaussian] [max_displacement D]")?;
+                let mut settings = OverdampedSettings::default();
+                if let Some(t) = opts.get("noise") {
+                    settings.noise = match t.text.as_str() {
+                        "uniform" => Noise::Uniform,
+                        "gaussian" => Noise::Gaussian,
+                        other => return Err(t.error(format!("found `{other}`, expected `uniform` or `gaussian`"))),
+                    };
+                }
+                if let Some(t) = opts.get("max_displacement") {
+                    settings.max_displacement = positive(t, "a maximum displacement per step")?;
+                }
+                self.actions.push(Action::Integrator(settings));
+            }
+            "neighbor" => {
+                expect_len(s, 2..=6, "neighbor skin S [every N] [check yes|no]")?;
+                let opts = options(&s[1..], &["skin", "every", "check"], "neighbor skin S [every N] [check yes|no]")?;
+                let mut n = NeighborSettings::default();
+                if let Some(t) = opts.get("skin") {
+                    n.skin = non_negative(t, "a skin distance")?;
+                }
+                if let Some(t) = opts.get("every") {
+                    n.every = parse_u64(t, "a step interval")?.max(1);
+                }
+                if let Some(t) = opts.get("check") {
+                    n.check = yes_no(t)?;
+                }
+                self.actions.push(Action::Neighbor(n));
+            }
+            "thermo" => {
+                expect_len(s, 1..=usize::MAX, "thermo N [column ...]")?;
+                let every = parse_u64(&s[1], "a thermo interval in steps")?;
+                let columns = if s.len() > 2 {
+                    self.thermo_columns(&s[2..])?
+                } else {
+                    vec![ThermoColumn::Step, ThermoColumn::Time, ThermoColumn::Pe, ThermoColumn::Fmax, ThermoColumn::Press]
+                };
+                self.actions.push(Action::Thermo { every, columns });
+            }
+            "thermo_file" => {
+                expect_len(s, 1..=1, "thermo_file FILE.csv")?;
+                self.actions.push(Action::ThermoFile(PathBuf::from(&s[1].text)));
+            }
+            "dump" => {
+                expect_len(s, 5..=5, "dump NAME every N mcap|xyz|lammps FILE")?;
+                if s[2].text != "every" {
+                    return Err(s[2].error(format!("found `{}`, expected `every`", s[2].text)));
+                }
+                let every = parse_u64(&s[3], "a dump interval in steps")?;
+                if every == 0 {
+                    return Err(s[3].error("found 0, expected a dump interval >= 1"));
+                }
+                let format = DumpFormat::from_keyword(&s[4].text).ok_or_else(|| s[4].error(format!("found format `{}`, expected `mcap`, `xyz` or `lammps`", s[4].text)))?;
+                let path = PathBuf::from(&s[5].text);
+                if self.dumps.contains_key(&s[1].text) {
+                    return Err(s[1].error(format!("dump `{}` is already active; expected a new name or `undump {}` first", s[1].text, s[1].text)));
+                }
+                if self.dumps.values().any(|p| *p == path) {
+                    return Err(s[5].error(format!("`{}` is already written by another dump; expected a different file", s[5].text)));
+                }
+                self.dumps.insert(s[1].text.clone(), path.clone());
+                self.actions.push(Action::Dump(DumpSpec { name: s[1].text.clone(), every, format, path }));
+            }
+            "undump" => {
+                expect_len(s, 1..=1, "undump NAME")?;
+                if self.dumps.remove(&s[1].text).is_none() {
+                    return Err(s[1].error(format!("found `{}`, expected the name of an active dump", s[1].text)));
+                }
+                self.actions.push(Action::Undump(s[1].text.clone()));
+            }
+            "group" => self.group(s)?,
+            "external" => {
+                expect_len(s, 3..=usize::MAX, "external NAME GROUP INTERACTION [param value]...")?;
+                let units = self.units;
+                self.model(kw)?;
+                let group = self.groups.get(&s[2].text).ok_or_else(|| {
+                    s[2].error(format!("found group `{}`, expected `all` or a group defined by a `group` command before", s[2].text))
+                })?;
+                let term = parse_params(&s[1], &s[3], &s[4..], Kind::External, units)?;
+                let external = External { term, group: group.name.clone(), members: group.members.clone() };
+                self.externals.insert(s[1].text.clone());
+                self.actions.push(Action::External(external));
+            }
+            "unexternal" => {
+                expect_len(s, 1..=1, "unexternal NAME")?;
+                if !self.externals.remove(&s[1].text) {
+                    return Err(s[1].error(format!("found `{}`, expected the name of an active external", s[1].text)));
+                }
+                self.actions.push(Action::Unexternal(s[1].text.clone()));
+            }
+            "coeff" => self.coeff(s)?,
+            "minimize" => {
+                let usage = "minimize [ftol F] [maxiter N] [dmax D]";
+                let opts = options(&s[1..], &["ftol", "maxiter", "dmax"], usage)?;
+                let mut f = FireSettings::default();
+                if let Some(t) = opts.get("ftol") {
+                    f.ftol = positive(t, "a force tolerance")?;
+                }
+                if let Some(t) = opts.get("maxiter") {
+                    f.max_iterations = parse_u64(t, "a maximum number of iterations")?;
+                }
+                if let Some(t) = opts.get("dmax") {
+                    f.dmax = positive(t, "a maximum move per iteration")?;
+                }
+                self.model(kw)?;
+                if !self.timestep_set {
+                    return Err(kw.error("`minimize` scales FIRE's step from the timestep; expected a `timestep DT` command before it"));
+                }
+                self.actions.push(Action::Minimize(f));
+            }
+            "run" => {
+                expect_len(s, 1..=1, "run N")?;
+                let n = parse_u64(&s[1], "a number of steps")?;
+                self.model(kw)?;
+                if !self.timestep_set {
+                    return Err(kw.error("no timestep; expected a `timestep DT` command before `run`"));
+                }
+                self.actions.push(Action::Run(n));
+            }
+            "write_state" => {
+                expect_len(s, 1..=1, "write_state FILE")?;
+                self.model(kw)?;
+                let path = PathBuf::from(&s[1].text);
+                self.states_written.insert(path.clone());
+                self.actions.push(Action::WriteState(path));
+            }
+            "read_state" => {
+                expect_len(s, 1..=1, "read_state FILE")?;
+                self.model(kw)?;
+                let written = PathBuf::from(&s[1].text);
+                let path = if self.states_written.contains(&written) { written } else { self.input_path(&s[1]) };
+                if !self.states_written.contains(&path) && !path.exists() {
+                    return Err(s[1].error(format!("cannot read `{}`: no such file; expected a restart file written by `write_state`", path.display())));
+                }
+                self.actions.push(Action::ReadState(path));
+            }
+            "print" => self.actions.push(Action::Print(s[1..].iter().map(|t| t.text.as_str()).collect::<Vec<_>>().join(" "))),
+            other => return Err(kw.error(format!("found unknown command `{other}`, expected one of: {COMMANDS}"))),
+        }
+        Ok(())
+    }
+}
+
+/// Validates a deck given as source text.
+pub fn validate(file: &std::sync::Arc<SourceFile>, deck_dir: &Path, overrides: &[(String, String)]) -> Result<Plan, InputError> {
+    let statements: Vec<Statement> = lex(file)?;
+    let mut v = Validator {
+        deck_dir: deck_dir.to_path_buf(),
+        vars: Variables::with_overrides(overrides),
+        units: UnitSystem::Cell,
+        topology: None,
+        forcefield: ForceField::default(),
+        forcefield_seen: false,
+        box_axes: None,
+        special_bonds: SpecialBonds::default(),
+        initial_model: None,
+        model: None,
+        positions: Vec::new(),
+        sim_box: None,
+        groups: HashMap::new(),
+        dumps: HashMap::new(),
+        externals: HashSet::new(),
+        states_written: HashSet::new(),
+        timestep_set: false,
+        actions: Vec::new(),
+    };
+    let mut last: Option<Token> = None;
+    for statement in &statements {
+        let kw = statement.keyword();
+        if kw.text == "variable" {
+            let rest: Vec<Token> = statement.tokens[1..].iter().map(|t| v.vars.substitute(t)).collect::<Result<_, _>>()?;
+            v.vars.define(kw, &rest)?;
+            continue;
+        }
+        let tokens: Vec<Token> = statement.tokens.iter().map(|t| v.vars.substitute(t)).collect::<Result<_, _>>()?;
+        v.command(&tokens)?;
+        last = Some(kw.clone());
+    }
+    let Some(last) = last else {
+        return Err(InputError::in_file(&file.path, "the deck is empty; expected at least `topology`, `forcefield`, `timestep` and `run`"));
+    };
+    v.model(&last)?;
+    Ok(Plan {
+        deck_path: PathBuf::from(&file.path),
+        model: v.initial_model.unwrap(),
+        sim_box: v.sim_box.unwrap(),
+        positions: v.positions,
+        actions: v.actions,
+    })
+}
+
+/// Reads and validates a deck file.
+pub fn validate_file(path: &Path, overrides: &[(String, String)]) -> Result<Plan, InputError> {
+    let file = SourceFile::read(path, None)?;
+    let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    validate(&file, &dir, overrides)
+}

@@ -1,0 +1,67 @@
+//! Deck variables: `variable NAME equal EXPR` / `variable NAME string TEXT`,
+//! used as `${NAME}` anywhere in a later token. Values given on the command
+//! line (`--var NAME=VALUE`) take precedence over the deck's definitions.
+
+use std::collections::HashMap;
+
+use crate::input::{evaluate_expression, InputError, Token};
+
+#[derive(Clone, Debug, Default)]
+pub struct Variables {
+    values: HashMap<String, String>,
+    from_command_line: HashMap<String, String>,
+}
+
+impl Variables {
+    /// Variables fixed on the command line.
+    pub fn with_overrides(overrides: &[(String, String)]) -> Self {
+        let from_command_line: HashMap<String, String> = overrides.iter().cloned().collect();
+        Self { values: from_command_line.clone(), from_command_line }
+    }
+
+    /// Handles `variable NAME equal|string VALUE...` (tokens after `variable`).
+    pub fn define(&mut self, keyword: &Token, tokens: &[Token]) -> Result<(), InputError> {
+        if tokens.len() < 3 {
+            return Err(keyword.error("expected `variable NAME equal EXPRESSION` or `variable NAME string TEXT`"));
+        }
+        let name = &tokens[0];
+        if !name.text.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+            return Err(name.error(format!("found variable name `{}`, expected letters, digits and `_`", name.text)));
+        }
+        let rest: Vec<&str> = tokens[2..].iter().map(|t| t.text.as_str()).collect();
+        let value = match tokens[1].text.as_str() {
+            "equal" => {
+                let v = evaluate_expression(&rest.join(" ")).map_err(|e| tokens[2].error(e))?;
+                format!("{v}")
+            }
+            "string" => rest.join(" "),
+            other => return Err(tokens[1].error(format!("found `{other}`, expected `equal` or `string`"))),
+        };
+        if !self.from_command_line.contains_key(&name.text) {
+            self.values.insert(name.text.clone(), value);
+        }
+        Ok(())
+    }
+
+    /// Replaces every `${NAME}` in a token.
+    pub fn substitute(&self, token: &Token) -> Result<Token, InputError> {
+        if !token.text.contains("${") {
+            return Ok(token.clone());
+        }
+        let mut out = String::new();
+        let mut rest = token.text.as_str();
+        while let Some(start) = rest.find("${") {
+            out.push_str(&rest[..start]);
+            let after = &rest[start + 2..];
+            let end = after.find('}').ok_or_else(|| token.error("unterminated `${`; expected `${NAME}`"))?;
+            let name = &after[..end];
+            let value = self.values.get(name).ok_or_else(|| {
+                token.error(format!("found undefined variable `{name}`, expected a `variable {name} ...` line before this one or `--var {name}=VALUE`"))
+            })?;
+            out.push_str(value);
+            rest = &after[end + 1..];
+        }
+        out.push_str(rest);
+        Ok(token.with_text(out))
+    }
+}

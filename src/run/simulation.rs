@@ -1,0 +1,371 @@
+//! The run loop: actions of a plan applied to a live system.
+
+use std::path::{Path, PathBuf};
+
+use glam::DVec3;
+use indicatif::{ProgressBar, ProgressStyle};
+
+use super::blowup::{culprit, RunError};
+use super::thermo::{Thermo, ThermoInputs};
+use crate::backend::{CpuBackend, Forces};
+use crate::deck::{Action, CoeffTarget, DumpSpec, NeighborSettings, Plan};
+use crate::integrate::fire::{fire_minimize, FireReport, FireSettings};
+use crate::integrate::overdamped::{overdamped_step, Blowup, OverdampedSettings};
+use crate::output::restart::{read_state, write_state, RestartData};
+use crate::output::{open_writer, FrameView, TopologyView, TrajectoryWriter};
+use crate::system::{Model, SimBox, State};
+
+/// How to run: where outputs go and how to report progress.
+#[derive(Clone, Debug)]
+pub struct RunOptions {
+    /// Directory that relative output paths are resolved against.
+    pub output_dir: PathBuf,
+    /// Show a progress bar (only when attached to a terminal).
+    pub progress: bool,
+    /// Print thermo and messages to stdout.
+    pub echo: bool,
+}
+
+impl Default for RunOptions {
+    fn default() -> Self {
+        Self { output_dir: PathBuf::from("."), progress: false, echo: false }
+    }
+}
+
+struct ActiveDump {
+    spec: DumpSpec,
+    path: PathBuf,
+    writer: Box<dyn TrajectoryWriter>,
+    last_step: Option<u64>,
+}
+
+/// A live simulation.
+pub struct Simulation {
+    pub model: Model,
+    pub state: State,
+    pub sim_box: SimBox,
+    pub forces: Forces,
+    pub kt: f64,
+    pub dt: f64,
+    pub seed: u64,
+    pub integrator: OverdampedSettings,
+    pub neighbor: NeighborSettings,
+    backend: Option<CpuBackend>,
+    forces_current: bool,
+    thermo: Thermo,
+    dumps: Vec<ActiveDump>,
+    options: RunOptions,
+    deck_stem: String,
+    scratch: Vec<DVec3>,
+    /// The last minimisation's outcome.
+    pub last_minimize: Option<FireReport>,
+}
+
+impl Simulation {
+    /// A simulation at the plan's initial state (positions wrapped into the box).
+    pub fn new(plan: &Plan, options: RunOptions) -> Self {
+        let mut state = State::new(plan.positions.clone());
+        for (x, image) in state.positions.iter_mut().zip(state.images.iter_mut()) {
+            plan.sim_box.wrap(x, image);
+        }
+        let deck_stem = plan.deck_path.file_stem().map_or("cellmd".into(), |s| s.to_string_lossy().into_owned());
+        Self {
+            thermo: Thermo::new(plan.model.units),
+            model: plan.model.clone(),
+            state,
+            sim_box: plan.sim_box,
+            forces: Forces::default(),
+            kt: 0.0,
+            dt: 0.0,
+            seed: 1,
+            integrator: OverdampedSettings::default(),
+            neighbor: NeighborSettings::default(),
+            backend: None,
+            forces_current: false,
+            dumps: Vec::new(),
+            options,
+            deck_stem,
+            scratch: Vec::new(),
+            last_minimize: None,
+        }
+    }
+
+    /// Runs every action of the plan; output files are closed cleanly even on error.
+    pub fn execute(plan: &Plan, options: RunOptions) -> Result<Simulation, RunError> {
+        let mut sim = Simulation::new(plan, options);
+        let result = plan.actions.iter().try_for_each(|a| sim.apply(a));
+        let closed = sim.close_outputs();
+        result?;
+        closed?;
+        Ok(sim)
+    }
+
+    fn say(&self, message: &str) {
+        if self.options.echo {
+            println!("{message}");
+        }
+    }
+
+    fn output_path(&self, path: &Path) -> PathBuf {
+        if path.is_absolute() {
+            path.to_path_buf()
+        } else {
+            self.options.output_dir.join(path)
+        }
+    }
+
+    /// Applies one action.
+    pub fn apply(&mut self, action: &Action) -> Result<(), RunError> {
+        match action {
+            Action::Temperature(kt) => self.kt = *kt,
+            Action::Timestep(dt) => self.dt = *dt,
+            Action::Seed(seed) => self.seed = *seed,
+            Action::Integrator(settings) => self.integrator = *settings,
+            Action::Neighbor(settings) => {
+                self.neighbor = *settings;
+                self.backend = None;
+            }
+            Action::Thermo { every, columns } => {
+                self.thermo.every = *every;
+                self.thermo.columns = columns.clone();
+            }
+            Action::ThermoFile(path) => {
+                let path = self.output_path(path);
+                self.thermo.set_file(std::fs::File::create(&path).map_err(|e| RunError::Io(format!("{}: {e}", path.display())))?)?;
+            }
+            Action::Dump(spec) => {
+                let path = self.output_path(&spec.path);
+                let writer = open_writer(spec.format, &path, &self.topology_view()).map_err(|e| RunError::Io(format!("{}: {e}", path.display())))?;
+                self.dumps.push(ActiveDump { spec: spec.clone(), path, writer, last_step: None });
+            }
+            Action::Undump(name) => {
+                if let Some(k) = self.dumps.iter().position(|d| d.spec.name == *name) {
+                    self.dumps.remove(k).writer.finish()?;
+                }
+            }
+            Action::External(external) => {
+                self.model.externals.retain(|e| e.term.label.text != external.term.label.text);
+                self.model.externals.push(external.clone());
+                self.forces_current = false;
+            }
+            Action::Unexternal(name) => {
+                self.model.externals.retain(|e| e.term.label.text != *name);
+                self.forces_current = false;
+            }
+            Action::Coeff { target, param, value } => {
+                let term = match target {
+                    CoeffTarget::BondType(k) => &mut self.model.bond_types[*k],
+                    CoeffTarget::AngleType(k) => &mut self.model.angle_types[*k],
+                    CoeffTarget::PairRule(k) => {
+                        self.backend = None; // the cutoff may change
+                        &mut self.model.pair_rules[*k]
+                    }
+                };
+                term.params[*param] = *value;
+                self.forces_current = false;
+            }
+            Action::Minimize(settings) => self.minimize(settings)?,
+            Action::Run(steps) => self.run(*steps)?,
+            Action::WriteState(path) => {
+                let path = self.output_path(path);
+                write_state(&path, &self.restart_data()).map_err(|e| RunError::Io(format!("{}: {e}", path.display())))?;
+                self.say(&format!("wrote state at step {} to {}", self.state.step, path.display()));
+            }
+            Action::ReadState(path) => {
+                let path = if path.exists() { path.clone() } else { self.output_path(path) };
+                let data = read_state(&path).map_err(|e| RunError::Setup(format!("{}: {e}", path.display())))?;
+                self.load_restart(data, &path)?;
+            }
+            Action::Print(text) => self.say(text),
+        }
+        Ok(())
+    }
+
+    fn topology_view(&self) -> TopologyView<'_> {
+        TopologyView {
+            units: self.model.units,
+            ids: &self.model.ids,
+            types: &self.model.types,
+            type_names: &self.model.type_names,
+            type_radius: &self.model.type_radius,
+            bonds: &self.model.bonds,
+            angles: &self.model.angles,
+            triangles: &self.model.triangles,
+        }
+    }
+
+    fn restart_data(&self) -> RestartData {
+        RestartData::new(self.model.units, &self.state, &self.sim_box, &self.model.ids)
+    }
+
+    fn load_restart(&mut self, data: RestartData, path: &Path) -> Result<(), RunError> {
+        if data.ids != self.model.ids {
+            return Err(RunError::Setup(format!("{}: the restart's particle ids do not match the topology", path.display())));
+        }
+        if data.units != self.model.units {
+            return Err(RunError::Setup(format!("{}: the restart was written in {:?} units, the deck uses {:?}", path.display(), data.units, self.model.units)));
+        }
+        self.sim_box = data.sim_box;
+        self.state = data.into_state();
+        self.backend = None;
+        self.forces_current = false;
+        Ok(())
+    }
+
+    /// Ensures a backend with a fresh neighbour list and forces at the current state.
+    fn ensure_forces(&mut self) -> Result<(), RunError> {
+        if self.backend.is_none() {
+            let backend = CpuBackend::new(&self.model, &self.state, &self.sim_box, self.neighbor.skin).map_err(RunError::Setup)?;
+            self.backend = Some(backend);
+            self.forces_current = false;
+        }
+        if !self.forces_current {
+            self.compute_forces()?;
+        }
+        Ok(())
+    }
+
+    fn compute_forces(&mut self) -> Result<(), RunError> {
+        let backend = self.backend.as_mut().expect("backend built");
+        backend.compute(&self.model, &self.state, &self.sim_box, &mut self.forces);
+        self.forces_current = true;
+        if let Some(i) = self.forces.forces.iter().position(|f| !f.is_finite()) {
+            return Err(self.blowup(i, "non-finite force".into()));
+        }
+        Ok(())
+    }
+
+    /// Builds the blow-up report and writes the last good frame.
+    fn blowup(&mut self, particle: usize, what: String) -> RunError {
+        let parts = match &self.backend {
+            Some(b) => b.breakdown(&self.model, &self.state, &self.sim_box, particle),
+            None => Vec::new(),
+        };
+        let mut last_good = Vec::new();
+        let step = self.state.step;
+        for i in 0..self.dumps.len() {
+            if self.dumps[i].last_step != Some(step) && self.write_dump(i).is_ok() {
+                last_good.push(self.dumps[i].path.display().to_string());
+            }
+        }
+        let restart = self.output_path(Path::new(&format!("{}.lastgood.restart", self.deck_stem)));
+        if write_state(&restart, &self.restart_data()).is_ok() {
+            last_good.push(restart.display().to_string());
+        }
+        RunError::Blowup { step, particle_id: self.model.ids[particle], what, culprit: culprit(parts), last_good }
+    }
+
+    fn write_dump(&mut self, i: usize) -> Result<(), RunError> {
+        let frame = FrameView { step: self.state.step, time: self.state.time, sim_box: &self.sim_box, positions: &self.state.positions, images: &self.state.images };
+        self.dumps[i].writer.write_frame(&frame)?;
+        self.dumps[i].last_step = Some(self.state.step);
+        Ok(())
+    }
+
+    fn outputs_at_step(&mut self, bar: &Option<ProgressBar>, force_thermo: bool) -> Result<(), RunError> {
+        let step = self.state.step;
+        for i in 0..self.dumps.len() {
+            if step % self.dumps[i].spec.every == 0 && self.dumps[i].last_step != Some(step) {
+                self.write_dump(i)?;
+            }
+        }
+        let due = self.thermo.every > 0 && step % self.thermo.every == 0;
+        if due || force_thermo {
+            let inputs = ThermoInputs {
+                step,
+                time: self.state.time,
+                forces: &self.forces,
+                n_particles: self.model.len(),
+                kt: self.kt,
+                volume: self.sim_box.volume(),
+                neighbor_builds: self.backend.as_ref().map_or(0, |b| b.neighbor_builds()),
+            };
+            let line = self.thermo.row(&inputs)?;
+            match bar {
+                Some(bar) => bar.println(line),
+                None => self.say(&line),
+            }
+        }
+        Ok(())
+    }
+
+    /// `run N`: N overdamped steps.
+    pub fn run(&mut self, steps: u64) -> Result<(), RunError> {
+        self.ensure_forces()?;
+        let bar = (self.options.progress && steps >= 1000).then(|| {
+            let bar = ProgressBar::new(steps);
+            bar.set_style(ProgressStyle::with_template("{bar:40} {pos}/{len} steps  {per_sec}  ETA {eta}").expect("valid template"));
+            bar
+        });
+        let header = self.thermo.header();
+        match &bar {
+            Some(b) => b.println(header),
+            None => self.say(&header),
+        }
+        self.outputs_at_step(&bar, true)?;
+        let last = self.state.step + steps;
+        while self.state.step < last {
+            let moved = overdamped_step(&self.model, &mut self.state, &self.forces.forces, &self.sim_box, self.dt, self.kt, self.seed, &self.integrator, &mut self.scratch);
+            if let Err(Blowup { particle, displacement }) = moved {
+                let what = format!("displacement {displacement:e} in one step exceeds max_displacement {:e}", self.integrator.max_displacement);
+                return Err(self.blowup(particle, what));
+            }
+            if self.state.step % self.neighbor.every == 0 {
+                let backend = self.backend.as_mut().expect("backend built");
+                backend.update_neighbors(&self.state, &self.sim_box, self.neighbor.check).map_err(RunError::Setup)?;
+            }
+            self.compute_forces()?;
+            let final_step = self.state.step == last;
+            self.outputs_at_step(&bar, final_step && (self.thermo.every == 0 || self.state.step % self.thermo.every != 0))?;
+            if let Some(b) = &bar {
+                b.inc(1);
+            }
+        }
+        if let Some(b) = bar {
+            b.finish_and_clear();
+        }
+        self.thermo.flush()?;
+        Ok(())
+    }
+
+    /// `minimize`: FIRE to max |F| < ftol. The step counter does not advance.
+    pub fn minimize(&mut self, settings: &FireSettings) -> Result<(), RunError> {
+        self.ensure_forces()?;
+        let mass: Vec<f64> = self.model.types.iter().map(|&t| self.model.type_drag[t as usize] * self.dt).collect();
+        let mut state = self.state.clone();
+        let backend = self.backend.as_mut().expect("backend built");
+        let (model, sim_box, forces) = (&self.model, &self.sim_box, &mut self.forces);
+        let report = fire_minimize(&mut state, sim_box, &mass, self.dt, settings, |s, f| {
+            backend.update_neighbors(s, sim_box, true).map_err(RunError::Setup)?;
+            backend.compute(model, s, sim_box, forces);
+            f.clone_from(&forces.forces);
+            Ok::<f64, RunError>(forces.total_energy())
+        })?;
+        self.state = state;
+        self.forces_current = true;
+        if let Some(i) = self.forces.forces.iter().position(|f| !f.is_finite()) {
+            return Err(self.blowup(i, "non-finite force during minimisation".into()));
+        }
+        let verdict = if report.converged { "converged" } else { "stopped at maxiter without converging" };
+        self.say(&format!(
+            "minimize (FIRE): {verdict} after {} iterations: max |F| = {:e} (ftol {:e}), pe = {:e}",
+            report.iterations, report.max_force, settings.ftol, report.energy
+        ));
+        self.last_minimize = Some(report);
+        Ok(())
+    }
+
+    /// Finishes every output file (called at the end and on errors).
+    pub fn close_outputs(&mut self) -> Result<(), RunError> {
+        let mut first_error = None;
+        for dump in self.dumps.drain(..) {
+            if let Err(e) = dump.writer.finish() {
+                first_error.get_or_insert(RunError::Io(format!("{}: {e}", dump.path.display())));
+            }
+        }
+        if let Err(e) = self.thermo.close() {
+            first_error.get_or_insert(RunError::Io(e.to_string()));
+        }
+        first_error.map_or(Ok(()), Err)
+    }
+}

@@ -1,0 +1,211 @@
+//! The resolved system (OpenMM's `System`): what interacts with what, and how.
+//!
+//! Built from a parsed topology and force field; every name is resolved here,
+//! so an unknown type is reported at its position in the topology file.
+
+use crate::forcefield::{ForceField, TermType};
+use crate::input::{InputError, Token};
+use crate::interactions::{Law, REGISTRY};
+use crate::topology::Topology;
+use crate::units::UnitSystem;
+
+/// An external field acting on a group of particles (deck `external`).
+#[derive(Clone, Debug)]
+pub struct External {
+    pub term: TermType,
+    pub group: String,
+    /// Internal indices of the particles it acts on, ascending.
+    pub members: Vec<u32>,
+}
+
+/// Which bonded neighbours are excluded from pair interactions
+/// (LAMMPS `special_bonds lj W12 W13 W14` with weights 0 or 1).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SpecialBonds {
+    pub exclude_12: bool,
+    pub exclude_13: bool,
+    pub exclude_14: bool,
+}
+
+impl Default for SpecialBonds {
+    /// Directly bonded pairs are excluded; 1-3 and 1-4 pairs interact.
+    fn default() -> Self {
+        Self { exclude_12: true, exclude_13: false, exclude_14: false }
+    }
+}
+
+/// The resolved system.
+#[derive(Clone, Debug)]
+pub struct Model {
+    pub units: UnitSystem,
+    /// User-facing particle ids, by internal index.
+    pub ids: Vec<u64>,
+    /// Particle type index (into `type_names`), by internal index.
+    pub types: Vec<u32>,
+    pub type_names: Vec<String>,
+    /// Drag γ per particle type.
+    pub type_drag: Vec<f64>,
+    /// Radius per particle type (0 if not given).
+    pub type_radius: Vec<f64>,
+    pub bond_types: Vec<TermType>,
+    pub bonds: Vec<[u32; 2]>,
+    pub bond_type: Vec<u32>,
+    pub angle_types: Vec<TermType>,
+    pub angles: Vec<[u32; 3]>,
+    pub angle_type: Vec<u32>,
+    pub pair_rules: Vec<TermType>,
+    /// The particle types (a, b) each pair rule acts between.
+    pub pair_rule_types: Vec<(u32, u32)>,
+    /// For type pair (a, b): indices into `pair_rules` (symmetric).
+    pub pair_table: Vec<Vec<u32>>,
+    pub externals: Vec<External>,
+    pub special_bonds: SpecialBonds,
+    /// Triangles of closed surfaces (outward-wound), kept for shell terms and output.
+    pub triangles: Vec<[u32; 3]>,
+    /// The body id of each triangle.
+    pub triangle_body: Vec<u64>,
+}
+
+fn resolve(name: &Token, table: &[TermType], what: &str) -> Result<u32, InputError> {
+    table.iter().position(|t| t.label.text == name.text).map(|i| i as u32).ok_or_else(|| {
+        let names: Vec<&str> = table.iter().map(|t| t.label.text.as_str()).collect();
+        let listed = if names.is_empty() { "none are defined".to_string() } else { names.join(", ") };
+        name.error(format!("found {what} type `{}`, expected one defined in the force field ({listed})", name.text))
+    })
+}
+
+impl Model {
+    /// Resolves a topology against a force field.
+    pub fn build(topology: &Topology, ff: &ForceField, units: UnitSystem, special_bonds: SpecialBonds) -> Result<Model, InputError> {
+        crate::forcefield::check_pair_types(ff)?;
+        let type_names: Vec<String> = ff.particle_types.iter().map(|t| t.name.text.clone()).collect();
+        let mut types = Vec::with_capacity(topology.ids.len());
+        for name in &topology.type_names {
+            let t = ff.particle_type(&name.text).ok_or_else(|| {
+                name.error(format!("found particle type `{}`, expected one defined in the force field ({})", name.text, type_names.join(", ")))
+            })?;
+            types.push(t as u32);
+        }
+        let bond_type = topology.bonds.iter().map(|b| resolve(&b.type_name, &ff.bond_types, "bond")).collect::<Result<_, _>>()?;
+        let angle_type = topology.angles.iter().map(|a| resolve(&a.type_name, &ff.angle_types, "angle")).collect::<Result<_, _>>()?;
+        let nt = type_names.len();
+        let mut pair_table = vec![Vec::new(); nt * nt];
+        let mut pair_rule_types = Vec::with_capacity(ff.pair_rules.len());
+        for (index, rule) in ff.pair_rules.iter().enumerate() {
+            let a = ff.particle_type(&rule.type_a.text).expect("checked by check_pair_types");
+            let b = ff.particle_type(&rule.type_b.text).expect("checked by check_pair_types");
+            pair_rule_types.push((a as u32, b as u32));
+            pair_table[a * nt + b].push(index as u32);
+            if a != b {
+                pair_table[b * nt + a].push(index as u32);
+            }
+        }
+        Ok(Model {
+            units,
+            ids: topology.ids.clone(),
+            types,
+            type_drag: ff.particle_types.iter().map(|t| t.drag).collect(),
+            type_radius: ff.particle_types.iter().map(|t| t.radius).collect(),
+            type_names,
+            bond_types: ff.bond_types.clone(),
+            bonds: topology.bonds.iter().map(|b| b.particles).collect(),
+            bond_type,
+            angle_types: ff.angle_types.clone(),
+            angles: topology.angles.iter().map(|a| a.particles).collect(),
+            angle_type,
+            pair_rules: ff.pair_rules.iter().map(|r| r.term.clone()).collect(),
+            pair_rule_types,
+            pair_table,
+            externals: Vec::new(),
+            special_bonds,
+            triangles: topology.triangles.iter().map(|t| t.1).collect(),
+            triangle_body: topology.triangles.iter().map(|t| t.0).collect(),
+        })
+    }
+
+    pub fn len(&self) -> usize {
+        self.ids.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.ids.is_empty()
+    }
+
+    /// Pair rules acting between particle types `a` and `b`.
+    #[inline]
+    pub fn pair_rules_between(&self, a: u32, b: u32) -> &[u32] {
+        &self.pair_table[a as usize * self.type_names.len() + b as usize]
+    }
+
+    /// The largest pair cutoff (0 when there are no pair rules).
+    pub fn max_pair_cutoff(&self) -> f64 {
+        self.pair_rules
+            .iter()
+            .map(|r| match r.interaction.law() {
+                Law::Radial { range, .. } => range(&r.params),
+                _ => 0.0,
+            })
+            .fold(0.0, f64::max)
+    }
+
+    /// Pairs excluded from pair interactions by `special_bonds` (i < j).
+    pub fn excluded_pairs(&self) -> Vec<(u32, u32)> {
+        let n = self.len();
+        let mut adjacency: Vec<Vec<u32>> = vec![Vec::new(); n];
+        for &[i, j] in &self.bonds {
+            adjacency[i as usize].push(j);
+            adjacency[j as usize].push(i);
+        }
+        let sb = self.special_bonds;
+        let mut pairs = Vec::new();
+        for start in 0..n as u32 {
+            // Breadth-first to depth 3 along bonds.
+            let mut frontier = vec![start];
+            let mut seen = vec![start];
+            for depth in 1..=3 {
+                let mut next = Vec::new();
+                for &p in &frontier {
+                    for &q in &adjacency[p as usize] {
+                        if !seen.contains(&q) {
+                            seen.push(q);
+                            next.push(q);
+                            let excluded = match depth {
+                                1 => sb.exclude_12,
+                                2 => sb.exclude_13,
+                                _ => sb.exclude_14,
+                            };
+                            if excluded && start < q {
+                                pairs.push((start, q));
+                            }
+                        }
+                    }
+                }
+                frontier = next;
+            }
+        }
+        pairs.sort_unstable();
+        pairs.dedup();
+        pairs
+    }
+
+    /// Index of each interaction type of the registry that this model uses,
+    /// in registry order (the `pe/NAME` thermo columns).
+    pub fn interactions_in_use(&self) -> Vec<usize> {
+        let mut used = vec![false; REGISTRY.len()];
+        let mut mark = |t: &TermType| {
+            if let Some(k) = REGISTRY.iter().position(|r| r.name() == t.interaction.name()) {
+                used[k] = true;
+            }
+        };
+        self.bond_types.iter().for_each(&mut mark);
+        self.angle_types.iter().for_each(&mut mark);
+        self.pair_rules.iter().for_each(&mut mark);
+        self.externals.iter().for_each(|e| mark(&e.term));
+        (0..REGISTRY.len()).filter(|&k| used[k]).collect()
+    }
+}
+
+/// Registry index of an interaction (for per-interaction energy accounting).
+pub fn registry_index(term: &TermType) -> usize {
+    REGISTRY.iter().position(|r| r.name() == term.interaction.name()).expect("term of a registered interaction")
+}
