@@ -23,11 +23,37 @@ use crate::units::Dim;
 pub mod testing;
 
 mod harmonic;
+mod fene;
+mod cable;
+mod spring;
+mod asymmetric;
+mod wlc_bending;
+mod harmonic_angle;
+mod cosine_angle;
+mod soft_repulsion;
+mod lj;
+mod wca;
+mod soft;
+mod wall;
+mod constant_force;
 
 /// Every registered interaction type. The parser, validator, `cellmd list`
 /// and the docs read this list; nothing else lists interaction names.
 pub static REGISTRY: &[&dyn Interaction] = &[
     &harmonic::Harmonic,
+    &fene::Fene,
+    &cable::Cable,
+    &spring::Spring,
+    &asymmetric::Asymmetric,
+    &wlc_bending::WlcBending,
+    &harmonic_angle::HarmonicAngle,
+    &cosine_angle::CosineAngle,
+    &soft_repulsion::SoftRepulsion,
+    &lj::Lj,
+    &wca::Wca,
+    &soft::Soft,
+    &wall::Wall,
+    &constant_force::ConstantForce,
 ];
 
 /// Looks an interaction type up by its registered name.

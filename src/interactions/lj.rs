@@ -1,0 +1,100 @@
+#![doc = include_str!("lj.md")]
+
+use super::{Interaction, Kind, Law, ParamSpec, Radial};
+use crate::units::Dim;
+
+const EPSILON: usize = 0;
+const SIGMA: usize = 1;
+const RC: usize = 2;
+
+static PARAMS: [ParamSpec; 3] = [
+    ParamSpec::new("epsilon", Dim::Energy, "well depth").non_negative(),
+    ParamSpec::new("sigma", Dim::Length, "distance at which E = 0").positive(),
+    ParamSpec::new("rc", Dim::Length, "cutoff (E = 0 beyond; not shifted)").positive(),
+];
+
+pub struct Lj;
+
+/// 4ε[(σ/r)¹² − (σ/r)⁶] and its first two derivatives (shared with `wca`).
+pub(crate) fn lennard_jones(epsilon: f64, sigma: f64, r: f64) -> Radial {
+    let s2 = sigma * sigma / (r * r);
+    let s6 = s2 * s2 * s2;
+    let s12 = s6 * s6;
+    Radial {
+        energy: 4.0 * epsilon * (s12 - s6),
+        de_dr: 4.0 * epsilon * (6.0 * s6 - 12.0 * s12) / r,
+        d2e_dr2: 4.0 * epsilon * (156.0 * s12 - 42.0 * s6) / (r * r),
+    }
+}
+
+fn eval(p: &[f64], r: f64) -> Radial {
+    if r < p[RC] {
+        lennard_jones(p[EPSILON], p[SIGMA], r)
+    } else {
+        Radial::ZERO
+    }
+}
+
+impl Interaction for Lj {
+    fn name(&self) -> &'static str {
+        "lj"
+    }
+    fn kind(&self) -> Kind {
+        Kind::Pair
+    }
+    fn summary(&self) -> &'static str {
+        "Lennard-Jones 12-6, cut at rc and not shifted (LAMMPS lj/cut)"
+    }
+    fn doc(&self) -> &'static str {
+        include_str!("lj.md")
+    }
+    fn params(&self) -> &'static [ParamSpec] {
+        &PARAMS
+    }
+    fn law(&self) -> Law {
+        Law::Radial { eval, range: |p| p[RC] }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::interactions::testing::*;
+    use glam::DVec3;
+
+    fn pair(r: f64) -> [DVec3; 2] {
+        let a = DVec3::new(-1.0, 0.5, 2.0);
+        [a, a + DVec3::new(1.0, 2.0, 2.0) / 3.0 * r]
+    }
+
+    fn argon_like() -> Vec<f64> {
+        params_of(&Lj, &[("epsilon", 1.0), ("sigma", 1.0), ("rc", 2.5)])
+    }
+
+    #[test]
+    fn shared_checks() {
+        let p = argon_like();
+        // Avoid the inflection point (≈ 1.244σ, where d²E/dr² = 0) and the cutoff.
+        for r in [0.9, 1.0, 1.15, 1.5, 2.2, 2.6] {
+            assert_all_checks(&Lj, &p, &pair(r), 1e-6, 1.0);
+        }
+        let rmin = 2f64.powf(1.0 / 6.0);
+        assert_zero_force_at_rest(&Lj, &p, &pair(rmin), 24.0);
+    }
+
+    #[test]
+    fn minimum_is_minus_epsilon_at_two_to_the_sixth_sigma() {
+        let p = params_of(&Lj, &[("epsilon", 0.5), ("sigma", 0.8), ("rc", 2.0)]);
+        let rmin = 2f64.powf(1.0 / 6.0) * 0.8;
+        let out = eval(&p, rmin);
+        assert!((out.energy + 0.5).abs() < 1e-14, "{out:?}");
+        assert!(out.de_dr.abs() < 1e-12);
+        // Curvature at the minimum: 72ε/(2^(1/3)σ²) ≈ 57.15 ε/σ².
+        assert!((out.d2e_dr2 - 72.0 * 0.5 / (2f64.powf(1.0 / 3.0) * 0.64)).abs() < 1e-10);
+        assert_eq!(eval(&p, 0.8).energy, 0.0);
+        // Unshifted: a jump of E(rc) at the cutoff (LAMMPS lj/cut without pair_modify shift).
+        let e_rc = 4.0 * 0.5 * ((0.4f64).powi(12) - (0.4f64).powi(6));
+        assert!((eval(&p, 2.0 - 1e-12).energy - e_rc).abs() < 1e-12);
+        assert_eq!(eval(&p, 2.0), Radial::ZERO);
+    }
+}

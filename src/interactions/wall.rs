@@ -1,0 +1,112 @@
+#![doc = include_str!("wall.md")]
+
+use glam::DVec3;
+
+use super::{Interaction, Kind, Law, OneBody, ParamSpec};
+use crate::units::Dim;
+
+const NX: usize = 0;
+const NY: usize = 1;
+const NZ: usize = 2;
+const D: usize = 3;
+const K: usize = 4;
+
+static PARAMS: [ParamSpec; 5] = [
+    ParamSpec::new("nx", Dim::Dimensionless, "x component of the wall normal (normalised internally)").default(0.0),
+    ParamSpec::new("ny", Dim::Dimensionless, "y component of the wall normal (normalised internally)").default(0.0),
+    ParamSpec::new("nz", Dim::Dimensionless, "z component of the wall normal (normalised internally)").default(1.0),
+    ParamSpec::new("d", Dim::Length, "offset of the plane n̂·x = d from the origin, along n̂").default(0.0),
+    ParamSpec::new("k", Dim::Stiffness, "stiffness of the wall").non_negative(),
+];
+
+pub struct Wall;
+
+/// The unit normal, or `None` for a zero (or non-finite) normal.
+fn unit_normal(p: &[f64]) -> Option<DVec3> {
+    let n = DVec3::new(p[NX], p[NY], p[NZ]);
+    // Scale first so that huge or tiny components neither overflow nor underflow.
+    let scale = n.abs().max_element();
+    if !(scale > 0.0 && scale.is_finite()) {
+        return None;
+    }
+    Some((n / scale).normalize())
+}
+
+fn eval(p: &[f64], x: DVec3) -> OneBody {
+    let Some(n) = unit_normal(p) else {
+        return OneBody { energy: 0.0, force: DVec3::ZERO };
+    };
+    let depth = p[D] - n.dot(x);
+    if depth > 0.0 {
+        OneBody { energy: 0.5 * p[K] * depth * depth, force: p[K] * depth * n }
+    } else {
+        OneBody { energy: 0.0, force: DVec3::ZERO }
+    }
+}
+
+impl Interaction for Wall {
+    fn name(&self) -> &'static str {
+        "wall"
+    }
+    fn kind(&self) -> Kind {
+        Kind::External
+    }
+    fn summary(&self) -> &'static str {
+        "One-sided harmonic plane (substrate): E = ½k(d − n̂·x)² when n̂·x < d"
+    }
+    fn doc(&self) -> &'static str {
+        include_str!("wall.md")
+    }
+    fn params(&self) -> &'static [ParamSpec] {
+        &PARAMS
+    }
+    fn law(&self) -> Law {
+        Law::OneBody(eval)
+    }
+    fn validate(&self, p: &[f64]) -> Result<(), String> {
+        match unit_normal(p) {
+            Some(_) => Ok(()),
+            None => Err(format!(
+                "a nonzero wall normal (nx, ny, nz), e.g. `nz 1` for a floor, found ({}, {}, {})",
+                p[NX], p[NY], p[NZ]
+            )),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::interactions::testing::*;
+
+    #[test]
+    fn shared_checks() {
+        let p = params_of(&Wall, &[("nx", 1.0), ("ny", -2.0), ("nz", 2.0), ("d", 0.5), ("k", 100.0)]);
+        for x in [DVec3::new(0.1, 0.2, 0.3), DVec3::new(-1.0, 3.0, -2.0), DVec3::new(2.0, 0.0, 1.0)] {
+            assert_all_checks(&Wall, &p, &[x], 1e-6, 1.0);
+        }
+        // On the allowed side, n̂·x >= d: no force.
+        assert_zero_force_at_rest(&Wall, &p, &[DVec3::new(1.0, -1.0, 1.0)], 100.0);
+        assert_zero_force_at_rest(&Wall, &p, &[DVec3::new(1.5, 0.0, 0.0)], 100.0);
+    }
+
+    #[test]
+    fn floor_pushes_up_only_below_it() {
+        let p = params_of(&Wall, &[("d", 1.0), ("k", 50.0)]); // default normal +z
+        let below = eval(&p, DVec3::new(3.0, -4.0, 0.8));
+        assert!((below.energy - 0.5 * 50.0 * 0.04).abs() < 1e-12);
+        assert!((below.force - DVec3::new(0.0, 0.0, 10.0)).length() < 1e-12);
+        assert_eq!(eval(&p, DVec3::new(3.0, -4.0, 1.2)).force, DVec3::ZERO);
+        // The normal is normalised: (0, 0, 7) is the same wall.
+        let q = params_of(&Wall, &[("nz", 7.0), ("d", 1.0), ("k", 50.0)]);
+        assert_eq!(eval(&q, DVec3::new(3.0, -4.0, 0.8)), below);
+    }
+
+    #[test]
+    fn zero_normal_is_rejected_with_what_is_expected() {
+        let err = Wall.validate(&[0.0, 0.0, 0.0, 0.0, 10.0]).unwrap_err();
+        assert!(err.contains("nonzero wall normal"), "{err}");
+        assert!(Wall.validate(&[0.0, 1e-300, 0.0, 0.0, 10.0]).is_ok());
+        assert!(Wall.validate(&[1e300, 1e300, 0.0, 0.0, 10.0]).is_ok());
+    }
+}
