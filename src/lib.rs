@@ -10,11 +10,12 @@
 //! | `forcefield` | particle/bond/angle/pair types checked against each interaction's schema |
 //! | [`interactions`] | the registry: one file per interaction type (its evaluator + docs) |
 //! | [`system`] | box and f64 state |
-//! | `neighbor` | cell list + Verlet list with skin |
+//! | [`neighbor`] | cell list + Verlet list with skin |
 //! | `integrate` | Philox RNG, overdamped Euler–Maruyama, FIRE |
 //! | `backend` | the CPU reference force engine (f64, rayon, deterministic) |
 //! | `output` | thermo, MCAP, extended XYZ, LAMMPS dump, restart |
 
 pub mod interactions;
+pub mod neighbor;
 pub mod system;
 pub mod units;
