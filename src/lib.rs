@@ -11,10 +11,11 @@
 //! | [`interactions`] | the registry: one file per interaction type (its evaluator + docs) |
 //! | [`system`] | box and f64 state |
 //! | [`neighbor`] | cell list + Verlet list with skin |
-//! | `integrate` | Philox RNG, overdamped Euler–Maruyama, FIRE |
+//! | [`integrate`] | Philox RNG, overdamped Euler–Maruyama, FIRE |
 //! | `backend` | the CPU reference force engine (f64, rayon, deterministic) |
 //! | `output` | thermo, MCAP, extended XYZ, LAMMPS dump, restart |
 
+pub mod integrate;
 pub mod interactions;
 pub mod neighbor;
 pub mod system;

@@ -117,7 +117,7 @@ impl NeighborList {
         positions.par_iter().zip(self.reference.par_iter()).with_min_len(4096).any(|(x, x0)| {
             let d2 = sim_box.minimum_image(*x - *x0).length_squared();
             // A NaN displacement also forces a rebuild (which then reports it).
-            !(d2 <= limit2)
+            d2.is_nan() || d2 > limit2
         })
     }
 
@@ -147,7 +147,8 @@ impl NeighborList {
         let lengths = sim_box.lengths();
         for a in 0..3 {
             let l = lengths[a];
-            if !(sim_box.lo[a].is_finite() && sim_box.hi[a].is_finite()) || !(l >= 0.0) {
+            let finite = sim_box.lo[a].is_finite() && sim_box.hi[a].is_finite();
+            if !finite || l.is_nan() || l < 0.0 {
                 return Err(format!(
                     "neighbour list: box along {} is [{}, {}); it must be finite with hi >= lo",
                     AXES[a], sim_box.lo[a], sim_box.hi[a]

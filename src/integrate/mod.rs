@@ -1,0 +1,3 @@
+//! Integrators and their random numbers.
+
+pub mod rng;
