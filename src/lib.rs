@@ -22,6 +22,8 @@ pub mod forcefield;
 pub mod input;
 pub mod integrate;
 pub mod interactions;
+pub mod neighbor;
+pub mod output;
 pub mod run;
 pub mod system;
 pub mod topology;

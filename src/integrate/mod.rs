@@ -1,0 +1,5 @@
+//! Integrators and their random numbers.
+
+pub mod fire;
+pub mod overdamped;
+pub mod rng;
