@@ -5,16 +5,16 @@
 //! | module | role |
 //! |---|---|
 //! | [`input`] | shared nom lexer for decks, topologies and force fields; `file:line:col` diagnostics |
-//! | [`deck`] | deck commands → validated plan |
+//! | [`deck`] | deck commands → validated [`deck::Plan`] |
 //! | [`topology`] | particles, bonds, angles, triangles, bodies |
 //! | [`forcefield`] | particle/bond/angle/pair types checked against each interaction's schema |
 //! | [`interactions`] | the registry: one file per interaction type (its evaluator + docs) |
-//! | [`system`] | box and f64 state |
-//! | [`neighbor`] | cell list + Verlet list with skin |
+//! | [`system`] | box, f64 state and the resolved [`system::Model`] |
+//! | [`neighbor`] | cell list + Verlet list with skin, exclusions |
 //! | [`integrate`] | Philox RNG, overdamped Euler–Maruyama, FIRE |
 //! | [`backend`] | the CPU reference force engine (f64, rayon, deterministic) |
 //! | [`output`] | MCAP, extended XYZ, LAMMPS dump, restart |
-| [`run`] | executes a plan: run loop, thermo, blow-up diagnosis, minimise |
+//! | [`run`] | executes a plan: run loop, thermo, blow-up diagnosis, minimise |
 
 pub mod backend;
 pub mod deck;

@@ -317,6 +317,7 @@ impl Validator {
         if (s.len() - start) % 2 != 0 || s.len() == start {
             return Err(s.last().unwrap().error("expected `PARAM VALUE` pairs"));
         }
+        let mut edits = Vec::new();
         for target in targets {
             let term = match &target {
                 CoeffTarget::BondType(k) => &mut model.bond_types[*k],
@@ -333,9 +334,10 @@ impl Validator {
                 spec.check(value).map_err(|e| pair[1].error(format!("expected {e}")))?;
                 term.params[index] = value;
                 term.interaction.validate(&term.params).map_err(|e| pair[1].error(format!("invalid `{}` parameters: expected {e}", term.interaction.name())))?;
-                self.actions.push(Action::Coeff { target: target.clone(), param: index, value });
+                edits.push(Action::Coeff { target: target.clone(), param: index, value });
             }
         }
+        self.actions.extend(edits);
         Ok(())
     }
 

@@ -87,7 +87,12 @@ pub struct Thermo {
     file_header_written: bool,
 }
 
+/// Minimum column width on stdout; longer names widen their column.
 const WIDTH: usize = 14;
+
+fn width(c: &ThermoColumn) -> usize {
+    WIDTH.max(column_name(c).chars().count() + 2)
+}
 
 impl Thermo {
     pub fn new(units: UnitSystem) -> Self {
@@ -109,8 +114,8 @@ impl Thermo {
 
     /// The two header lines (names, then units) for stdout.
     pub fn header(&self) -> String {
-        let names: String = self.columns.iter().map(|c| format!("{:>WIDTH$}", column_name(c))).collect();
-        let units: String = self.columns.iter().map(|c| format!("{:>WIDTH$}", format!("[{}]", column_unit(c, self.units)))).collect();
+        let names: String = self.columns.iter().map(|c| format!("{:>w$}", column_name(c), w = width(c))).collect();
+        let units: String = self.columns.iter().map(|c| format!("{:>w$}", format!("[{}]", column_unit(c, self.units)), w = width(c))).collect();
         format!("{names}\n{units}")
     }
 
@@ -121,7 +126,7 @@ impl Thermo {
             .columns
             .iter()
             .zip(&values)
-            .map(|(c, v)| if is_integer(c) { format!("{:>WIDTH$}", *v as u64) } else { format!("{:>WIDTH$.6e}", v) })
+            .map(|(c, v)| if is_integer(c) { format!("{:>w$}", *v as u64, w = width(c)) } else { format!("{:>w$.6e}", v, w = width(c)) })
             .collect();
         if let Some(file) = &mut self.file {
             if !self.file_header_written {

@@ -29,4 +29,4 @@
 
 mod parse;
 
-pub use self::parse::{parse_topology, BoxAxis, Topology, TypedTerm};
+pub use self::parse::{parse_box_axis, parse_topology, BoxAxis, Topology, TypedTerm};
