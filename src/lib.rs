@@ -13,10 +13,11 @@
 //! | [`neighbor`] | cell list + Verlet list with skin |
 //! | [`integrate`] | Philox RNG, overdamped Euler–Maruyama, FIRE |
 //! | `backend` | the CPU reference force engine (f64, rayon, deterministic) |
-//! | `output` | thermo, MCAP, extended XYZ, LAMMPS dump, restart |
+//! | [`output`] | thermo, MCAP, extended XYZ, LAMMPS dump, restart |
 
 pub mod integrate;
 pub mod interactions;
 pub mod neighbor;
+pub mod output;
 pub mod system;
 pub mod units;
