@@ -78,7 +78,7 @@ fn harmonic_trap_reaches_equipartition() {
     let mut values = Vec::new();
     for s in 0..samples {
         let data = cellmd::output::restart::read_state(&case.path(&format!("s{s}.state"))).unwrap();
-        values.extend(data.into_state().positions.iter().map(|x| x.z * x.z));
+        values.extend(data.to_state().positions.iter().map(|x| x.z * x.z));
     }
     let mean = values.iter().sum::<f64>() / values.len() as f64;
     let expected = kt / (k * (1.0 - k * dt / (2.0 * gamma)));

@@ -195,18 +195,16 @@ impl Simulation {
     }
 
     fn restart_data(&self) -> RestartData {
-        RestartData::new(self.model.units, &self.state, &self.sim_box, &self.model.ids)
+        RestartData::from_state(self.model.units, &self.state, &self.sim_box, &self.model.ids)
     }
 
     fn load_restart(&mut self, data: RestartData, path: &Path) -> Result<(), RunError> {
-        if data.ids != self.model.ids {
-            return Err(RunError::Setup(format!("{}: the restart's particle ids do not match the topology", path.display())));
-        }
+        data.check_ids(&self.model.ids).map_err(|e| RunError::Setup(format!("{}: {e}", path.display())))?;
         if data.units != self.model.units {
             return Err(RunError::Setup(format!("{}: the restart was written in {:?} units, the deck uses {:?}", path.display(), data.units, self.model.units)));
         }
         self.sim_box = data.sim_box;
-        self.state = data.into_state();
+        self.state = data.to_state();
         self.backend = None;
         self.forces_current = false;
         Ok(())

@@ -1,0 +1,373 @@
+//! Trajectory output (MCAP, extended XYZ, LAMMPS dump) and restart files.
+//!
+//! A run hands each writer borrowed views of what it has: a [`TopologyView`]
+//! once, when the writer is opened, and a [`FrameView`] per frame. Writers
+//! copy the few topology arrays they need, so the run keeps ownership of
+//! everything.
+//!
+//! | format | keyword | module | contents |
+//! |---|---|---|---|
+//! | MCAP (Foxglove) | `mcap` | [`mcap_writer`] | topology, frames, bond state, a 3D scene |
+//! | extended XYZ (OVITO, ASE) | `xyz` | [`xyz`] | species, position, id; box and pbc per frame |
+//! | LAMMPS text dump | `lammps` | [`lammps_dump`] | id, type, position, image flags, sorted by id |
+//! | restart (JSON) | — | [`restart`] | step, time, box, ids, positions, images, bond state |
+//!
+//! Conventions shared by all writers:
+//!
+//! * Particles are stored by internal index `0..N`; outputs name them by their
+//!   user id `ids[i]`. Bonds, angles and triangles in a [`TopologyView`] hold
+//!   internal indices and are written as user ids.
+//! * `types[i]` indexes `type_names` (and `type_radius`); LAMMPS dumps write
+//!   the 1-based number `types[i] + 1`.
+//! * Positions are the stored ones (wrapped into the box on periodic axes);
+//!   the image counters give the unwrapped position `x + image·L`.
+//! * `images` may be empty (e.g. a minimiser that does not track images): it
+//!   then reads as all zeros.
+//! * Text formats print f64 in Rust's shortest round-trip form (`{}`, or
+//!   `{:e}` outside `1e-5 ≤ |x| < 1e16`), so a value read back is bit-identical
+//!   to the one written.
+
+use std::fmt;
+use std::io;
+use std::path::Path;
+
+use glam::DVec3;
+
+use crate::system::SimBox;
+use crate::units::UnitSystem;
+
+pub mod lammps_dump;
+pub mod mcap_writer;
+pub mod restart;
+pub mod xyz;
+
+pub use self::lammps_dump::LammpsDumpWriter;
+pub use self::mcap_writer::McapWriter;
+pub use self::restart::{read_state, write_state, RestartData};
+pub use self::xyz::XyzWriter;
+
+/// The static description of the particles, borrowed from the run.
+#[derive(Clone, Copy, Debug)]
+pub struct TopologyView<'a> {
+    pub units: UnitSystem,
+    /// User id of each particle, by internal index.
+    pub ids: &'a [u64],
+    /// Type index (into `type_names`) of each particle.
+    pub types: &'a [u32],
+    pub type_names: &'a [String],
+    /// Radius per type (length units; 0 = not set). May be shorter than `type_names`.
+    pub type_radius: &'a [f64],
+    /// Bonded pairs, internal indices.
+    pub bonds: &'a [[u32; 2]],
+    /// Angle triples, internal indices.
+    pub angles: &'a [[u32; 3]],
+    /// Surface triangles, internal indices.
+    pub triangles: &'a [[u32; 3]],
+}
+
+/// One frame of the trajectory, borrowed from the run.
+#[derive(Clone, Copy, Debug)]
+pub struct FrameView<'a> {
+    pub step: u64,
+    pub time: f64,
+    pub sim_box: &'a SimBox,
+    /// Positions by internal index (wrapped on periodic axes).
+    pub positions: &'a [DVec3],
+    /// Image counters by internal index, or empty for all zeros.
+    pub images: &'a [[i32; 3]],
+}
+
+impl FrameView<'_> {
+    /// The image counter of particle `i` (zeros when `images` is empty).
+    #[inline]
+    pub fn image(&self, i: usize) -> [i32; 3] {
+        self.images.get(i).copied().unwrap_or([0; 3])
+    }
+}
+
+/// A trajectory sink: frames in, a complete file after [`finish`](Self::finish).
+pub trait TrajectoryWriter: Send {
+    /// Appends one frame.
+    fn write_frame(&mut self, frame: &FrameView) -> io::Result<()>;
+    /// Flushes and completes the file (MCAP writes its summary and footer here).
+    fn finish(self: Box<Self>) -> io::Result<()>;
+}
+
+/// The trajectory formats a deck can ask for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DumpFormat {
+    Mcap,
+    Xyz,
+    Lammps,
+}
+
+impl DumpFormat {
+    /// Parses the deck keyword `mcap`, `xyz` or `lammps`.
+    pub fn from_keyword(word: &str) -> Option<Self> {
+        match word {
+            "mcap" => Some(Self::Mcap),
+            "xyz" => Some(Self::Xyz),
+            "lammps" => Some(Self::Lammps),
+            _ => None,
+        }
+    }
+
+    /// The deck keyword.
+    pub fn keyword(self) -> &'static str {
+        match self {
+            Self::Mcap => "mcap",
+            Self::Xyz => "xyz",
+            Self::Lammps => "lammps",
+        }
+    }
+
+    /// The customary file extension.
+    pub fn extension(self) -> &'static str {
+        match self {
+            Self::Mcap => "mcap",
+            Self::Xyz => "xyz",
+            Self::Lammps => "lammpstrj",
+        }
+    }
+}
+
+/// Opens a writer of `format` at `path` (created or truncated).
+pub fn open_writer(
+    format: DumpFormat,
+    path: &Path,
+    topology: &TopologyView,
+) -> io::Result<Box<dyn TrajectoryWriter>> {
+    Ok(match format {
+        DumpFormat::Mcap => Box::new(McapWriter::create(path, topology)?),
+        DumpFormat::Xyz => Box::new(XyzWriter::create(path, topology)?),
+        DumpFormat::Lammps => Box::new(LammpsDumpWriter::create(path, topology)?),
+    })
+}
+
+/// The deck keyword of a unit system (`cell`, `lj`).
+pub(crate) fn units_keyword(units: UnitSystem) -> &'static str {
+    match units {
+        UnitSystem::Cell => "cell",
+        UnitSystem::Lj => "lj",
+    }
+}
+
+pub(crate) fn invalid_input(message: String) -> io::Error {
+    io::Error::new(io::ErrorKind::InvalidInput, message)
+}
+
+/// Checks that the arrays of a topology agree with each other.
+pub(crate) fn check_topology(t: &TopologyView) -> io::Result<()> {
+    let n = t.ids.len();
+    if t.types.len() != n {
+        return Err(invalid_input(format!(
+            "topology has {n} ids but {} types",
+            t.types.len()
+        )));
+    }
+    if let Some((i, &ty)) = t.types.iter().enumerate().find(|(_, &ty)| ty as usize >= t.type_names.len()) {
+        return Err(invalid_input(format!(
+            "particle {} has type index {ty} but only {} type names are given",
+            t.ids[i],
+            t.type_names.len()
+        )));
+    }
+    let out_of_range = |what: &str, k: usize, idx: &[u32]| -> io::Result<()> {
+        match idx.iter().find(|&&p| p as usize >= n) {
+            Some(p) => Err(invalid_input(format!(
+                "{what} {k} names particle index {p}, but there are {n} particles"
+            ))),
+            None => Ok(()),
+        }
+    };
+    for (k, b) in t.bonds.iter().enumerate() {
+        out_of_range("bond", k, b)?;
+    }
+    for (k, a) in t.angles.iter().enumerate() {
+        out_of_range("angle", k, a)?;
+    }
+    for (k, tri) in t.triangles.iter().enumerate() {
+        out_of_range("triangle", k, tri)?;
+    }
+    Ok(())
+}
+
+/// Checks that a frame has one position (and image, unless empty) per particle.
+pub(crate) fn check_frame(n: usize, frame: &FrameView) -> io::Result<()> {
+    if frame.positions.len() != n {
+        return Err(invalid_input(format!(
+            "frame at step {} has {} positions for {n} particles",
+            frame.step,
+            frame.positions.len()
+        )));
+    }
+    if !frame.images.is_empty() && frame.images.len() != n {
+        return Err(invalid_input(format!(
+            "frame at step {} has {} image counters for {n} particles",
+            frame.step,
+            frame.images.len()
+        )));
+    }
+    Ok(())
+}
+
+/// An f64 printed in shortest round-trip form: plain decimal for moderate
+/// magnitudes, scientific (`1e-300`) otherwise.
+#[derive(Clone, Copy)]
+pub(crate) struct Real(pub f64);
+
+impl fmt::Display for Real {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let x = self.0;
+        let a = x.abs();
+        if x == 0.0 || !x.is_finite() || (1e-5..1e16).contains(&a) {
+            write!(f, "{x}")
+        } else {
+            write!(f, "{x:e}")
+        }
+    }
+}
+
+/// A type name usable as one whitespace-free token (whitespace becomes `_`).
+pub(crate) fn token(name: &str) -> String {
+    if name.is_empty() {
+        return "_".to_string();
+    }
+    name.chars().map(|c| if c.is_whitespace() { '_' } else { c }).collect()
+}
+
+#[cfg(test)]
+pub(crate) mod test_support {
+    //! A small system shared by the writer tests.
+    use super::*;
+
+    pub struct Sample {
+        pub ids: Vec<u64>,
+        pub types: Vec<u32>,
+        pub type_names: Vec<String>,
+        pub type_radius: Vec<f64>,
+        pub bonds: Vec<[u32; 2]>,
+        pub angles: Vec<[u32; 3]>,
+        pub triangles: Vec<[u32; 3]>,
+        pub sim_box: SimBox,
+        /// Positions per frame.
+        pub frames: Vec<Vec<DVec3>>,
+        pub images: Vec<[i32; 3]>,
+    }
+
+    impl Sample {
+        pub fn new(n_frames: usize) -> Self {
+            let base = [
+                DVec3::new(0.1 + 0.2, 1e-300, -0.0),
+                DVec3::new(9.95, 5.0, 2.5),
+                DVec3::new(0.05, 5.0, 2.5),
+                DVec3::new(3.0, 7.25, -1.5),
+            ];
+            let frames = (0..n_frames)
+                .map(|f| {
+                    // Frame 0 keeps the awkward values (adding 0.0 would turn −0.0 into +0.0).
+                    let shift = DVec3::new(0.0, 0.0, 0.001 * f as f64 / 3.0);
+                    base.iter().map(|p| if f == 0 { *p } else { *p + shift }).collect()
+                })
+                .collect();
+            Self {
+                ids: vec![40, 7, 12, 3],
+                types: vec![0, 1, 1, 0],
+                type_names: vec!["cortex".into(), "adhesion site".into()],
+                type_radius: vec![0.25, 0.0],
+                bonds: vec![[1, 2], [0, 3]],
+                angles: vec![[0, 1, 2]],
+                triangles: vec![[0, 1, 3]],
+                sim_box: SimBox::new(DVec3::new(0.0, 0.0, -5.0), DVec3::new(10.0, 10.0, 5.0), [true, true, false]),
+                frames,
+                images: vec![[0, 0, 0], [-1, 2, 0], [1, 0, 0], [0, 0, 0]],
+            }
+        }
+
+        pub fn topology(&self) -> TopologyView<'_> {
+            TopologyView {
+                units: UnitSystem::Cell,
+                ids: &self.ids,
+                types: &self.types,
+                type_names: &self.type_names,
+                type_radius: &self.type_radius,
+                bonds: &self.bonds,
+                angles: &self.angles,
+                triangles: &self.triangles,
+            }
+        }
+
+        pub fn frame(&self, f: usize) -> FrameView<'_> {
+            FrameView {
+                step: 100 * f as u64,
+                time: 0.1 * f as f64,
+                sim_box: &self.sim_box,
+                positions: &self.frames[f],
+                images: &self.images,
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::test_support::Sample;
+    use super::*;
+
+    #[test]
+    fn keywords_round_trip() {
+        for f in [DumpFormat::Mcap, DumpFormat::Xyz, DumpFormat::Lammps] {
+            assert_eq!(DumpFormat::from_keyword(f.keyword()), Some(f));
+        }
+        assert_eq!(DumpFormat::from_keyword("dcd"), None);
+    }
+
+    #[test]
+    fn reals_print_in_round_trip_form() {
+        for x in [0.1 + 0.2, 1e-300, -0.0, 1e16, 123.456, -7e-6, 5e-324, f64::MAX, 1.0 / 3.0] {
+            let s = Real(x).to_string();
+            assert_eq!(s.parse::<f64>().unwrap().to_bits(), x.to_bits(), "{s}");
+        }
+        assert_eq!(Real(0.5).to_string(), "0.5");
+        assert_eq!(Real(1e-300).to_string(), "1e-300");
+        assert_eq!(token("adhesion site"), "adhesion_site");
+    }
+
+    #[test]
+    fn inconsistent_topologies_and_frames_are_rejected() {
+        let s = Sample::new(1);
+        let mut t = s.topology();
+        let short = [0u32; 3];
+        t.types = &short;
+        assert!(check_topology(&t).unwrap_err().to_string().contains("4 ids but 3 types"));
+        let bad_type = [0u32, 0, 5, 0];
+        let mut t = s.topology();
+        t.types = &bad_type;
+        assert!(check_topology(&t).unwrap_err().to_string().contains("type index 5"));
+        let bad_bond = [[0u32, 4]];
+        let mut t = s.topology();
+        t.bonds = &bad_bond;
+        assert!(check_topology(&t).unwrap_err().to_string().contains("bond 0 names particle index 4"));
+        let mut f = s.frame(0);
+        f.positions = &s.frames[0][..2];
+        assert!(check_frame(4, &f).is_err());
+        let mut f = s.frame(0);
+        f.images = &[];
+        assert!(check_frame(4, &f).is_ok());
+        assert_eq!(f.image(2), [0; 3]);
+    }
+
+    #[test]
+    fn open_writer_makes_every_format() {
+        let s = Sample::new(2);
+        let dir = tempfile::tempdir().unwrap();
+        for format in [DumpFormat::Mcap, DumpFormat::Xyz, DumpFormat::Lammps] {
+            let path = dir.path().join(format!("traj.{}", format.extension()));
+            let mut w = open_writer(format, &path, &s.topology()).unwrap();
+            w.write_frame(&s.frame(0)).unwrap();
+            w.write_frame(&s.frame(1)).unwrap();
+            w.finish().unwrap();
+            assert!(std::fs::metadata(&path).unwrap().len() > 0);
+        }
+    }
+}

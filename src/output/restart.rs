@@ -1,0 +1,387 @@
+//! Restart files: the dynamic state of a run as a JSON document.
+//!
+//! # Format (version 1)
+//!
+//! ```json
+//! {
+//!   "format": "cellmd-restart",
+//!   "version": 1,
+//!   "units": "cell",
+//!   "step": 2000,
+//!   "time": 0.2,
+//!   "box": {"lo": [0.0, 0.0, -5.0], "hi": [10.0, 10.0, 5.0], "periodic": [true, true, false]},
+//!   "ids": [40, 7, 12, 3],
+//!   "positions": [[0.30000000000000004, 1e-300, -0.0], ...],
+//!   "images": [[0, 0, 0], [-1, 2, 0], ...],
+//!   "bond_params": [[0.8], ...]
+//! }
+//! ```
+//!
+//! * `ids` are the user ids by internal index: on restart they are checked
+//!   against the topology ([`RestartData::check_ids`]) so a restart is never
+//!   applied to a different system or ordering.
+//! * `positions` are stored (wrapped) positions, `images` their counters.
+//! * `bond_params` is reserved for per-bond stateful parameters (e.g. a rest
+//!   length or a bound flag under kinetics), one list per bond; it may be empty.
+//! * Unknown keys are ignored, so later versions may add fields.
+//!
+//! Every f64 round-trips bit-exactly: serde_json prints the shortest string
+//! that parses back to the same value, and this crate enables serde_json's
+//! `float_roundtrip` feature so the parser is correctly rounded (the default
+//! parser may be off by one ulp). `-0.0`, subnormals and `1e-300` survive;
+//! non-finite values cannot be represented in JSON and are rejected on write.
+//!
+//! # Atomic writes
+//!
+//! [`write_state`] writes `<path>.tmp`, flushes it to disk and renames it over
+//! `<path>`, so an interrupted write leaves either the old file or the new
+//! one, never a truncated mix.
+
+use std::fs::{self, File};
+use std::io::{self, BufReader, BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+
+use crate::system::{SimBox, State};
+use crate::units::UnitSystem;
+
+/// The `format` tag of a restart file.
+pub const RESTART_FORMAT: &str = "cellmd-restart";
+/// The restart format version this build writes and reads.
+pub const RESTART_VERSION: u64 = 1;
+
+/// Everything needed to continue a run, besides the deck and topology.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RestartData {
+    #[serde(with = "units_keyword")]
+    pub units: UnitSystem,
+    pub step: u64,
+    pub time: f64,
+    #[serde(rename = "box")]
+    pub sim_box: SimBox,
+    /// User id of each particle, by internal index.
+    pub ids: Vec<u64>,
+    pub positions: Vec<DVec3>,
+    pub images: Vec<[i32; 3]>,
+    /// Per-bond stateful parameters (reserved; may be empty).
+    #[serde(default)]
+    pub bond_params: Vec<Vec<f64>>,
+}
+
+impl RestartData {
+    /// Captures a [`State`] with its box and particle ids.
+    pub fn from_state(units: UnitSystem, state: &State, sim_box: &SimBox, ids: &[u64]) -> Self {
+        Self {
+            units,
+            step: state.step,
+            time: state.time,
+            sim_box: *sim_box,
+            ids: ids.to_vec(),
+            positions: state.positions.clone(),
+            images: state.images.clone(),
+            bond_params: Vec::new(),
+        }
+    }
+
+    /// The [`State`] to continue from.
+    pub fn to_state(&self) -> State {
+        State {
+            step: self.step,
+            time: self.time,
+            positions: self.positions.clone(),
+            images: self.images.clone(),
+        }
+    }
+
+    /// Checks that the restart belongs to a topology with these ids, in this order.
+    pub fn check_ids(&self, ids: &[u64]) -> Result<(), String> {
+        if self.ids.len() != ids.len() {
+            return Err(format!(
+                "the restart file has {} particles but the topology has {}",
+                self.ids.len(),
+                ids.len()
+            ));
+        }
+        if let Some(i) = (0..ids.len()).find(|&i| self.ids[i] != ids[i]) {
+            return Err(format!(
+                "particle {i} has id {} in the restart file but id {} in the topology \
+                 (the restart belongs to a different system or particle order)",
+                self.ids[i], ids[i]
+            ));
+        }
+        Ok(())
+    }
+
+    fn check_consistent(&self) -> Result<(), String> {
+        let n = self.ids.len();
+        if self.positions.len() != n || self.images.len() != n {
+            return Err(format!(
+                "{} ids, {} positions and {} image counters; they must all have the same length",
+                n,
+                self.positions.len(),
+                self.images.len()
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Writes `data` to `path` atomically (via `<path>.tmp` and a rename).
+pub fn write_state(path: &Path, data: &RestartData) -> Result<(), String> {
+    data.check_consistent().map_err(|e| format!("cannot write restart file '{}': {e}", path.display()))?;
+    let finite = data.time.is_finite()
+        && data.positions.iter().all(|x| x.is_finite())
+        && data.sim_box.lo.is_finite()
+        && data.sim_box.hi.is_finite()
+        && data.bond_params.iter().flatten().all(|v| v.is_finite());
+    if !finite {
+        return Err(format!(
+            "cannot write restart file '{}': the state contains a non-finite number",
+            path.display()
+        ));
+    }
+    #[derive(Serialize)]
+    struct Document<'a> {
+        format: &'static str,
+        version: u64,
+        #[serde(flatten)]
+        data: &'a RestartData,
+    }
+    let tmp = tmp_path(path);
+    let result = (|| -> io::Result<()> {
+        let file = File::create(&tmp)?;
+        let mut out = BufWriter::new(file);
+        serde_json::to_writer(&mut out, &Document { format: RESTART_FORMAT, version: RESTART_VERSION, data })
+            .map_err(io::Error::other)?;
+        out.write_all(b"\n")?;
+        let file = out.into_inner().map_err(|e| e.into_error())?;
+        file.sync_all()?;
+        drop(file);
+        fs::rename(&tmp, path)?;
+        // Persist the rename itself where the platform allows opening a directory.
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            if let Ok(dir) = File::open(dir) {
+                let _ = dir.sync_all();
+            }
+        }
+        Ok(())
+    })();
+    result.map_err(|e| {
+        let _ = fs::remove_file(&tmp);
+        format!("cannot write restart file '{}': {e}", path.display())
+    })
+}
+
+/// Reads a restart file, checking its format tag, version and array lengths.
+pub fn read_state(path: &Path) -> Result<RestartData, String> {
+    let shown = path.display();
+    let file = File::open(path).map_err(|e| match e.kind() {
+        io::ErrorKind::NotFound => format!("restart file '{shown}' not found"),
+        _ => format!("cannot open restart file '{shown}': {e}"),
+    })?;
+    let value: serde_json::Value = serde_json::from_reader(BufReader::new(file))
+        .map_err(|e| format!("restart file '{shown}' is not valid JSON: {e}"))?;
+    match value.get("format").and_then(|f| f.as_str()) {
+        Some(RESTART_FORMAT) => {}
+        Some(other) => {
+            return Err(format!(
+                "'{shown}' is not a cellmd restart file (format is \"{other}\", expected \"{RESTART_FORMAT}\")"
+            ))
+        }
+        None => {
+            return Err(format!(
+                "'{shown}' is not a cellmd restart file (no \"format\": \"{RESTART_FORMAT}\" entry)"
+            ))
+        }
+    }
+    match value.get("version").and_then(|v| v.as_u64()) {
+        Some(RESTART_VERSION) => {}
+        Some(v) => {
+            return Err(format!(
+                "restart file '{shown}' has format version {v}; this cellmd reads version {RESTART_VERSION}"
+            ))
+        }
+        None => return Err(format!("restart file '{shown}' has no valid \"version\" entry")),
+    }
+    let data: RestartData =
+        serde_json::from_value(value).map_err(|e| format!("restart file '{shown}' is malformed: {e}"))?;
+    data.check_consistent().map_err(|e| format!("restart file '{shown}' is inconsistent: {e}"))?;
+    Ok(data)
+}
+
+fn tmp_path(path: &Path) -> PathBuf {
+    let mut name = path.as_os_str().to_owned();
+    name.push(".tmp");
+    PathBuf::from(name)
+}
+
+/// Serializes a [`UnitSystem`] as its deck keyword (`cell`, `lj`).
+mod units_keyword {
+    use serde::{de::Error, Deserialize, Deserializer, Serializer};
+
+    use crate::units::UnitSystem;
+
+    pub fn serialize<S: Serializer>(units: &UnitSystem, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(super::super::units_keyword(*units))
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<UnitSystem, D::Error> {
+        let word = String::deserialize(d)?;
+        UnitSystem::from_keyword(&word)
+            .ok_or_else(|| D::Error::custom(format!("unknown unit system \"{word}\" (expected cell or lj)")))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample() -> RestartData {
+        RestartData {
+            units: UnitSystem::Cell,
+            step: 123_456_789_012,
+            time: 0.1 + 0.2,
+            sim_box: SimBox::new(DVec3::new(-0.0, 0.0, -5.0), DVec3::new(10.0, 1.0 / 3.0, 5.0), [true, false, true]),
+            ids: vec![40, 7, u64::MAX],
+            positions: vec![
+                DVec3::new(0.1 + 0.2, 1e-300, -0.0),
+                DVec3::new(5e-324, f64::MAX, -f64::MIN_POSITIVE),
+                DVec3::new(std::f64::consts::PI, 1e22, 9007199254740993.0),
+            ],
+            images: vec![[0, 0, 0], [-1, 2, 0], [i32::MIN, i32::MAX, 3]],
+            bond_params: vec![vec![0.8, 1e-17], vec![]],
+        }
+    }
+
+    fn bits(d: &RestartData) -> Vec<u64> {
+        let mut v = vec![d.time.to_bits()];
+        v.extend(d.sim_box.lo.to_array().map(f64::to_bits));
+        v.extend(d.sim_box.hi.to_array().map(f64::to_bits));
+        for x in &d.positions {
+            v.extend(x.to_array().map(f64::to_bits));
+        }
+        v.extend(d.bond_params.iter().flatten().map(|x| x.to_bits()));
+        v
+    }
+
+    #[test]
+    fn round_trips_bit_exactly() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("state.json");
+        let data = sample();
+        write_state(&path, &data).unwrap();
+        assert!(!tmp_path(&path).exists());
+        let back = read_state(&path).unwrap();
+        assert_eq!(back, data);
+        assert_eq!(bits(&back), bits(&data), "-0.0 and every other value keep their bits");
+        let text = fs::read_to_string(&path).unwrap();
+        assert!(text.starts_with(r#"{"format":"cellmd-restart","version":1,"units":"cell","#), "{text}");
+    }
+
+    #[test]
+    fn random_bit_patterns_round_trip() {
+        // splitmix64 over raw bit patterns: every finite f64 class, all exponents.
+        let mut s = 0x1234_5678u64;
+        let mut positions = Vec::new();
+        while positions.len() < 20_000 {
+            let mut v = [0.0; 3];
+            for x in &mut v {
+                loop {
+                    s = s.wrapping_add(0x9E37_79B9_7F4A_7C15);
+                    let mut z = s;
+                    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+                    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+                    let candidate = f64::from_bits(z ^ (z >> 31));
+                    if candidate.is_finite() {
+                        *x = candidate;
+                        break;
+                    }
+                }
+            }
+            positions.push(DVec3::from_array(v));
+        }
+        let data = RestartData {
+            ids: (0..positions.len() as u64).collect(),
+            images: vec![[0; 3]; positions.len()],
+            positions,
+            ..sample()
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("state.json");
+        write_state(&path, &data).unwrap();
+        assert_eq!(bits(&read_state(&path).unwrap()), bits(&data));
+    }
+
+    #[test]
+    fn state_conversion_and_id_check() {
+        let mut state = State::new(vec![DVec3::ONE, DVec3::ZERO]);
+        state.step = 7;
+        state.time = 0.7;
+        state.images[1] = [1, 0, -1];
+        let b = SimBox::new(DVec3::ZERO, DVec3::splat(4.0), [true; 3]);
+        let data = RestartData::from_state(UnitSystem::Lj, &state, &b, &[5, 6]);
+        assert_eq!(data.to_state(), state);
+        assert!(data.check_ids(&[5, 6]).is_ok());
+        assert!(data.check_ids(&[5]).unwrap_err().contains("2 particles but the topology has 1"));
+        let err = data.check_ids(&[5, 9]).unwrap_err();
+        assert!(err.contains("particle 1 has id 6 in the restart file but id 9"), "{err}");
+    }
+
+    #[test]
+    fn clear_errors() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("missing.json");
+        let err = read_state(&path).unwrap_err();
+        assert!(err.contains("not found") && err.contains("missing.json"), "{err}");
+
+        let write = |name: &str, text: &str| {
+            let p = dir.path().join(name);
+            fs::write(&p, text).unwrap();
+            p
+        };
+        let err = read_state(&write("garbage.json", "{ not json")).unwrap_err();
+        assert!(err.contains("not valid JSON"), "{err}");
+        let err = read_state(&write("other.json", r#"{"format": "xyz", "version": 1}"#)).unwrap_err();
+        assert!(err.contains("not a cellmd restart file") && err.contains("\"xyz\""), "{err}");
+        let err = read_state(&write("untagged.json", r#"{"version": 1}"#)).unwrap_err();
+        assert!(err.contains("not a cellmd restart file"), "{err}");
+        let err = read_state(&write("v2.json", r#"{"format": "cellmd-restart", "version": 2}"#)).unwrap_err();
+        assert!(err.contains("version 2") && err.contains("reads version 1"), "{err}");
+        let err = read_state(&write("partial.json", r#"{"format": "cellmd-restart", "version": 1, "step": 3}"#))
+            .unwrap_err();
+        assert!(err.contains("malformed") && err.contains("missing field"), "{err}");
+
+        // Inconsistent lengths are refused on write and on read.
+        let mut bad = sample();
+        bad.images.pop();
+        let p = dir.path().join("bad.json");
+        assert!(write_state(&p, &bad).unwrap_err().contains("same length"));
+        let mut text = serde_json::to_value(sample()).unwrap();
+        text["format"] = RESTART_FORMAT.into();
+        text["version"] = 1.into();
+        text["images"].as_array_mut().unwrap().pop();
+        let err = read_state(&write("short.json", &text.to_string())).unwrap_err();
+        assert!(err.contains("inconsistent"), "{err}");
+
+        let mut nan = sample();
+        nan.positions[0].x = f64::NAN;
+        assert!(write_state(&p, &nan).unwrap_err().contains("non-finite"));
+        assert!(!p.exists());
+    }
+
+    #[test]
+    fn overwrite_replaces_the_old_file_atomically() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("state.json");
+        let mut data = sample();
+        write_state(&path, &data).unwrap();
+        data.step += 1;
+        // A stale temporary from an interrupted earlier write is simply replaced.
+        fs::write(tmp_path(&path), "partial garbage").unwrap();
+        write_state(&path, &data).unwrap();
+        assert_eq!(read_state(&path).unwrap().step, data.step);
+        assert!(!tmp_path(&path).exists());
+    }
+}

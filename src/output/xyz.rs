@@ -1,0 +1,143 @@
+//! Extended XYZ trajectories (OVITO, ASE, VMD with the extxyz plugin).
+//!
+//! # Format
+//!
+//! Each frame is `N + 2` lines:
+//!
+//! ```text
+//! 4
+//! Lattice="10 0 0 0 10 0 0 0 10" Origin="0 0 -5" Properties=species:S:1:pos:R:3:id:I:1 Time=0.1 Step=100 pbc="T T F" Units=cell
+//! cortex 0.30000000000000004 1e-300 -0 40
+//! adhesion_site 9.95 5 2.5 7
+//! ...
+//! ```
+//!
+//! * `Lattice` holds the three cell vectors (orthorhombic here) row by row,
+//!   `Origin` the lower corner `lo`, `pbc` the periodic flags (`T`/`F`).
+//! * `Time` (time units of `Units`) and `Step` are extra per-frame keys.
+//! * One line per particle in internal order: type name (whitespace replaced
+//!   by `_`), stored (wrapped) position, user id. Reals are printed in
+//!   shortest round-trip form, so they read back bit-exactly.
+//!
+//! Image counters are not written (extended XYZ has no standard column for
+//! them); use the LAMMPS dump or MCAP output when unwrapped paths matter.
+
+use std::fs::File;
+use std::io::{self, BufWriter, Write};
+use std::path::Path;
+
+use super::{check_frame, check_topology, token, units_keyword, FrameView, Real, TopologyView, TrajectoryWriter};
+
+/// Writes extended XYZ frames to a file.
+pub struct XyzWriter {
+    out: BufWriter<File>,
+    ids: Vec<u64>,
+    /// Species token of each particle.
+    species: Vec<String>,
+    units: &'static str,
+}
+
+impl XyzWriter {
+    /// Creates (or truncates) `path`.
+    pub fn create(path: &Path, topology: &TopologyView) -> io::Result<Self> {
+        check_topology(topology)?;
+        let names: Vec<String> = topology.type_names.iter().map(|n| token(n)).collect();
+        let species = topology.types.iter().map(|&t| names[t as usize].clone()).collect();
+        Ok(Self {
+            out: BufWriter::new(File::create(path)?),
+            ids: topology.ids.to_vec(),
+            species,
+            units: units_keyword(topology.units),
+        })
+    }
+}
+
+impl TrajectoryWriter for XyzWriter {
+    fn write_frame(&mut self, frame: &FrameView) -> io::Result<()> {
+        check_frame(self.ids.len(), frame)?;
+        let b = frame.sim_box;
+        let l = b.lengths();
+        let tf = |p: bool| if p { 'T' } else { 'F' };
+        let out = &mut self.out;
+        writeln!(out, "{}", self.ids.len())?;
+        writeln!(
+            out,
+            "Lattice=\"{} 0 0 0 {} 0 0 0 {}\" Origin=\"{} {} {}\" \
+             Properties=species:S:1:pos:R:3:id:I:1 Time={} Step={} pbc=\"{} {} {}\" Units={}",
+            Real(l.x),
+            Real(l.y),
+            Real(l.z),
+            Real(b.lo.x),
+            Real(b.lo.y),
+            Real(b.lo.z),
+            Real(frame.time),
+            frame.step,
+            tf(b.periodic[0]),
+            tf(b.periodic[1]),
+            tf(b.periodic[2]),
+            self.units
+        )?;
+        for (i, x) in frame.positions.iter().enumerate() {
+            writeln!(out, "{} {} {} {} {}", self.species[i], Real(x.x), Real(x.y), Real(x.z), self.ids[i])?;
+        }
+        Ok(())
+    }
+
+    fn finish(mut self: Box<Self>) -> io::Result<()> {
+        self.out.flush()?;
+        self.out.get_ref().sync_data()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::test_support::Sample;
+    use super::*;
+
+    #[test]
+    fn two_frames_read_back() {
+        let s = Sample::new(2);
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.xyz");
+        let mut w: Box<dyn TrajectoryWriter> = Box::new(XyzWriter::create(&path, &s.topology()).unwrap());
+        w.write_frame(&s.frame(0)).unwrap();
+        w.write_frame(&s.frame(1)).unwrap();
+        w.finish().unwrap();
+
+        let text = std::fs::read_to_string(&path).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines.len(), 2 * (4 + 2));
+        for f in 0..2 {
+            let frame = &lines[f * 6..(f + 1) * 6];
+            assert_eq!(frame[0], "4");
+            assert!(frame[1].starts_with("Lattice=\"10 0 0 0 10 0 0 0 10\" Origin=\"0 0 -5\" "), "{}", frame[1]);
+            assert!(frame[1].contains("Properties=species:S:1:pos:R:3:id:I:1"));
+            assert!(frame[1].contains("pbc=\"T T F\""));
+            assert!(frame[1].contains(&format!("Step={} ", 100 * f)));
+            let time: f64 = frame[1].split("Time=").nth(1).unwrap().split(' ').next().unwrap().parse().unwrap();
+            assert_eq!(time, 0.1 * f as f64);
+            for (i, line) in frame[2..].iter().enumerate() {
+                let cols: Vec<&str> = line.split(' ').collect();
+                assert_eq!(cols.len(), 5, "{line}");
+                assert_eq!(cols[0], ["cortex", "adhesion_site"][s.types[i] as usize]);
+                let x: Vec<f64> = cols[1..4].iter().map(|c| c.parse().unwrap()).collect();
+                let want = s.frames[f][i];
+                for a in 0..3 {
+                    assert_eq!(x[a].to_bits(), want[a].to_bits(), "particle {i} axis {a}: {line}");
+                }
+                assert_eq!(cols[4].parse::<u64>().unwrap(), s.ids[i]);
+            }
+        }
+        assert_eq!(lines[2], "cortex 0.30000000000000004 1e-300 -0 40");
+    }
+
+    #[test]
+    fn wrong_particle_count_is_an_error() {
+        let s = Sample::new(1);
+        let dir = tempfile::tempdir().unwrap();
+        let mut w = XyzWriter::create(&dir.path().join("t.xyz"), &s.topology()).unwrap();
+        let mut f = s.frame(0);
+        f.positions = &s.frames[0][..3];
+        assert_eq!(w.write_frame(&f).unwrap_err().kind(), io::ErrorKind::InvalidInput);
+    }
+}
