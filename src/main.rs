@@ -61,6 +61,8 @@ fn report(error: impl miette::Diagnostic + Send + Sync + 'static) -> ExitCode {
 }
 
 fn main() -> ExitCode {
+    // One unwrapped `file:line:col: message` line, then the source snippet.
+    let _ = miette::set_hook(Box::new(|_| Box::new(miette::MietteHandlerOpts::new().wrap_lines(false).build())));
     let cli = Cli::parse();
     match cli.command {
         Command::List { name, lj } => {
