@@ -180,8 +180,8 @@ impl Validator {
                 let mut exclude = [false; 3];
                 for (k, t) in s[1..].iter().enumerate() {
                     exclude[k] = match parse_f64(t, "a weight")? {
-                        w if w == 0.0 => true,
-                        w if w == 1.0 => false,
+                        0.0 => true,
+                        1.0 => false,
                         w => return Err(t.error(format!("found weight {w}, expected 0 (exclude) or 1 (include); fractional weights are not supported"))),
                     };
                 }
@@ -314,7 +314,7 @@ impl Validator {
             }
             other => return Err(s[1].error(format!("found `{other}`, expected `bond`, `angle` or `pair`"))),
         };
-        if (s.len() - start) % 2 != 0 || s.len() == start {
+        if !(s.len() - start).is_multiple_of(2) || s.len() == start {
             return Err(s.last().unwrap().error("expected `PARAM VALUE` pairs"));
         }
         let mut edits = Vec::new();

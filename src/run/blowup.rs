@@ -13,7 +13,7 @@ pub enum RunError {
         particle_id: u64,
         what: String,
         /// The entry contributing the largest force on the particle, if any.
-        culprit: Option<ForceBreakdown>,
+        culprit: Option<Box<ForceBreakdown>>,
         /// Where the last good frame was written.
         last_good: Vec<String>,
     },
@@ -51,10 +51,11 @@ impl From<std::io::Error> for RunError {
 }
 
 /// The entry with the largest (or a non-finite) force among `parts`.
-pub fn culprit(parts: Vec<ForceBreakdown>) -> Option<ForceBreakdown> {
+pub fn culprit(parts: Vec<ForceBreakdown>) -> Option<Box<ForceBreakdown>> {
     let key = |p: &ForceBreakdown| if p.force.is_finite() { p.force.length() } else { f64::INFINITY };
     parts.into_iter().fold(None, |best: Option<ForceBreakdown>, p| match &best {
         Some(b) if key(b) >= key(&p) => best,
         _ => Some(p),
     })
+    .map(Box::new)
 }

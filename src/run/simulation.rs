@@ -263,11 +263,11 @@ impl Simulation {
     fn outputs_at_step(&mut self, bar: &Option<ProgressBar>, force_thermo: bool) -> Result<(), RunError> {
         let step = self.state.step;
         for i in 0..self.dumps.len() {
-            if step % self.dumps[i].spec.every == 0 && self.dumps[i].last_step != Some(step) {
+            if step.is_multiple_of(self.dumps[i].spec.every) && self.dumps[i].last_step != Some(step) {
                 self.write_dump(i)?;
             }
         }
-        let due = self.thermo.every > 0 && step % self.thermo.every == 0;
+        let due = self.thermo.every > 0 && step.is_multiple_of(self.thermo.every);
         if due || force_thermo {
             let inputs = ThermoInputs {
                 step,
@@ -308,13 +308,13 @@ impl Simulation {
                 let what = format!("displacement {displacement:e} in one step exceeds max_displacement {:e}", self.integrator.max_displacement);
                 return Err(self.blowup(particle, what));
             }
-            if self.state.step % self.neighbor.every == 0 {
+            if self.state.step.is_multiple_of(self.neighbor.every) {
                 let backend = self.backend.as_mut().expect("backend built");
                 backend.update_neighbors(&self.state, &self.sim_box, self.neighbor.check).map_err(RunError::Setup)?;
             }
             self.compute_forces()?;
             let final_step = self.state.step == last;
-            self.outputs_at_step(&bar, final_step && (self.thermo.every == 0 || self.state.step % self.thermo.every != 0))?;
+            self.outputs_at_step(&bar, final_step && (self.thermo.every == 0 || !self.state.step.is_multiple_of(self.thermo.every)))?;
             if let Some(b) = &bar {
                 b.inc(1);
             }

@@ -1,0 +1,72 @@
+//! A run that blows up stops with the step, the particle and the interaction
+//! responsible, writes the last good frame, and leaves complete output files.
+
+mod common;
+
+use cellmd::deck::validate_file;
+use cellmd::run::{RunError, RunOptions, Simulation};
+use common::Case;
+
+fn run_to_error(case: &Case) -> RunError {
+    let plan = validate_file(&case.path("deck.in"), &[]).unwrap();
+    match Simulation::execute(&plan, RunOptions { output_dir: case.output_dir().to_path_buf(), ..Default::default() }) {
+        Ok(_) => panic!("the run should blow up"),
+        Err(e) => e,
+    }
+}
+
+/// Frames (steps) in an MCAP file, read back through the summary-independent stream.
+fn mcap_frame_steps(path: &std::path::Path) -> Vec<u64> {
+    let bytes = std::fs::read(path).unwrap();
+    // A file without its footer (truncated) fails to read in mcap::read::Summary.
+    assert!(mcap::Summary::read(&bytes).unwrap().is_some(), "no summary: the MCAP was not finished");
+    mcap::MessageStream::new(&bytes)
+        .unwrap()
+        .map(|m| m.unwrap())
+        .filter(|m| m.channel.topic == "/cellmd/frame")
+        .map(|m| serde_json::from_slice::<serde_json::Value>(&m.data).unwrap()["step"].as_u64().unwrap())
+        .collect()
+}
+
+#[test]
+fn runaway_displacement_is_diagnosed() {
+    // Two LJ particles placed far inside the core: the first step launches them.
+    let top = "[ particles ]\n1 p 0 0 0\n2 p 0.55 0 0\n3 p 5 5 5\n";
+    let ff = "particle p drag 1\npair p p lj epsilon 1 sigma 1 rc 2.5\n";
+    let deck = "units lj\ntopology t.top\nforcefield f.ff\nbox x -10 10 f y -10 10 f z -10 10 f\ntimestep 0.01\n\
+                integrator overdamped max_displacement 0.5\ndump traj every 1 mcap traj.mcap\ndump x every 1 xyz traj.xyz\nrun 100\n";
+    let case = Case::new(&[("t.top", top), ("f.ff", ff), ("deck.in", deck)]);
+    let error = run_to_error(&case);
+    let RunError::Blowup { step, particle_id, culprit, last_good, .. } = &error else { panic!("{error}") };
+    assert_eq!(*step, 0, "{error}");
+    assert_eq!(*particle_id, 1);
+    let culprit = culprit.as_ref().unwrap();
+    assert_eq!((culprit.kind, culprit.interaction), ("pair", "lj"));
+    let message = error.to_string();
+    assert!(message.contains("step 0") && message.contains("particle 1") && message.contains("(lj)"), "{message}");
+    assert!(last_good.iter().any(|p| p.ends_with("deck.lastgood.restart")), "{message}");
+    // The last good frame is the unchanged initial configuration.
+    let restart = cellmd::output::restart::read_state(&case.path("deck.lastgood.restart")).unwrap();
+    assert_eq!(restart.to_state().positions[1].x, 0.55);
+    assert_eq!(mcap_frame_steps(&case.path("traj.mcap")), vec![0]);
+    assert_eq!(std::fs::read_to_string(case.path("traj.xyz")).unwrap().lines().count(), 5);
+}
+
+#[test]
+fn non_finite_force_names_the_bond() {
+    // A FENE bond pulled past its maximum extent R0 by a constant force in one
+    // step (the displacement bound is raised so the bond, not the bound, trips).
+    let top = "[ particles ]\n1 p 0 0 0\n2 p 1 0 0\n[ bonds ]\nchain 1 2\n";
+    let ff = "particle p drag 1\nbond chain fene K 30 R0 1.5 epsilon 1 sigma 1\n";
+    let deck = "units lj\ntopology t.top\nforcefield f.ff\nbox x -10 10 f y -10 10 f z -10 10 f\ntimestep 0.01\n\
+                integrator overdamped max_displacement 100\ngroup end id 2\nexternal pull end constant_force fx 500\n\
+                dump traj every 5 mcap traj.mcap\nrun 1000\n";
+    let case = Case::new(&[("t.top", top), ("f.ff", ff), ("deck.in", deck)]);
+    let error = run_to_error(&case);
+    let RunError::Blowup { step, culprit, what, .. } = &error else { panic!("{error}") };
+    assert_eq!(*step, 1, "{error}");
+    assert!(what.contains("non-finite force"), "{error}");
+    assert_eq!(culprit.as_ref().unwrap().interaction, "fene", "{error}");
+    // Dumped at step 0, then the frame at which the force became non-finite.
+    assert_eq!(mcap_frame_steps(&case.path("traj.mcap")), vec![0, 1]);
+}
