@@ -129,7 +129,13 @@ fn fire_converges_a_stretched_network() {
     for i in 0..n {
         for j in 0..n {
             for k in 0..n {
-                top += &format!("{} p {} {} {}\n", index(i, j, k), 1.3 * i as f64 + jitter(), 1.3 * j as f64 + jitter(), 1.3 * k as f64 + jitter());
+                top += &format!(
+                    "{} p {} {} {}\n",
+                    index(i, j, k),
+                    1.3 * i as f64 + jitter(),
+                    1.3 * j as f64 + jitter(),
+                    1.3 * k as f64 + jitter()
+                );
             }
         }
     }
@@ -160,6 +166,8 @@ fn fire_converges_a_stretched_network() {
     let (fmax, _) = sim.forces.max_force();
     assert!(fmax < 1e-8, "max |F| = {fmax}");
     // A stretched network that is free relaxes to (nearly) unstretched bonds.
-    let mean_bond: f64 = sim.model.bonds.iter().map(|&[i, j]| (sim.state.positions[j as usize] - sim.state.positions[i as usize]).length()).sum::<f64>() / sim.model.bonds.len() as f64;
+    let mean_bond: f64 =
+        sim.model.bonds.iter().map(|&[i, j]| (sim.state.positions[j as usize] - sim.state.positions[i as usize]).length()).sum::<f64>()
+            / sim.model.bonds.len() as f64;
     assert!((mean_bond - 1.0).abs() < 0.05, "mean bond length {mean_bond}");
 }

@@ -20,7 +20,8 @@ fn every_input_deck_runs_shortened() {
         }
         let out = tempfile::tempdir().unwrap();
         let plan = validate_file(&path, &shortened()).unwrap_or_else(|e| panic!("{e}"));
-        Simulation::execute(&plan, RunOptions { output_dir: out.path().to_path_buf(), ..Default::default() }).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        Simulation::execute(&plan, RunOptions { output_dir: out.path().to_path_buf(), ..Default::default() })
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         decks += 1;
     }
     assert!(decks >= 1);

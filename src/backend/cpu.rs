@@ -189,12 +189,8 @@ impl CpuBackend {
         let (bond_slots, angle_slots) = self.slot_forces.split_at_mut(self.layout.angle_slot_base);
         let (bond_energy, angle_energy) = self.term_energy.split_at_mut(model.bonds.len());
         let (bond_virial, angle_virial) = self.term_virial.split_at_mut(model.bonds.len());
-        bond_slots
-            .par_chunks_mut(2)
-            .zip(bond_energy.par_iter_mut())
-            .zip(bond_virial.par_iter_mut())
-            .enumerate()
-            .for_each(|(b, ((slots, energy), virial))| {
+        bond_slots.par_chunks_mut(2).zip(bond_energy.par_iter_mut()).zip(bond_virial.par_iter_mut()).enumerate().for_each(
+            |(b, ((slots, energy), virial))| {
                 let [i, j] = model.bonds[b];
                 let term = &model.bond_types[model.bond_type[b] as usize];
                 let Law::Radial { eval, .. } = term.interaction.law() else { unreachable!("bond law is radial") };
@@ -206,13 +202,10 @@ impl CpuBackend {
                 slots[1] = f_j;
                 *energy = radial.energy;
                 *virial = outer(d, f_j);
-            });
-        angle_slots
-            .par_chunks_mut(3)
-            .zip(angle_energy.par_iter_mut())
-            .zip(angle_virial.par_iter_mut())
-            .enumerate()
-            .for_each(|(a, ((slots, energy), virial))| {
+            },
+        );
+        angle_slots.par_chunks_mut(3).zip(angle_energy.par_iter_mut()).zip(angle_virial.par_iter_mut()).enumerate().for_each(
+            |(a, ((slots, energy), virial))| {
                 let [i, j, k] = model.angles[a];
                 let term = &model.angle_types[model.angle_type[a] as usize];
                 let Law::ThreeBody(eval) = term.interaction.law() else { unreachable!("angle law is three-body") };
@@ -225,7 +218,8 @@ impl CpuBackend {
                 let mut w = outer(xi - xj, out.forces[0]);
                 add6(&mut w, outer(xk - xj, out.forces[2]));
                 *virial = w;
-            });
+            },
+        );
     }
 
     fn pair_pass(&mut self, model: &Model, state: &State, sim_box: &SimBox) {
@@ -319,7 +313,12 @@ impl CpuBackend {
             } else {
                 ("angle", &model.angle_types[model.angle_type[(s - layout.angle_slot_base) / 3] as usize])
             };
-            parts.push(ForceBreakdown { kind, label: term.label.text.clone(), interaction: term.interaction.name(), force: self.slot_forces[s] });
+            parts.push(ForceBreakdown {
+                kind,
+                label: term.label.text.clone(),
+                interaction: term.interaction.name(),
+                force: self.slot_forces[s],
+            });
         }
         if !self.pair_interactions.is_empty() {
             let x = &state.positions;
@@ -332,7 +331,12 @@ impl CpuBackend {
                     if r < range(&term.params) {
                         let radial = eval(&term.params, r);
                         let label = format!("{} {}-{}", term.label.text, model.ids[i], model.ids[j as usize]);
-                        parts.push(ForceBreakdown { kind: "pair", label, interaction: term.interaction.name(), force: radial.de_dr * d / r });
+                        parts.push(ForceBreakdown {
+                            kind: "pair",
+                            label,
+                            interaction: term.interaction.name(),
+                            force: radial.de_dr * d / r,
+                        });
                     }
                 }
             }
@@ -341,7 +345,12 @@ impl CpuBackend {
             if external.members.binary_search(&(i as u32)).is_ok() {
                 let Law::OneBody(eval) = external.term.interaction.law() else { continue };
                 let out = eval(&external.term.params, sim_box.unwrap(state.positions[i], state.images[i]));
-                parts.push(ForceBreakdown { kind: "external", label: external.term.label.text.clone(), interaction: external.term.interaction.name(), force: out.force });
+                parts.push(ForceBreakdown {
+                    kind: "external",
+                    label: external.term.label.text.clone(),
+                    interaction: external.term.interaction.name(),
+                    force: out.force,
+                });
             }
         }
         parts

@@ -70,14 +70,21 @@ pub enum Action {
     Seed(u64),
     Integrator(OverdampedSettings),
     Neighbor(NeighborSettings),
-    Thermo { every: u64, columns: Vec<ThermoColumn> },
+    Thermo {
+        every: u64,
+        columns: Vec<ThermoColumn>,
+    },
     ThermoFile(PathBuf),
     Dump(DumpSpec),
     Undump(String),
     External(External),
     Unexternal(String),
     /// Changes one parameter of a bond type, angle type or pair rule.
-    Coeff { target: CoeffTarget, param: usize, value: f64 },
+    Coeff {
+        target: CoeffTarget,
+        param: usize,
+        value: f64,
+    },
     Minimize(FireSettings),
     Run(u64),
     WriteState(PathBuf),
@@ -102,4 +109,3 @@ pub struct Plan {
     pub positions: Vec<glam::DVec3>,
     pub actions: Vec<Action>,
 }
-

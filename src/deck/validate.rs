@@ -113,12 +113,18 @@ impl Validator {
     /// The model, built on first use from the setup commands seen so far.
     fn model(&mut self, at: &Token) -> Result<&mut Model, InputError> {
         if self.model.is_none() {
-            let topology = self.topology.as_ref().ok_or_else(|| at.error(format!("`{}` needs a system; expected a `topology FILE` command before it", at.text)))?;
+            let topology = self
+                .topology
+                .as_ref()
+                .ok_or_else(|| at.error(format!("`{}` needs a system; expected a `topology FILE` command before it", at.text)))?;
             if !self.forcefield_seen {
                 return Err(at.error(format!("`{}` needs a force field; expected a `forcefield FILE` command before it", at.text)));
             }
             let axes = self.box_axes.clone().or_else(|| topology.box_axes.clone()).ok_or_else(|| {
-                at.error(format!("no simulation box: expected a `box` command before `{}` or a [ box ] section in {}", at.text, topology.path))
+                at.error(format!(
+                    "no simulation box: expected a `box` command before `{}` or a [ box ] section in {}",
+                    at.text, topology.path
+                ))
             })?;
             let sim_box = SimBox::new(
                 DVec3::new(axes[0].lo, axes[1].lo, axes[2].lo),
@@ -146,7 +152,8 @@ impl Validator {
                 if self.topology.is_some() || self.forcefield_seen {
                     return Err(kw.error("`units` must come before `topology` and `forcefield`"));
                 }
-                self.units = UnitSystem::from_keyword(&s[1].text).ok_or_else(|| s[1].error(format!("found `{}`, expected `cell` (µm, s, pN) or `lj`", s[1].text)))?;
+                self.units = UnitSystem::from_keyword(&s[1].text)
+                    .ok_or_else(|| s[1].error(format!("found `{}`, expected `cell` (µm, s, pN) or `lj`", s[1].text)))?;
             }
             "topology" => {
                 expect_len(s, 1..=1, "topology FILE")?;
@@ -182,7 +189,11 @@ impl Validator {
                     exclude[k] = match parse_f64(t, "a weight")? {
                         0.0 => true,
                         1.0 => false,
-                        w => return Err(t.error(format!("found weight {w}, expected 0 (exclude) or 1 (include); fractional weights are not supported"))),
+                        w => {
+                            return Err(t.error(format!(
+                                "found weight {w}, expected 0 (exclude) or 1 (include); fractional weights are not supported"
+                            )))
+                        }
                     };
                 }
                 self.special_bonds = SpecialBonds { exclude_12: exclude[0], exclude_13: exclude[1], exclude_14: exclude[2] };
@@ -213,7 +224,9 @@ impl Validator {
                     "nbuild" => ThermoColumn::Nbuild,
                     other => match other.strip_prefix("pe/") {
                         Some(name) => ThermoColumn::PeOf(REGISTRY.iter().position(|i| i.name() == name).ok_or_else(|| {
-                            t.error(format!("found `pe/{name}`, expected pe/ followed by a registered interaction name (see `cellmd list`)"))
+                            t.error(format!(
+                                "found `pe/{name}`, expected pe/ followed by a registered interaction name (see `cellmd list`)"
+                            ))
                         })?),
                         None => return Err(t.error(format!("found thermo column `{other}`, expected one of: {FIXED}"))),
                     },
@@ -308,7 +321,9 @@ impl Validator {
                     .map(|(k, _)| CoeffTarget::PairRule(k))
                     .collect();
                 if rules.is_empty() {
-                    return Err(s[2].error(format!("no pair rule between `{a}` and `{b}`; expected a type pair with a `pair` line in the force field")));
+                    return Err(s[2].error(format!(
+                        "no pair rule between `{a}` and `{b}`; expected a type pair with a `pair` line in the force field"
+                    )));
                 }
                 (rules, 4)
             }
@@ -327,13 +342,20 @@ impl Validator {
             for pair in s[start..].chunks(2) {
                 let index = param_index(term.interaction, &pair[0].text).ok_or_else(|| {
                     let names: Vec<&str> = term.interaction.params().iter().map(|p| p.name).collect();
-                    pair[0].error(format!("found parameter `{}`, expected one of `{}`'s parameters: {}", pair[0].text, term.interaction.name(), names.join(", ")))
+                    pair[0].error(format!(
+                        "found parameter `{}`, expected one of `{}`'s parameters: {}",
+                        pair[0].text,
+                        term.interaction.name(),
+                        names.join(", ")
+                    ))
                 })?;
                 let spec = &term.interaction.params()[index];
                 let value = parse_f64(&pair[1], &format!("a value for `{}` in {}", spec.name, units.label(spec.dim)))?;
                 spec.check(value).map_err(|e| pair[1].error(format!("expected {e}")))?;
                 term.params[index] = value;
-                term.interaction.validate(&term.params).map_err(|e| pair[1].error(format!("invalid `{}` parameters: expected {e}", term.interaction.name())))?;
+                term.interaction
+                    .validate(&term.params)
+                    .map_err(|e| pair[1].error(format!("invalid `{}` parameters: expected {e}", term.interaction.name())))?;
                 edits.push(Action::Coeff { target: target.clone(), param: index, value });
             }
         }
@@ -368,7 +390,11 @@ impl Validator {
                 if s[1].text != "overdamped" {
                     return Err(s[1].error(format!("found integrator `{}`, expected `overdamped`", s[1].text)));
                 }
-                let opts = options(&s[2..], &["noise", "max_displacement"], "integrator overdamped [noise uniform|gaussian] [max_displacement D]")?;
+                let opts = options(
+                    &s[2..],
+                    &["noise", "max_displacement"],
+                    "integrator overdamped [noise uniform|gaussian] [max_displacement D]",
+                )?;
                 let mut settings = OverdampedSettings::default();
                 if let Some(t) = opts.get("noise") {
                     settings.noise = match t.text.as_str() {
@@ -420,10 +446,13 @@ impl Validator {
                 if every == 0 {
                     return Err(s[3].error("found 0, expected a dump interval >= 1"));
                 }
-                let format = DumpFormat::from_keyword(&s[4].text).ok_or_else(|| s[4].error(format!("found format `{}`, expected `mcap`, `xyz` or `lammps`", s[4].text)))?;
+                let format = DumpFormat::from_keyword(&s[4].text)
+                    .ok_or_else(|| s[4].error(format!("found format `{}`, expected `mcap`, `xyz` or `lammps`", s[4].text)))?;
                 let path = PathBuf::from(&s[5].text);
                 if self.dumps.contains_key(&s[1].text) {
-                    return Err(s[1].error(format!("dump `{}` is already active; expected a new name or `undump {}` first", s[1].text, s[1].text)));
+                    return Err(
+                        s[1].error(format!("dump `{}` is already active; expected a new name or `undump {}` first", s[1].text, s[1].text))
+                    );
                 }
                 if self.dumps.values().any(|p| *p == path) {
                     return Err(s[5].error(format!("`{}` is already written by another dump; expected a different file", s[5].text)));
@@ -500,7 +529,10 @@ impl Validator {
                 let written = PathBuf::from(&s[1].text);
                 let path = if self.states_written.contains(&written) { written } else { self.input_path(&s[1]) };
                 if !self.states_written.contains(&path) && !path.exists() {
-                    return Err(s[1].error(format!("cannot read `{}`: no such file; expected a restart file written by `write_state`", path.display())));
+                    return Err(s[1].error(format!(
+                        "cannot read `{}`: no such file; expected a restart file written by `write_state`",
+                        path.display()
+                    )));
                 }
                 self.actions.push(Action::ReadState(path));
             }

@@ -56,7 +56,9 @@ impl Variables {
             let end = after.find('}').ok_or_else(|| token.error("unterminated `${`; expected `${NAME}`"))?;
             let name = &after[..end];
             let value = self.values.get(name).ok_or_else(|| {
-                token.error(format!("found undefined variable `{name}`, expected a `variable {name} ...` line before this one or `--var {name}=VALUE`"))
+                token.error(format!(
+                    "found undefined variable `{name}`, expected a `variable {name} ...` line before this one or `--var {name}=VALUE`"
+                ))
             })?;
             out.push_str(value);
             rest = &after[end + 1..];

@@ -23,7 +23,13 @@ impl std::fmt::Debug for TermType {
 
 /// Resolves `interaction_token` against the registry (it must be of `kind`)
 /// and parses `tokens` as its `name value` pairs, filling defaults.
-pub fn parse_params(label: &Token, interaction_token: &Token, tokens: &[Token], kind: Kind, units: UnitSystem) -> Result<TermType, InputError> {
+pub fn parse_params(
+    label: &Token,
+    interaction_token: &Token,
+    tokens: &[Token],
+    kind: Kind,
+    units: UnitSystem,
+) -> Result<TermType, InputError> {
     let interaction = lookup(&interaction_token.text).ok_or_else(|| {
         let names: Vec<&str> = REGISTRY.iter().filter(|i| i.kind() == kind).map(|i| i.name()).collect();
         interaction_token.error(format!(
@@ -48,7 +54,12 @@ pub fn parse_params(label: &Token, interaction_token: &Token, tokens: &[Token], 
         let name = &pair[0];
         let index = specs.iter().position(|s| s.name == name.text).ok_or_else(|| {
             let names: Vec<&str> = specs.iter().map(|s| s.name).collect();
-            name.error(format!("found parameter `{}`, expected one of `{}`'s parameters: {}", name.text, interaction.name(), names.join(", ")))
+            name.error(format!(
+                "found parameter `{}`, expected one of `{}`'s parameters: {}",
+                name.text,
+                interaction.name(),
+                names.join(", ")
+            ))
         })?;
         let Some(value_token) = pair.get(1) else {
             return Err(name.error(format!("parameter `{}` has no value; expected `{} VALUE`", name.text, name.text)));
@@ -77,7 +88,9 @@ pub fn parse_params(label: &Token, interaction_token: &Token, tokens: &[Token], 
             }
         }
     }
-    interaction.validate(&params).map_err(|e| interaction_token.error(format!("invalid `{}` parameters: expected {e}", interaction.name())))?;
+    interaction
+        .validate(&params)
+        .map_err(|e| interaction_token.error(format!("invalid `{}` parameters: expected {e}", interaction.name())))?;
     Ok(TermType { label: label.clone(), interaction, params })
 }
 
@@ -94,8 +107,14 @@ mod tests {
     #[test]
     fn schema_is_enforced() {
         assert_eq!(parse("s harmonic r0 0.1 k 4").unwrap().params, vec![4.0, 0.1]);
-        assert_eq!(parse("s harmonic k 4").unwrap_err(), "f.ff:1:3: `harmonic` needs parameter `r0` (rest length, µm): expected `r0 VALUE`");
-        assert_eq!(parse("s harmonic k 4 r0 0.1 kk 2").unwrap_err(), "f.ff:1:23: found parameter `kk`, expected one of `harmonic`'s parameters: k, r0");
+        assert_eq!(
+            parse("s harmonic k 4").unwrap_err(),
+            "f.ff:1:3: `harmonic` needs parameter `r0` (rest length, µm): expected `r0 VALUE`"
+        );
+        assert_eq!(
+            parse("s harmonic k 4 r0 0.1 kk 2").unwrap_err(),
+            "f.ff:1:23: found parameter `kk`, expected one of `harmonic`'s parameters: k, r0"
+        );
         assert_eq!(parse("s harmonic k -4 r0 0.1").unwrap_err(), "f.ff:1:14: expected `k` >= 0, found -4");
         assert!(parse("s harmonic k nan r0 0.1").unwrap_err().contains("a finite number"));
         assert!(parse("s harmonic k 1 k 2 r0 1").unwrap_err().contains("given twice"));

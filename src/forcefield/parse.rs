@@ -86,7 +86,9 @@ fn particle(s: &Statement) -> Result<ParticleType, InputError> {
             }
             6.0 * std::f64::consts::PI * eta * radius
         }
-        (None, None) => return Err(name.error(format!("particle type `{}` has no drag; expected `drag G` or `radius A viscosity ETA`", name.text))),
+        (None, None) => {
+            return Err(name.error(format!("particle type `{}` has no drag; expected `drag G` or `radius A viscosity ETA`", name.text)))
+        }
     };
     Ok(ParticleType { name: name.clone(), drag, radius })
 }
@@ -95,7 +97,13 @@ fn particle(s: &Statement) -> Result<ParticleType, InputError> {
 ///
 /// `requested_by` is the deck token naming the file (for a missing-file error);
 /// `stack` guards against include cycles.
-pub fn load_forcefield(path: &Path, requested_by: Option<&Token>, units: UnitSystem, ff: &mut ForceField, stack: &mut Vec<PathBuf>) -> Result<(), InputError> {
+pub fn load_forcefield(
+    path: &Path,
+    requested_by: Option<&Token>,
+    units: UnitSystem,
+    ff: &mut ForceField,
+    stack: &mut Vec<PathBuf>,
+) -> Result<(), InputError> {
     let file = SourceFile::read(path, requested_by)?;
     let canonical = path.canonicalize().unwrap_or_else(|_| path.to_path_buf());
     if stack.contains(&canonical) {
@@ -187,11 +195,16 @@ mod tests {
 
     #[test]
     fn errors() {
-        assert_eq!(load(&[("m.ff", "particle a\n")]).unwrap_err(), "m.ff:1:10: particle type `a` has no drag; expected `drag G` or `radius A viscosity ETA`");
+        assert_eq!(
+            load(&[("m.ff", "particle a\n")]).unwrap_err(),
+            "m.ff:1:10: particle type `a` has no drag; expected `drag G` or `radius A viscosity ETA`"
+        );
         assert!(load(&[("m.ff", "particle a drag 1\nparticle a drag 2\n")]).unwrap_err().contains("already defined at"));
         assert!(load(&[("m.ff", "include m.ff\n")]).unwrap_err().contains("include cycle"));
         assert!(load(&[("m.ff", "include missing.ff\n")]).unwrap_err().starts_with("m.ff:1:9: cannot read"));
-        assert!(load(&[("m.ff", "angle x harmonic k 1 r0 1\n")]).unwrap_err().contains("is a bond interaction, expected an angle interaction"));
+        assert!(load(&[("m.ff", "angle x harmonic k 1 r0 1\n")])
+            .unwrap_err()
+            .contains("is a bond interaction, expected an angle interaction"));
         assert!(load(&[("m.ff", "bnd x harmonic\n")]).unwrap_err().contains("expected `include`, `particle`"));
     }
 }

@@ -116,11 +116,7 @@ fn token(input: Span) -> IResult<Span, (Span, bool)> {
 
 /// Tokens of one physical line, then the optional comment (not the line end).
 fn physical_line(input: Span) -> IResult<Span, Vec<(Span, bool)>> {
-    terminated(
-        preceded(space0, many0(terminated(token, space0))),
-        opt(preceded(tag("#"), not_line_ending)),
-    )
-    .parse(input)
+    terminated(preceded(space0, many0(terminated(token, space0))), opt(preceded(tag("#"), not_line_ending))).parse(input)
 }
 
 /// Splits a file into statements.
@@ -177,11 +173,7 @@ mod tests {
 
     fn words(text: &str) -> Vec<Vec<(String, u32, u32)>> {
         let file = SourceFile::new("t.in", text);
-        lex(&file)
-            .unwrap()
-            .into_iter()
-            .map(|s| s.tokens.into_iter().map(|t| (t.text, t.line, t.col)).collect())
-            .collect()
+        lex(&file).unwrap().into_iter().map(|s| s.tokens.into_iter().map(|t| (t.text, t.line, t.col)).collect()).collect()
     }
 
     #[test]

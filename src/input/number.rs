@@ -31,12 +31,12 @@ pub fn parse_f64(token: &Token, what: &str) -> Result<f64, InputError> {
 /// A non-negative integer; `what` says what the token should be.
 pub fn parse_u64(token: &Token, what: &str) -> Result<u64, InputError> {
     let parsed: IResult<&str, u64> = all_consuming(nom::character::complete::u64).parse(token.text.as_str());
-    parsed
-        .map(|(_, v)| v)
-        .map_err(|_| token.error(format!("found `{}`, expected {what} (a non-negative integer)", token.text)))
+    parsed.map(|(_, v)| v).map_err(|_| token.error(format!("found `{}`, expected {what} (a non-negative integer)", token.text)))
 }
 
-fn ws<'a, O>(inner: impl Parser<&'a str, Output = O, Error = nom::error::Error<&'a str>>) -> impl Parser<&'a str, Output = O, Error = nom::error::Error<&'a str>> {
+fn ws<'a, O>(
+    inner: impl Parser<&'a str, Output = O, Error = nom::error::Error<&'a str>>,
+) -> impl Parser<&'a str, Output = O, Error = nom::error::Error<&'a str>> {
     delimited(multispace0, inner, multispace0)
 }
 

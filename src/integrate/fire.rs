@@ -104,12 +104,13 @@ mod tests {
         let sim_box = SimBox::new(DVec3::splat(-10.0), DVec3::splat(10.0), [false; 3]);
         let mut state = State::new(vec![DVec3::new(1.0, -2.0, 0.5), DVec3::new(-0.3, 0.2, 0.9)]);
         let k = DVec3::new(1.0, 50.0, 400.0);
-        let report = fire_minimize::<()>(&mut state, &sim_box, &[1e-3, 1e-3], 1e-3, &FireSettings { ftol: 1e-8, ..Default::default() }, |s, f| {
-            f.clear();
-            f.extend(s.positions.iter().map(|x| -k * *x));
-            Ok(s.positions.iter().map(|x| 0.5 * (k * *x).dot(*x)).sum())
-        })
-        .unwrap();
+        let report =
+            fire_minimize::<()>(&mut state, &sim_box, &[1e-3, 1e-3], 1e-3, &FireSettings { ftol: 1e-8, ..Default::default() }, |s, f| {
+                f.clear();
+                f.extend(s.positions.iter().map(|x| -k * *x));
+                Ok(s.positions.iter().map(|x| 0.5 * (k * *x).dot(*x)).sum())
+            })
+            .unwrap();
         assert!(report.converged, "{report:?}");
         assert!(state.positions.iter().all(|x| x.length() < 1e-8 / 1.0));
     }

@@ -69,22 +69,13 @@ pub fn overdamped_step(
         }
         *dx = d;
     });
-    if let Some((particle, d)) = scratch
-        .iter()
-        .enumerate()
-        .find(|(_, d)| !d.is_finite() || d.length() > settings.max_displacement)
-    {
+    if let Some((particle, d)) = scratch.iter().enumerate().find(|(_, d)| !d.is_finite() || d.length() > settings.max_displacement) {
         return Err(Blowup { particle, displacement: d.length() });
     }
-    state
-        .positions
-        .par_iter_mut()
-        .zip(state.images.par_iter_mut())
-        .zip(scratch.par_iter())
-        .for_each(|((x, image), d)| {
-            *x += *d;
-            sim_box.wrap(x, image);
-        });
+    state.positions.par_iter_mut().zip(state.images.par_iter_mut()).zip(scratch.par_iter()).for_each(|((x, image), d)| {
+        *x += *d;
+        sim_box.wrap(x, image);
+    });
     state.step += 1;
     state.time += dt;
     Ok(())

@@ -136,11 +136,7 @@ pub fn open_unit_52(a: u32, b: u32) -> f64 {
 pub fn noise3(seed: u64, step: u64, id: u32, kind: Noise) -> [f64; 3] {
     let b0 = block(seed, step, id, STREAM_NOISE);
     match kind {
-        Noise::Uniform => [
-            uniform_unit_variance(b0[0]),
-            uniform_unit_variance(b0[1]),
-            uniform_unit_variance(b0[2]),
-        ],
+        Noise::Uniform => [uniform_unit_variance(b0[0]), uniform_unit_variance(b0[1]), uniform_unit_variance(b0[2])],
         Noise::Gaussian => {
             let b1 = block(seed, step, id, STREAM_NOISE_GAUSSIAN);
             let u1 = open_unit_52(b0[0], b0[1]);
@@ -162,10 +158,7 @@ mod tests {
     #[test]
     fn random123_known_answers() {
         assert_eq!(philox4x32_10([0; 4], [0; 2]), [0x6627e8d5, 0xe169c58d, 0xbc57ac4c, 0x9b00dbd8]);
-        assert_eq!(
-            philox4x32_10([u32::MAX; 4], [u32::MAX; 2]),
-            [0x408f276d, 0x41c83b0e, 0xa20bc7c6, 0x6d5451fd]
-        );
+        assert_eq!(philox4x32_10([u32::MAX; 4], [u32::MAX; 2]), [0x408f276d, 0x41c83b0e, 0xa20bc7c6, 0x6d5451fd]);
         assert_eq!(
             philox4x32_10([0x243f6a88, 0x85a308d3, 0x13198a2e, 0x03707344], [0xa4093822, 0x299f31d0]),
             [0xd16cfe09, 0x94fdcceb, 0x5001e420, 0x24126ea1]
@@ -176,10 +169,7 @@ mod tests {
     fn block_layout() {
         let seed = 0x0123_4567_89ab_cdef_u64;
         let step = 0xfedc_ba98_7654_3210_u64;
-        assert_eq!(
-            block(seed, step, 7, 3),
-            philox4x32_10([7, 3, 0x7654_3210, 0xfedc_ba98], [0x89ab_cdef, 0x0123_4567])
-        );
+        assert_eq!(block(seed, step, 7, 3), philox4x32_10([7, 3, 0x7654_3210, 0xfedc_ba98], [0x89ab_cdef, 0x0123_4567]));
     }
 
     /// Mean, variance, fourth moment and the largest |cross-correlation|.

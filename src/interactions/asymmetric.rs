@@ -1,6 +1,6 @@
 #![doc = include_str!("asymmetric.md")]
 
-use super::{Interaction, Kind, Law, ParamSpec, Radial};
+use super::{Kind, Law, ParamSpec, Radial};
 use crate::units::Dim;
 
 const K_TENSION: usize = 0;
@@ -13,34 +13,19 @@ static PARAMS: [ParamSpec; 3] = [
     ParamSpec::new("r0", Dim::Length, "rest length").non_negative(),
 ];
 
-pub struct Asymmetric;
-
 fn eval(p: &[f64], r: f64) -> Radial {
     let stretch = r - p[R0];
     let k = if stretch > 0.0 { p[K_TENSION] } else { p[K_COMPRESSION] };
     Radial { energy: 0.5 * k * stretch * stretch, de_dr: k * stretch, d2e_dr2: k }
 }
 
-impl Interaction for Asymmetric {
-    fn name(&self) -> &'static str {
-        "asymmetric"
-    }
-    fn kind(&self) -> Kind {
-        Kind::Bond
-    }
-    fn summary(&self) -> &'static str {
-        "Bilinear bond, stiffer in tension than compression: E = ½k_t(r − r0)² or ½k_c(r − r0)²"
-    }
-    fn doc(&self) -> &'static str {
-        include_str!("asymmetric.md")
-    }
-    fn params(&self) -> &'static [ParamSpec] {
-        &PARAMS
-    }
-    fn law(&self) -> Law {
-        Law::Radial { eval, range: |_| f64::INFINITY }
-    }
-}
+interaction!(
+    Asymmetric,
+    "asymmetric",
+    Kind::Bond,
+    "Bilinear bond, stiffer in tension than compression: E = ½k_t(r − r0)² or ½k_c(r − r0)²",
+    Law::Radial { eval, range: |_| f64::INFINITY }
+);
 
 #[cfg(test)]
 mod tests {

@@ -1,6 +1,6 @@
 #![doc = include_str!("cable.md")]
 
-use super::{Interaction, Kind, Law, ParamSpec, Radial};
+use super::{Kind, Law, ParamSpec, Radial};
 use crate::units::Dim;
 
 const K: usize = 0;
@@ -13,8 +13,6 @@ static PARAMS: [ParamSpec; 3] = [
     ParamSpec::new("tau", Dim::Dimensionless, "pre-strain added to the strain (tau > 0: pre-tensioned)").default(0.0),
 ];
 
-pub struct Cable;
-
 fn eval(p: &[f64], r: f64) -> Radial {
     let (k, r0) = (p[K], p[R0]);
     let strain = (r - r0) / r0 + p[TAU];
@@ -26,26 +24,13 @@ fn eval(p: &[f64], r: f64) -> Radial {
     }
 }
 
-impl Interaction for Cable {
-    fn name(&self) -> &'static str {
-        "cable"
-    }
-    fn kind(&self) -> Kind {
-        Kind::Bond
-    }
-    fn summary(&self) -> &'static str {
-        "Tension-only cable with pre-strain, F = k·⟨(r − r0)/r0 + τ⟩₊"
-    }
-    fn doc(&self) -> &'static str {
-        include_str!("cable.md")
-    }
-    fn params(&self) -> &'static [ParamSpec] {
-        &PARAMS
-    }
-    fn law(&self) -> Law {
-        Law::Radial { eval, range: |_| f64::INFINITY }
-    }
-}
+interaction!(
+    Cable,
+    "cable",
+    Kind::Bond,
+    "Tension-only cable with pre-strain, F = k·⟨(r − r0)/r0 + τ⟩₊",
+    Law::Radial { eval, range: |_| f64::INFINITY }
+);
 
 #[cfg(test)]
 mod tests {

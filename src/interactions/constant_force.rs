@@ -2,7 +2,7 @@
 
 use glam::DVec3;
 
-use super::{Interaction, Kind, Law, OneBody, ParamSpec};
+use super::{Kind, Law, OneBody, ParamSpec};
 use crate::units::Dim;
 
 const FX: usize = 0;
@@ -15,33 +15,18 @@ static PARAMS: [ParamSpec; 3] = [
     ParamSpec::new("fz", Dim::Force, "z component of the force on each particle").default(0.0),
 ];
 
-pub struct ConstantForce;
-
 fn eval(p: &[f64], x: DVec3) -> OneBody {
     let f = DVec3::new(p[FX], p[FY], p[FZ]);
     OneBody { energy: -f.dot(x), force: f }
 }
 
-impl Interaction for ConstantForce {
-    fn name(&self) -> &'static str {
-        "constant_force"
-    }
-    fn kind(&self) -> Kind {
-        Kind::External
-    }
-    fn summary(&self) -> &'static str {
-        "Constant pulling force F on each particle of a group, E = −F·x"
-    }
-    fn doc(&self) -> &'static str {
-        include_str!("constant_force.md")
-    }
-    fn params(&self) -> &'static [ParamSpec] {
-        &PARAMS
-    }
-    fn law(&self) -> Law {
-        Law::OneBody(eval)
-    }
-}
+interaction!(
+    ConstantForce,
+    "constant_force",
+    Kind::External,
+    "Constant pulling force F on each particle of a group, E = −F·x",
+    Law::OneBody(eval)
+);
 
 #[cfg(test)]
 mod tests {

@@ -2,14 +2,12 @@
 
 use glam::DVec3;
 
-use super::{Interaction, Kind, Law, ParamSpec, ThreeBody};
+use super::{Kind, Law, ParamSpec, ThreeBody};
 use crate::units::Dim;
 
 const K: usize = 0;
 
 static PARAMS: [ParamSpec; 1] = [ParamSpec::new("K", Dim::Energy, "bending energy scale (E = K[1 + cos θ])").non_negative()];
-
-pub struct CosineAngle;
 
 fn eval(p: &[f64], [ri, rj, rk]: [DVec3; 3]) -> ThreeBody {
     let u = ri - rj;
@@ -23,26 +21,7 @@ fn eval(p: &[f64], [ri, rj, rk]: [DVec3; 3]) -> ThreeBody {
     ThreeBody { energy: p[K] * (1.0 + c), forces: [fi, -fi - fk, fk] }
 }
 
-impl Interaction for CosineAngle {
-    fn name(&self) -> &'static str {
-        "cosine_angle"
-    }
-    fn kind(&self) -> Kind {
-        Kind::Angle
-    }
-    fn summary(&self) -> &'static str {
-        "Cosine angle E = K[1 + cos θ] (LAMMPS angle_style cosine)"
-    }
-    fn doc(&self) -> &'static str {
-        include_str!("cosine_angle.md")
-    }
-    fn params(&self) -> &'static [ParamSpec] {
-        &PARAMS
-    }
-    fn law(&self) -> Law {
-        Law::ThreeBody(eval)
-    }
-}
+interaction!(CosineAngle, "cosine_angle", Kind::Angle, "Cosine angle E = K[1 + cos θ] (LAMMPS angle_style cosine)", Law::ThreeBody(eval));
 
 #[cfg(test)]
 mod tests {

@@ -1,6 +1,6 @@
 #![doc = include_str!("fene.md")]
 
-use super::{Interaction, Kind, Law, ParamSpec, Radial};
+use super::{Kind, Law, ParamSpec, Radial};
 use crate::units::Dim;
 
 const K: usize = 0;
@@ -15,8 +15,6 @@ static PARAMS: [ParamSpec; 4] = [
     ParamSpec::new("sigma", Dim::Length, "size of the WCA core; it acts for r < 2^(1/6)·sigma").positive(),
 ];
 
-pub struct Fene;
-
 /// 2^(1/3): the WCA core acts for r² < 2^(1/3)·σ² (LAMMPS `MY_CUBEROOT2`).
 const CUBEROOT2: f64 = 1.259_921_049_894_873_2;
 
@@ -28,11 +26,7 @@ fn eval(p: &[f64], r: f64) -> Radial {
         return Radial { energy: f64::INFINITY, de_dr: f64::INFINITY, d2e_dr2: f64::INFINITY };
     }
     let logarg = 1.0 - x2;
-    let mut out = Radial {
-        energy: -0.5 * k * r0 * r0 * logarg.ln(),
-        de_dr: k * r / logarg,
-        d2e_dr2: k * (1.0 + x2) / (logarg * logarg),
-    };
+    let mut out = Radial { energy: -0.5 * k * r0 * r0 * logarg.ln(), de_dr: k * r / logarg, d2e_dr2: k * (1.0 + x2) / (logarg * logarg) };
     let (eps, sigma) = (p[EPSILON], p[SIGMA]);
     if r * r < CUBEROOT2 * sigma * sigma {
         let s2 = sigma * sigma / (r * r);
@@ -45,26 +39,13 @@ fn eval(p: &[f64], r: f64) -> Radial {
     out
 }
 
-impl Interaction for Fene {
-    fn name(&self) -> &'static str {
-        "fene"
-    }
-    fn kind(&self) -> Kind {
-        Kind::Bond
-    }
-    fn summary(&self) -> &'static str {
-        "FENE bond with WCA core, E = −½K·R0²·ln(1 − (r/R0)²) + WCA (LAMMPS bond_style fene)"
-    }
-    fn doc(&self) -> &'static str {
-        include_str!("fene.md")
-    }
-    fn params(&self) -> &'static [ParamSpec] {
-        &PARAMS
-    }
-    fn law(&self) -> Law {
-        Law::Radial { eval, range: |_| f64::INFINITY }
-    }
-}
+interaction!(
+    Fene,
+    "fene",
+    Kind::Bond,
+    "FENE bond with WCA core, E = −½K·R0²·ln(1 − (r/R0)²) + WCA (LAMMPS bond_style fene)",
+    Law::Radial { eval, range: |_| f64::INFINITY }
+);
 
 #[cfg(test)]
 mod tests {

@@ -1,6 +1,6 @@
 #![doc = include_str!("harmonic.md")]
 
-use super::{Interaction, Kind, Law, ParamSpec, Radial};
+use super::{Kind, Law, ParamSpec, Radial};
 use crate::units::Dim;
 
 const K: usize = 0;
@@ -11,33 +11,12 @@ static PARAMS: [ParamSpec; 2] = [
     ParamSpec::new("r0", Dim::Length, "rest length").non_negative(),
 ];
 
-pub struct Harmonic;
-
 fn eval(p: &[f64], r: f64) -> Radial {
     let stretch = r - p[R0];
     Radial { energy: 0.5 * p[K] * stretch * stretch, de_dr: p[K] * stretch, d2e_dr2: p[K] }
 }
 
-impl Interaction for Harmonic {
-    fn name(&self) -> &'static str {
-        "harmonic"
-    }
-    fn kind(&self) -> Kind {
-        Kind::Bond
-    }
-    fn summary(&self) -> &'static str {
-        "Hookean bond E = ½k(r − r0)²"
-    }
-    fn doc(&self) -> &'static str {
-        include_str!("harmonic.md")
-    }
-    fn params(&self) -> &'static [ParamSpec] {
-        &PARAMS
-    }
-    fn law(&self) -> Law {
-        Law::Radial { eval, range: |_| f64::INFINITY }
-    }
-}
+interaction!(Harmonic, "harmonic", Kind::Bond, "Hookean bond E = ½k(r − r0)²", Law::Radial { eval, range: |_| f64::INFINITY });
 
 #[cfg(test)]
 mod tests {

@@ -2,7 +2,7 @@
 
 use glam::DVec3;
 
-use super::{Interaction, Kind, Law, ParamSpec, ThreeBody};
+use super::{Kind, Law, ParamSpec, ThreeBody};
 use crate::units::Dim;
 
 const K: usize = 0;
@@ -12,8 +12,6 @@ static PARAMS: [ParamSpec; 2] = [
     ParamSpec::new("k", Dim::AngularStiffness, "angular spring constant (E = ½k(θ − θ0)²)").non_negative(),
     ParamSpec::new("theta0", Dim::Degrees, "rest angle at the vertex j, in degrees").non_negative().at_most(180.0),
 ];
-
-pub struct HarmonicAngle;
 
 /// Floor on sin θ: keeps forces finite (not NaN) for exactly collinear input.
 const SIN_FLOOR: f64 = 1e-12;
@@ -39,26 +37,7 @@ fn eval(p: &[f64], [ri, rj, rk]: [DVec3; 3]) -> ThreeBody {
     ThreeBody { energy: 0.5 * p[K] * dtheta * dtheta, forces: [fi, -fi - fk, fk] }
 }
 
-impl Interaction for HarmonicAngle {
-    fn name(&self) -> &'static str {
-        "harmonic_angle"
-    }
-    fn kind(&self) -> Kind {
-        Kind::Angle
-    }
-    fn summary(&self) -> &'static str {
-        "Harmonic angle E = ½k(θ − θ0)², θ0 in degrees"
-    }
-    fn doc(&self) -> &'static str {
-        include_str!("harmonic_angle.md")
-    }
-    fn params(&self) -> &'static [ParamSpec] {
-        &PARAMS
-    }
-    fn law(&self) -> Law {
-        Law::ThreeBody(eval)
-    }
-}
+interaction!(HarmonicAngle, "harmonic_angle", Kind::Angle, "Harmonic angle E = ½k(θ − θ0)², θ0 in degrees", Law::ThreeBody(eval));
 
 #[cfg(test)]
 mod tests {

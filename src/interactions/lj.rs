@@ -1,6 +1,6 @@
 #![doc = include_str!("lj.md")]
 
-use super::{Interaction, Kind, Law, ParamSpec, Radial};
+use super::{Kind, Law, ParamSpec, Radial};
 use crate::units::Dim;
 
 const EPSILON: usize = 0;
@@ -12,8 +12,6 @@ static PARAMS: [ParamSpec; 3] = [
     ParamSpec::new("sigma", Dim::Length, "distance at which E = 0").positive(),
     ParamSpec::new("rc", Dim::Length, "cutoff (E = 0 beyond; not shifted)").positive(),
 ];
-
-pub struct Lj;
 
 /// 4ε[(σ/r)¹² − (σ/r)⁶] and its first two derivatives (shared with `wca`).
 pub(crate) fn lennard_jones(epsilon: f64, sigma: f64, r: f64) -> Radial {
@@ -35,26 +33,7 @@ fn eval(p: &[f64], r: f64) -> Radial {
     }
 }
 
-impl Interaction for Lj {
-    fn name(&self) -> &'static str {
-        "lj"
-    }
-    fn kind(&self) -> Kind {
-        Kind::Pair
-    }
-    fn summary(&self) -> &'static str {
-        "Lennard-Jones 12-6, cut at rc and not shifted (LAMMPS lj/cut)"
-    }
-    fn doc(&self) -> &'static str {
-        include_str!("lj.md")
-    }
-    fn params(&self) -> &'static [ParamSpec] {
-        &PARAMS
-    }
-    fn law(&self) -> Law {
-        Law::Radial { eval, range: |p| p[RC] }
-    }
-}
+interaction!(Lj, "lj", Kind::Pair, "Lennard-Jones 12-6, cut at rc and not shifted (LAMMPS lj/cut)", Law::Radial { eval, range: |p| p[RC] });
 
 #[cfg(test)]
 mod tests {

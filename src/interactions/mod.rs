@@ -20,22 +20,55 @@ use glam::DVec3;
 
 use crate::units::Dim;
 
+/// Implements [`Interaction`] for a unit struct from its registration data:
+/// the name (also the stem of its `.md` doc file), kind, one-line summary,
+/// the module's `PARAMS` schema, its law, and optionally a `validate` function.
+macro_rules! interaction {
+    ($ty:ident, $name:literal, $kind:expr, $summary:literal, $law:expr $(, validate = $validate:path)?) => {
+        pub struct $ty;
+
+        impl $crate::interactions::Interaction for $ty {
+            fn name(&self) -> &'static str {
+                $name
+            }
+            fn kind(&self) -> $crate::interactions::Kind {
+                $kind
+            }
+            fn summary(&self) -> &'static str {
+                $summary
+            }
+            fn doc(&self) -> &'static str {
+                include_str!(concat!($name, ".md"))
+            }
+            fn params(&self) -> &'static [$crate::interactions::ParamSpec] {
+                &PARAMS
+            }
+            fn law(&self) -> $crate::interactions::Law {
+                $law
+            }
+            $(fn validate(&self, params: &[f64]) -> Result<(), String> {
+                $validate(params)
+            })?
+        }
+    };
+}
+
 pub mod testing;
 
-mod harmonic;
-mod fene;
-mod cable;
-mod spring;
 mod asymmetric;
-mod wlc_bending;
-mod harmonic_angle;
-mod cosine_angle;
-mod soft_repulsion;
-mod lj;
-mod wca;
-mod soft;
-mod wall;
+mod cable;
 mod constant_force;
+mod cosine_angle;
+mod fene;
+mod harmonic;
+mod harmonic_angle;
+mod lj;
+mod soft;
+mod soft_repulsion;
+mod spring;
+mod wall;
+mod wca;
+mod wlc_bending;
 
 /// Every registered interaction type. The parser, validator, `cellmd list`
 /// and the docs read this list; nothing else lists interaction names.
@@ -264,14 +297,7 @@ pub fn documentation(interaction: &dyn Interaction, units: crate::units::UnitSys
     );
     for p in interaction.params() {
         let default = p.default.map_or("required".to_string(), |d| d.to_string());
-        page += &format!(
-            "| `{}` | {} | {} | {} | {} |\n",
-            p.name,
-            units.label(p.dim),
-            p.range_text(),
-            default,
-            p.doc
-        );
+        page += &format!("| `{}` | {} | {} | {} | {} |\n", p.name, units.label(p.dim), p.range_text(), default, p.doc);
     }
     page += "\n";
     page += interaction.doc();
@@ -287,11 +313,7 @@ mod tests {
         let mut seen = std::collections::HashSet::new();
         for i in REGISTRY {
             assert!(seen.insert(i.name()), "duplicate {}", i.name());
-            assert!(
-                i.name().chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_'),
-                "{} is not snake_case",
-                i.name()
-            );
+            assert!(i.name().chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_'), "{} is not snake_case", i.name());
             let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/src/interactions/");
             for ext in ["rs", "md"] {
                 let path = format!("{dir}{}.{ext}", i.name());
@@ -324,9 +346,7 @@ mod tests {
             }
             // Kind and law agree.
             match (i.kind(), i.law()) {
-                (Kind::Bond | Kind::Pair, Law::Radial { .. })
-                | (Kind::Angle, Law::ThreeBody(_))
-                | (Kind::External, Law::OneBody(_)) => {}
+                (Kind::Bond | Kind::Pair, Law::Radial { .. }) | (Kind::Angle, Law::ThreeBody(_)) | (Kind::External, Law::OneBody(_)) => {}
                 _ => panic!("{}: kind and law disagree", i.name()),
             }
         }

@@ -2,7 +2,7 @@
 
 use std::f64::consts::PI;
 
-use super::{Interaction, Kind, Law, ParamSpec, Radial};
+use super::{Kind, Law, ParamSpec, Radial};
 use crate::units::Dim;
 
 const A: usize = 0;
@@ -12,8 +12,6 @@ static PARAMS: [ParamSpec; 2] = [
     ParamSpec::new("A", Dim::Energy, "energy at full overlap is 2A").non_negative(),
     ParamSpec::new("rc", Dim::Length, "cutoff").positive(),
 ];
-
-pub struct Soft;
 
 fn eval(p: &[f64], r: f64) -> Radial {
     let (a, rc) = (p[A], p[RC]);
@@ -26,26 +24,13 @@ fn eval(p: &[f64], r: f64) -> Radial {
     }
 }
 
-impl Interaction for Soft {
-    fn name(&self) -> &'static str {
-        "soft"
-    }
-    fn kind(&self) -> Kind {
-        Kind::Pair
-    }
-    fn summary(&self) -> &'static str {
-        "Cosine soft repulsion E = A[1 + cos(πr/rc)] (LAMMPS pair_style soft)"
-    }
-    fn doc(&self) -> &'static str {
-        include_str!("soft.md")
-    }
-    fn params(&self) -> &'static [ParamSpec] {
-        &PARAMS
-    }
-    fn law(&self) -> Law {
-        Law::Radial { eval, range: |p| p[RC] }
-    }
-}
+interaction!(
+    Soft,
+    "soft",
+    Kind::Pair,
+    "Cosine soft repulsion E = A[1 + cos(πr/rc)] (LAMMPS pair_style soft)",
+    Law::Radial { eval, range: |p| p[RC] }
+);
 
 #[cfg(test)]
 mod tests {
@@ -74,7 +59,7 @@ mod tests {
         let p = params_of(&Soft, &[("A", 10.0), ("rc", 2.0)]);
         assert!((eval(&p, 1e-9).energy - 20.0).abs() < 1e-9); // 2A at full overlap
         assert!((eval(&p, 1.0).energy - 10.0).abs() < 1e-12); // A at rc/2
-        // LAMMPS: fpair = A·π/rc·sin(πr/rc)/r (F/r, repulsive).
+                                                              // LAMMPS: fpair = A·π/rc·sin(πr/rc)/r (F/r, repulsive).
         let r = 0.6;
         let fpair = 10.0 * PI / 2.0 * (PI * r / 2.0).sin() / r;
         assert!((eval(&p, r).de_dr + fpair * r).abs() < 1e-12);

@@ -1,6 +1,6 @@
 #![doc = include_str!("soft_repulsion.md")]
 
-use super::{Interaction, Kind, Law, ParamSpec, Radial};
+use super::{Kind, Law, ParamSpec, Radial};
 use crate::units::Dim;
 
 const K: usize = 0;
@@ -11,8 +11,6 @@ static PARAMS: [ParamSpec; 2] = [
     ParamSpec::new("sigma", Dim::Length, "contact distance (typically the sum of the two radii); also the cutoff").positive(),
 ];
 
-pub struct SoftRepulsion;
-
 fn eval(p: &[f64], r: f64) -> Radial {
     let overlap = p[SIGMA] - r;
     if overlap > 0.0 {
@@ -22,26 +20,13 @@ fn eval(p: &[f64], r: f64) -> Radial {
     }
 }
 
-impl Interaction for SoftRepulsion {
-    fn name(&self) -> &'static str {
-        "soft_repulsion"
-    }
-    fn kind(&self) -> Kind {
-        Kind::Pair
-    }
-    fn summary(&self) -> &'static str {
-        "One-sided harmonic excluded volume E = ½k(σ − r)² for r < σ"
-    }
-    fn doc(&self) -> &'static str {
-        include_str!("soft_repulsion.md")
-    }
-    fn params(&self) -> &'static [ParamSpec] {
-        &PARAMS
-    }
-    fn law(&self) -> Law {
-        Law::Radial { eval, range: |p| p[SIGMA] }
-    }
-}
+interaction!(
+    SoftRepulsion,
+    "soft_repulsion",
+    Kind::Pair,
+    "One-sided harmonic excluded volume E = ½k(σ − r)² for r < σ",
+    Law::Radial { eval, range: |p| p[SIGMA] }
+);
 
 #[cfg(test)]
 mod tests {

@@ -1,6 +1,6 @@
 #![doc = include_str!("spring.md")]
 
-use super::{Interaction, Kind, Law, ParamSpec, Radial};
+use super::{Kind, Law, ParamSpec, Radial};
 use crate::units::Dim;
 
 const K: usize = 0;
@@ -13,34 +13,19 @@ static PARAMS: [ParamSpec; 3] = [
     ParamSpec::new("tau", Dim::Dimensionless, "pre-strain added to the strain (tau > 0: pre-tensioned)").default(0.0),
 ];
 
-pub struct Spring;
-
 fn eval(p: &[f64], r: f64) -> Radial {
     let (k, r0) = (p[K], p[R0]);
     let strain = (r - r0) / r0 + p[TAU];
     Radial { energy: 0.5 * k * r0 * strain * strain, de_dr: k * strain, d2e_dr2: k / r0 }
 }
 
-impl Interaction for Spring {
-    fn name(&self) -> &'static str {
-        "spring"
-    }
-    fn kind(&self) -> Kind {
-        Kind::Bond
-    }
-    fn summary(&self) -> &'static str {
-        "Strain spring with pre-strain, F = k·((r − r0)/r0 + τ) in tension and compression"
-    }
-    fn doc(&self) -> &'static str {
-        include_str!("spring.md")
-    }
-    fn params(&self) -> &'static [ParamSpec] {
-        &PARAMS
-    }
-    fn law(&self) -> Law {
-        Law::Radial { eval, range: |_| f64::INFINITY }
-    }
-}
+interaction!(
+    Spring,
+    "spring",
+    Kind::Bond,
+    "Strain spring with pre-strain, F = k·((r − r0)/r0 + τ) in tension and compression",
+    Law::Radial { eval, range: |_| f64::INFINITY }
+);
 
 #[cfg(test)]
 mod tests {

@@ -10,7 +10,8 @@
 
 use glam::{DMat3, DVec3};
 
-use super::{Interaction, Law};
+pub use super::Interaction;
+use super::Law;
 
 /// Energy and per-particle forces of `law` at `positions` (1, 2 or 3 particles).
 pub fn evaluate(law: Law, params: &[f64], positions: &[DVec3]) -> (f64, Vec<DVec3>) {
@@ -120,17 +121,11 @@ pub fn assert_zero_force_at_rest(interaction: &dyn Interaction, params: &[f64], 
 
 /// For a radial law, d²E/dr² matches a central difference of dE/dr at `r`.
 pub fn assert_radial_curvature(interaction: &dyn Interaction, params: &[f64], r: f64, h: f64) {
-    let Law::Radial { eval, .. } = interaction.law() else {
-        panic!("{} is not radial", interaction.name())
-    };
+    let Law::Radial { eval, .. } = interaction.law() else { panic!("{} is not radial", interaction.name()) };
     let numeric = (eval(params, r + h).de_dr - eval(params, r - h).de_dr) / (2.0 * h);
     let analytic = eval(params, r).d2e_dr2;
     let scale = analytic.abs().max(numeric.abs()).max(1e-300);
-    assert!(
-        (analytic - numeric).abs() / scale < 1e-5,
-        "{}: d2E/dr2 at r = {r}: analytic {analytic} numeric {numeric}",
-        interaction.name()
-    );
+    assert!((analytic - numeric).abs() / scale < 1e-5, "{}: d2E/dr2 at r = {r}: analytic {analytic} numeric {numeric}", interaction.name());
 }
 
 /// Runs every generic check appropriate to the law at `positions`.

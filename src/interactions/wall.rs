@@ -2,7 +2,7 @@
 
 use glam::DVec3;
 
-use super::{Interaction, Kind, Law, OneBody, ParamSpec};
+use super::{Kind, Law, OneBody, ParamSpec};
 use crate::units::Dim;
 
 const NX: usize = 0;
@@ -18,8 +18,6 @@ static PARAMS: [ParamSpec; 5] = [
     ParamSpec::new("d", Dim::Length, "offset of the plane n̂·x = d from the origin, along n̂").default(0.0),
     ParamSpec::new("k", Dim::Stiffness, "stiffness of the wall").non_negative(),
 ];
-
-pub struct Wall;
 
 /// The unit normal, or `None` for a zero (or non-finite) normal.
 fn unit_normal(p: &[f64]) -> Option<DVec3> {
@@ -44,33 +42,19 @@ fn eval(p: &[f64], x: DVec3) -> OneBody {
     }
 }
 
-impl Interaction for Wall {
-    fn name(&self) -> &'static str {
-        "wall"
-    }
-    fn kind(&self) -> Kind {
-        Kind::External
-    }
-    fn summary(&self) -> &'static str {
-        "One-sided harmonic plane (substrate): E = ½k(d − n̂·x)² when n̂·x < d"
-    }
-    fn doc(&self) -> &'static str {
-        include_str!("wall.md")
-    }
-    fn params(&self) -> &'static [ParamSpec] {
-        &PARAMS
-    }
-    fn law(&self) -> Law {
-        Law::OneBody(eval)
-    }
-    fn validate(&self, p: &[f64]) -> Result<(), String> {
-        match unit_normal(p) {
-            Some(_) => Ok(()),
-            None => Err(format!(
-                "a nonzero wall normal (nx, ny, nz), e.g. `nz 1` for a floor, found ({}, {}, {})",
-                p[NX], p[NY], p[NZ]
-            )),
-        }
+interaction!(
+    Wall,
+    "wall",
+    Kind::External,
+    "One-sided harmonic plane (substrate): E = ½k(d − n̂·x)² when n̂·x < d",
+    Law::OneBody(eval),
+    validate = validate
+);
+
+fn validate(p: &[f64]) -> Result<(), String> {
+    match unit_normal(p) {
+        Some(_) => Ok(()),
+        None => Err(format!("a nonzero wall normal (nx, ny, nz), e.g. `nz 1` for a floor, found ({}, {}, {})", p[NX], p[NY], p[NZ])),
     }
 }
 

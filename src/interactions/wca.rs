@@ -1,7 +1,7 @@
 #![doc = include_str!("wca.md")]
 
 use super::lj::lennard_jones;
-use super::{Interaction, Kind, Law, ParamSpec, Radial};
+use super::{Kind, Law, ParamSpec, Radial};
 use crate::units::Dim;
 
 const EPSILON: usize = 0;
@@ -11,8 +11,6 @@ static PARAMS: [ParamSpec; 2] = [
     ParamSpec::new("epsilon", Dim::Energy, "energy scale of the repulsion").non_negative(),
     ParamSpec::new("sigma", Dim::Length, "particle diameter; the cutoff is 2^(1/6)·sigma").positive(),
 ];
-
-pub struct Wca;
 
 /// 2^(1/6): the LJ minimum in units of σ.
 const TWO_SIXTH: f64 = 1.122_462_048_309_373;
@@ -31,26 +29,13 @@ fn eval(p: &[f64], r: f64) -> Radial {
     }
 }
 
-impl Interaction for Wca {
-    fn name(&self) -> &'static str {
-        "wca"
-    }
-    fn kind(&self) -> Kind {
-        Kind::Pair
-    }
-    fn summary(&self) -> &'static str {
-        "Weeks–Chandler–Andersen repulsion: LJ cut at 2^(1/6)σ and shifted up by ε"
-    }
-    fn doc(&self) -> &'static str {
-        include_str!("wca.md")
-    }
-    fn params(&self) -> &'static [ParamSpec] {
-        &PARAMS
-    }
-    fn law(&self) -> Law {
-        Law::Radial { eval, range: cutoff }
-    }
-}
+interaction!(
+    Wca,
+    "wca",
+    Kind::Pair,
+    "Weeks–Chandler–Andersen repulsion: LJ cut at 2^(1/6)σ and shifted up by ε",
+    Law::Radial { eval, range: cutoff }
+);
 
 #[cfg(test)]
 mod tests {

@@ -2,7 +2,7 @@
 
 use glam::DVec3;
 
-use super::{Interaction, Kind, Law, ParamSpec, ThreeBody};
+use super::{Kind, Law, ParamSpec, ThreeBody};
 use crate::units::Dim;
 
 const KAPPA: usize = 0;
@@ -12,8 +12,6 @@ static PARAMS: [ParamSpec; 2] = [
     ParamSpec::new("kappa", Dim::BendingModulus, "bending modulus κ = kT·Lp (actin: ≈ 0.07 pN·µm²)").non_negative(),
     ParamSpec::new("l0", Dim::Length, "rest segment length ℓ of the discretisation").positive(),
 ];
-
-pub struct WlcBending;
 
 fn eval(p: &[f64], [ri, rj, rk]: [DVec3; 3]) -> ThreeBody {
     let strength = p[KAPPA] / p[L0];
@@ -32,26 +30,13 @@ fn eval(p: &[f64], [ri, rj, rk]: [DVec3; 3]) -> ThreeBody {
     ThreeBody { energy: strength * (1.0 - c), forces: [fi, -fi - fk, fk] }
 }
 
-impl Interaction for WlcBending {
-    fn name(&self) -> &'static str {
-        "wlc_bending"
-    }
-    fn kind(&self) -> Kind {
-        Kind::Angle
-    }
-    fn summary(&self) -> &'static str {
-        "Discrete worm-like-chain bending E = (κ/ℓ)(1 − t1·t2) (Cytosim)"
-    }
-    fn doc(&self) -> &'static str {
-        include_str!("wlc_bending.md")
-    }
-    fn params(&self) -> &'static [ParamSpec] {
-        &PARAMS
-    }
-    fn law(&self) -> Law {
-        Law::ThreeBody(eval)
-    }
-}
+interaction!(
+    WlcBending,
+    "wlc_bending",
+    Kind::Angle,
+    "Discrete worm-like-chain bending E = (κ/ℓ)(1 − t1·t2) (Cytosim)",
+    Law::ThreeBody(eval)
+);
 
 #[cfg(test)]
 mod tests {

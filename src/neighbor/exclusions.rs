@@ -27,10 +27,7 @@ impl Exclusions {
     pub fn from_pairs(n: usize, pairs: &[(u32, u32)]) -> Self {
         let mut counts = vec![0u32; n + 1];
         for &(i, j) in pairs {
-            assert!(
-                (i as usize) < n && (j as usize) < n,
-                "exclusion pair ({i}, {j}) names a particle outside 0..{n}"
-            );
+            assert!((i as usize) < n && (j as usize) < n, "exclusion pair ({i}, {j}) names a particle outside 0..{n}");
             if i != j {
                 counts[i as usize + 1] += 1;
                 counts[j as usize + 1] += 1;

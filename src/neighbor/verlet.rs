@@ -28,16 +28,7 @@ impl NeighborList {
     ///
     /// Invalid values (negative or non-finite) are reported by [`Self::build`].
     pub fn new(cutoff: f64, skin: f64) -> Self {
-        Self {
-            cutoff,
-            skin,
-            offsets: vec![0],
-            neighbors: Vec::new(),
-            reference: Vec::new(),
-            reference_box: None,
-            builds: 0,
-            grid: [0; 3],
-        }
+        Self { cutoff, skin, offsets: vec![0], neighbors: Vec::new(), reference: Vec::new(), reference_box: None, builds: 0, grid: [0; 3] }
     }
 
     /// The interaction cutoff.
@@ -127,12 +118,7 @@ impl NeighborList {
     /// cutoff/skin, an inverted or non-finite box, a periodic edge shorter
     /// than `2·(cutoff + skin)`, a non-finite position, or more than `u32::MAX`
     /// particles or pairs.
-    pub fn build(
-        &mut self,
-        positions: &[DVec3],
-        sim_box: &SimBox,
-        exclusions: &Exclusions,
-    ) -> Result<(), String> {
+    pub fn build(&mut self, positions: &[DVec3], sim_box: &SimBox, exclusions: &Exclusions) -> Result<(), String> {
         let range = self.range();
         if !(self.cutoff.is_finite() && self.cutoff >= 0.0) {
             return Err(format!("neighbour list: cutoff must be finite and >= 0, got {}", self.cutoff));
@@ -167,10 +153,7 @@ impl NeighborList {
             }
         }
         if let Some(i) = positions.iter().position(|x| !x.is_finite()) {
-            return Err(format!(
-                "neighbour list: particle {i} has a non-finite position {}",
-                positions[i]
-            ));
+            return Err(format!("neighbour list: particle {i} has a non-finite position {}", positions[i]));
         }
 
         if range == 0.0 || n == 0 {
@@ -337,13 +320,7 @@ impl CellGrid {
     }
 
     /// Each particle's sorted neighbour list.
-    fn gather(
-        &self,
-        positions: &[DVec3],
-        sim_box: &SimBox,
-        exclusions: &Exclusions,
-        range2: f64,
-    ) -> Vec<Vec<u32>> {
+    fn gather(&self, positions: &[DVec3], sim_box: &SimBox, exclusions: &Exclusions, range2: f64) -> Vec<Vec<u32>> {
         (0..positions.len())
             .into_par_iter()
             .with_min_len(256)
@@ -358,8 +335,7 @@ impl CellGrid {
                     for &cy in &ny[..ky] {
                         for &cx in &nx[..kx] {
                             let cell = self.flat([cx, cy, cz]) as usize;
-                            let members =
-                                &self.members[self.start[cell] as usize..self.start[cell + 1] as usize];
+                            let members = &self.members[self.start[cell] as usize..self.start[cell + 1] as usize];
                             for &j in members {
                                 if j as usize == i {
                                     continue;
@@ -411,9 +387,7 @@ mod tests {
             .map(|i| {
                 (0..x.len())
                     .filter(|&j| {
-                        j != i
-                            && !ex.is_excluded(i as u32, j as u32)
-                            && b.minimum_image(x[j] - x[i]).length_squared() < range * range
+                        j != i && !ex.is_excluded(i as u32, j as u32) && b.minimum_image(x[j] - x[i]).length_squared() < range * range
                     })
                     .map(|j| j as u32)
                     .collect()
@@ -435,13 +409,10 @@ mod tests {
     }
 
     fn random_positions(rng: &mut Rng, n: usize, lo: DVec3, hi: DVec3) -> Vec<DVec3> {
-        (0..n)
-            .map(|_| DVec3::new(rng.range(lo.x, hi.x), rng.range(lo.y, hi.y), rng.range(lo.z, hi.z)))
-            .collect()
+        (0..n).map(|_| DVec3::new(rng.range(lo.x, hi.x), rng.range(lo.y, hi.y), rng.range(lo.z, hi.z))).collect()
     }
 
-    const PERIODICITIES: [[bool; 3]; 4] =
-        [[true, true, true], [false, false, false], [true, true, false], [false, true, false]];
+    const PERIODICITIES: [[bool; 3]; 4] = [[true, true, true], [false, false, false], [true, true, false], [false, true, false]];
 
     #[test]
     fn matches_brute_force_dense_and_sparse() {
@@ -631,11 +602,7 @@ mod tests {
         fresh.build(&x, &b, &Exclusions::none()).unwrap();
         for i in 0..x.len() {
             let within = |l: &NeighborList| -> Vec<u32> {
-                l.neighbors(i)
-                    .iter()
-                    .copied()
-                    .filter(|&j| b.minimum_image(x[j as usize] - x[i]).length() < 1.0)
-                    .collect()
+                l.neighbors(i).iter().copied().filter(|&j| b.minimum_image(x[j as usize] - x[i]).length() < 1.0).collect()
             };
             assert_eq!(within(&early), within(&fresh));
         }

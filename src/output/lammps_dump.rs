@@ -49,12 +49,7 @@ impl LammpsDumpWriter {
         check_topology(topology)?;
         let mut order: Vec<usize> = (0..topology.ids.len()).collect();
         order.sort_by_key(|&i| topology.ids[i]);
-        Ok(Self {
-            out: BufWriter::new(File::create(path)?),
-            ids: topology.ids.to_vec(),
-            types: topology.types.to_vec(),
-            order,
-        })
+        Ok(Self { out: BufWriter::new(File::create(path)?), ids: topology.ids.to_vec(), types: topology.types.to_vec(), order })
     }
 }
 
@@ -65,13 +60,7 @@ impl TrajectoryWriter for LammpsDumpWriter {
         let out = &mut self.out;
         writeln!(out, "ITEM: TIMESTEP\n{}", frame.step)?;
         writeln!(out, "ITEM: NUMBER OF ATOMS\n{}", self.ids.len())?;
-        writeln!(
-            out,
-            "ITEM: BOX BOUNDS {0}{0} {1}{1} {2}{2}",
-            b.boundary_letter(0),
-            b.boundary_letter(1),
-            b.boundary_letter(2)
-        )?;
+        writeln!(out, "ITEM: BOX BOUNDS {0}{0} {1}{1} {2}{2}", b.boundary_letter(0), b.boundary_letter(1), b.boundary_letter(2))?;
         for a in 0..3 {
             writeln!(out, "{} {}", Real(b.lo[a]), Real(b.hi[a]))?;
         }
@@ -79,18 +68,7 @@ impl TrajectoryWriter for LammpsDumpWriter {
         for &i in &self.order {
             let x = frame.positions[i];
             let im = frame.image(i);
-            writeln!(
-                out,
-                "{} {} {} {} {} {} {} {}",
-                self.ids[i],
-                self.types[i] + 1,
-                Real(x.x),
-                Real(x.y),
-                Real(x.z),
-                im[0],
-                im[1],
-                im[2]
-            )?;
+            writeln!(out, "{} {} {} {} {} {} {} {}", self.ids[i], self.types[i] + 1, Real(x.x), Real(x.y), Real(x.z), im[0], im[1], im[2])?;
         }
         Ok(())
     }

@@ -266,10 +266,7 @@ impl McapWriter {
     /// Creates (or truncates) `path` and registers the schemas and channels.
     pub fn create(path: &Path, topology: &TopologyView) -> io::Result<Self> {
         check_topology(topology)?;
-        let options = mcap::WriteOptions::new()
-            .compression(None)
-            .profile("")
-            .library(format!("cellmd {}", env!("CARGO_PKG_VERSION")));
+        let options = mcap::WriteOptions::new().compression(None).profile("").library(format!("cellmd {}", env!("CARGO_PKG_VERSION")));
         let mut writer = options.create(BufWriter::new(File::create(path)?)).map_err(mcap_err)?;
         let no_metadata = BTreeMap::new();
         let mut channel = |schema_name: &str, schema: &str, topic: &str| -> io::Result<u16> {
@@ -311,11 +308,7 @@ impl McapWriter {
     /// `round(time·10⁹)` ns, not forced monotone.
     pub fn write_bond_state(&mut self, step: u64, time: f64, bound: &[bool]) -> io::Result<()> {
         if bound.len() != self.bonds.len() {
-            return Err(invalid_input(format!(
-                "bond state at step {step} has {} flags for {} bonds",
-                bound.len(),
-                self.bonds.len()
-            )));
+            return Err(invalid_input(format!("bond state at step {step} has {} flags for {} bonds", bound.len(), self.bonds.len())));
         }
         self.sink.publish(self.channel_bond_state, time_ns(time), &BondState { step, time, bound })
     }

@@ -132,11 +132,7 @@ impl DumpFormat {
 }
 
 /// Opens a writer of `format` at `path` (created or truncated).
-pub fn open_writer(
-    format: DumpFormat,
-    path: &Path,
-    topology: &TopologyView,
-) -> io::Result<Box<dyn TrajectoryWriter>> {
+pub fn open_writer(format: DumpFormat, path: &Path, topology: &TopologyView) -> io::Result<Box<dyn TrajectoryWriter>> {
     Ok(match format {
         DumpFormat::Mcap => Box::new(McapWriter::create(path, topology)?),
         DumpFormat::Xyz => Box::new(XyzWriter::create(path, topology)?),
@@ -160,10 +156,7 @@ pub(crate) fn invalid_input(message: String) -> io::Error {
 pub(crate) fn check_topology(t: &TopologyView) -> io::Result<()> {
     let n = t.ids.len();
     if t.types.len() != n {
-        return Err(invalid_input(format!(
-            "topology has {n} ids but {} types",
-            t.types.len()
-        )));
+        return Err(invalid_input(format!("topology has {n} ids but {} types", t.types.len())));
     }
     if let Some((i, &ty)) = t.types.iter().enumerate().find(|(_, &ty)| ty as usize >= t.type_names.len()) {
         return Err(invalid_input(format!(
@@ -174,9 +167,7 @@ pub(crate) fn check_topology(t: &TopologyView) -> io::Result<()> {
     }
     let out_of_range = |what: &str, k: usize, idx: &[u32]| -> io::Result<()> {
         match idx.iter().find(|&&p| p as usize >= n) {
-            Some(p) => Err(invalid_input(format!(
-                "{what} {k} names particle index {p}, but there are {n} particles"
-            ))),
+            Some(p) => Err(invalid_input(format!("{what} {k} names particle index {p}, but there are {n} particles"))),
             None => Ok(()),
         }
     };
@@ -195,18 +186,10 @@ pub(crate) fn check_topology(t: &TopologyView) -> io::Result<()> {
 /// Checks that a frame has one position (and image, unless empty) per particle.
 pub(crate) fn check_frame(n: usize, frame: &FrameView) -> io::Result<()> {
     if frame.positions.len() != n {
-        return Err(invalid_input(format!(
-            "frame at step {} has {} positions for {n} particles",
-            frame.step,
-            frame.positions.len()
-        )));
+        return Err(invalid_input(format!("frame at step {} has {} positions for {n} particles", frame.step, frame.positions.len())));
     }
     if !frame.images.is_empty() && frame.images.len() != n {
-        return Err(invalid_input(format!(
-            "frame at step {} has {} image counters for {n} particles",
-            frame.step,
-            frame.images.len()
-        )));
+        return Err(invalid_input(format!("frame at step {} has {} image counters for {n} particles", frame.step, frame.images.len())));
     }
     Ok(())
 }
@@ -257,12 +240,8 @@ pub(crate) mod test_support {
 
     impl Sample {
         pub fn new(n_frames: usize) -> Self {
-            let base = [
-                DVec3::new(0.1 + 0.2, 1e-300, -0.0),
-                DVec3::new(9.95, 5.0, 2.5),
-                DVec3::new(0.05, 5.0, 2.5),
-                DVec3::new(3.0, 7.25, -1.5),
-            ];
+            let base =
+                [DVec3::new(0.1 + 0.2, 1e-300, -0.0), DVec3::new(9.95, 5.0, 2.5), DVec3::new(0.05, 5.0, 2.5), DVec3::new(3.0, 7.25, -1.5)];
             let frames = (0..n_frames)
                 .map(|f| {
                     // Frame 0 keeps the awkward values (adding 0.0 would turn −0.0 into +0.0).

@@ -87,22 +87,13 @@ impl RestartData {
 
     /// The [`State`] to continue from.
     pub fn to_state(&self) -> State {
-        State {
-            step: self.step,
-            time: self.time,
-            positions: self.positions.clone(),
-            images: self.images.clone(),
-        }
+        State { step: self.step, time: self.time, positions: self.positions.clone(), images: self.images.clone() }
     }
 
     /// Checks that the restart belongs to a topology with these ids, in this order.
     pub fn check_ids(&self, ids: &[u64]) -> Result<(), String> {
         if self.ids.len() != ids.len() {
-            return Err(format!(
-                "the restart file has {} particles but the topology has {}",
-                self.ids.len(),
-                ids.len()
-            ));
+            return Err(format!("the restart file has {} particles but the topology has {}", self.ids.len(), ids.len()));
         }
         if let Some(i) = (0..ids.len()).find(|&i| self.ids[i] != ids[i]) {
             return Err(format!(
@@ -137,10 +128,7 @@ pub fn write_state(path: &Path, data: &RestartData) -> Result<(), String> {
         && data.sim_box.hi.is_finite()
         && data.bond_params.iter().flatten().all(|v| v.is_finite());
     if !finite {
-        return Err(format!(
-            "cannot write restart file '{}': the state contains a non-finite number",
-            path.display()
-        ));
+        return Err(format!("cannot write restart file '{}': the state contains a non-finite number", path.display()));
     }
     #[derive(Serialize)]
     struct Document<'a> {
@@ -153,8 +141,7 @@ pub fn write_state(path: &Path, data: &RestartData) -> Result<(), String> {
     let result = (|| -> io::Result<()> {
         let file = File::create(&tmp)?;
         let mut out = BufWriter::new(file);
-        serde_json::to_writer(&mut out, &Document { format: RESTART_FORMAT, version: RESTART_VERSION, data })
-            .map_err(io::Error::other)?;
+        serde_json::to_writer(&mut out, &Document { format: RESTART_FORMAT, version: RESTART_VERSION, data }).map_err(io::Error::other)?;
         out.write_all(b"\n")?;
         let file = out.into_inner().map_err(|e| e.into_error())?;
         file.sync_all()?;
@@ -181,32 +168,21 @@ pub fn read_state(path: &Path) -> Result<RestartData, String> {
         io::ErrorKind::NotFound => format!("restart file '{shown}' not found"),
         _ => format!("cannot open restart file '{shown}': {e}"),
     })?;
-    let value: serde_json::Value = serde_json::from_reader(BufReader::new(file))
-        .map_err(|e| format!("restart file '{shown}' is not valid JSON: {e}"))?;
+    let value: serde_json::Value =
+        serde_json::from_reader(BufReader::new(file)).map_err(|e| format!("restart file '{shown}' is not valid JSON: {e}"))?;
     match value.get("format").and_then(|f| f.as_str()) {
         Some(RESTART_FORMAT) => {}
         Some(other) => {
-            return Err(format!(
-                "'{shown}' is not a cellmd restart file (format is \"{other}\", expected \"{RESTART_FORMAT}\")"
-            ))
+            return Err(format!("'{shown}' is not a cellmd restart file (format is \"{other}\", expected \"{RESTART_FORMAT}\")"))
         }
-        None => {
-            return Err(format!(
-                "'{shown}' is not a cellmd restart file (no \"format\": \"{RESTART_FORMAT}\" entry)"
-            ))
-        }
+        None => return Err(format!("'{shown}' is not a cellmd restart file (no \"format\": \"{RESTART_FORMAT}\" entry)")),
     }
     match value.get("version").and_then(|v| v.as_u64()) {
         Some(RESTART_VERSION) => {}
-        Some(v) => {
-            return Err(format!(
-                "restart file '{shown}' has format version {v}; this cellmd reads version {RESTART_VERSION}"
-            ))
-        }
+        Some(v) => return Err(format!("restart file '{shown}' has format version {v}; this cellmd reads version {RESTART_VERSION}")),
         None => return Err(format!("restart file '{shown}' has no valid \"version\" entry")),
     }
-    let data: RestartData =
-        serde_json::from_value(value).map_err(|e| format!("restart file '{shown}' is malformed: {e}"))?;
+    let data: RestartData = serde_json::from_value(value).map_err(|e| format!("restart file '{shown}' is malformed: {e}"))?;
     data.check_consistent().map_err(|e| format!("restart file '{shown}' is inconsistent: {e}"))?;
     Ok(data)
 }
@@ -229,8 +205,7 @@ mod units_keyword {
 
     pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<UnitSystem, D::Error> {
         let word = String::deserialize(d)?;
-        UnitSystem::from_keyword(&word)
-            .ok_or_else(|| D::Error::custom(format!("unknown unit system \"{word}\" (expected cell or lj)")))
+        UnitSystem::from_keyword(&word).ok_or_else(|| D::Error::custom(format!("unknown unit system \"{word}\" (expected cell or lj)")))
     }
 }
 
@@ -302,12 +277,7 @@ mod tests {
             }
             positions.push(DVec3::from_array(v));
         }
-        let data = RestartData {
-            ids: (0..positions.len() as u64).collect(),
-            images: vec![[0; 3]; positions.len()],
-            positions,
-            ..sample()
-        };
+        let data = RestartData { ids: (0..positions.len() as u64).collect(), images: vec![[0; 3]; positions.len()], positions, ..sample() };
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("state.json");
         write_state(&path, &data).unwrap();
@@ -349,8 +319,7 @@ mod tests {
         assert!(err.contains("not a cellmd restart file"), "{err}");
         let err = read_state(&write("v2.json", r#"{"format": "cellmd-restart", "version": 2}"#)).unwrap_err();
         assert!(err.contains("version 2") && err.contains("reads version 1"), "{err}");
-        let err = read_state(&write("partial.json", r#"{"format": "cellmd-restart", "version": 1, "step": 3}"#))
-            .unwrap_err();
+        let err = read_state(&write("partial.json", r#"{"format": "cellmd-restart", "version": 1, "step": 3}"#)).unwrap_err();
         assert!(err.contains("malformed") && err.contains("missing field"), "{err}");
 
         // Inconsistent lengths are refused on write and on read.

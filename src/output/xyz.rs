@@ -43,12 +43,7 @@ impl XyzWriter {
         check_topology(topology)?;
         let names: Vec<String> = topology.type_names.iter().map(|n| token(n)).collect();
         let species = topology.types.iter().map(|&t| names[t as usize].clone()).collect();
-        Ok(Self {
-            out: BufWriter::new(File::create(path)?),
-            ids: topology.ids.to_vec(),
-            species,
-            units: units_keyword(topology.units),
-        })
+        Ok(Self { out: BufWriter::new(File::create(path)?), ids: topology.ids.to_vec(), species, units: units_keyword(topology.units) })
     }
 }
 

@@ -28,7 +28,9 @@ impl fmt::Display for RunError {
             RunError::Blowup { step, particle_id, what, culprit, last_good } => {
                 write!(f, "simulation blew up at step {step}: particle {particle_id}: {what}")?;
                 match culprit {
-                    Some(c) => write!(f, "; largest force on it from {} `{}` ({}), |F| = {:e}", c.kind, c.label, c.interaction, c.force.length())?,
+                    Some(c) => {
+                        write!(f, "; largest force on it from {} `{}` ({}), |F| = {:e}", c.kind, c.label, c.interaction, c.force.length())?
+                    }
                     None => write!(f, "; no interaction acts on it (check the timestep, drag and temperature)")?,
                 }
                 if !last_good.is_empty() {
@@ -53,9 +55,11 @@ impl From<std::io::Error> for RunError {
 /// The entry with the largest (or a non-finite) force among `parts`.
 pub fn culprit(parts: Vec<ForceBreakdown>) -> Option<Box<ForceBreakdown>> {
     let key = |p: &ForceBreakdown| if p.force.is_finite() { p.force.length() } else { f64::INFINITY };
-    parts.into_iter().fold(None, |best: Option<ForceBreakdown>, p| match &best {
-        Some(b) if key(b) >= key(&p) => best,
-        _ => Some(p),
-    })
-    .map(Box::new)
+    parts
+        .into_iter()
+        .fold(None, |best: Option<ForceBreakdown>, p| match &best {
+            Some(b) if key(b) >= key(&p) => best,
+            _ => Some(p),
+        })
+        .map(Box::new)
 }

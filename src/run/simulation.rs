@@ -135,7 +135,8 @@ impl Simulation {
             }
             Action::Dump(spec) => {
                 let path = self.output_path(&spec.path);
-                let writer = open_writer(spec.format, &path, &self.topology_view()).map_err(|e| RunError::Io(format!("{}: {e}", path.display())))?;
+                let writer =
+                    open_writer(spec.format, &path, &self.topology_view()).map_err(|e| RunError::Io(format!("{}: {e}", path.display())))?;
                 self.dumps.push(ActiveDump { spec: spec.clone(), path, writer, last_step: None });
             }
             Action::Undump(name) => {
@@ -201,7 +202,12 @@ impl Simulation {
     fn load_restart(&mut self, data: RestartData, path: &Path) -> Result<(), RunError> {
         data.check_ids(&self.model.ids).map_err(|e| RunError::Setup(format!("{}: {e}", path.display())))?;
         if data.units != self.model.units {
-            return Err(RunError::Setup(format!("{}: the restart was written in {:?} units, the deck uses {:?}", path.display(), data.units, self.model.units)));
+            return Err(RunError::Setup(format!(
+                "{}: the restart was written in {:?} units, the deck uses {:?}",
+                path.display(),
+                data.units,
+                self.model.units
+            )));
         }
         self.sim_box = data.sim_box;
         self.state = data.to_state();
@@ -254,7 +260,13 @@ impl Simulation {
     }
 
     fn write_dump(&mut self, i: usize) -> Result<(), RunError> {
-        let frame = FrameView { step: self.state.step, time: self.state.time, sim_box: &self.sim_box, positions: &self.state.positions, images: &self.state.images };
+        let frame = FrameView {
+            step: self.state.step,
+            time: self.state.time,
+            sim_box: &self.sim_box,
+            positions: &self.state.positions,
+            images: &self.state.images,
+        };
         self.dumps[i].writer.write_frame(&frame)?;
         self.dumps[i].last_step = Some(self.state.step);
         Ok(())
@@ -303,9 +315,20 @@ impl Simulation {
         self.outputs_at_step(&bar, true)?;
         let last = self.state.step + steps;
         while self.state.step < last {
-            let moved = overdamped_step(&self.model, &mut self.state, &self.forces.forces, &self.sim_box, self.dt, self.kt, self.seed, &self.integrator, &mut self.scratch);
+            let moved = overdamped_step(
+                &self.model,
+                &mut self.state,
+                &self.forces.forces,
+                &self.sim_box,
+                self.dt,
+                self.kt,
+                self.seed,
+                &self.integrator,
+                &mut self.scratch,
+            );
             if let Err(Blowup { particle, displacement }) = moved {
-                let what = format!("displacement {displacement:e} in one step exceeds max_displacement {:e}", self.integrator.max_displacement);
+                let what =
+                    format!("displacement {displacement:e} in one step exceeds max_displacement {:e}", self.integrator.max_displacement);
                 return Err(self.blowup(particle, what));
             }
             if self.state.step.is_multiple_of(self.neighbor.every) {

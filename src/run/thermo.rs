@@ -115,7 +115,8 @@ impl Thermo {
     /// The two header lines (names, then units) for stdout.
     pub fn header(&self) -> String {
         let names: String = self.columns.iter().map(|c| format!("{:>w$}", column_name(c), w = width(c))).collect();
-        let units: String = self.columns.iter().map(|c| format!("{:>w$}", format!("[{}]", column_unit(c, self.units)), w = width(c))).collect();
+        let units: String =
+            self.columns.iter().map(|c| format!("{:>w$}", format!("[{}]", column_unit(c, self.units)), w = width(c))).collect();
         format!("{names}\n{units}")
     }
 
@@ -130,11 +131,17 @@ impl Thermo {
             .collect();
         if let Some(file) = &mut self.file {
             if !self.file_header_written {
-                let header: Vec<String> = self.columns.iter().map(|c| format!("{}[{}]", column_name(c), column_unit(c, self.units))).collect();
+                let header: Vec<String> =
+                    self.columns.iter().map(|c| format!("{}[{}]", column_name(c), column_unit(c, self.units))).collect();
                 writeln!(file, "{}", header.join(","))?;
                 self.file_header_written = true;
             }
-            let fields: Vec<String> = self.columns.iter().zip(&values).map(|(c, v)| if is_integer(c) { format!("{}", *v as u64) } else { format!("{v:e}") }).collect();
+            let fields: Vec<String> = self
+                .columns
+                .iter()
+                .zip(&values)
+                .map(|(c, v)| if is_integer(c) { format!("{}", *v as u64) } else { format!("{v:e}") })
+                .collect();
             writeln!(file, "{}", fields.join(","))?;
         }
         Ok(line)

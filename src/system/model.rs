@@ -82,7 +82,11 @@ impl Model {
         let mut types = Vec::with_capacity(topology.ids.len());
         for name in &topology.type_names {
             let t = ff.particle_type(&name.text).ok_or_else(|| {
-                name.error(format!("found particle type `{}`, expected one defined in the force field ({})", name.text, type_names.join(", ")))
+                name.error(format!(
+                    "found particle type `{}`, expected one defined in the force field ({})",
+                    name.text,
+                    type_names.join(", ")
+                ))
             })?;
             types.push(t as u32);
         }

@@ -88,9 +88,10 @@ struct Parser {
 impl Parser {
     fn particle_index(&self, token: &Token) -> Result<u32, InputError> {
         let id = parse_u64(token, "a particle id")?;
-        self.index_of_id.get(&id).map(|(index, _)| *index).ok_or_else(|| {
-            token.error(format!("found particle id {id}, expected the id of a particle listed in [ particles ] before it"))
-        })
+        self.index_of_id
+            .get(&id)
+            .map(|(index, _)| *index)
+            .ok_or_else(|| token.error(format!("found particle id {id}, expected the id of a particle listed in [ particles ] before it")))
     }
 
     fn axis(&mut self, s: &Statement, seen: &mut [bool; 3]) -> Result<(), InputError> {
@@ -200,7 +201,11 @@ pub fn parse_box_axis(t: &[Token], axes: &mut [BoxAxis]) -> Result<usize, InputE
 /// Reads and parses a topology file.
 pub fn parse_topology(file: &Arc<SourceFile>) -> Result<Topology, InputError> {
     let statements = lex(file)?;
-    let mut parser = Parser { topology: Topology { path: file.path.clone(), ..Default::default() }, index_of_id: HashMap::new(), body_ids: HashMap::new() };
+    let mut parser = Parser {
+        topology: Topology { path: file.path.clone(), ..Default::default() },
+        index_of_id: HashMap::new(),
+        body_ids: HashMap::new(),
+    };
     let mut section: Option<Section> = None;
     let mut seen_sections: Vec<Section> = Vec::new();
     let mut seen_axes = [false; 3];
@@ -215,7 +220,11 @@ pub fn parse_topology(file: &Arc<SourceFile>) -> Result<Topology, InputError> {
             continue;
         }
         match section {
-            None => return Err(s.keyword().error(format!("found `{}` before any section, expected a section header {SECTIONS}", s.keyword().text))),
+            None => {
+                return Err(s
+                    .keyword()
+                    .error(format!("found `{}` before any section, expected a section header {SECTIONS}", s.keyword().text)))
+            }
             Some(Section::Box) => parser.axis(s, &mut seen_axes)?,
             Some(Section::Particles) => parser.particle(s)?,
             Some(Section::Bonds) => {

@@ -32,7 +32,8 @@ impl Case {
 
     pub fn run(&self) -> Simulation {
         let plan = self.plan();
-        Simulation::execute(&plan, RunOptions { output_dir: self.dir.path().to_path_buf(), ..Default::default() }).unwrap_or_else(|e| panic!("{e}"))
+        Simulation::execute(&plan, RunOptions { output_dir: self.dir.path().to_path_buf(), ..Default::default() })
+            .unwrap_or_else(|e| panic!("{e}"))
     }
 
     pub fn output_dir(&self) -> &Path {
