@@ -213,3 +213,41 @@ impl Model {
 pub fn registry_index(term: &TermType) -> usize {
     REGISTRY.iter().position(|r| r.name() == term.interaction.name()).expect("term of a registered interaction")
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::forcefield::{load_forcefield, ForceField};
+    use crate::input::SourceFile;
+    use crate::topology::parse_topology;
+
+    /// A branched molecule 1-2-3-4-5 with 6 bonded to 3.
+    fn model(special_bonds: SpecialBonds) -> Model {
+        let top = parse_topology(&SourceFile::new(
+            "t.top",
+            "[ particles ]\n1 p 0 0 0\n2 p 1 0 0\n3 p 2 0 0\n4 p 3 0 0\n5 p 4 0 0\n6 p 2 1 0\n[ bonds ]\ns 1 2\ns 2 3\ns 3 4\ns 4 5\ns 3 6\n",
+        ))
+        .unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("f.ff"), "particle p drag 1\nbond s harmonic k 1 r0 1\n").unwrap();
+        let mut ff = ForceField::default();
+        load_forcefield(&dir.path().join("f.ff"), None, UnitSystem::Lj, &mut ff, &mut Vec::new()).unwrap();
+        Model::build(&top, &ff, UnitSystem::Lj, special_bonds).unwrap()
+    }
+
+    fn one_based(pairs: Vec<(u32, u32)>) -> Vec<(u32, u32)> {
+        pairs.into_iter().map(|(a, b)| (a + 1, b + 1)).collect()
+    }
+
+    #[test]
+    fn special_bonds_follow_the_bond_graph() {
+        let only_12 = SpecialBonds::default();
+        assert_eq!(one_based(model(only_12).excluded_pairs()), vec![(1, 2), (2, 3), (3, 4), (3, 6), (4, 5)]);
+        let only_13 = SpecialBonds { exclude_12: false, exclude_13: true, exclude_14: false };
+        assert_eq!(one_based(model(only_13).excluded_pairs()), vec![(1, 3), (2, 4), (2, 6), (3, 5), (4, 6)]);
+        let only_14 = SpecialBonds { exclude_12: false, exclude_13: false, exclude_14: true };
+        assert_eq!(one_based(model(only_14).excluded_pairs()), vec![(1, 4), (1, 6), (2, 5), (5, 6)]);
+        let none = SpecialBonds { exclude_12: false, exclude_13: false, exclude_14: false };
+        assert!(model(none).excluded_pairs().is_empty());
+    }
+}
