@@ -12,6 +12,7 @@
 //! | [`system`] | box, f64 state and the resolved [`system::Model`] |
 //! | [`neighbor`] | cell list + Verlet list with skin, exclusions |
 //! | [`integrate`] | Philox RNG, overdamped Euler–Maruyama, FIRE |
+//! | [`kinetics`] | stateful bonds: force-dependent unbinding, rebinding, motors, ratchets, plasticity, maturation |
 //! | [`backend`] | the CPU reference force engine (f64, rayon, deterministic) |
 //! | [`output`] | MCAP, extended XYZ, LAMMPS dump, restart |
 //! | [`run`] | executes a plan: run loop, thermo, blow-up diagnosis, minimise |
@@ -22,6 +23,7 @@ pub mod forcefield;
 pub mod input;
 pub mod integrate;
 pub mod interactions;
+pub mod kinetics;
 pub mod neighbor;
 pub mod output;
 pub mod run;

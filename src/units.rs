@@ -42,6 +42,10 @@ pub enum Dim {
     Temperature,
     /// Energy per length² (e.g. a surface tension).
     Tension,
+    /// Events per unit time (a kinetic rate).
+    Rate,
+    /// Length per unit time.
+    Velocity,
 }
 
 impl UnitSystem {
@@ -79,6 +83,8 @@ impl UnitSystem {
             (Self::Cell, Dim::Pressure) => "Pa",
             (Self::Cell, Dim::Temperature) => "K",
             (Self::Cell, Dim::Tension) => "pN/µm",
+            (Self::Cell, Dim::Rate) => "1/s",
+            (Self::Cell, Dim::Velocity) => "µm/s",
             (Self::Lj, Dim::Length) => "σ",
             (Self::Lj, Dim::Time) => "τ",
             (Self::Lj, Dim::Force) => "ε/σ",
@@ -91,6 +97,8 @@ impl UnitSystem {
             (Self::Lj, Dim::Pressure) => "ε/σ³",
             (Self::Lj, Dim::Temperature) => "ε/k_B",
             (Self::Lj, Dim::Tension) => "ε/σ²",
+            (Self::Lj, Dim::Rate) => "1/τ",
+            (Self::Lj, Dim::Velocity) => "σ/τ",
         }
     }
 }

@@ -54,7 +54,7 @@ fn brute_force(case: &Case) -> (Forces, Vec<DVec3>) {
     let mut forces = vec![DVec3::ZERO; n];
     let mut energy = vec![0.0; REGISTRY.len()];
     let mut virial = [0.0; 6];
-    let excluded = model.excluded_pairs();
+    let excluded = model.excluded_pairs(None);
     let mut add_virial = |r: DVec3, f: DVec3| {
         let w = [r.x * f.x, r.y * f.y, r.z * f.z, r.x * f.y, r.x * f.z, r.y * f.z];
         for k in 0..6 {

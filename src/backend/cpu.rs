@@ -17,7 +17,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use crate::interactions::{Law, REGISTRY};
+use crate::interactions::{Law, Radial, REGISTRY};
 use crate::neighbor::{Exclusions, NeighborList};
 use crate::system::{registry_index, Model, SimBox, State};
 
@@ -97,6 +97,9 @@ pub struct CpuBackend {
     slot_forces: Vec<DVec3>,
     term_energy: Vec<f64>,
     term_virial: Vec<[f64; 6]>,
+    /// Per bond: tension dE/dr (0 when unbound) and length, for kinetics.
+    bond_tension: Vec<f64>,
+    bond_length: Vec<f64>,
     /// Per particle: half the pair energy, per pair interaction in use.
     pair_energy: Vec<f64>,
     /// Per particle: its pair force and half its pair virial.
@@ -131,11 +134,13 @@ impl CpuBackend {
         let n_terms = model.bonds.len() + model.angles.len();
         let mut backend = Self {
             neighbors: NeighborList::new(model.max_pair_cutoff(), skin),
-            exclusions: Exclusions::from_pairs(model.len(), &model.excluded_pairs()),
+            exclusions: Exclusions::from_pairs(model.len(), &model.excluded_pairs(state.bonds.as_ref().map(|b| b.bound.as_slice()))),
             slot_forces: vec![DVec3::ZERO; layout.n_slots],
             layout,
             term_energy: vec![0.0; n_terms],
             term_virial: vec![[0.0; 6]; n_terms],
+            bond_tension: vec![0.0; model.bonds.len()],
+            bond_length: vec![0.0; model.bonds.len()],
             pair_energy: vec![0.0; model.len() * pair_interactions.len()],
             pair_force: vec![DVec3::ZERO; model.len()],
             pair_virial: vec![[0.0; 6]; model.len()],
@@ -164,6 +169,12 @@ impl CpuBackend {
         Ok(true)
     }
 
+    /// Tension (dE/dr, positive when stretched; 0 when unbound) and length of
+    /// every bond at the last [`compute`](Self::compute).
+    pub fn bond_tension_and_length(&self) -> (&[f64], &[f64]) {
+        (&self.bond_tension, &self.bond_length)
+    }
+
     /// Number of neighbour-list builds so far.
     pub fn neighbor_builds(&self) -> u64 {
         self.neighbors.builds()
@@ -189,21 +200,34 @@ impl CpuBackend {
         let (bond_slots, angle_slots) = self.slot_forces.split_at_mut(self.layout.angle_slot_base);
         let (bond_energy, angle_energy) = self.term_energy.split_at_mut(model.bonds.len());
         let (bond_virial, angle_virial) = self.term_virial.split_at_mut(model.bonds.len());
-        bond_slots.par_chunks_mut(2).zip(bond_energy.par_iter_mut()).zip(bond_virial.par_iter_mut()).enumerate().for_each(
-            |(b, ((slots, energy), virial))| {
+        let bond_state = state.bonds.as_ref();
+        bond_slots
+            .par_chunks_mut(2)
+            .zip(bond_energy.par_iter_mut())
+            .zip(bond_virial.par_iter_mut())
+            .zip(self.bond_tension.par_iter_mut().zip(self.bond_length.par_iter_mut()))
+            .enumerate()
+            .for_each(|(b, (((slots, energy), virial), (tension, length)))| {
                 let [i, j] = model.bonds[b];
-                let term = &model.bond_types[model.bond_type[b] as usize];
-                let Law::Radial { eval, .. } = term.interaction.law() else { unreachable!("bond law is radial") };
+                let t = model.bond_type[b] as usize;
+                let term = &model.bond_types[t];
                 let d = sim_box.minimum_image(x[j as usize] - x[i as usize]);
                 let r = d.length();
-                let radial = eval(&term.params, r);
+                *length = r;
+                let radial = match bond_state {
+                    Some(s) if !s.bound[b] => Radial::ZERO,
+                    Some(s) => {
+                        stateful_bond(term.interaction.law(), &term.params, model.bond_kinetics[t].rest_index, s.rest[b], s.scale[b], r)
+                    }
+                    None => stateful_bond(term.interaction.law(), &term.params, None, None, 1.0, r),
+                };
                 let f_j = -radial.de_dr * d / r;
                 slots[0] = -f_j;
                 slots[1] = f_j;
                 *energy = radial.energy;
                 *virial = outer(d, f_j);
-            },
-        );
+                *tension = radial.de_dr;
+            });
         angle_slots.par_chunks_mut(3).zip(angle_energy.par_iter_mut()).zip(angle_virial.par_iter_mut()).enumerate().for_each(
             |(a, ((slots, energy), virial))| {
                 let [i, j, k] = model.angles[a];
@@ -357,6 +381,30 @@ impl CpuBackend {
     }
 }
 
+/// A bond law evaluated with its own rest length (`None`: the type's) and
+/// stiffness scale.
+fn stateful_bond(law: Law, params: &[f64], rest_index: Option<usize>, rest: Option<f64>, scale: f64, r: f64) -> Radial {
+    let Law::Radial { eval, .. } = law else { unreachable!("bond law is radial") };
+    let mut radial = match (rest_index, rest) {
+        (Some(k), Some(rest)) => {
+            let mut own = [0.0; MAX_BOND_PARAMS];
+            own[..params.len()].copy_from_slice(params);
+            own[k] = rest;
+            eval(&own[..params.len()], r)
+        }
+        _ => eval(params, r),
+    };
+    if scale != 1.0 {
+        radial.energy *= scale;
+        radial.de_dr *= scale;
+        radial.d2e_dr2 *= scale;
+    }
+    radial
+}
+
+/// Largest parameter count of a bond law (checked by a test).
+const MAX_BOND_PARAMS: usize = 8;
+
 /// External fields: evaluated on unwrapped positions, members in ascending order.
 fn apply_externals(model: &Model, state: &State, sim_box: &SimBox, out: &mut Forces) {
     for external in &model.externals {
@@ -370,5 +418,18 @@ fn apply_externals(model: &Model, state: &State, sim_box: &SimBox, out: &mut For
             energy += field.energy;
         }
         out.energy_by_interaction[reg] += energy;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::MAX_BOND_PARAMS;
+    use crate::interactions::{Kind, REGISTRY};
+
+    #[test]
+    fn bond_laws_fit_the_stateful_parameter_buffer() {
+        for i in REGISTRY.iter().filter(|i| i.kind() == Kind::Bond) {
+            assert!(i.params().len() <= MAX_BOND_PARAMS, "{} has too many parameters", i.name());
+        }
     }
 }

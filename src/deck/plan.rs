@@ -43,6 +43,12 @@ pub enum ThermoColumn {
     Pressure(usize),
     /// Neighbour-list builds so far.
     Nbuild,
+    /// Cumulative count of bond events of one kind.
+    Events(crate::kinetics::EventKind),
+    /// Bound bonds of a bond type (index into `Model::bond_types`).
+    Bound(usize),
+    /// Summed tension of the bound bonds of a bond type (e.g. clutch traction).
+    Tension(usize),
 }
 
 /// A named trajectory output.
@@ -75,6 +81,8 @@ pub enum Action {
         columns: Vec<ThermoColumn>,
     },
     ThermoFile(PathBuf),
+    /// CSV log of bond kinetics events.
+    EventFile(PathBuf),
     Dump(DumpSpec),
     Undump(String),
     External(External),

@@ -13,13 +13,14 @@ use crate::integrate::fire::FireSettings;
 use crate::integrate::overdamped::OverdampedSettings;
 use crate::integrate::rng::Noise;
 use crate::interactions::{param_index, Kind, REGISTRY};
+use crate::kinetics::EventKind;
 use crate::output::DumpFormat;
 use crate::system::{External, Model, SimBox, SpecialBonds};
 use crate::topology::{parse_box_axis, parse_topology, BoxAxis, Topology};
 use crate::units::UnitSystem;
 
 /// The commands a deck understands (for "expected ..." messages).
-const COMMANDS: &str = "units, variable, topology, forcefield, box, special_bonds, temperature, timestep, seed, integrator, neighbor, thermo, thermo_file, dump, undump, group, external, unexternal, coeff, minimize, run, write_state, read_state, print";
+const COMMANDS: &str = "units, variable, topology, forcefield, box, special_bonds, temperature, timestep, seed, integrator, neighbor, thermo, thermo_file, events, dump, undump, group, external, unexternal, coeff, minimize, run, write_state, read_state, print";
 
 /// Commands that define the system and must come before it is first used.
 const SETUP: [&str; 5] = ["units", "topology", "forcefield", "box", "special_bonds"];
@@ -204,7 +205,14 @@ impl Validator {
     }
 
     fn thermo_columns(&self, tokens: &[Token]) -> Result<Vec<ThermoColumn>, InputError> {
-        const FIXED: &str = "step, time, pe, pe/NAME, fmax, fnorm, press, pxx, pyy, pzz, pxy, pxz, pyz, nbuild";
+        const FIXED: &str =
+            "step, time, pe, pe/NAME, fmax, fnorm, press, pxx, pyy, pzz, pxy, pxz, pyz, nbuild, breaks, rebinds, forms, resets, nbound/BONDTYPE, tension/BONDTYPE";
+        let bond_type = |t: &Token, name: &str| {
+            self.forcefield.bond_types.iter().position(|b| b.label.text == name).ok_or_else(|| {
+                let names: Vec<&str> = self.forcefield.bond_types.iter().map(|b| b.label.text.as_str()).collect();
+                t.error(format!("found bond type `{name}`, expected one defined in the force field ({})", names.join(", ")))
+            })
+        };
         tokens
             .iter()
             .map(|t| {
@@ -222,13 +230,19 @@ impl Validator {
                     "pxz" => ThermoColumn::Pressure(4),
                     "pyz" => ThermoColumn::Pressure(5),
                     "nbuild" => ThermoColumn::Nbuild,
-                    other => match other.strip_prefix("pe/") {
-                        Some(name) => ThermoColumn::PeOf(REGISTRY.iter().position(|i| i.name() == name).ok_or_else(|| {
+                    "breaks" => ThermoColumn::Events(EventKind::Break),
+                    "rebinds" => ThermoColumn::Events(EventKind::Rebind),
+                    "forms" => ThermoColumn::Events(EventKind::Form),
+                    "resets" => ThermoColumn::Events(EventKind::Reset),
+                    other => match other.split_once('/') {
+                        Some(("pe", name)) => ThermoColumn::PeOf(REGISTRY.iter().position(|i| i.name() == name).ok_or_else(|| {
                             t.error(format!(
                                 "found `pe/{name}`, expected pe/ followed by a registered interaction name (see `cellmd list`)"
                             ))
                         })?),
-                        None => return Err(t.error(format!("found thermo column `{other}`, expected one of: {FIXED}"))),
+                        Some(("nbound", name)) => ThermoColumn::Bound(bond_type(t, name)?),
+                        Some(("tension", name)) => ThermoColumn::Tension(bond_type(t, name)?),
+                        _ => return Err(t.error(format!("found thermo column `{other}`, expected one of: {FIXED}"))),
                     },
                 })
             })
@@ -436,6 +450,10 @@ impl Validator {
             "thermo_file" => {
                 expect_len(s, 1..=1, "thermo_file FILE.csv")?;
                 self.actions.push(Action::ThermoFile(PathBuf::from(&s[1].text)));
+            }
+            "events" => {
+                expect_len(s, 1..=1, "events FILE.csv")?;
+                self.actions.push(Action::EventFile(PathBuf::from(&s[1].text)));
             }
             "dump" => {
                 expect_len(s, 5..=5, "dump NAME every N mcap|xyz|lammps FILE")?;

@@ -15,9 +15,12 @@
 //! missing required values, non-finite or out-of-range values and an
 //! interaction of the wrong kind are errors at their `file:line:col`.
 //! Several `pair` lines for one type pair add up (like LAMMPS `hybrid/overlay`).
+//!
+//! A `bond` line may end with kinetic rules (see [`crate::kinetics`]):
+//! `bond clutch harmonic k 5 r0 0.02 kinetics catch_slip kc0 10 xc 0.002 ks0 0.05 xs 0.001`.
 
 mod params;
 mod parse;
 
-pub use self::params::{parse_params, TermType};
+pub use self::params::{parse_kinetics, parse_params, parse_values, BondTypeKinetics, TermType};
 pub use self::parse::{check_pair_types, load_forcefield, ForceField, PairRule, ParticleType};

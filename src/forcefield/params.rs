@@ -1,7 +1,8 @@
 //! `name value` parameter lists checked against an interaction's schema.
 
 use crate::input::{parse_f64, InputError, Token};
-use crate::interactions::{lookup, Interaction, Kind, REGISTRY};
+use crate::interactions::{lookup, Interaction, Kind, ParamSpec, REGISTRY};
+use crate::kinetics::{lookup_rule, RuleUse, RULES};
 use crate::units::UnitSystem;
 
 /// A named, parameterised use of an interaction type (a bond type, an angle
@@ -47,19 +48,29 @@ pub fn parse_params(
             kind.with_article()
         )));
     }
-    let specs = interaction.params();
+    let params = parse_values(interaction.params(), interaction.name(), interaction_token, tokens, units)?;
+    interaction
+        .validate(&params)
+        .map_err(|e| interaction_token.error(format!("invalid `{}` parameters: expected {e}", interaction.name())))?;
+    Ok(TermType { label: label.clone(), interaction, params })
+}
+
+/// Parses `name value` pairs against a schema (in schema order, defaults
+/// filled); `owner` names the interaction or rule in messages and
+/// `owner_token` is where a missing parameter is reported.
+pub fn parse_values(
+    specs: &[ParamSpec],
+    owner: &str,
+    owner_token: &Token,
+    tokens: &[Token],
+    units: UnitSystem,
+) -> Result<Vec<f64>, InputError> {
     let mut values: Vec<Option<f64>> = vec![None; specs.len()];
-    let mut pairs = tokens.chunks(2);
-    for pair in &mut pairs {
+    for pair in tokens.chunks(2) {
         let name = &pair[0];
         let index = specs.iter().position(|s| s.name == name.text).ok_or_else(|| {
             let names: Vec<&str> = specs.iter().map(|s| s.name).collect();
-            name.error(format!(
-                "found parameter `{}`, expected one of `{}`'s parameters: {}",
-                name.text,
-                interaction.name(),
-                names.join(", ")
-            ))
+            name.error(format!("found parameter `{}`, expected one of `{owner}`'s parameters: {}", name.text, names.join(", ")))
         })?;
         let Some(value_token) = pair.get(1) else {
             return Err(name.error(format!("parameter `{}` has no value; expected `{} VALUE`", name.text, name.text)));
@@ -72,26 +83,58 @@ pub fn parse_params(
         spec.check(value).map_err(|e| value_token.error(format!("expected {e}")))?;
         values[index] = Some(value);
     }
-    let mut params = Vec::with_capacity(specs.len());
-    for (spec, value) in specs.iter().zip(values) {
-        match value.or(spec.default) {
-            Some(v) => params.push(v),
-            None => {
-                return Err(interaction_token.error(format!(
-                    "`{}` needs parameter `{}` ({}, {}): expected `{} VALUE`",
-                    interaction.name(),
+    specs
+        .iter()
+        .zip(values)
+        .map(|(spec, value)| {
+            value.or(spec.default).ok_or_else(|| {
+                owner_token.error(format!(
+                    "`{owner}` needs parameter `{}` ({}, {}): expected `{} VALUE`",
                     spec.name,
                     spec.doc,
                     units.label(spec.dim),
                     spec.name
-                )))
-            }
+                ))
+            })
+        })
+        .collect()
+}
+
+/// Parses the `kinetics RULE name value ...` clauses that follow a bond
+/// type's law parameters. `tokens` starts at the first `kinetics`.
+pub fn parse_kinetics(law: &TermType, tokens: &[Token], units: UnitSystem) -> Result<BondTypeKinetics, InputError> {
+    let rest_index = crate::interactions::param_index(law.interaction, "r0");
+    let mut rules = Vec::new();
+    let starts: Vec<usize> = tokens.iter().enumerate().filter(|(_, t)| t.text == "kinetics").map(|(k, _)| k).collect();
+    for (n, &start) in starts.iter().enumerate() {
+        let end = starts.get(n + 1).copied().unwrap_or(tokens.len());
+        let Some(rule_token) = tokens.get(start + 1).filter(|_| start + 1 < end) else {
+            return Err(tokens[start].error("expected a kinetic rule name after `kinetics`"));
+        };
+        let rule = lookup_rule(&rule_token.text).ok_or_else(|| {
+            let names: Vec<&str> = RULES.iter().map(|r| r.name()).collect();
+            rule_token.error(format!("found `{}`, expected a registered kinetic rule: {}", rule_token.text, names.join(", ")))
+        })?;
+        if rule.needs_rest_length() && rest_index.is_none() {
+            return Err(rule_token.error(format!(
+                "`{}` changes the rest length, expected a bond law with a rest length `r0` (`{}` has none)",
+                rule.name(),
+                law.interaction.name()
+            )));
         }
+        let params = parse_values(rule.params(), rule.name(), rule_token, &tokens[start + 2..end], units)?;
+        rule.validate(&params).map_err(|e| rule_token.error(format!("invalid `{}` parameters: expected {e}", rule.name())))?;
+        rules.push(RuleUse { rule, params });
     }
-    interaction
-        .validate(&params)
-        .map_err(|e| interaction_token.error(format!("invalid `{}` parameters: expected {e}", interaction.name())))?;
-    Ok(TermType { label: label.clone(), interaction, params })
+    Ok(BondTypeKinetics { rules, rest_index })
+}
+
+/// The kinetic rules of a bond type.
+#[derive(Clone, Debug, Default)]
+pub struct BondTypeKinetics {
+    pub rules: Vec<RuleUse>,
+    /// Index of `r0` in the law's parameters, if it has one.
+    pub rest_index: Option<usize>,
 }
 
 #[cfg(test)]

@@ -7,7 +7,7 @@ use crate::input::{lex, parse_f64, InputError, SourceFile, Statement, Token};
 use crate::interactions::Kind;
 use crate::units::UnitSystem;
 
-use super::params::{parse_params, TermType};
+use super::params::{parse_kinetics, parse_params, BondTypeKinetics, TermType};
 
 /// A particle type: overdamped drag coefficient and radius.
 #[derive(Clone, Debug)]
@@ -32,6 +32,8 @@ pub struct PairRule {
 pub struct ForceField {
     pub particle_types: Vec<ParticleType>,
     pub bond_types: Vec<TermType>,
+    /// Kinetic rules of each bond type (same order as `bond_types`).
+    pub bond_kinetics: Vec<BondTypeKinetics>,
     pub angle_types: Vec<TermType>,
     pub pair_rules: Vec<PairRule>,
 }
@@ -130,13 +132,22 @@ pub fn load_forcefield(
                 check_unique(&p.name, ff.particle_types.iter().map(|x| &x.name), "particle type")?;
                 ff.particle_types.push(p);
             }
-            "bond" | "angle" => {
+            "bond" => {
                 if t.len() < 3 {
-                    return Err(kw.error(format!("expected `{} NAME INTERACTION [param value]...`", kw.text)));
+                    return Err(kw.error("expected `bond NAME INTERACTION [param value]... [kinetics RULE [param value]...]...`"));
                 }
-                let (kind, list) = if kw.text == "bond" { (Kind::Bond, &mut ff.bond_types) } else { (Kind::Angle, &mut ff.angle_types) };
-                check_unique(&t[1], list.iter().map(|x| &x.label), &format!("{} type", kw.text))?;
-                list.push(parse_params(&t[1], &t[2], &t[3..], kind, units)?);
+                check_unique(&t[1], ff.bond_types.iter().map(|x| &x.label), "bond type")?;
+                let law_end = t.iter().position(|x| x.text == "kinetics").unwrap_or(t.len());
+                let law = parse_params(&t[1], &t[2], &t[3..law_end], Kind::Bond, units)?;
+                ff.bond_kinetics.push(parse_kinetics(&law, &t[law_end..], units)?);
+                ff.bond_types.push(law);
+            }
+            "angle" => {
+                if t.len() < 3 {
+                    return Err(kw.error("expected `angle NAME INTERACTION [param value]...`"));
+                }
+                check_unique(&t[1], ff.angle_types.iter().map(|x| &x.label), "angle type")?;
+                ff.angle_types.push(parse_params(&t[1], &t[2], &t[3..], Kind::Angle, units)?);
             }
             "pair" => {
                 if t.len() < 4 {

@@ -289,19 +289,21 @@ pub fn param_index(interaction: &dyn Interaction, name: &str) -> Option<usize> {
 
 /// Full documentation page of an interaction type (what `cellmd list NAME` prints).
 pub fn documentation(interaction: &dyn Interaction, units: crate::units::UnitSystem) -> String {
-    let mut page = format!(
-        "# {} ({})\n\n{}\n\n## Parameters\n\n| name | unit | allowed | default | meaning |\n|---|---|---|---|---|\n",
-        interaction.name(),
-        interaction.kind().keyword(),
-        interaction.summary()
-    );
-    for p in interaction.params() {
-        let default = p.default.map_or("required".to_string(), |d| d.to_string());
-        page += &format!("| `{}` | {} | {} | {} | {} |\n", p.name, units.label(p.dim), p.range_text(), default, p.doc);
-    }
+    let mut page = format!("# {} ({})\n\n{}\n\n", interaction.name(), interaction.kind().keyword(), interaction.summary());
+    page += &parameter_table(interaction.params(), units);
     page += "\n";
     page += interaction.doc();
     page
+}
+
+/// The `## Parameters` table of a schema, with units of `units`.
+pub fn parameter_table(params: &[ParamSpec], units: crate::units::UnitSystem) -> String {
+    let mut table = String::from("## Parameters\n\n| name | unit | allowed | default | meaning |\n|---|---|---|---|---|\n");
+    for p in params {
+        let default = p.default.map_or("required".to_string(), |d| d.to_string());
+        table += &format!("| `{}` | {} | {} | {} | {} |\n", p.name, units.label(p.dim), p.range_text(), default, p.doc);
+    }
+    table
 }
 
 #[cfg(test)]

@@ -64,6 +64,8 @@ pub const TOPIC_FRAME: &str = "/cellmd/frame";
 pub const TOPIC_BOND_STATE: &str = "/cellmd/bond_state";
 /// Topic of the Foxglove 3D scene.
 pub const TOPIC_SCENE: &str = "/scene";
+/// Bond kinetics events (`cellmd.BondEvents`), one message per step that has any.
+pub const TOPIC_EVENTS: &str = "/cellmd/events";
 
 /// Sphere radius drawn for types whose radius is 0 (length units).
 pub const DEFAULT_RADIUS: f64 = 0.05;
@@ -126,6 +128,24 @@ pub const FRAME_SCHEMA: &str = r#"{
 }"#;
 
 /// JSON Schema of `cellmd.BondState`.
+/// JSON Schema of `cellmd.BondEvents`: the events of one step (see `crate::kinetics::Event`).
+pub const BOND_EVENTS_SCHEMA: &str = r#"{
+  "title": "cellmd.BondEvents",
+  "type": "object",
+  "properties": {
+    "step": {"type": "integer"},
+    "time": {"type": "number"},
+    "events": {"type": "array", "items": {"type": "object", "properties": {
+      "step": {"type": "integer"}, "time": {"type": "number"},
+      "kind": {"type": "string", "enum": ["break", "rebind", "form", "reset"]},
+      "bond": {"type": "integer", "description": "bond index, topology order, new bonds appended"},
+      "bond_type": {"type": "string"},
+      "particles": {"type": "array", "items": {"type": "integer"}, "minItems": 2, "maxItems": 2},
+      "force": {"type": "number", "description": "tension dE/dr when decided"},
+      "length": {"type": "number"}}}}
+  }
+}"#;
+
 pub const BOND_STATE_SCHEMA: &str = r#"{
   "title": "cellmd.BondState",
   "description": "Which bonds of cellmd.Topology are currently bound",
@@ -224,6 +244,7 @@ pub struct McapWriter {
     channel_frame: u16,
     channel_bond_state: u16,
     channel_scene: u16,
+    channel_events: u16,
     /// Stamp of the previous frame (ns).
     last_frame_ns: Option<u64>,
     scene: bool,
@@ -277,12 +298,14 @@ impl McapWriter {
         let channel_frame = channel("cellmd.Frame", FRAME_SCHEMA, TOPIC_FRAME)?;
         let channel_bond_state = channel("cellmd.BondState", BOND_STATE_SCHEMA, TOPIC_BOND_STATE)?;
         let channel_scene = channel("foxglove.SceneUpdate", SCENE_UPDATE_SCHEMA, TOPIC_SCENE)?;
+        let channel_events = channel("cellmd.BondEvents", BOND_EVENTS_SCHEMA, TOPIC_EVENTS)?;
         Ok(Self {
             sink: Sink { writer, sequence: BTreeMap::new(), buffer: Vec::new() },
             channel_topology,
             channel_frame,
             channel_bond_state,
             channel_scene,
+            channel_events,
             last_frame_ns: None,
             scene: true,
             units: units_keyword(topology.units),
@@ -419,6 +442,22 @@ impl TrajectoryWriter for McapWriter {
         self.sink.publish(self.channel_frame, ns, &message)?;
         if self.scene {
             self.write_scene(ns, frame)?;
+        }
+        Ok(())
+    }
+
+    fn write_bond_events(&mut self, events: &[crate::kinetics::Event], bound: &[bool]) -> io::Result<()> {
+        let Some(first) = events.first() else { return Ok(()) };
+        #[derive(Serialize)]
+        struct BondEvents<'a> {
+            step: u64,
+            time: f64,
+            events: &'a [crate::kinetics::Event],
+        }
+        let ns = time_ns(first.time);
+        self.sink.publish(self.channel_events, ns, &BondEvents { step: first.step, time: first.time, events })?;
+        if bound.len() == self.bonds.len() {
+            self.write_bond_state(first.step, first.time, bound)?;
         }
         Ok(())
     }
@@ -620,6 +659,7 @@ mod tests {
             ("cellmd.Topology", TOPOLOGY_SCHEMA),
             ("cellmd.Frame", FRAME_SCHEMA),
             ("cellmd.BondState", BOND_STATE_SCHEMA),
+            ("cellmd.BondEvents", BOND_EVENTS_SCHEMA),
             ("foxglove.SceneUpdate", SCENE_UPDATE_SCHEMA),
         ] {
             let v: Value = serde_json::from_str(schema).unwrap_or_else(|e| panic!("{name}: {e}"));
@@ -640,7 +680,8 @@ mod tests {
         let summary = mcap::Summary::read(&bytes).unwrap().expect("summary section");
         let stats = summary.stats.expect("statistics");
         assert_eq!(stats.message_count, 1 + 1 + 3 + 3);
-        assert_eq!(summary.channels.len(), 4);
+        // topology, frame, bond state, scene and (empty here) bond events.
+        assert_eq!(summary.channels.len(), 5);
 
         let mut counts: BTreeMap<String, usize> = BTreeMap::new();
         let mut frame_stamps = Vec::new();

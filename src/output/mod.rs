@@ -91,6 +91,11 @@ pub trait TrajectoryWriter: Send {
     fn write_frame(&mut self, frame: &FrameView) -> io::Result<()>;
     /// Flushes and completes the file (MCAP writes its summary and footer here).
     fn finish(self: Box<Self>) -> io::Result<()>;
+    /// Records the bond events of one step and the bound flags after them.
+    /// Formats without a channel for them ignore this.
+    fn write_bond_events(&mut self, _events: &[crate::kinetics::Event], _bound: &[bool]) -> io::Result<()> {
+        Ok(())
+    }
 }
 
 /// The trajectory formats a deck can ask for.

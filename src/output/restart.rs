@@ -65,9 +65,9 @@ pub struct RestartData {
     pub ids: Vec<u64>,
     pub positions: Vec<DVec3>,
     pub images: Vec<[i32; 3]>,
-    /// Per-bond stateful parameters (reserved; may be empty).
+    /// Bond state (bound, age, rest length, scale) when bonds have kinetics.
     #[serde(default)]
-    pub bond_params: Vec<Vec<f64>>,
+    pub bonds: Option<crate::kinetics::BondState>,
 }
 
 impl RestartData {
@@ -81,13 +81,19 @@ impl RestartData {
             ids: ids.to_vec(),
             positions: state.positions.clone(),
             images: state.images.clone(),
-            bond_params: Vec::new(),
+            bonds: state.bonds.clone(),
         }
     }
 
     /// The [`State`] to continue from.
     pub fn to_state(&self) -> State {
-        State { step: self.step, time: self.time, positions: self.positions.clone(), images: self.images.clone() }
+        State {
+            step: self.step,
+            time: self.time,
+            positions: self.positions.clone(),
+            images: self.images.clone(),
+            bonds: self.bonds.clone(),
+        }
     }
 
     /// Checks that the restart belongs to a topology with these ids, in this order.
@@ -126,7 +132,7 @@ pub fn write_state(path: &Path, data: &RestartData) -> Result<(), String> {
         && data.positions.iter().all(|x| x.is_finite())
         && data.sim_box.lo.is_finite()
         && data.sim_box.hi.is_finite()
-        && data.bond_params.iter().flatten().all(|v| v.is_finite());
+        && data.bonds.as_ref().is_none_or(|b| b.age.iter().chain(&b.scale).chain(b.rest.iter().flatten()).all(|v| v.is_finite()));
     if !finite {
         return Err(format!("cannot write restart file '{}': the state contains a non-finite number", path.display()));
     }
@@ -226,7 +232,12 @@ mod tests {
                 DVec3::new(std::f64::consts::PI, 1e22, 9007199254740993.0),
             ],
             images: vec![[0, 0, 0], [-1, 2, 0], [i32::MIN, i32::MAX, 3]],
-            bond_params: vec![vec![0.8, 1e-17], vec![]],
+            bonds: Some(crate::kinetics::BondState {
+                bound: vec![true, false],
+                age: vec![0.1 + 0.2, 5e-324],
+                rest: vec![Some(0.8), None],
+                scale: vec![1e-17, 1.0],
+            }),
         }
     }
 
@@ -237,7 +248,10 @@ mod tests {
         for x in &d.positions {
             v.extend(x.to_array().map(f64::to_bits));
         }
-        v.extend(d.bond_params.iter().flatten().map(|x| x.to_bits()));
+        if let Some(b) = &d.bonds {
+            v.extend(b.age.iter().chain(&b.scale).chain(b.rest.iter().flatten()).map(|x| x.to_bits()));
+            v.extend(b.bound.iter().map(|&x| x as u64));
+        }
         v
     }
 

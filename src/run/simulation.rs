@@ -11,6 +11,7 @@ use crate::backend::{CpuBackend, Forces};
 use crate::deck::{Action, CoeffTarget, DumpSpec, NeighborSettings, Plan};
 use crate::integrate::fire::{fire_minimize, FireReport, FireSettings};
 use crate::integrate::overdamped::{overdamped_step, Blowup, OverdampedSettings};
+use crate::kinetics::{initial_bond_state, EventLog, Kinetics};
 use crate::output::restart::{read_state, write_state, RestartData};
 use crate::output::{open_writer, FrameView, TopologyView, TrajectoryWriter};
 use crate::system::{Model, SimBox, State};
@@ -54,6 +55,9 @@ pub struct Simulation {
     forces_current: bool,
     thermo: Thermo,
     dumps: Vec<ActiveDump>,
+    /// Bond kinetics: event counts and the CSV event log.
+    pub kinetics: Kinetics,
+    event_log: Option<EventLog>,
     options: RunOptions,
     deck_stem: String,
     scratch: Vec<DVec3>,
@@ -68,9 +72,10 @@ impl Simulation {
         for (x, image) in state.positions.iter_mut().zip(state.images.iter_mut()) {
             plan.sim_box.wrap(x, image);
         }
+        state.bonds = initial_bond_state(&plan.model);
         let deck_stem = plan.deck_path.file_stem().map_or("cellmd".into(), |s| s.to_string_lossy().into_owned());
         Self {
-            thermo: Thermo::new(plan.model.units),
+            thermo: Thermo::new(&plan.model),
             model: plan.model.clone(),
             state,
             sim_box: plan.sim_box,
@@ -83,6 +88,8 @@ impl Simulation {
             backend: None,
             forces_current: false,
             dumps: Vec::new(),
+            kinetics: Kinetics::default(),
+            event_log: None,
             options,
             deck_stem,
             scratch: Vec::new(),
@@ -127,7 +134,14 @@ impl Simulation {
             }
             Action::Thermo { every, columns } => {
                 self.thermo.every = *every;
-                self.thermo.columns = columns.clone();
+                self.thermo.set_columns(columns.clone(), &self.model);
+            }
+            Action::EventFile(path) => {
+                let path = self.output_path(path);
+                let file = std::fs::File::create(&path).map_err(|e| RunError::Io(format!("{}: {e}", path.display())))?;
+                if let Some(old) = self.event_log.replace(EventLog::create(file, self.model.units)?) {
+                    old.finish()?;
+                }
             }
             Action::ThermoFile(path) => {
                 let path = self.output_path(path);
@@ -211,6 +225,9 @@ impl Simulation {
         }
         self.sim_box = data.sim_box;
         self.state = data.to_state();
+        if self.state.bonds.is_none() {
+            self.state.bonds = initial_bond_state(&self.model);
+        }
         self.backend = None;
         self.forces_current = false;
         Ok(())
@@ -281,7 +298,12 @@ impl Simulation {
         }
         let due = self.thermo.every > 0 && step.is_multiple_of(self.thermo.every);
         if due || force_thermo {
+            let (bond_tension, _) = self.backend.as_ref().expect("backend built").bond_tension_and_length();
             let inputs = ThermoInputs {
+                model: &self.model,
+                bonds: self.state.bonds.as_ref(),
+                bond_tension,
+                kinetics: &self.kinetics,
                 step,
                 time: self.state.time,
                 forces: &self.forces,
@@ -301,6 +323,7 @@ impl Simulation {
 
     /// `run N`: N overdamped steps.
     pub fn run(&mut self, steps: u64) -> Result<(), RunError> {
+        self.check_kinetics_temperature()?;
         self.ensure_forces()?;
         let bar = (self.options.progress && steps >= 1000).then(|| {
             let bar = ProgressBar::new(steps);
@@ -331,11 +354,18 @@ impl Simulation {
                     format!("displacement {displacement:e} in one step exceeds max_displacement {:e}", self.integrator.max_displacement);
                 return Err(self.blowup(particle, what));
             }
-            if self.state.step.is_multiple_of(self.neighbor.every) {
-                let backend = self.backend.as_mut().expect("backend built");
-                backend.update_neighbors(&self.state, &self.sim_box, self.neighbor.check).map_err(RunError::Setup)?;
+            if self.state.bonds.is_some() {
+                self.kinetics_step()?;
             }
-            self.compute_forces()?;
+            match self.backend.as_mut() {
+                Some(backend) => {
+                    if self.state.step.is_multiple_of(self.neighbor.every) {
+                        backend.update_neighbors(&self.state, &self.sim_box, self.neighbor.check).map_err(RunError::Setup)?;
+                    }
+                    self.compute_forces()?;
+                }
+                None => self.ensure_forces()?,
+            }
             let final_step = self.state.step == last;
             self.outputs_at_step(&bar, final_step && (self.thermo.every == 0 || !self.state.step.is_multiple_of(self.thermo.every)))?;
             if let Some(b) = &bar {
@@ -346,6 +376,48 @@ impl Simulation {
             b.finish_and_clear();
         }
         self.thermo.flush()?;
+        Ok(())
+    }
+
+    /// Bond kinetics of the step just integrated, decided from the tensions of
+    /// its force pass; a break or rebind rebuilds exclusions (and the backend).
+    fn kinetics_step(&mut self) -> Result<(), RunError> {
+        let step = self.state.step - 1;
+        let backend = self.backend.as_ref().expect("backend built");
+        let (tension, length) = backend.bond_tension_and_length();
+        let report = self.kinetics.step(&self.model, &mut self.state, tension, length, step, self.dt, self.kt, self.seed);
+        for warning in &report.warnings {
+            eprintln!("{warning}");
+        }
+        if !report.events.is_empty() {
+            if let Some(log) = &mut self.event_log {
+                log.write(&report.events)?;
+            }
+            let bound = &self.state.bonds.as_ref().expect("kinetics has bond state").bound;
+            for dump in &mut self.dumps {
+                dump.writer.write_bond_events(&report.events, bound)?;
+            }
+        }
+        if report.bonds_changed {
+            self.backend = None;
+        }
+        Ok(())
+    }
+
+    /// Rules whose rates depend on kT refuse to run at T = 0.
+    fn check_kinetics_temperature(&self) -> Result<(), RunError> {
+        if self.kt > 0.0 {
+            return Ok(());
+        }
+        for (t, kinetics) in self.model.bond_kinetics.iter().enumerate() {
+            if let Some(rule) = kinetics.rules.iter().find(|r| r.rule.needs_temperature()) {
+                return Err(RunError::Setup(format!(
+                    "bond type `{}`: kinetic rule `{}` has rates that depend on kT; expected a `temperature` > 0",
+                    self.model.bond_types[t].label.text,
+                    rule.rule.name()
+                )));
+            }
+        }
         Ok(())
     }
 
@@ -386,6 +458,11 @@ impl Simulation {
         }
         if let Err(e) = self.thermo.close() {
             first_error.get_or_insert(RunError::Io(e.to_string()));
+        }
+        if let Some(log) = self.event_log.take() {
+            if let Err(e) = log.finish() {
+                first_error.get_or_insert(RunError::Io(e.to_string()));
+            }
         }
         first_error.map_or(Ok(()), Err)
     }

@@ -13,6 +13,9 @@
 //! | `fnorm` | √(Σ|F|²) | pN |
 //! | `press`, `pxx` … `pyz` | pressure tensor P = (N·kT/V)·I + W/V | Pa |
 //! | `nbuild` | neighbour-list builds so far | – |
+//! | `breaks`, `rebinds`, `forms`, `resets` | bond events so far | – |
+//! | `nbound/TYPE` | bound bonds of bond type TYPE | – |
+//! | `tension/TYPE` | summed tension of TYPE's bound bonds (clutch traction) | pN |
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -24,6 +27,11 @@ use crate::units::{Dim, UnitSystem};
 
 /// Values a thermo row is made from.
 pub struct ThermoInputs<'a> {
+    pub model: &'a crate::system::Model,
+    pub bonds: Option<&'a crate::kinetics::BondState>,
+    /// Per-bond tension of the last force pass.
+    pub bond_tension: &'a [f64],
+    pub kinetics: &'a crate::kinetics::Kinetics,
     pub step: u64,
     pub time: f64,
     pub forces: &'a Forces,
@@ -33,7 +41,8 @@ pub struct ThermoInputs<'a> {
     pub neighbor_builds: u64,
 }
 
-pub fn column_name(c: &ThermoColumn) -> String {
+/// A column's header name (bond-type columns name their type).
+pub fn column_label(c: &ThermoColumn, model: &crate::system::Model) -> String {
     match c {
         ThermoColumn::Step => "step".into(),
         ThermoColumn::Time => "time".into(),
@@ -44,12 +53,16 @@ pub fn column_name(c: &ThermoColumn) -> String {
         ThermoColumn::Press => "press".into(),
         ThermoColumn::Pressure(k) => ["pxx", "pyy", "pzz", "pxy", "pxz", "pyz"][*k].into(),
         ThermoColumn::Nbuild => "nbuild".into(),
+        ThermoColumn::Events(kind) => format!("{}s", kind.name()),
+        ThermoColumn::Bound(t) => format!("nbound/{}", model.bond_types[*t].label.text),
+        ThermoColumn::Tension(t) => format!("tension/{}", model.bond_types[*t].label.text),
     }
 }
 
 pub fn column_unit(c: &ThermoColumn, units: UnitSystem) -> &'static str {
     match c {
-        ThermoColumn::Step | ThermoColumn::Nbuild => "-",
+        ThermoColumn::Step | ThermoColumn::Nbuild | ThermoColumn::Events(_) | ThermoColumn::Bound(_) => "-",
+        ThermoColumn::Tension(_) => units.label(Dim::Force),
         ThermoColumn::Time => units.label(Dim::Time),
         ThermoColumn::Pe | ThermoColumn::PeOf(_) => units.label(Dim::Energy),
         ThermoColumn::Fmax | ThermoColumn::Fnorm => units.label(Dim::Force),
@@ -71,17 +84,27 @@ pub fn column_value(c: &ThermoColumn, t: &ThermoInputs) -> f64 {
         ThermoColumn::Press => ideal + (w[0] + w[1] + w[2]) / (3.0 * t.volume),
         ThermoColumn::Pressure(k) => (if *k < 3 { ideal } else { 0.0 }) + w[*k] / t.volume,
         ThermoColumn::Nbuild => t.neighbor_builds as f64,
+        ThermoColumn::Events(kind) => t.kinetics.count(*kind) as f64,
+        ThermoColumn::Bound(ty) => bonds_of_type(t, *ty).count() as f64,
+        ThermoColumn::Tension(ty) => bonds_of_type(t, *ty).map(|b| t.bond_tension[b]).sum(),
     }
 }
 
+/// Indices of the bound bonds of a bond type.
+fn bonds_of_type<'a>(t: &'a ThermoInputs, ty: usize) -> impl Iterator<Item = usize> + 'a {
+    (0..t.model.bonds.len()).filter(move |&b| t.model.bond_type[b] as usize == ty && t.bonds.is_none_or(|s| s.bound[b]))
+}
+
 fn is_integer(c: &ThermoColumn) -> bool {
-    matches!(c, ThermoColumn::Step | ThermoColumn::Nbuild)
+    matches!(c, ThermoColumn::Step | ThermoColumn::Nbuild | ThermoColumn::Events(_) | ThermoColumn::Bound(_))
 }
 
 /// Thermo state of a running deck.
 pub struct Thermo {
     pub every: u64,
-    pub columns: Vec<ThermoColumn>,
+    columns: Vec<ThermoColumn>,
+    /// Header name of each column.
+    labels: Vec<String>,
     pub units: UnitSystem,
     file: Option<BufWriter<File>>,
     file_header_written: bool,
@@ -90,19 +113,25 @@ pub struct Thermo {
 /// Minimum column width on stdout; longer names widen their column.
 const WIDTH: usize = 14;
 
-fn width(c: &ThermoColumn) -> usize {
-    WIDTH.max(column_name(c).chars().count() + 2)
-}
-
 impl Thermo {
-    pub fn new(units: UnitSystem) -> Self {
-        Self {
-            every: 0,
-            columns: vec![ThermoColumn::Step, ThermoColumn::Time, ThermoColumn::Pe, ThermoColumn::Fmax, ThermoColumn::Press],
-            units,
-            file: None,
-            file_header_written: false,
+    pub fn new(model: &crate::system::Model) -> Self {
+        let mut thermo =
+            Self { every: 0, columns: Vec::new(), labels: Vec::new(), units: model.units, file: None, file_header_written: false };
+        thermo.set_columns(vec![ThermoColumn::Step, ThermoColumn::Time, ThermoColumn::Pe, ThermoColumn::Fmax, ThermoColumn::Press], model);
+        thermo
+    }
+
+    /// New columns; a CSV file gets a new header line before its next row.
+    pub fn set_columns(&mut self, columns: Vec<ThermoColumn>, model: &crate::system::Model) {
+        if columns != self.columns {
+            self.file_header_written = false;
         }
+        self.labels = columns.iter().map(|c| column_label(c, model)).collect();
+        self.columns = columns;
+    }
+
+    fn width(&self, k: usize) -> usize {
+        WIDTH.max(self.labels[k].chars().count() + 2)
     }
 
     pub fn set_file(&mut self, file: File) -> std::io::Result<()> {
@@ -114,25 +143,30 @@ impl Thermo {
 
     /// The two header lines (names, then units) for stdout.
     pub fn header(&self) -> String {
-        let names: String = self.columns.iter().map(|c| format!("{:>w$}", column_name(c), w = width(c))).collect();
-        let units: String =
-            self.columns.iter().map(|c| format!("{:>w$}", format!("[{}]", column_unit(c, self.units)), w = width(c))).collect();
+        let names: String = (0..self.columns.len()).map(|k| format!("{:>w$}", self.labels[k], w = self.width(k))).collect();
+        let units: String = (0..self.columns.len())
+            .map(|k| format!("{:>w$}", format!("[{}]", column_unit(&self.columns[k], self.units)), w = self.width(k)))
+            .collect();
         format!("{names}\n{units}")
     }
 
     /// A row for stdout; also appended to the CSV file when one is set.
     pub fn row(&mut self, inputs: &ThermoInputs) -> std::io::Result<String> {
         let values: Vec<f64> = self.columns.iter().map(|c| column_value(c, inputs)).collect();
-        let line: String = self
-            .columns
-            .iter()
-            .zip(&values)
-            .map(|(c, v)| if is_integer(c) { format!("{:>w$}", *v as u64, w = width(c)) } else { format!("{:>w$.6e}", v, w = width(c)) })
+        let line: String = (0..self.columns.len())
+            .map(|k| {
+                let w = self.width(k);
+                if is_integer(&self.columns[k]) {
+                    format!("{:>w$}", values[k] as u64)
+                } else {
+                    format!("{:>w$.6e}", values[k])
+                }
+            })
             .collect();
         if let Some(file) = &mut self.file {
             if !self.file_header_written {
                 let header: Vec<String> =
-                    self.columns.iter().map(|c| format!("{}[{}]", column_name(c), column_unit(c, self.units))).collect();
+                    self.columns.iter().zip(&self.labels).map(|(c, l)| format!("{l}[{}]", column_unit(c, self.units))).collect();
                 writeln!(file, "{}", header.join(","))?;
                 self.file_header_written = true;
             }

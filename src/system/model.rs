@@ -3,7 +3,7 @@
 //! Built from a parsed topology and force field; every name is resolved here,
 //! so an unknown type is reported at its position in the topology file.
 
-use crate::forcefield::{ForceField, TermType};
+use crate::forcefield::{BondTypeKinetics, ForceField, TermType};
 use crate::input::{InputError, Token};
 use crate::interactions::{Law, REGISTRY};
 use crate::topology::Topology;
@@ -48,6 +48,8 @@ pub struct Model {
     /// Radius per particle type (0 if not given).
     pub type_radius: Vec<f64>,
     pub bond_types: Vec<TermType>,
+    /// Kinetic rules of each bond type (same order as `bond_types`).
+    pub bond_kinetics: Vec<BondTypeKinetics>,
     pub bonds: Vec<[u32; 2]>,
     pub bond_type: Vec<u32>,
     pub angle_types: Vec<TermType>,
@@ -112,6 +114,7 @@ impl Model {
             type_radius: ff.particle_types.iter().map(|t| t.radius).collect(),
             type_names,
             bond_types: ff.bond_types.clone(),
+            bond_kinetics: ff.bond_kinetics.clone(),
             bonds: topology.bonds.iter().map(|b| b.particles).collect(),
             bond_type,
             angle_types: ff.angle_types.clone(),
@@ -135,6 +138,25 @@ impl Model {
         self.ids.is_empty()
     }
 
+    /// Whether any bond type has kinetic rules (bonds then carry state).
+    pub fn has_kinetics(&self) -> bool {
+        self.bond_kinetics.iter().any(|k| !k.rules.is_empty())
+    }
+
+    /// The initial rest length of bonds of a type whose rules evolve it
+    /// (motor, ratchet, plastic); `None` when the type's `r0` always applies.
+    pub fn evolving_rest_length(&self, bond_type: usize) -> Option<f64> {
+        let kinetics = &self.bond_kinetics[bond_type];
+        let evolves = kinetics.rules.iter().any(|r| r.rule.needs_rest_length());
+        kinetics.rest_index.filter(|_| evolves).map(|k| self.bond_types[bond_type].params[k])
+    }
+
+    /// The rest length bond `b` has now (NaN if its law has none).
+    pub fn rest_length(&self, b: usize, bonds: &crate::kinetics::BondState) -> f64 {
+        let t = self.bond_type[b] as usize;
+        bonds.rest[b].or_else(|| self.bond_kinetics[t].rest_index.map(|k| self.bond_types[t].params[k])).unwrap_or(f64::NAN)
+    }
+
     /// Pair rules acting between particle types `a` and `b`.
     #[inline]
     pub fn pair_rules_between(&self, a: u32, b: u32) -> &[u32] {
@@ -152,11 +174,15 @@ impl Model {
             .fold(0.0, f64::max)
     }
 
-    /// Pairs excluded from pair interactions by `special_bonds` (i < j).
-    pub fn excluded_pairs(&self) -> Vec<(u32, u32)> {
+    /// Pairs excluded from pair interactions by `special_bonds` (i < j),
+    /// following the bonds that are bound (`bound` = None: all of them).
+    pub fn excluded_pairs(&self, bound: Option<&[bool]>) -> Vec<(u32, u32)> {
         let n = self.len();
         let mut adjacency: Vec<Vec<u32>> = vec![Vec::new(); n];
-        for &[i, j] in &self.bonds {
+        for (b, &[i, j]) in self.bonds.iter().enumerate() {
+            if bound.is_some_and(|bound| !bound[b]) {
+                continue;
+            }
             adjacency[i as usize].push(j);
             adjacency[j as usize].push(i);
         }
@@ -242,12 +268,12 @@ mod tests {
     #[test]
     fn special_bonds_follow_the_bond_graph() {
         let only_12 = SpecialBonds::default();
-        assert_eq!(one_based(model(only_12).excluded_pairs()), vec![(1, 2), (2, 3), (3, 4), (3, 6), (4, 5)]);
+        assert_eq!(one_based(model(only_12).excluded_pairs(None)), vec![(1, 2), (2, 3), (3, 4), (3, 6), (4, 5)]);
         let only_13 = SpecialBonds { exclude_12: false, exclude_13: true, exclude_14: false };
-        assert_eq!(one_based(model(only_13).excluded_pairs()), vec![(1, 3), (2, 4), (2, 6), (3, 5), (4, 6)]);
+        assert_eq!(one_based(model(only_13).excluded_pairs(None)), vec![(1, 3), (2, 4), (2, 6), (3, 5), (4, 6)]);
         let only_14 = SpecialBonds { exclude_12: false, exclude_13: false, exclude_14: true };
-        assert_eq!(one_based(model(only_14).excluded_pairs()), vec![(1, 4), (1, 6), (2, 5), (5, 6)]);
+        assert_eq!(one_based(model(only_14).excluded_pairs(None)), vec![(1, 4), (1, 6), (2, 5), (5, 6)]);
         let none = SpecialBonds { exclude_12: false, exclude_13: false, exclude_14: false };
-        assert!(model(none).excluded_pairs().is_empty());
+        assert!(model(none).excluded_pairs(None).is_empty());
     }
 }

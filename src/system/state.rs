@@ -14,12 +14,15 @@ pub struct State {
     pub time: f64,
     pub positions: Vec<DVec3>,
     pub images: Vec<[i32; 3]>,
+    /// Bond state, when some bond type has kinetic rules.
+    #[serde(default)]
+    pub bonds: Option<crate::kinetics::BondState>,
 }
 
 impl State {
     pub fn new(positions: Vec<DVec3>) -> Self {
         let images = vec![[0; 3]; positions.len()];
-        Self { step: 0, time: 0.0, positions, images }
+        Self { step: 0, time: 0.0, positions, images, bonds: None }
     }
 
     pub fn len(&self) -> usize {

@@ -1,0 +1,214 @@
+//! The per-step kinetics engine: decide every bond's state change from the
+//! force it carried, then apply all changes together.
+//!
+//! Order within a time step s (one force pass per step):
+//! 1. forces F(x_s) with bond state S_s, tensions and lengths recorded per bond;
+//! 2. the integrator moves x_s → x_{s+1};
+//! 3. [`Kinetics::step`] decides, from the tensions of pass 1 and random
+//!    numbers keyed by (seed, s, bond index), every break, rebind and reset,
+//!    advances ages, rest lengths (motor, ratchet) and maturation scales, and
+//!    applies them together: S_s → S_{s+1};
+//! 4. the next force pass sees S_{s+1}.
+//!
+//! Decisions are computed in parallel per bond and applied in bond order, so
+//! a run is bit-identical on any thread count and across restarts.
+
+use rayon::prelude::*;
+
+use super::events::{Event, EventKind};
+use super::state::BondState;
+use super::Effect;
+use crate::integrate::rng::block;
+use crate::system::{Model, State};
+
+/// Philox stream of per-step kinetic decisions.
+const STREAM_KINETICS: u32 = 2;
+/// Philox stream of quenched per-bond disorder (threshold spread).
+const STREAM_QUENCHED: u32 = 3;
+/// k·dt above which a step is too coarse to resolve a bond's lifetime.
+const COARSE_RATE_DT: f64 = 0.1;
+
+fn uniform(x: u32) -> f64 {
+    (x as f64 + 0.5) / 4_294_967_296.0
+}
+
+/// The bond state at the start of a deck: every bond bound, age 0, rest
+/// lengths from the types that evolve them, maturation scale at age 0.
+pub fn initial_bond_state(model: &Model) -> Option<BondState> {
+    if !model.has_kinetics() {
+        return None;
+    }
+    let mut state = BondState::new(model.bond_type.iter().map(|&t| model.evolving_rest_length(t as usize)).collect());
+    for (b, &t) in model.bond_type.iter().enumerate() {
+        state.scale[b] = maturation_scale(model, t as usize, 0.0);
+    }
+    Some(state)
+}
+
+fn maturation_scale(model: &Model, bond_type: usize, age: f64) -> f64 {
+    model.bond_kinetics[bond_type].rules.iter().fold(1.0, |s, r| match r.rule.effect() {
+        Effect::Maturation(f) => s * f(&r.params, age),
+        _ => s,
+    })
+}
+
+/// What one bond does this step.
+#[derive(Clone, Copy, Debug, Default)]
+struct Outcome {
+    event: Option<EventKind>,
+    rest: Option<f64>,
+    scale: f64,
+    age: f64,
+    /// k·dt of the unbinding rate, for the coarse-step warning.
+    rate_dt: f64,
+}
+
+/// Results of one kinetics step.
+#[derive(Clone, Debug, Default)]
+pub struct KineticsReport {
+    pub events: Vec<Event>,
+    /// A bond broke or (re)bound: exclusions and neighbour lists must be rebuilt.
+    pub bonds_changed: bool,
+    /// One-time warnings (coarse time step).
+    pub warnings: Vec<String>,
+}
+
+/// Cumulative event counts and warning memory.
+#[derive(Clone, Debug, Default)]
+pub struct Kinetics {
+    pub breaks: u64,
+    pub rebinds: u64,
+    pub resets: u64,
+    pub forms: u64,
+    warned: Vec<bool>,
+}
+
+impl Kinetics {
+    /// Events of one kind so far.
+    pub fn count(&self, kind: EventKind) -> u64 {
+        match kind {
+            EventKind::Break => self.breaks,
+            EventKind::Rebind => self.rebinds,
+            EventKind::Form => self.forms,
+            EventKind::Reset => self.resets,
+        }
+    }
+
+    /// Decides and applies the state changes of step `state.step − 1` (the
+    /// step whose forces produced `tension` and `length`).
+    #[allow(clippy::too_many_arguments)]
+    pub fn step(
+        &mut self,
+        model: &Model,
+        state: &mut State,
+        tension: &[f64],
+        length: &[f64],
+        step: u64,
+        dt: f64,
+        kt: f64,
+        seed: u64,
+    ) -> KineticsReport {
+        let mut report = KineticsReport::default();
+        let Some(bonds) = state.bonds.as_mut() else { return report };
+        self.warned.resize(model.bond_types.len(), false);
+        let outcomes: Vec<Outcome> =
+            (0..bonds.len()).into_par_iter().map(|b| decide(model, bonds, b, tension[b], length[b], step, dt, kt, seed)).collect();
+        for (b, o) in outcomes.iter().enumerate() {
+            let t = model.bond_type[b] as usize;
+            if o.rate_dt > COARSE_RATE_DT && !self.warned[t] {
+                self.warned[t] = true;
+                report.warnings.push(format!(
+                    "warning: step {step}: bond type `{}` has k_off·dt = {:.3} > {COARSE_RATE_DT}: lifetimes shorter than ~10 steps are not resolved; reduce the timestep",
+                    model.bond_types[t].label.text, o.rate_dt
+                ));
+            }
+            bonds.rest[b] = o.rest;
+            bonds.scale[b] = o.scale;
+            bonds.age[b] = o.age;
+            let Some(kind) = o.event else { continue };
+            match kind {
+                EventKind::Break => {
+                    bonds.bound[b] = false;
+                    self.breaks += 1;
+                }
+                EventKind::Rebind => {
+                    bonds.bound[b] = true;
+                    self.rebinds += 1;
+                }
+                EventKind::Reset => self.resets += 1,
+                EventKind::Form => self.forms += 1,
+            }
+            report.bonds_changed |= kind != EventKind::Reset;
+            let [i, j] = model.bonds[b];
+            report.events.push(Event {
+                step,
+                time: step as f64 * dt,
+                kind,
+                bond: b,
+                bond_type: model.bond_types[t].label.text.clone(),
+                particles: [model.ids[i as usize], model.ids[j as usize]],
+                force: tension[b],
+                length: length[b],
+            });
+        }
+        report
+    }
+}
+
+/// One bond's decision: a pure function of its state, force and random numbers.
+#[allow(clippy::too_many_arguments)]
+fn decide(model: &Model, bonds: &BondState, b: usize, force: f64, length: f64, step: u64, dt: f64, kt: f64, seed: u64) -> Outcome {
+    let t = model.bond_type[b] as usize;
+    let mut out = Outcome { event: None, rest: bonds.rest[b], scale: bonds.scale[b], age: bonds.age[b], rate_dt: 0.0 };
+    let rules = &model.bond_kinetics[t].rules;
+    if rules.is_empty() {
+        return out;
+    }
+    let u = uniform(block(seed, step, b as u32, STREAM_KINETICS)[0]);
+    if !bonds.bound[b] {
+        for r in rules {
+            if let Effect::Rebind(on) = r.rule.effect() {
+                let (k_on, capture) = on(&r.params);
+                if length < capture && u < -(-k_on * dt).exp_m1() {
+                    out.event = Some(EventKind::Rebind);
+                    out.age = 0.0;
+                    out.scale = maturation_scale(model, t, 0.0);
+                }
+            }
+        }
+        return out;
+    }
+    let rest = model.rest_length(b, bonds);
+    let strain = if rest > 0.0 { (length - rest) / rest } else { 0.0 };
+    let mut rate = 0.0;
+    let mut immediate = false;
+    for r in rules {
+        let p = &r.params;
+        match r.rule.effect() {
+            Effect::Unbind(k) => rate += k(p, force, kt),
+            Effect::Threshold(beyond) => {
+                let quenched = uniform(block(seed, u64::MAX, b as u32, STREAM_QUENCHED)[0]);
+                match beyond(p, force, strain, quenched) {
+                    Some(r) if r.is_infinite() => immediate = true,
+                    Some(r) => rate += r,
+                    None => {}
+                }
+            }
+            Effect::RestLengthRate(v) => out.rest = Some((out.rest.unwrap_or(rest) + v(p, force, kt) * dt).max(0.0)),
+            Effect::PlasticReset(threshold) => {
+                if strain.abs() > threshold(p) {
+                    out.rest = Some(length);
+                    out.event = Some(EventKind::Reset);
+                }
+            }
+            Effect::Maturation(_) | Effect::Rebind(_) => {}
+        }
+    }
+    out.rate_dt = rate * dt;
+    if immediate || (rate > 0.0 && u < -(-rate * dt).exp_m1()) {
+        out.event = Some(EventKind::Break);
+    }
+    out.age += dt;
+    out.scale = maturation_scale(model, t, out.age);
+    out
+}

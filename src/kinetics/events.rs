@@ -1,0 +1,90 @@
+//! Bond events and the plain-text event log.
+//!
+//! The CSV event file (`events FILE` in a deck) has one row per event:
+//! `step,time[s],event,bond,type,i,j,force[pN],length[µm]` — `event` is
+//! `break`, `rebind`, `form` or `reset`, `bond` the bond's index (0-based, in
+//! topology order, new bonds appended), `i j` the particle ids, `force` the
+//! tension the bond carried (dE/dr, positive when stretched) and `length` its
+//! length when the event was decided.
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+
+use crate::units::{Dim, UnitSystem};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum EventKind {
+    Break,
+    Rebind,
+    Form,
+    Reset,
+}
+
+impl EventKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            EventKind::Break => "break",
+            EventKind::Rebind => "rebind",
+            EventKind::Form => "form",
+            EventKind::Reset => "reset",
+        }
+    }
+}
+
+/// One state change of one bond.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Event {
+    pub step: u64,
+    pub time: f64,
+    pub kind: EventKind,
+    pub bond: usize,
+    pub bond_type: String,
+    /// Particle ids.
+    pub particles: [u64; 2],
+    pub force: f64,
+    pub length: f64,
+}
+
+/// The CSV event file.
+pub struct EventLog {
+    out: BufWriter<File>,
+}
+
+impl EventLog {
+    pub fn create(file: File, units: UnitSystem) -> std::io::Result<Self> {
+        let mut out = BufWriter::new(file);
+        writeln!(
+            out,
+            "step,time[{}],event,bond,type,i,j,force[{}],length[{}]",
+            units.label(Dim::Time),
+            units.label(Dim::Force),
+            units.label(Dim::Length)
+        )?;
+        Ok(Self { out })
+    }
+
+    pub fn write(&mut self, events: &[Event]) -> std::io::Result<()> {
+        for e in events {
+            writeln!(
+                self.out,
+                "{},{:e},{},{},{},{},{},{:e},{:e}",
+                e.step,
+                e.time,
+                e.kind.name(),
+                e.bond,
+                e.bond_type,
+                e.particles[0],
+                e.particles[1],
+                e.force,
+                e.length
+            )?;
+        }
+        Ok(())
+    }
+
+    pub fn finish(mut self) -> std::io::Result<()> {
+        self.out.flush()?;
+        self.out.get_ref().sync_data()
+    }
+}

@@ -1,0 +1,181 @@
+//! Force-dependent bond kinetics: stateful bonds that break, rebind, slide,
+//! mature and yield according to the force they carry.
+//!
+//! A bond type combines a mechanical law (any registered bond interaction)
+//! with zero or more **kinetic rules**, written after `kinetics` on its
+//! force-field line:
+//!
+//! ```text
+//! bond clutch harmonic k 1 r0 0.02 kinetics catch_slip kc0 10 xc 0.002 ks0 0.1 xs 0.001 kinetics rebind k_on 5 capture 0.05
+//! ```
+//!
+//! Each bond then carries state ([`BondState`]): bound or not, its age since
+//! formation, its current rest length and a stiffness scale. After every force
+//! pass the [`Kinetics`] engine reads each bond's tension F (= dE/dr, positive
+//! when stretched) and length, decides every state change with counter-based
+//! random numbers keyed by (seed, step, bond index), queues the events, and
+//! applies them together; the run loop then recomputes the forces. A bond
+//! survives a step at rate k(F) with the exact probability exp(−k·dt); when
+//! k·dt > 0.1 the step is too coarse to resolve the bond's lifetime, and a
+//! warning is printed once per bond type.
+//!
+//! Rules are registered in [`RULES`], one file each, with the same
+//! documentation layout as interactions (`cellmd list NAME`).
+
+use crate::interactions::ParamSpec;
+
+mod engine;
+mod events;
+mod state;
+
+mod cadherin;
+mod catch_slip;
+mod maturation;
+mod motor;
+mod plastic;
+mod ratchet;
+mod rebind;
+mod slip;
+mod threshold;
+
+pub use self::engine::{initial_bond_state, Kinetics, KineticsReport};
+pub use self::events::{Event, EventKind, EventLog};
+pub use self::state::BondState;
+
+/// Every registered kinetic rule.
+pub static RULES: &[&dyn KineticRule] = &[
+    &slip::Slip,
+    &catch_slip::CatchSlip,
+    &cadherin::Cadherin,
+    &threshold::Threshold,
+    &rebind::Rebind,
+    &maturation::Maturation,
+    &plastic::Plastic,
+    &motor::Motor,
+    &ratchet::Ratchet,
+];
+
+/// Looks a kinetic rule up by name.
+pub fn lookup_rule(name: &str) -> Option<&'static dyn KineticRule> {
+    RULES.iter().copied().find(|r| r.name() == name)
+}
+
+/// What a rule does to a bond, with its evaluator.
+#[derive(Clone, Copy)]
+pub enum Effect {
+    /// A bound bond breaks at rate k_off(F, kT) (per time unit).
+    Unbind(fn(&[f64], f64, f64) -> f64),
+    /// Beyond its threshold a bound bond breaks at the returned rate
+    /// (infinite: at once); `None` below it. Arguments: params, F, strain, and
+    /// `u`, a uniform number in (0, 1) fixed per bond (its quenched disorder).
+    Threshold(fn(&[f64], f64, f64, f64) -> Option<f64>),
+    /// An unbound bond rebinds at rate k_on when its length is below the
+    /// capture radius: returns (k_on, capture).
+    Rebind(fn(&[f64]) -> (f64, f64)),
+    /// The rest length changes at dL0/dt = v(F, kT) (length/time).
+    RestLengthRate(fn(&[f64], f64, f64) -> f64),
+    /// When |L − L0|/L0 exceeds the returned threshold, L0 becomes L.
+    PlasticReset(fn(&[f64]) -> f64),
+    /// Stiffness (energy and force) scale as a function of the bond's age.
+    Maturation(fn(&[f64], f64) -> f64),
+}
+
+/// A registered kinetic rule.
+pub trait KineticRule: Sync + Send {
+    fn name(&self) -> &'static str;
+    fn summary(&self) -> &'static str;
+    /// Markdown with the headings Rate, References, Example.
+    fn doc(&self) -> &'static str;
+    fn params(&self) -> &'static [ParamSpec];
+    fn effect(&self) -> Effect;
+    fn validate(&self, _params: &[f64]) -> Result<(), String> {
+        Ok(())
+    }
+    /// Whether the rule's rates depend on kT (it then needs `temperature` > 0).
+    fn needs_temperature(&self) -> bool {
+        matches!(self.effect(), Effect::Unbind(_))
+    }
+    /// Whether the rule changes the rest length (the bond law must have `r0`).
+    fn needs_rest_length(&self) -> bool {
+        matches!(self.effect(), Effect::RestLengthRate(_) | Effect::PlasticReset(_))
+    }
+}
+
+/// A rule as used by a bond type, with its parameter values.
+#[derive(Clone)]
+pub struct RuleUse {
+    pub rule: &'static dyn KineticRule,
+    pub params: Vec<f64>,
+}
+
+impl std::fmt::Debug for RuleUse {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} {:?}", self.rule.name(), self.params)
+    }
+}
+
+/// Implements [`KineticRule`] for a unit struct (name = stem of its `.md`).
+macro_rules! kinetic_rule {
+    ($ty:ident, $name:literal, $summary:literal, $effect:expr $(, validate = $validate:path)? $(, needs_temperature = $needs_kt:expr)?) => {
+        pub struct $ty;
+
+        impl $crate::kinetics::KineticRule for $ty {
+            fn name(&self) -> &'static str {
+                $name
+            }
+            fn summary(&self) -> &'static str {
+                $summary
+            }
+            fn doc(&self) -> &'static str {
+                include_str!(concat!($name, ".md"))
+            }
+            fn params(&self) -> &'static [$crate::interactions::ParamSpec] {
+                &PARAMS
+            }
+            fn effect(&self) -> $crate::kinetics::Effect {
+                $effect
+            }
+            $(fn validate(&self, params: &[f64]) -> Result<(), String> {
+                $validate(params)
+            })?
+            $(fn needs_temperature(&self) -> bool {
+                $needs_kt
+            })?
+        }
+    };
+}
+pub(crate) use kinetic_rule;
+
+/// Documentation page of a rule (what `cellmd list NAME` prints).
+pub fn rule_documentation(rule: &dyn KineticRule, units: crate::units::UnitSystem) -> String {
+    let mut page = format!("# {} (kinetic rule)\n\n{}\n\n", rule.name(), rule.summary());
+    page += &crate::interactions::parameter_table(rule.params(), units);
+    page += "\n";
+    page += rule.doc();
+    page
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rules_have_unique_names_docs_and_files() {
+        let mut seen = std::collections::HashSet::new();
+        for r in RULES {
+            assert!(seen.insert(r.name()), "duplicate {}", r.name());
+            assert!(crate::interactions::lookup(r.name()).is_none(), "{} clashes with an interaction name", r.name());
+            for heading in ["## Rate", "## References", "## Example"] {
+                assert!(r.doc().contains(heading), "{} doc lacks {heading}", r.name());
+            }
+            for p in r.params() {
+                assert!(!p.doc.is_empty());
+                if let Some(d) = p.default {
+                    p.check(d).unwrap();
+                }
+            }
+            let path = format!("{}/src/kinetics/{}.rs", env!("CARGO_MANIFEST_DIR"), r.name());
+            assert!(std::path::Path::new(&path).exists(), "{path}");
+        }
+    }
+}
