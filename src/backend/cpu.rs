@@ -151,6 +151,17 @@ impl CpuBackend {
         Ok(backend)
     }
 
+    /// Bonds broke or bound: pair exclusions follow the bound bonds, so they
+    /// and the neighbour list are rebuilt (nothing to do without pair terms).
+    pub fn bonds_changed(&mut self, model: &Model, state: &State, sim_box: &SimBox) -> Result<(), String> {
+        if self.pair_interactions.is_empty() {
+            return Ok(());
+        }
+        let bound = state.bonds.as_ref().map(|b| b.bound.as_slice());
+        self.exclusions = Exclusions::from_pairs(model.len(), &model.excluded_pairs(bound));
+        self.rebuild_neighbors(state, sim_box)
+    }
+
     /// Rebuilds the neighbour list now.
     pub fn rebuild_neighbors(&mut self, state: &State, sim_box: &SimBox) -> Result<(), String> {
         if self.pair_interactions.is_empty() {
@@ -304,13 +315,15 @@ impl CpuBackend {
 
     fn reduce(&self, model: &Model, out: &mut Forces) {
         // Bonded energies and virial: sequential in term order.
+        let bond_registry: Vec<usize> = model.bond_types.iter().map(registry_index).collect();
+        let angle_registry: Vec<usize> = model.angle_types.iter().map(registry_index).collect();
         for (b, e) in self.term_energy.iter().enumerate() {
-            let term = if b < model.bonds.len() {
-                &model.bond_types[model.bond_type[b] as usize]
+            let registry = if b < model.bonds.len() {
+                bond_registry[model.bond_type[b] as usize]
             } else {
-                &model.angle_types[model.angle_type[b - model.bonds.len()] as usize]
+                angle_registry[model.angle_type[b - model.bonds.len()] as usize]
             };
-            out.energy_by_interaction[registry_index(term)] += e;
+            out.energy_by_interaction[registry] += e;
             add6(&mut out.virial, self.term_virial[b]);
         }
         let columns = self.pair_interactions.len();

@@ -13,7 +13,7 @@ use super::params::{parse_kinetics, parse_params, BondTypeKinetics, TermType};
 #[derive(Clone, Debug)]
 pub struct ParticleType {
     pub name: Token,
-    /// γ (drag units): force = γ·velocity.
+    /// γ (drag units): force = γ·velocity; infinite for a `fixed` particle.
     pub drag: f64,
     /// Radius (length units), for Stokes drag, output and export; 0 if not given.
     pub radius: f64,
@@ -59,13 +59,17 @@ fn check_unique<'a>(name: &Token, existing: impl Iterator<Item = &'a Token>, wha
 fn particle(s: &Statement) -> Result<ParticleType, InputError> {
     let t = &s.tokens;
     let Some(name) = t.get(1) else {
-        return Err(t[0].error("expected `particle NAME drag G [radius A]` or `particle NAME radius A viscosity ETA`"));
+        return Err(t[0].error(
+            "expected `particle NAME drag G [radius A]`, `particle NAME radius A viscosity ETA` or `particle NAME fixed [radius A]`",
+        ));
     };
+    let fixed = t[2..].iter().find(|x| x.text == "fixed");
     let mut fields: HashMap<&str, (f64, &Token)> = HashMap::new();
-    for pair in t[2..].chunks(2) {
-        let key = &pair[0];
+    let values: Vec<&Token> = t[2..].iter().filter(|x| x.text != "fixed").collect();
+    for pair in values.chunks(2) {
+        let key = pair[0];
         if !["drag", "radius", "viscosity"].contains(&key.text.as_str()) {
-            return Err(key.error(format!("found `{}`, expected `drag`, `radius` or `viscosity`", key.text)));
+            return Err(key.error(format!("found `{}`, expected `drag`, `radius`, `viscosity` or `fixed`", key.text)));
         }
         let Some(value) = pair.get(1) else {
             return Err(key.error(format!("`{}` has no value; expected `{} VALUE`", key.text, key.text)));
@@ -79,17 +83,23 @@ fn particle(s: &Statement) -> Result<ParticleType, InputError> {
         }
     }
     let radius = fields.get("radius").map_or(0.0, |f| f.0);
-    let drag = match (fields.get("drag"), fields.get("viscosity")) {
-        (Some(_), Some((_, key))) => return Err(key.error("give either `drag` or `radius` + `viscosity`, not both")),
-        (Some((g, _)), None) => *g,
-        (None, Some((eta, key))) => {
+    let drag = match (fixed, fields.get("drag"), fields.get("viscosity")) {
+        (Some(_), Some((_, key)), _) | (Some(_), _, Some((_, key))) => {
+            return Err(key.error("a `fixed` particle does not move; expected no `drag` or `viscosity`"))
+        }
+        (Some(_), None, None) => f64::INFINITY,
+        (None, Some(_), Some((_, key))) => return Err(key.error("give either `drag` or `radius` + `viscosity`, not both")),
+        (None, Some((g, _)), None) => *g,
+        (None, None, Some((eta, key))) => {
             if radius <= 0.0 {
                 return Err(key.error("`viscosity` needs `radius` > 0 for the Stokes drag 6πηa"));
             }
             6.0 * std::f64::consts::PI * eta * radius
         }
-        (None, None) => {
-            return Err(name.error(format!("particle type `{}` has no drag; expected `drag G` or `radius A viscosity ETA`", name.text)))
+        (None, None, None) => {
+            return Err(
+                name.error(format!("particle type `{}` has no drag; expected `drag G`, `radius A viscosity ETA` or `fixed`", name.text))
+            )
         }
     };
     Ok(ParticleType { name: name.clone(), drag, radius })
@@ -208,7 +218,7 @@ mod tests {
     fn errors() {
         assert_eq!(
             load(&[("m.ff", "particle a\n")]).unwrap_err(),
-            "m.ff:1:10: particle type `a` has no drag; expected `drag G` or `radius A viscosity ETA`"
+            "m.ff:1:10: particle type `a` has no drag; expected `drag G`, `radius A viscosity ETA` or `fixed`"
         );
         assert!(load(&[("m.ff", "particle a drag 1\nparticle a drag 2\n")]).unwrap_err().contains("already defined at"));
         assert!(load(&[("m.ff", "include m.ff\n")]).unwrap_err().contains("include cycle"));

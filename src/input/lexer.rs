@@ -141,7 +141,7 @@ pub fn lex(file: &Arc<SourceFile>) -> Result<Vec<Statement>, InputError> {
             .into_iter()
             .map(|(span, quoted)| {
                 let token_offset = span.location_offset() - usize::from(quoted);
-                let (line, col) = file.line_col(token_offset);
+                let (line, col) = (span.location_line(), span.get_utf8_column() as u32 - u32::from(quoted));
                 Token {
                     text: span.fragment().to_string(),
                     line,

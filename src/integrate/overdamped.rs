@@ -61,6 +61,11 @@ pub fn overdamped_step(
     scratch.resize(state.len(), DVec3::ZERO);
     scratch.par_iter_mut().enumerate().for_each(|(i, dx)| {
         let gamma = model.type_drag[model.types[i] as usize];
+        if gamma.is_infinite() {
+            // A `fixed` particle never moves (and draws no noise).
+            *dx = DVec3::ZERO;
+            return;
+        }
         let mut d = forces[i] * (dt / gamma);
         if kt > 0.0 {
             let amplitude = (2.0 * kt * dt / gamma).sqrt();

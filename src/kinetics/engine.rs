@@ -81,6 +81,8 @@ pub struct Kinetics {
     pub resets: u64,
     pub forms: u64,
     warned: Vec<bool>,
+    /// Per-bond decisions of the current step (reused between steps).
+    outcomes: Vec<Outcome>,
 }
 
 impl Kinetics {
@@ -151,6 +153,7 @@ impl Kinetics {
                 length: length[b],
             });
         }
+        self.outcomes = outcomes;
         report
     }
 }
@@ -164,12 +167,13 @@ fn decide(model: &Model, bonds: &BondState, b: usize, force: f64, length: f64, s
     if rules.is_empty() {
         return out;
     }
-    let u = uniform(block(seed, step, b as u32, STREAM_KINETICS)[0]);
+    // The step's uniform number, drawn only when a rate is to be tested.
+    let u = || uniform(block(seed, step, b as u32, STREAM_KINETICS)[0]);
     if !bonds.bound[b] {
         for r in rules {
             if let Effect::Rebind(on) = r.rule.effect() {
                 let (k_on, capture) = on(&r.params);
-                if length < capture && u < -(-k_on * dt).exp_m1() {
+                if length < capture && u() < -(-k_on * dt).exp_m1() {
                     out.event = Some(EventKind::Rebind);
                     out.age = 0.0;
                     out.scale = maturation_scale(model, t, 0.0);
@@ -205,7 +209,7 @@ fn decide(model: &Model, bonds: &BondState, b: usize, force: f64, length: f64, s
         }
     }
     out.rate_dt = rate * dt;
-    if immediate || (rate > 0.0 && u < -(-rate * dt).exp_m1()) {
+    if immediate || (rate > 0.0 && u() < -(-rate * dt).exp_m1()) {
         out.event = Some(EventKind::Break);
     }
     out.age += dt;

@@ -357,15 +357,11 @@ impl Simulation {
             if self.state.bonds.is_some() {
                 self.kinetics_step()?;
             }
-            match self.backend.as_mut() {
-                Some(backend) => {
-                    if self.state.step.is_multiple_of(self.neighbor.every) {
-                        backend.update_neighbors(&self.state, &self.sim_box, self.neighbor.check).map_err(RunError::Setup)?;
-                    }
-                    self.compute_forces()?;
-                }
-                None => self.ensure_forces()?,
+            if self.state.step.is_multiple_of(self.neighbor.every) {
+                let backend = self.backend.as_mut().expect("backend built");
+                backend.update_neighbors(&self.state, &self.sim_box, self.neighbor.check).map_err(RunError::Setup)?;
             }
+            self.compute_forces()?;
             let final_step = self.state.step == last;
             self.outputs_at_step(&bar, final_step && (self.thermo.every == 0 || !self.state.step.is_multiple_of(self.thermo.every)))?;
             if let Some(b) = &bar {
@@ -380,7 +376,7 @@ impl Simulation {
     }
 
     /// Bond kinetics of the step just integrated, decided from the tensions of
-    /// its force pass; a break or rebind rebuilds exclusions (and the backend).
+    /// its force pass; a break or rebind updates the pair exclusions.
     fn kinetics_step(&mut self) -> Result<(), RunError> {
         let step = self.state.step - 1;
         let backend = self.backend.as_ref().expect("backend built");
@@ -399,7 +395,8 @@ impl Simulation {
             }
         }
         if report.bonds_changed {
-            self.backend = None;
+            let backend = self.backend.as_mut().expect("backend built");
+            backend.bonds_changed(&self.model, &self.state, &self.sim_box).map_err(RunError::Setup)?;
         }
         Ok(())
     }

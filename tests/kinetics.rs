@@ -1,0 +1,203 @@
+//! Bond kinetics against exact results (issue: stateful bonds). Analytic
+//! formulas here are test oracles only; the runtime decides every event per
+//! bond from the force it carries.
+//!
+//! Most systems are pairs of `fixed` particles, so each bond's length — and
+//! hence its force — is set by geometry alone and no noise enters.
+
+mod common;
+
+use common::Case;
+
+/// `n` pairs of fixed particles at separations `lengths[p % lengths.len()]`,
+/// joined by bonds of type `b`.
+fn fixed_pairs(n: usize, lengths: &[f64]) -> String {
+    let mut top = String::from("[ particles ]\n");
+    let mut bonds = String::from("[ bonds ]\n");
+    for p in 0..n {
+        let (x, y) = ((p % 300) as f64 * 3.0, (p / 300) as f64 * 3.0);
+        let l = lengths[p % lengths.len()];
+        top += &format!("{} a {x} {y} 0\n{} a {x} {y} {l}\n", 2 * p + 1, 2 * p + 2);
+        bonds += &format!("b {} {}\n", 2 * p + 1, 2 * p + 2);
+    }
+    top + &bonds
+}
+
+fn case(top: &str, bond_line: &str, deck_body: &str) -> Case {
+    let ff = format!("particle a fixed\n{bond_line}\n");
+    let deck = format!("units lj\ntopology t.top\nforcefield f.ff\nbox x -10 1000 f y -10 1000 f z -10 1000 f\n{deck_body}");
+    Case::new(&[("t.top", top), ("f.ff", &ff), ("deck.in", &deck)])
+}
+
+/// Rows of the CSV event log: (step, event, bond, force).
+fn events(case: &Case) -> Vec<(u64, String, usize, f64)> {
+    std::fs::read_to_string(case.path("events.csv"))
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            (f[0].parse().unwrap(), f[2].to_string(), f[3].parse().unwrap(), f[7].parse().unwrap())
+        })
+        .collect()
+}
+
+/// Lifetimes at fixed force across a sweep spanning the catch-slip maximum:
+/// mean lifetime = 1/k(F) within 2 % with ≥ 10⁴ bonds per force, the
+/// lifetime distribution is exponential, and the longest-lived force is F*.
+#[test]
+fn catch_slip_lifetimes_follow_the_two_pathway_law() {
+    let (kc0, xc, ks0, xs) = (1.0, 1.0, 0.01, 0.5);
+    let kt = 1.0;
+    let f_star = kt * (kc0 * xc / (ks0 * xs) as f64).ln() / (xc + xs);
+    let fractions = [0.5, 0.75, 1.0, 1.25, 1.5];
+    let forces: Vec<f64> = fractions.iter().map(|a| a * f_star).collect();
+    let k_bond = 10.0;
+    let lengths: Vec<f64> = forces.iter().map(|f| 1.0 + f / k_bond).collect();
+    let rate = |f: f64| kc0 * (-f * xc / kt).exp() + ks0 * (f * xs / kt).exp();
+    let k_max = forces.iter().map(|&f| rate(f)).fold(0.0, f64::max);
+    let dt = 0.05 / k_max;
+    let per_force = 40_000;
+    let n = per_force * forces.len();
+    let bond = format!("bond b harmonic k {k_bond} r0 1 kinetics catch_slip kc0 {kc0} xc {xc} ks0 {ks0} xs {xs}");
+    let k_min = forces.iter().map(|&f| rate(f)).fold(f64::INFINITY, f64::min);
+    let steps = (20.0 / (k_min * dt)).ceil() as u64;
+    let c = case(&fixed_pairs(n, &lengths), &bond, &format!("temperature {kt}\ntimestep {dt}\nseed 17\nevents events.csv\nrun {steps}\n"));
+    let sim = c.run();
+    assert_eq!(sim.kinetics.breaks as usize, n, "some bonds never broke");
+    let mut lifetimes: Vec<Vec<f64>> = vec![Vec::new(); forces.len()];
+    let mut steps_of: Vec<Vec<u64>> = vec![Vec::new(); forces.len()];
+    for (step, kind, bond, force) in events(&c) {
+        assert_eq!(kind, "break");
+        let group = bond % forces.len();
+        assert!((force - forces[group]).abs() < 1e-9 * forces[group], "bond {bond} carried {force}");
+        // A bond that breaks while deciding step s was bound through s·dt and
+        // broke within the step: its lifetime is (s + ½)·dt to O(k·dt²).
+        lifetimes[group].push((step as f64 + 0.5) * dt);
+        steps_of[group].push(step);
+    }
+    let mut measured = Vec::new();
+    for (g, &f) in forces.iter().enumerate() {
+        let mean = lifetimes[g].iter().sum::<f64>() / lifetimes[g].len() as f64;
+        let expected = 1.0 / rate(f);
+        assert!((mean / expected - 1.0).abs() < 0.02, "F = {f}: mean lifetime {mean}, 1/k = {expected}");
+        measured.push(mean);
+        // Kolmogorov–Smirnov against the exact law of the break step,
+        // P(s ≤ m) = 1 − exp(−k·dt·(m + 1)), compared at each distinct step
+        // (the data are discrete); critical value 1.95/√N (α = 0.001).
+        let mut s = steps_of[g].clone();
+        s.sort_unstable();
+        let nn = s.len() as f64;
+        let mut d: f64 = 0.0;
+        for (i, &m) in s.iter().enumerate() {
+            if s.get(i + 1) != Some(&m) {
+                let cdf = 1.0 - (-rate(f) * dt * (m as f64 + 1.0)).exp();
+                d = d.max(((i + 1) as f64 / nn - cdf).abs());
+            }
+        }
+        assert!(d * nn.sqrt() < 1.95, "F = {f}: lifetimes not exponential, KS D√N = {}", d * nn.sqrt());
+    }
+    // The longest-lived force of the sweep is F*, and lifetimes fall on both sides.
+    let best = (0..forces.len()).max_by(|&a, &b| measured[a].total_cmp(&measured[b])).unwrap();
+    assert_eq!(fractions[best], 1.0, "longest lifetime at {} F*, lifetimes {measured:?}", fractions[best]);
+}
+
+/// Constant loading rate r: slip bonds rupture most probably at
+/// F* = Fβ·ln(r/(k0·Fβ)), and the rupture forces follow the Bell–Evans law
+/// p(F) = (k(F)/r)·exp(−∫₀^F k/r).
+///
+/// The load ramps because a `motor` rule with an unreachable stall force
+/// shortens each bond's rest length at constant speed v0 between fixed
+/// ends: F(t) = k_bond·v0·t.
+#[test]
+fn slip_bonds_under_a_force_ramp_rupture_at_the_bell_evans_force() {
+    let (k0, x_beta, kt): (f64, f64, f64) = (1.0, 1.0, 1.0);
+    let f_beta = kt / x_beta;
+    let (k_bond, v0): (f64, f64) = (100.0, 1.0);
+    let r = k_bond * v0;
+    let f_star = f_beta * (r / (k0 * f_beta)).ln();
+    let dt = 2e-5;
+    let n = 20_000;
+    let steps = ((f_star + 6.0 * f_beta) / (r * dt)) as u64;
+    let bond = format!("bond b harmonic k {k_bond} r0 1 kinetics motor v0 {v0} fs 1e12 kinetics slip k0 {k0} x_beta {x_beta}");
+    let c = case(&fixed_pairs(n, &[1.0]), &bond, &format!("temperature {kt}\ntimestep {dt}\nseed 5\nevents events.csv\nrun {steps}\n"));
+    let sim = c.run();
+    assert_eq!(sim.kinetics.breaks as usize, n);
+    let mut forces: Vec<f64> = events(&c).iter().map(|e| e.3).collect();
+    forces.sort_by(f64::total_cmp);
+    // Kolmogorov–Smirnov against the exact CDF 1 − exp(−(k0/r)(e^(F/Fβ) − 1)·Fβ).
+    let cdf = |f: f64| 1.0 - (-(k0 * f_beta / r) * ((f / f_beta).exp() - 1.0)).exp();
+    let nn = n as f64;
+    let d = forces
+        .iter()
+        .enumerate()
+        .map(|(i, &f)| ((i + 1) as f64 / nn - cdf(f)).abs().max((i as f64 / nn - cdf(f)).abs()))
+        .fold(0.0, f64::max);
+    // The force is known only to within one step's increment r·dt = 0.002 Fβ.
+    assert!(d * nn.sqrt() < 1.95, "rupture forces do not follow Bell–Evans: KS D√N = {}", d * nn.sqrt());
+    // Most probable force: the peak of a Gaussian kernel density estimate.
+    let h = 0.1 * f_beta;
+    let density = |f: f64| forces.iter().map(|&x| (-(x - f).powi(2) / (2.0 * h * h)).exp()).sum::<f64>();
+    let mode = (0..=400).map(|k| f_star - 2.0 + k as f64 * 0.01).max_by(|a, b| density(*a).total_cmp(&density(*b))).unwrap();
+    assert!((mode - f_star).abs() < 0.1 * f_beta, "most probable rupture force {mode}, F* = {f_star}");
+}
+
+/// Rebinding at k_on and unbinding at k_off reach the bound fraction
+/// k_on/(k_on + k_off); per step the chain is exactly two-state with
+/// probabilities a = 1 − e^(−k_off·dt) and b = 1 − e^(−k_on·dt), stationary b/(a + b).
+#[test]
+fn binding_and_unbinding_reach_the_steady_state_fraction() {
+    let (k_on, k_off, dt) = (2.0, 3.0, 0.002);
+    let n = 10_000;
+    let bond = format!("bond b harmonic k 1 r0 1 kinetics slip k0 {k_off} x_beta 0 kinetics rebind k_on {k_on} capture 2");
+    let relax = (1.0 / ((k_on + k_off) * dt)) as u64; // one correlation time in steps
+    let c = case(
+        &fixed_pairs(n, &[1.0]),
+        &bond,
+        &format!("temperature 1\ntimestep {dt}\nseed 9\nthermo {relax} step nbound/b\nthermo_file t.csv\nrun {}\n", 60 * relax),
+    );
+    c.run();
+    let rows: Vec<f64> =
+        std::fs::read_to_string(c.path("t.csv")).unwrap().lines().skip(1).map(|l| l.split(',').nth(1).unwrap().parse().unwrap()).collect();
+    // Skip 10 correlation times, then average samples one correlation time apart.
+    let samples = &rows[10..];
+    let fraction = samples.iter().sum::<f64>() / (samples.len() as f64 * n as f64);
+    let (a, b) = (-(-k_off * dt as f64).exp_m1(), -(-k_on * dt as f64).exp_m1());
+    let discrete = b / (a + b);
+    let continuous = k_on / (k_on + k_off);
+    // Binomial error of one sample, samples correlated by e^(−1): inflate by √((1+e⁻¹)/(1−e⁻¹)).
+    let e1 = (-1.0f64).exp();
+    let error = (discrete * (1.0 - discrete) / n as f64).sqrt() * ((1.0 + e1) / (1.0 - e1)).sqrt() / (samples.len() as f64).sqrt();
+    assert!((fraction - discrete).abs() < 4.0 * error, "bound fraction {fraction}, expected {discrete} ± {error}");
+    assert!((discrete - continuous).abs() < 1e-3, "the time step biases the steady state: {discrete} vs {continuous}");
+}
+
+/// Equal-load-sharing fibre bundle with thresholds uniform on [0, 1]: the
+/// load per fibre k·ε·(1 − ε) peaks at 1/4 at strain 1/2 (Daniels).
+#[test]
+fn fibre_bundle_with_uniform_thresholds_peaks_at_a_quarter() {
+    let n = 20_000;
+    // Strain grows as the rest length shrinks at v0 between fixed ends 1 apart.
+    let (v0, dt) = (0.5, 1e-4);
+    let bond = format!("bond b spring k 1 r0 1 kinetics threshold strain 0.5 spread 2 kinetics motor v0 {v0} fs 1e12");
+    let steps = (0.45 / (v0 * dt)) as u64; // r0 from 1 to 0.55: strain up to 0.82
+    let c = case(
+        &fixed_pairs(n, &[1.0]),
+        &bond,
+        &format!("timestep {dt}\nthermo 10 step nbound/b tension/b\nthermo_file t.csv\nrun {steps}\n"),
+    );
+    c.run();
+    let (mut peak_load, mut peak_strain) = (0.0, 0.0);
+    for line in std::fs::read_to_string(c.path("t.csv")).unwrap().lines().skip(1) {
+        let v: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
+        let (bound, tension) = (v[1], v[2]);
+        let load = tension / n as f64;
+        if load > peak_load && bound > 0.0 {
+            // Every intact fibre carries k·ε: the strain is tension/bound.
+            (peak_load, peak_strain) = (load, tension / bound);
+        }
+    }
+    // Finite-N fluctuations of the surviving fraction are ~0.5/√N ≈ 0.004.
+    assert!((peak_load - 0.25).abs() < 0.01, "peak load per fibre {peak_load}");
+    assert!((peak_strain - 0.5).abs() < 0.03, "strain at peak {peak_strain}");
+}
