@@ -1,7 +1,9 @@
 //! Agreement figures between two [`Probes`] and the verdict against tolerances.
 //!
 //! Every figure is a relative error with a stated scale, so one tolerance
-//! fits systems of any size and units:
+//! fits systems of any size and units (after a run, each scale is the largest
+//! of the start and the end: a relaxed end state has tiny forces, but the
+//! round-off grew with the forces met on the way):
 //! - energy of each key: |ΔE| / max(|E_ref|, largest |E_ref| of any key);
 //! - forces: max_i |ΔF_i| / max_i |F_ref,i| (and the RMS of |ΔF_i|, absolute);
 //! - virial: max_k |ΔW_k| / max_k |W_ref,k|;
@@ -116,7 +118,12 @@ fn point(cellmd: &Snapshot, reference: &Snapshot, start: Option<&Snapshot>) -> R
     if cellmd.step != reference.step {
         return Err(format!("probed at step {} in cellmd but {} in the reference", cellmd.step, reference.step));
     }
-    let scale = reference.energies.values().map(|e| e.abs()).fold(0.0, f64::max);
+    // After a run, scales are those of the whole run (start and end): a relaxed
+    // end state has tiny forces, but round-off grew with the forces met on the way.
+    let runs = std::iter::once(reference).chain(start);
+    let scale = runs.clone().flat_map(|s| s.energies.values()).map(|e| e.abs()).fold(0.0, f64::max);
+    let force_scale = runs.clone().map(|s| max_norm(s.forces.iter().copied())).fold(0.0, f64::max);
+    let virial_scale = runs.flat_map(|s| s.virial).map(f64::abs).fold(0.0, f64::max);
     let mut energies: Vec<EnergyRow> = reference
         .energies
         .iter()
@@ -139,9 +146,9 @@ fn point(cellmd: &Snapshot, reference: &Snapshot, start: Option<&Snapshot>) -> R
         energies,
         force_max_diff: df.iter().copied().fold(0.0, f64::max),
         force_rms_diff: (df.iter().map(|d| d * d).sum::<f64>() / n).sqrt(),
-        force_scale: max_norm(reference.forces.iter().copied()),
+        force_scale,
         virial_max_diff: (0..6).map(|k| (cellmd.virial[k] - reference.virial[k]).abs()).fold(0.0, f64::max),
-        virial_scale: reference.virial.iter().map(|w| w.abs()).fold(0.0, f64::max),
+        virial_scale,
         position_max_diff: if start.is_some() { dx.iter().copied().fold(0.0, f64::max) } else { 0.0 },
         position_rmsd: (dx.iter().map(|d| d * d).sum::<f64>() / n).sqrt(),
         displacement_scale,
