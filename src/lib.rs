@@ -15,10 +15,14 @@
 //! | [`kinetics`] | stateful bonds: force-dependent unbinding, rebinding, motors, ratchets, plasticity, maturation |
 //! | [`backend`] | the CPU reference force engine (f64, rayon, deterministic) |
 //! | [`output`] | MCAP, extended XYZ, LAMMPS dump, restart |
+//! | [`export`] | a deck as LAMMPS data + input (`cellmd export-lammps`) |
+//! | [`compare`] | cellmd vs LAMMPS probes, agreement table, golden reference files (`cellmd compare`) |
 //! | [`run`] | executes a plan: run loop, thermo, blow-up diagnosis, minimise |
 
 pub mod backend;
+pub mod compare;
 pub mod deck;
+pub mod export;
 pub mod forcefield;
 pub mod input;
 pub mod integrate;

@@ -1,4 +1,4 @@
-//! `cellmd` command line: run | check | list.
+//! `cellmd` command line: run | check | list | export-lammps | compare.
 
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -6,7 +6,9 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+use cellmd::compare::{cellmd_probes, golden, run_lammps, Agreement, Lmp, Tolerance};
 use cellmd::deck::validate_file;
+use cellmd::export::{self, ExportOptions};
 use cellmd::interactions::{documentation, lookup, REGISTRY};
 use cellmd::run::{RunOptions, Simulation};
 use cellmd::units::UnitSystem;
@@ -41,6 +43,41 @@ enum Command {
         deck: PathBuf,
         #[arg(long = "var", value_name = "NAME=VALUE", value_parser = parse_var)]
         vars: Vec<(String, String)>,
+    },
+    /// Write a LAMMPS data file and input script equivalent to the deck.
+    ExportLammps {
+        deck: PathBuf,
+        /// Directory for `data.lammps` and `in.lammps`.
+        outdir: PathBuf,
+        #[arg(long = "var", value_name = "NAME=VALUE", value_parser = parse_var)]
+        vars: Vec<(String, String)>,
+        /// Also write the probe files `cellmd compare` reads.
+        #[arg(long)]
+        probes: bool,
+    },
+    /// Run the deck in cellmd and in LAMMPS and compare energies, forces and positions.
+    Compare {
+        deck: PathBuf,
+        #[arg(long = "var", value_name = "NAME=VALUE", value_parser = parse_var)]
+        vars: Vec<(String, String)>,
+        /// The lmp executable (default: $CELLMD_LMP, lmp on PATH, or scripts/reference-venv --lmp).
+        #[arg(long)]
+        lmp: Option<PathBuf>,
+        /// Keep LAMMPS' files in this directory (default: a temporary one).
+        #[arg(long)]
+        workdir: Option<PathBuf>,
+        /// Tolerance of energies, forces and virial at one configuration (relative).
+        #[arg(long, default_value_t = 1e-10)]
+        tol: f64,
+        /// Tolerance of positions, forces and energies after the run (relative).
+        #[arg(long, default_value_t = 1e-9)]
+        run_tol: f64,
+        /// Also write LAMMPS' results as a golden document (reference/*.yaml) to this file.
+        #[arg(long, value_name = "FILE")]
+        write_golden: Option<PathBuf>,
+        /// `key=value` header entries of the golden document (repeatable).
+        #[arg(long = "golden-header", value_name = "KEY=VALUE", value_parser = parse_var)]
+        golden_header: Vec<(String, String)>,
     },
     /// List interaction types, or print one type's documentation.
     List {
@@ -99,6 +136,42 @@ fn main() -> ExitCode {
             }
             Err(e) => report(e),
         },
+        Command::ExportLammps { deck, outdir, vars, probes } => {
+            let plan = match validate_file(&deck, &vars) {
+                Ok(plan) => plan,
+                Err(e) => return report(e),
+            };
+            match export::export(&plan, ExportOptions { probes }) {
+                Ok(lammps) => match export::lammps::write(&lammps, &outdir) {
+                    Ok(()) => {
+                        println!("wrote {0}/data.lammps and {0}/in.lammps", outdir.display());
+                        ExitCode::SUCCESS
+                    }
+                    Err(e) => {
+                        eprintln!("error: {}: {e}", outdir.display());
+                        ExitCode::from(1)
+                    }
+                },
+                Err(e) => {
+                    eprintln!("error: cannot export {} to LAMMPS: {e}", deck.display());
+                    ExitCode::from(2)
+                }
+            }
+        }
+        Command::Compare { deck, vars, lmp, workdir, tol, run_tol, write_golden, golden_header } => {
+            let plan = match validate_file(&deck, &vars) {
+                Ok(plan) => plan,
+                Err(e) => return report(e),
+            };
+            match compare(&plan, lmp, workdir, Tolerance { single_point: tol, run: run_tol }, write_golden, golden_header) {
+                Ok(true) => ExitCode::SUCCESS,
+                Ok(false) => ExitCode::from(4),
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::from(2)
+                }
+            }
+        }
         Command::Run { deck, output_dir, vars, threads, quiet } => {
             if let Some(n) = threads {
                 if let Err(e) = rayon::ThreadPoolBuilder::new().num_threads(n).build_global() {
@@ -139,4 +212,33 @@ fn main() -> ExitCode {
             }
         }
     }
+}
+
+/// `cellmd compare`: prints the table; returns whether the engines agree.
+fn compare(
+    plan: &cellmd::deck::Plan,
+    lmp: Option<PathBuf>,
+    workdir: Option<PathBuf>,
+    tol: Tolerance,
+    write_golden: Option<PathBuf>,
+    header: Vec<(String, String)>,
+) -> Result<bool, String> {
+    let lmp = match lmp {
+        Some(p) => Lmp::at(p),
+        None => Lmp::find()?,
+    };
+    let scratch = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let dir = workdir.unwrap_or_else(|| scratch.path().to_path_buf());
+    let (reference, version) = run_lammps(plan, &lmp, &dir)?;
+    let ours = cellmd_probes(plan)?;
+    let agreement = Agreement::new(&ours, &reference)?;
+    println!("cellmd {} vs {version} on {}", env!("CARGO_PKG_VERSION"), plan.deck_path.display());
+    print!("{}", agreement.table("LAMMPS", tol));
+    if let Some(path) = write_golden {
+        let mut entries = vec![("generator", format!("{version} via cellmd export-lammps"))];
+        entries.extend(header.iter().map(|(k, v)| (k.as_str(), v.clone())));
+        let doc = golden::document_of(&entries, &reference);
+        std::fs::write(&path, golden::write(&[doc])).map_err(|e| format!("{}: {e}", path.display()))?;
+    }
+    Ok(agreement.agrees(tol))
 }

@@ -233,6 +233,13 @@ impl Simulation {
         Ok(())
     }
 
+    /// Forces, energies by interaction and virial at the current state
+    /// (computed now if stale).
+    pub fn current_forces(&mut self) -> Result<&Forces, RunError> {
+        self.ensure_forces()?;
+        Ok(&self.forces)
+    }
+
     /// Ensures a backend with a fresh neighbour list and forces at the current state.
     fn ensure_forces(&mut self) -> Result<(), RunError> {
         if self.backend.is_none() {

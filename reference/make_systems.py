@@ -1,0 +1,185 @@
+#!/usr/bin/env python3
+"""Writes the reference systems: for each interaction type NAME,
+reference/NAME/NAME.ff and two cases, `small` (1-3 particles) and `random`
+(>= 100 particles, periodic where the type allows, with images, exclusions
+and two particle types exercised), each a topology and an ordinary cellmd deck
+in `units lj`. Deterministic (fixed seeds); rerun only to change the systems,
+then `reference/regenerate` to record LAMMPS' answers.
+"""
+import math
+import os
+import random
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+
+# name: (force-field body, dt, small topology, kind of random system)
+BOND_FF = {
+    "harmonic": "bond s harmonic k 50 r0 1.0\nbond t harmonic k 80 r0 0.8\n",
+    "fene": "bond s fene K 30 R0 1.5 epsilon 1 sigma 1\nbond t fene K 20 R0 1.6 epsilon 0.5 sigma 0.9\n",
+    "cable": "bond s cable k 40 r0 1.0 tau 0.1\nbond t cable k 60 r0 1.1\n",
+    "spring": "bond s spring k 40 r0 1.0 tau -0.1\nbond t spring k 25 r0 0.9 tau 0.05\n",
+    "asymmetric": "bond s asymmetric k_tension 100 k_compression 10 r0 1.0\nbond t asymmetric k_tension 20 k_compression 60 r0 0.9\n",
+}
+ANGLE_FF = {
+    "harmonic_angle": "angle s harmonic_angle k 3 theta0 110\nangle t harmonic_angle k 5 theta0 150\n",
+    "cosine_angle": "angle s cosine_angle K 2\nangle t cosine_angle K 0.7\n",
+    "wlc_bending": "angle s wlc_bending kappa 0.5 l0 0.25\nangle t wlc_bending kappa 0.3 l0 0.5\n",
+}
+PAIR_FF = {
+    "lj": "pair a a lj epsilon 1 sigma 1 rc 2.5\npair a b lj epsilon 0.8 sigma 0.9 rc 2.2\npair b b lj epsilon 1.2 sigma 1.1 rc 2.5\n",
+    "wca": "pair a a wca epsilon 1 sigma 1\npair a b wca epsilon 1.5 sigma 0.9\npair b b wca epsilon 0.5 sigma 1.2\n",
+    "soft_repulsion": "pair a a soft_repulsion k 50 sigma 1.0\npair a b soft_repulsion k 30 sigma 1.2\npair b b soft_repulsion k 80 sigma 0.9\n",
+    "soft": "pair a a soft A 5 rc 1.0\npair a b soft A 3 rc 1.2\npair b b soft A 8 rc 1.1\n",
+}
+TYPES = "particle a drag 1\nparticle b drag 2.5\n"
+
+
+def fmt(x):
+    return repr(round(x, 6))
+
+
+def unit_vector(rng):
+    while True:
+        v = [rng.uniform(-1, 1) for _ in range(3)]
+        n = math.sqrt(sum(c * c for c in v))
+        if 0.1 < n <= 1:
+            return [c / n for c in v]
+
+
+def particles_block(points, types):
+    lines = ["[ particles ]"]
+    for k, (p, t) in enumerate(zip(points, types)):
+        lines.append(f"{k + 1} {t} {fmt(p[0])} {fmt(p[1])} {fmt(p[2])}")
+    return "\n".join(lines) + "\n"
+
+
+def chains(rng, n_chains, length, step, lo, box, bend_max=None):
+    """Random walks with segment lengths in [lo, hi]; unwrapped coordinates."""
+    points = []
+    for _ in range(n_chains):
+        p = [rng.uniform(0, box) for _ in range(3)]
+        previous = None
+        for _ in range(length):
+            points.append(p)
+            while True:
+                d = unit_vector(rng)
+                if previous is None or bend_max is None:
+                    break
+                cos = sum(a * b for a, b in zip(d, previous))
+                if cos > math.cos(math.radians(bend_max)):
+                    break
+            previous = d
+            r = rng.uniform(lo, step)
+            p = [a + r * b for a, b in zip(p, d)]
+    return points
+
+
+def deck(top, ff, box, dt, steps=100, extra=""):
+    return (f"units lj\ntopology {top}\nforcefield {ff}\nbox {box}\n{extra}"
+            f"temperature 0\ntimestep {dt}\nthermo 0\nrun {steps}\n")
+
+
+def write(name, files):
+    d = os.path.join(HERE, name)
+    os.makedirs(d, exist_ok=True)
+    for fname, text in files.items():
+        with open(os.path.join(d, fname), "w") as f:
+            f.write(text)
+
+
+def bonded(name, ff, kind):
+    rng = random.Random(hash(name) % 1000 if False else sum(map(ord, name)))
+    lo, hi = {"fene": (0.95, 1.25)}.get(name, (0.7, 1.3))
+    # small: a 3-particle chain, one bond stretched and one compressed (angle: one angle)
+    small = [[0.1, 0.2, 0.3], [1.2, 0.5, 0.1], [1.7, 1.2, 0.6]] if name != "fene" else [[0.1, 0.2, 0.3], [1.1, 0.5, 0.1], [1.9, 1.0, 0.4]]
+    top = particles_block(small, ["a", "b", "a"])
+    top += "[ bonds ]\ns 1 2\nt 2 3\n" if kind == "bond" else "[ angles ]\ns 1 2 3\n"
+    n_chains, length, box = 12, 10, 6.0
+    pts = chains(rng, n_chains, length, hi, lo, box, bend_max=120 if kind == "angle" else None)
+    types = ["a" if (k // length) % 3 else "b" for k in range(len(pts))]
+    rtop = f"[ box ]\nx 0 {box} p\ny 0 {box} p\nz 0 {box} p\n" + particles_block(pts, types)
+    if kind == "bond":
+        rtop += "[ bonds ]\n" + "".join(f"{'s' if k % 2 else 't'} {c * length + k + 1} {c * length + k + 2}\n" for c in range(n_chains) for k in range(length - 1))
+    else:
+        rtop += "[ angles ]\n" + "".join(f"{'s' if k % 2 else 't'} {c * length + k + 1} {c * length + k + 2} {c * length + k + 3}\n" for c in range(n_chains) for k in range(length - 2))
+    dt = {"fene": 1e-4, "harmonic": 1e-3, "asymmetric": 1e-3}.get(name, 2e-3)
+    write(name, {
+        f"{name}.ff": TYPES + ff,
+        "small.top": top,
+        "random.top": rtop,
+        "small.in": deck("small.top", f"{name}.ff", "x -5 5 f y -5 5 f z -5 5 f", dt),
+        "random.in": deck("random.top", f"{name}.ff", f"x 0 {box} p y 0 {box} p z 0 {box} p", dt),
+    })
+
+
+def pairs(name, ff):
+    rng = random.Random(sum(map(ord, name)))
+    dmin = {"lj": 0.9, "wca": 0.9}.get(name, 0.3)
+    box, n = 6.5, 150
+    pts = []
+    # chains of 5 bonded beads (exclusions), placed with a minimum distance
+    while len(pts) < n:
+        p = [rng.uniform(0, box) for _ in range(3)] if len(pts) % 5 == 0 else [a + 1.0 * b for a, b in zip(pts[-1], unit_vector(rng))]
+        ok = all(math.dist(min_image(p, q, box), [0, 0, 0]) > dmin for q in pts)
+        if ok:
+            pts.append(p)
+        elif len(pts) % 5:
+            del pts[-(len(pts) % 5):]
+    types = ["b" if k % 3 == 0 else "a" for k in range(n)]
+    rtop = particles_block(pts, types) + "[ bonds ]\n" + "".join(f"s {c * 5 + k + 1} {c * 5 + k + 2}\n" for c in range(n // 5) for k in range(4))
+    small = [[0.1, 0.2, 0.3], [0.95, 0.4, 0.1], [0.6, 1.0, 0.5]] if name != "soft_repulsion" else [[0.1, 0.2, 0.3], [0.8, 0.4, 0.1], [0.5, 0.9, 0.5]]
+    stop = particles_block(small, ["a", "a", "b"])
+    dt = {"lj": 5e-5, "wca": 5e-5}.get(name, 1e-3)
+    write(name, {
+        f"{name}.ff": TYPES + "bond s harmonic k 20 r0 1.0\n" + ff,
+        "small.top": stop,
+        "random.top": rtop,
+        "small.in": deck("small.top", f"{name}.ff", "x -5 5 f y -5 5 f z -5 5 f", dt),
+        "random.in": deck("random.top", f"{name}.ff", f"x 0 {box} p y 0 {box} p z 0 {box} p", dt),
+    })
+
+
+def min_image(p, q, box):
+    return [(a - b) - box * round((a - b) / box) for a, b in zip(p, q)]
+
+
+def externals():
+    rng = random.Random(7)
+    box = 5.0
+    # wall: a floor on everything, a ceiling on type b; periodic in x and y
+    pts = [[rng.uniform(0, box), rng.uniform(0, box), rng.uniform(-0.5, 4.6)] for _ in range(100)]
+    types = ["b" if k % 2 else "a" for k in range(100)]
+    walls = ("group bs type b\nexternal floor all wall nz 1 d 0 k 20\n"
+             "external ceiling bs wall nz -2 d -4 k 30\nexternal side all wall nx 1 nz 0 d 0.5 k 5\n")
+    small_walls = "external floor all wall nz 1 d 0 k 20\nexternal ceiling all wall ny -1 nz 0 d -1 k 30\n"
+    write("wall", {
+        "wall.ff": TYPES,
+        "small.top": particles_block([[0.3, 0.2, -0.25], [0.1, 1.2, 0.5]], ["a", "b"]),
+        "random.top": particles_block(pts, types),
+        "small.in": deck("small.top", "wall.ff", "x -5 5 f y -5 5 f z -5 5 f", 1e-3, extra=small_walls),
+        "random.in": deck("random.top", "wall.ff", f"x 0 {box} f y 0 {box} p z -1 5 f", 1e-3, extra=walls),
+    })
+    # constant_force: chains in a periodic box dragged across its faces
+    pts = chains(rng, 10, 10, 1.2, 0.8, box)
+    types = ["b" if (k // 10) % 2 else "a" for k in range(100)]
+    rtop = particles_block(pts, types) + "[ bonds ]\n" + "".join(f"s {c * 10 + k + 1} {c * 10 + k + 2}\n" for c in range(10) for k in range(9))
+    pull = ("group as type a\ngroup head id 1:20\nexternal drift as constant_force fx 2.5 fy -1.5 fz 1\n"
+            "external pull head constant_force fz 3\n")
+    write("constant_force", {
+        "constant_force.ff": TYPES + "bond s harmonic k 20 r0 1.0\n",
+        "small.top": particles_block([[0.3, 0.2, 0.1], [1.1, -0.4, 2.0]], ["a", "b"]),
+        "random.top": rtop,
+        "small.in": deck("small.top", "constant_force.ff", "x -5 5 f y -5 5 f z -5 5 f", 1e-2,
+                         extra="external pull all constant_force fx 0.5 fy -0.25 fz 2\n"),
+        "random.in": deck("random.top", "constant_force.ff", f"x 0 {box} p y 0 {box} p z 0 {box} p", 1e-2, extra=pull),
+    })
+
+
+if __name__ == "__main__":
+    for name, ff in BOND_FF.items():
+        bonded(name, ff, "bond")
+    for name, ff in ANGLE_FF.items():
+        bonded(name, ff, "angle")
+    for name, ff in PAIR_FF.items():
+        pairs(name, ff)
+    externals()

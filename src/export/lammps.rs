@@ -1,0 +1,539 @@
+//! A validated deck as a LAMMPS data file and input script.
+//!
+//! Units: a `units lj` deck becomes LAMMPS `units lj` verbatim. A `cell` deck
+//! (µm, s, pN) is also written as LAMMPS `units lj`, where every conversion
+//! factor is 1: σ = 1 µm, τ = 1 s, ε = 1 pN·µm, and the LAMMPS temperature is
+//! kT in pN·µm. Overdamped dynamics is `fix brownian` per particle type with
+//! `gamma_t` = the type's drag (LAMMPS moves x by dt·F/γ_t, with no mass
+//! dependence). A deterministic deck (temperature 0) gets `rng none` with
+//! T = 1: LAMMPS refuses T = 0, and `rng none` drops the noise whatever T is.
+//!
+//! Styles are always `hybrid` (`hybrid/overlay` for pairs) so that LAMMPS'
+//! `compute bond|angle|pair` report the energy of each style. With probes on,
+//! the script writes `cellmd_probe.txt` (step, energy by interaction, virial
+//! W = P·V) and `cellmd_probe_init.dump` / `cellmd_probe_final.dump` (id,
+//! unwrapped positions and forces, 17 digits) before the first and after the
+//! last run; [`crate::compare`] reads them back.
+
+use std::collections::BTreeMap;
+use std::fmt::Write;
+
+use super::styles::{self, num, PairStyled, Styled};
+use crate::deck::{Action, CoeffTarget, Plan};
+use crate::forcefield::TermType;
+use crate::integrate::rng::Noise;
+use crate::system::{External, Model};
+use crate::units::UnitSystem;
+
+/// The two files of an exported deck.
+#[derive(Clone, Debug)]
+pub struct LammpsDeck {
+    /// `data.lammps`: box, types, atoms, bonds, angles.
+    pub data: String,
+    /// `in.lammps`: reads `data.lammps` from its own directory.
+    pub input: String,
+}
+
+/// Export options.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct ExportOptions {
+    /// Write the probe files that `cellmd compare` reads.
+    pub probes: bool,
+}
+
+/// Name of the data file the input script reads.
+pub const DATA_FILE: &str = "data.lammps";
+/// Name of the input script.
+pub const INPUT_FILE: &str = "in.lammps";
+/// Name of the probe text file.
+pub const PROBE_FILE: &str = "cellmd_probe.txt";
+
+/// A LAMMPS identifier from a user name (letters, digits, underscores).
+fn ident(prefix: &str, name: &str) -> String {
+    let clean: String = name.chars().map(|c| if c.is_ascii_alphanumeric() || c == '_' { c } else { '_' }).collect();
+    format!("{prefix}{clean}")
+}
+
+/// Sub-styles in order of first use, and the sub-style of each type.
+struct Hybrid {
+    styles: Vec<&'static str>,
+    /// The cellmd interactions each sub-style stands for (energy keys).
+    interactions: Vec<Vec<&'static str>>,
+    per_type: Vec<Styled>,
+}
+
+impl Hybrid {
+    fn new(types: &[TermType], map: fn(&TermType) -> Result<Styled, String>) -> Result<Self, String> {
+        let mut h = Hybrid { styles: Vec::new(), interactions: Vec::new(), per_type: Vec::new() };
+        for t in types {
+            let s = map(t)?;
+            let k = h.styles.iter().position(|&x| x == s.style).unwrap_or_else(|| {
+                h.styles.push(s.style);
+                h.interactions.push(Vec::new());
+                h.styles.len() - 1
+            });
+            if !h.interactions[k].contains(&t.interaction.name()) {
+                h.interactions[k].push(t.interaction.name());
+            }
+            h.per_type.push(s);
+        }
+        Ok(h)
+    }
+}
+
+/// One `pair_style hybrid/overlay` instance: a style serving one cellmd interaction.
+struct PairInstance {
+    interaction: &'static str,
+    style: &'static str,
+    shift: bool,
+    /// `lj/cut 2` when the style appears more than once, else `lj/cut`.
+    reference: String,
+}
+
+struct Pairs {
+    instances: Vec<PairInstance>,
+    /// For each pair rule: its instance and converted coefficients.
+    per_rule: Vec<(usize, PairStyled)>,
+    max_cutoff: f64,
+}
+
+impl Pairs {
+    fn new(model: &Model) -> Result<Self, String> {
+        let mut instances: Vec<PairInstance> = Vec::new();
+        let mut per_rule = Vec::new();
+        // The n-th rule of an interaction on one type pair uses that interaction's n-th instance.
+        let mut seen: BTreeMap<(u32, u32, &'static str), usize> = BTreeMap::new();
+        for (rule, term) in model.pair_rules.iter().enumerate() {
+            let styled = styles::pair(term)?;
+            let (a, b) = model.pair_rule_types[rule];
+            let nth = seen.entry((a.min(b), a.max(b), term.interaction.name())).or_default();
+            let mut found = None;
+            let mut count = 0;
+            for (k, inst) in instances.iter().enumerate() {
+                if inst.interaction == term.interaction.name() {
+                    if count == *nth {
+                        found = Some(k);
+                    }
+                    count += 1;
+                }
+            }
+            let k = found.unwrap_or_else(|| {
+                instances.push(PairInstance {
+                    interaction: term.interaction.name(),
+                    style: styled.style,
+                    shift: styled.shift,
+                    reference: String::new(),
+                });
+                instances.len() - 1
+            });
+            *nth += 1;
+            per_rule.push((k, styled));
+        }
+        let names: Vec<&str> = instances.iter().map(|i| i.style).collect();
+        let mut index: BTreeMap<&str, usize> = BTreeMap::new();
+        for inst in &mut instances {
+            let n = index.entry(inst.style).or_default();
+            *n += 1;
+            inst.reference =
+                if names.iter().filter(|&&s| s == inst.style).count() > 1 { format!("{} {n}", inst.style) } else { inst.style.to_string() };
+        }
+        let max_cutoff = per_rule.iter().map(|(_, s)| s.cutoff).fold(0.0, f64::max);
+        Ok(Pairs { instances, per_rule, max_cutoff })
+    }
+
+    fn coeff_line(&self, model: &Model, rule: usize, term: &TermType) -> Result<String, String> {
+        let (a, b) = model.pair_rule_types[rule];
+        let (k, _) = &self.per_rule[rule];
+        let styled = styles::pair(term)?;
+        Ok(format!("pair_coeff {} {} {} {}", a.min(b) + 1, a.max(b) + 1, self.instances[*k].reference, styled.coeffs))
+    }
+}
+
+/// Ids as LAMMPS `group ... id` arguments, consecutive runs as `a:b`.
+fn id_ranges(ids: &mut [u64]) -> String {
+    ids.sort_unstable();
+    let mut out = Vec::new();
+    let mut k = 0;
+    while k < ids.len() {
+        let start = ids[k];
+        while k + 1 < ids.len() && ids[k + 1] == ids[k] + 1 {
+            k += 1;
+        }
+        out.push(if ids[k] == start { start.to_string() } else { format!("{start}:{}", ids[k]) });
+        k += 1;
+    }
+    out.join(" ")
+}
+
+/// Writes the data file.
+fn data_file(plan: &Plan, title: &str) -> String {
+    let m = &plan.model;
+    let b = &plan.sim_box;
+    let mut s = format!("{title}\n\n{} atoms\n{} bonds\n{} angles\n", m.len(), m.bonds.len(), m.angles.len());
+    let _ = writeln!(
+        s,
+        "{} atom types\n{} bond types\n{} angle types\n",
+        m.type_names.len(),
+        m.bond_types.len().max(1),
+        m.angle_types.len().max(1)
+    );
+    for (a, (lo, hi)) in ["x", "y", "z"].iter().zip(b.lo.to_array().iter().zip(b.hi.to_array())) {
+        let _ = writeln!(s, "{} {} {a}lo {a}hi", num(*lo), num(hi));
+    }
+    s += "\nMasses\n\n";
+    for (t, name) in m.type_names.iter().enumerate() {
+        let _ = writeln!(s, "{} 1.0  # {name}", t + 1);
+    }
+    s += "\nAtoms # angle\n\n";
+    for (i, x) in plan.positions.iter().enumerate() {
+        let (mut x, mut image) = (*x, [0; 3]);
+        b.wrap(&mut x, &mut image);
+        let _ =
+            writeln!(s, "{} 1 {} {} {} {} {} {} {}", m.ids[i], m.types[i] + 1, num(x.x), num(x.y), num(x.z), image[0], image[1], image[2]);
+    }
+    if !m.bonds.is_empty() {
+        s += "\nBonds\n\n";
+        for (k, (&[i, j], t)) in m.bonds.iter().zip(&m.bond_type).enumerate() {
+            let _ = writeln!(s, "{} {} {} {}", k + 1, t + 1, m.ids[i as usize], m.ids[j as usize]);
+        }
+    }
+    if !m.angles.is_empty() {
+        s += "\nAngles\n\n";
+        for (k, (&[i, j, l], t)) in m.angles.iter().zip(&m.angle_type).enumerate() {
+            let _ = writeln!(s, "{} {} {} {} {}", k + 1, t + 1, m.ids[i as usize], m.ids[j as usize], m.ids[l as usize]);
+        }
+    }
+    s
+}
+
+/// Largest distance between particles of one bond or angle (minimum image), so
+/// LAMMPS' ghost cutoff reaches every bonded partner.
+fn bonded_extent(plan: &Plan) -> f64 {
+    let x = &plan.positions;
+    let d = |i: u32, j: u32| plan.sim_box.minimum_image(x[j as usize] - x[i as usize]).length();
+    let bonds = plan.model.bonds.iter().map(|&[i, j]| d(i, j));
+    let angles = plan.model.angles.iter().map(|&[i, j, k]| d(i, j) + d(j, k));
+    bonds.chain(angles).fold(0.0, f64::max)
+}
+
+/// State of the script being written.
+struct Writer<'a> {
+    plan: &'a Plan,
+    model: Model,
+    options: ExportOptions,
+    out: String,
+    bonds: Hybrid,
+    angles: Hybrid,
+    pairs: Pairs,
+    /// Active externals: LAMMPS fix id and cellmd interaction name.
+    fixes: Vec<(String, &'static str)>,
+    kt: f64,
+    seed: u64,
+    noise: Noise,
+    dt_set: bool,
+}
+
+impl Writer<'_> {
+    fn line(&mut self, text: impl AsRef<str>) {
+        self.out += text.as_ref();
+        self.out.push('\n');
+    }
+
+    fn setup(&mut self) -> Result<(), String> {
+        let b = self.plan.sim_box;
+        let letters: Vec<&str> = (0..3).map(|a| if b.periodic[a] { "p" } else { "m" }).collect();
+        self.line("units lj");
+        self.line("atom_style angle");
+        self.line(format!("boundary {}", letters.join(" ")));
+        self.line(format!("read_data {DATA_FILE}"));
+        let sb = self.model.special_bonds;
+        let w = |excluded: bool| if excluded { "0.0" } else { "1.0" };
+        self.line(format!("special_bonds lj {} {} {}", w(sb.exclude_12), w(sb.exclude_13), w(sb.exclude_14)));
+        if !self.bonds.styles.is_empty() {
+            // LAMMPS shifts a lepton bond's energy to zero at r0 unless told not to.
+            let list: Vec<&str> = self.bonds.styles.iter().map(|&s| if s == "lepton" { "lepton no_offset" } else { s }).collect();
+            self.line(format!("bond_style hybrid {}", list.join(" ")));
+            for (t, s) in self.bonds.per_type.iter().enumerate() {
+                self.out += &format!("bond_coeff {} {} {}\n", t + 1, s.style, s.coeffs);
+            }
+        }
+        if !self.angles.styles.is_empty() {
+            self.line(format!("angle_style hybrid {}", self.angles.styles.join(" ")));
+            for (t, s) in self.angles.per_type.iter().enumerate() {
+                self.out += &format!("angle_coeff {} {} {}\n", t + 1, s.style, s.coeffs);
+            }
+        }
+        if !self.pairs.instances.is_empty() {
+            let cut = num(self.pairs.max_cutoff);
+            let list: Vec<String> = self
+                .pairs
+                .instances
+                .iter()
+                .map(|i| if i.style == "harmonic/cut" { i.style.to_string() } else { format!("{} {cut}", i.style) })
+                .collect();
+            self.line(format!("pair_style hybrid/overlay {}", list.join(" ")));
+            self.line("pair_coeff * * none");
+            for (rule, term) in self.model.pair_rules.clone().iter().enumerate() {
+                let line = self.pairs.coeff_line(&self.model, rule, term)?;
+                self.line(line);
+            }
+            for inst in self.pairs.instances.iter().filter(|i| i.shift).map(|i| i.reference.clone()).collect::<Vec<_>>() {
+                self.line(format!("pair_modify pair {inst} shift yes"));
+            }
+        }
+        let skin = self.plan_skin();
+        self.line(format!("neighbor {} bin", num(skin)));
+        self.line("neigh_modify every 1 delay 0 check yes");
+        let ghost = (self.pairs.max_cutoff + skin).max(2.0 * bonded_extent(self.plan) + skin);
+        self.line(format!("comm_modify cutoff {}", num(ghost)));
+        for t in 0..self.model.type_names.len() {
+            self.line(format!("group cellmd_t{} type {}", t + 1, t + 1));
+        }
+        if self.options.probes {
+            if !self.bonds.styles.is_empty() {
+                self.line("compute cellmd_bond all bond");
+            }
+            if !self.angles.styles.is_empty() {
+                self.line("compute cellmd_angle all angle");
+            }
+            for (k, inst) in self.pairs.instances.iter().enumerate().map(|(k, i)| (k, i.reference.clone())).collect::<Vec<_>>() {
+                self.line(format!("compute cellmd_pair{k} all pair {inst}"));
+            }
+            self.line("compute cellmd_virial all pressure NULL virial");
+        }
+        self.thermo_style();
+        Ok(())
+    }
+
+    fn plan_skin(&self) -> f64 {
+        let skin =
+            self.plan.actions.iter().rev().find_map(|a| if let Action::Neighbor(n) = a { Some(n.skin) } else { None }).unwrap_or(0.0);
+        if skin > 0.0 {
+            skin
+        } else {
+            0.3 * self.pairs.max_cutoff.max(1.0)
+        }
+    }
+
+    /// Energy terms: (key of cellmd interactions, LAMMPS reference).
+    fn energy_terms(&self) -> Vec<(String, String)> {
+        let mut terms = Vec::new();
+        for (k, names) in self.bonds.interactions.iter().enumerate() {
+            terms.push((names.join("+"), format!("c_cellmd_bond[{}]", k + 1)));
+        }
+        for (k, names) in self.angles.interactions.iter().enumerate() {
+            terms.push((names.join("+"), format!("c_cellmd_angle[{}]", k + 1)));
+        }
+        for (k, inst) in self.pairs.instances.iter().enumerate() {
+            terms.push((inst.interaction.to_string(), format!("c_cellmd_pair{k}")));
+        }
+        for (id, name) in &self.fixes {
+            terms.push((name.to_string(), format!("f_{id}")));
+        }
+        terms
+    }
+
+    /// Thermo output that keeps every probed compute current.
+    fn thermo_style(&mut self) {
+        let mut columns = vec!["step".to_string(), "pe".into()];
+        if self.options.probes {
+            columns.extend(self.energy_terms().into_iter().map(|(_, r)| r));
+            columns.extend((1..=6).map(|k| format!("c_cellmd_virial[{k}]")));
+            columns.push("vol".into());
+        }
+        self.line(format!("thermo_style custom {}", columns.join(" ")));
+        self.line("thermo_modify norm no format float %.17g");
+    }
+
+    fn probe(&mut self, tag: &str, first: bool) {
+        let mut lines = vec![format!("step $(step) {tag}")];
+        for (key, reference) in self.energy_terms() {
+            lines.push(format!("energy {key} $({reference}:%.17g)"));
+        }
+        let virial: Vec<String> = (1..=6).map(|k| format!("$(c_cellmd_virial[{k}]*vol:%.17g)")).collect();
+        lines.push(format!("virial {}", virial.join(" ")));
+        for (k, text) in lines.iter().enumerate() {
+            let mode = if first && k == 0 { "file" } else { "append" };
+            self.line(format!("print \"{text}\" {mode} {PROBE_FILE} screen no"));
+        }
+        self.line(format!("write_dump all custom cellmd_probe_{tag}.dump id xu yu zu fx fy fz modify format float %.17g sort id"));
+    }
+
+    fn brownian(&mut self) {
+        let (temperature, rng) = if self.kt > 0.0 {
+            (
+                self.kt,
+                match self.noise {
+                    Noise::Uniform => "uniform",
+                    Noise::Gaussian => "gaussian",
+                },
+            )
+        } else {
+            (1.0, "none")
+        };
+        let seed = (self.seed % 900_000_000).max(1);
+        for t in 0..self.model.type_names.len() {
+            let gamma = self.model.type_drag[t];
+            self.line(format!(
+                "fix cellmd_bd{} cellmd_t{} brownian {} {seed} gamma_t {} rng {rng}",
+                t + 1,
+                t + 1,
+                num(temperature),
+                num(gamma)
+            ));
+        }
+    }
+
+    fn external(&mut self, external: &External) -> Result<(), String> {
+        let b = self.plan.sim_box;
+        let args = styles::external(&external.term, |a| b.lengths()[a], |a| b.periodic[a])?;
+        let id = ident("x_", &external.term.label.text);
+        let mut ids: Vec<u64> = external.members.iter().map(|&m| self.model.ids[m as usize]).collect();
+        let group = ident("g_", &external.term.label.text);
+        if ids.is_empty() {
+            return Err(format!("external `{}` acts on an empty group", external.term.label.text));
+        }
+        self.unexternal(&external.term.label.text);
+        self.line(format!("group {group} id {}", id_ranges(&mut ids)));
+        self.line(format!("fix {id} {group} {args}"));
+        self.fixes.push((id, external.term.interaction.name()));
+        self.thermo_style();
+        Ok(())
+    }
+
+    fn unexternal(&mut self, name: &str) {
+        let id = ident("x_", name);
+        if let Some(k) = self.fixes.iter().position(|(f, _)| *f == id) {
+            self.fixes.remove(k);
+            self.line(format!("unfix {id}"));
+            self.line(format!("group {} delete", ident("g_", name)));
+            self.thermo_style();
+        }
+    }
+
+    fn coeff(&mut self, target: &CoeffTarget, param: usize, value: f64) -> Result<(), String> {
+        match target {
+            CoeffTarget::BondType(k) => {
+                self.model.bond_types[*k].params[param] = value;
+                let s = styles::bond(&self.model.bond_types[*k])?;
+                self.line(format!("bond_coeff {} {} {}", k + 1, s.style, s.coeffs));
+            }
+            CoeffTarget::AngleType(k) => {
+                self.model.angle_types[*k].params[param] = value;
+                let s = styles::angle(&self.model.angle_types[*k])?;
+                self.line(format!("angle_coeff {} {} {}", k + 1, s.style, s.coeffs));
+            }
+            CoeffTarget::PairRule(k) => {
+                self.model.pair_rules[*k].params[param] = value;
+                let term = self.model.pair_rules[*k].clone();
+                let line = self.pairs.coeff_line(&self.model, *k, &term)?;
+                self.line(line);
+            }
+        }
+        Ok(())
+    }
+
+    fn actions(&mut self) -> Result<(), String> {
+        let actions = &self.plan.actions;
+        let first_run = actions.iter().position(|a| matches!(a, Action::Run(_)));
+        let last_run = actions.iter().rposition(|a| matches!(a, Action::Run(_)));
+        for (k, action) in actions.iter().enumerate() {
+            if Some(k) == first_run && self.options.probes {
+                self.initial_probe();
+            }
+            match action {
+                Action::Temperature(kt) => self.kt = *kt,
+                Action::Timestep(dt) => {
+                    self.dt_set = true;
+                    self.line(format!("timestep {}", num(*dt)));
+                }
+                Action::Seed(seed) => self.seed = *seed,
+                Action::Integrator(s) => self.noise = s.noise,
+                Action::Neighbor(_) => {}
+                Action::Thermo { every, .. } => self.line(format!("thermo {every}")),
+                Action::ThermoFile(path) => self.line(format!("# thermo_file {}: the LAMMPS log holds the thermo table", path.display())),
+                Action::Dump(spec) => self.line(format!(
+                    "dump {} all custom {} {} id type xu yu zu",
+                    ident("d_", &spec.name),
+                    spec.every,
+                    spec.path.display()
+                )),
+                Action::Undump(name) => self.line(format!("undump {}", ident("d_", name))),
+                Action::External(e) => self.external(e)?,
+                Action::Unexternal(name) => self.unexternal(name),
+                Action::Coeff { target, param, value } => self.coeff(target, *param, *value)?,
+                Action::Minimize(_) => {
+                    return Err(
+                        "`minimize` (FIRE with drag-scaled masses) has no exact LAMMPS equivalent; export the deck without it".into()
+                    )
+                }
+                Action::ReadState(_) => return Err("`read_state` cannot be exported: LAMMPS cannot read cellmd restart files".into()),
+                Action::WriteState(path) => self.line(format!("# write_state {}: not exported", path.display())),
+                Action::Print(text) => self.line(format!("print \"{}\"", text.replace('"', "'"))),
+                Action::Run(steps) => {
+                    self.brownian();
+                    self.line(format!("run {steps} post no"));
+                }
+            }
+            if Some(k) == last_run && self.options.probes {
+                self.probe("final", false);
+            }
+        }
+        if first_run.is_none() && self.options.probes {
+            self.initial_probe();
+        }
+        Ok(())
+    }
+
+    fn initial_probe(&mut self) {
+        if !self.dt_set {
+            self.line("timestep 0.0");
+        }
+        self.brownian();
+        self.line("run 0 post no");
+        self.probe("init", true);
+    }
+}
+
+/// Exports a validated deck. Interactions or commands LAMMPS cannot express
+/// are errors naming them.
+pub fn export(plan: &Plan, options: ExportOptions) -> Result<LammpsDeck, String> {
+    let model = plan.model.clone();
+    let bonds = Hybrid::new(&model.bond_types, styles::bond)?;
+    let angles = Hybrid::new(&model.angle_types, styles::angle)?;
+    let pairs = Pairs::new(&model)?;
+    // Externals and coefficients that only appear later are checked when written.
+    let title = format!("cellmd export of {}", plan.deck_path.display());
+    let mut w = Writer {
+        plan,
+        model,
+        options,
+        out: String::new(),
+        bonds,
+        angles,
+        pairs,
+        fixes: Vec::new(),
+        kt: 0.0,
+        seed: 1,
+        noise: Noise::Uniform,
+        dt_set: false,
+    };
+    let units = match plan.model.units {
+        UnitSystem::Lj => "units lj (identical)".to_string(),
+        UnitSystem::Cell => {
+            "cell units (µm, s, pN) written as LAMMPS units lj: sigma = 1 µm, tau = 1 s, epsilon = 1 pN·µm, T = kT in pN·µm".to_string()
+        }
+    };
+    w.line(format!("# {title} ({units})"));
+    w.line("# Overdamped dynamics: fix brownian per particle type, gamma_t = the type's drag.");
+    w.setup()?;
+    w.actions()?;
+    Ok(LammpsDeck { data: data_file(plan, &title), input: w.out })
+}
+
+/// Writes `data.lammps` and `in.lammps` into `dir` (created if needed).
+pub fn write(deck: &LammpsDeck, dir: &std::path::Path) -> std::io::Result<()> {
+    std::fs::create_dir_all(dir)?;
+    std::fs::write(dir.join(DATA_FILE), &deck.data)?;
+    std::fs::write(dir.join(INPUT_FILE), &deck.input)
+}

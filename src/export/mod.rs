@@ -1,0 +1,12 @@
+//! Export of a cellmd deck to other engines.
+//!
+//! [`lammps::export`] turns a validated [`crate::deck::Plan`] into a LAMMPS data
+//! file and input script that compute the same energies and forces and run the
+//! same overdamped dynamics (`cellmd export-lammps DECK OUTDIR`). The
+//! correspondence of every interaction type is in [`styles`]; an interaction
+//! LAMMPS cannot express is an error that names it.
+
+pub mod lammps;
+pub mod styles;
+
+pub use self::lammps::{export, ExportOptions, LammpsDeck};

@@ -1,0 +1,142 @@
+//! How each registered interaction type is written in LAMMPS, with the
+//! conversion of its parameters (the one place that knows both conventions).
+//!
+//! | cellmd | LAMMPS | conversion |
+//! |---|---|---|
+//! | `harmonic` ½k(r−r0)² | `bond_style harmonic` K(r−r0)² | K = k/2 |
+//! | `fene` | `bond_style fene` | identical (K, R0, ε, σ) |
+//! | `cable`, `spring`, `asymmetric` | `bond_style lepton` | exact expression in Δr = r − r0 (LAMMPS' lepton bond variable) |
+//! | `harmonic_angle` ½k(θ−θ0)² | `angle_style harmonic` K(θ−θ0)² | K = k/2 |
+//! | `cosine_angle` K(1+cos θ) | `angle_style cosine` | identical |
+//! | `wlc_bending` (κ/ℓ)(1−t1·t2) | `angle_style cosine` | K = κ/ℓ, since t1·t2 = −cos θ |
+//! | `lj` | `pair_style lj/cut` | identical, not shifted |
+//! | `wca` | `pair_style lj/cut` at 2^(1/6)σ | `pair_modify shift yes` |
+//! | `soft_repulsion` ½k(σ−r)² | `pair_style harmonic/cut` k(rc−r)² | k/2, rc = σ |
+//! | `soft` | `pair_style soft` | identical |
+//! | `wall` (axis-aligned normal) | `fix wall/harmonic` ε(r−rc)² | ε = k/2, wall placed at d − rc |
+//! | `constant_force` | `fix addforce` | identical; its scalar is −F·x on unwrapped x |
+
+use crate::forcefield::TermType;
+use crate::interactions::{param_index, Law};
+
+/// Shortest text that reads back as exactly `x` (LAMMPS parses it with strtod).
+pub fn num(x: f64) -> String {
+    format!("{x:?}")
+}
+
+fn param(term: &TermType, name: &str) -> f64 {
+    term.params[param_index(term.interaction, name).unwrap_or_else(|| panic!("{} has no `{name}`", term.interaction.name()))]
+}
+
+/// A bonded style: the sub-style name and the coefficients after it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Styled {
+    pub style: &'static str,
+    pub coeffs: String,
+}
+
+/// A pair style instance: style, coefficients (including the cutoff), and
+/// whether the style's energy is shifted to zero at the cutoff.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PairStyled {
+    pub style: &'static str,
+    pub coeffs: String,
+    pub cutoff: f64,
+    pub shift: bool,
+}
+
+fn unsupported(term: &TermType) -> String {
+    format!(
+        "{} `{}` uses `{}`, which LAMMPS cannot express",
+        term.interaction.kind().with_article(),
+        term.label.text,
+        term.interaction.name()
+    )
+}
+
+/// The `bond_style` sub-style and `bond_coeff` values of a bond type.
+pub fn bond(term: &TermType) -> Result<Styled, String> {
+    let p = |n| param(term, n);
+    let lepton = |expression: String, r0: f64| Styled { style: "lepton", coeffs: format!("{} \"{expression}\"", num(r0)) };
+    Ok(match term.interaction.name() {
+        "harmonic" => Styled { style: "harmonic", coeffs: format!("{} {}", num(0.5 * p("k")), num(p("r0"))) },
+        "fene" => Styled { style: "fene", coeffs: format!("{} {} {} {}", num(p("K")), num(p("R0")), num(p("epsilon")), num(p("sigma"))) },
+        // In LAMMPS' lepton bond the variable r is the displacement r − r0.
+        "cable" => {
+            let (k, r0, tau) = (p("k"), p("r0"), p("tau"));
+            lepton(format!("0.5*{}*{}*max(0,r/{}+({}))^2", num(k), num(r0), num(r0), num(tau)), r0)
+        }
+        "spring" => {
+            let (k, r0, tau) = (p("k"), p("r0"), p("tau"));
+            lepton(format!("0.5*{}*{}*(r/{}+({}))^2", num(k), num(r0), num(r0), num(tau)), r0)
+        }
+        "asymmetric" => {
+            let (kt, kc) = (p("k_tension"), p("k_compression"));
+            lepton(format!("0.5*({}*step(r)+{}*(1-step(r)))*r^2", num(kt), num(kc)), p("r0"))
+        }
+        _ => return Err(unsupported(term)),
+    })
+}
+
+/// The `angle_style` sub-style and `angle_coeff` values of an angle type.
+pub fn angle(term: &TermType) -> Result<Styled, String> {
+    let p = |n| param(term, n);
+    Ok(match term.interaction.name() {
+        "harmonic_angle" => Styled { style: "harmonic", coeffs: format!("{} {}", num(0.5 * p("k")), num(p("theta0"))) },
+        "cosine_angle" => Styled { style: "cosine", coeffs: num(p("K")) },
+        "wlc_bending" => Styled { style: "cosine", coeffs: num(p("kappa") / p("l0")) },
+        _ => return Err(unsupported(term)),
+    })
+}
+
+/// The `pair_style` instance and `pair_coeff` values of a pair rule.
+pub fn pair(term: &TermType) -> Result<PairStyled, String> {
+    let p = |n| param(term, n);
+    let Law::Radial { range, .. } = term.interaction.law() else { return Err(unsupported(term)) };
+    let cutoff = range(&term.params);
+    let (style, coeffs, shift) = match term.interaction.name() {
+        "lj" => ("lj/cut", format!("{} {} {}", num(p("epsilon")), num(p("sigma")), num(cutoff)), false),
+        "wca" => ("lj/cut", format!("{} {} {}", num(p("epsilon")), num(p("sigma")), num(cutoff)), true),
+        "soft_repulsion" => ("harmonic/cut", format!("{} {}", num(0.5 * p("k")), num(cutoff)), false),
+        "soft" => ("soft", format!("{} {}", num(p("A")), num(cutoff)), false),
+        _ => return Err(unsupported(term)),
+    };
+    Ok(PairStyled { style, coeffs, cutoff, shift })
+}
+
+/// A LAMMPS fix equivalent to an external field: the fix style and its
+/// arguments after the group. `axis_length(a)` is the box edge along axis a,
+/// `periodic(a)` whether that axis is periodic.
+pub fn external(term: &TermType, axis_length: impl Fn(usize) -> f64, periodic: impl Fn(usize) -> bool) -> Result<String, String> {
+    let p = |n| param(term, n);
+    match term.interaction.name() {
+        "constant_force" => Ok(format!("addforce {} {} {}", num(p("fx")), num(p("fy")), num(p("fz")))),
+        "wall" => {
+            let n = [p("nx"), p("ny"), p("nz")];
+            let axes: Vec<usize> = (0..3).filter(|&a| n[a] != 0.0).collect();
+            let [axis] = axes[..] else {
+                return Err(format!(
+                    "external `{}`: a wall with the oblique normal ({}, {}, {}) has no LAMMPS equivalent (fix wall/* faces are axis-aligned)",
+                    term.label.text, n[0], n[1], n[2]
+                ));
+            };
+            if periodic(axis) {
+                return Err(format!(
+                    "external `{}`: LAMMPS cannot put a wall across the periodic axis {}",
+                    term.label.text,
+                    "xyz".as_bytes()[axis] as char
+                ));
+            }
+            // E = ε(r − rc)² for r < rc with r the distance from the LAMMPS wall:
+            // a wall rc below the cellmd plane gives ε(d − n̂·x)² = ½k(d − n̂·x)².
+            // rc only has to exceed the deepest penetration; a small rc keeps
+            // the round-off of (r − rc) small.
+            let rc = axis_length(axis).max(1.0);
+            let d = p("d");
+            let letter = "xyz".as_bytes()[axis] as char;
+            let face = if n[axis] > 0.0 { format!("{letter}lo {}", num(d - rc)) } else { format!("{letter}hi {}", num(-d + rc)) };
+            Ok(format!("wall/harmonic {face} {} 1.0 {} units box", num(0.5 * p("k")), num(rc)))
+        }
+        _ => Err(unsupported(term)),
+    }
+}

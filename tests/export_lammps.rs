@@ -1,0 +1,73 @@
+//! `cellmd export-lammps`: the conversions of each interaction, and clear
+//! errors for what LAMMPS cannot express. (Agreement with LAMMPS itself is
+//! checked by tests/golden.rs and `scripts/test-all`.)
+
+mod common;
+
+use cellmd::export::{export, ExportOptions};
+use common::Case;
+
+const TOP: &str = "[ particles ]\n1 a 0 0 0.5\n2 a 1.1 0 0.5\n3 a 1.5 0.9 0.5\n[ bonds ]\nh 1 2\nc 2 3\n[ angles ]\nw 1 2 3\n";
+const FF: &str = "particle a drag 2\nbond h harmonic k 50 r0 1\nbond c cable k 40 r0 1 tau 0.1\nangle w wlc_bending kappa 0.5 l0 0.25\n\
+                  pair a a wca epsilon 1 sigma 1\npair a a lj epsilon 0.5 sigma 1 rc 2.5\n";
+
+fn deck(extra: &str) -> Case {
+    let deck =
+        format!("units lj\ntopology t.top\nforcefield f.ff\nbox x -5 5 p y -5 5 p z 0 5 f\n{extra}temperature 0\ntimestep 0.001\nrun 10\n");
+    Case::new(&[("t.top", TOP), ("f.ff", FF), ("deck.in", &deck)])
+}
+
+#[test]
+fn interactions_map_to_their_exact_lammps_forms() {
+    let out = export(&deck("external floor all wall nz 1 d 0 k 20\n").plan(), ExportOptions::default()).unwrap();
+    let input = out.input;
+    for line in [
+        "bond_style hybrid harmonic lepton no_offset",
+        "bond_coeff 1 harmonic 25.0 1.0",
+        "bond_coeff 2 lepton 1.0 \"0.5*40.0*1.0*max(0,r/1.0+(0.1))^2\"",
+        "angle_coeff 1 cosine 2.0",
+        "pair_style hybrid/overlay lj/cut 2.5 lj/cut 2.5",
+        "pair_modify pair lj/cut 1 shift yes",
+        "special_bonds lj 0.0 1.0 1.0",
+        "boundary p p m",
+        "fix x_floor g_floor wall/harmonic zlo -5.0 10.0 1.0 5.0 units box",
+        "fix cellmd_bd1 cellmd_t1 brownian 1.0 1 gamma_t 2.0 rng none",
+        "run 10 post no",
+    ] {
+        assert!(input.lines().any(|l| l == line), "in.lammps lacks `{line}`:\n{input}");
+    }
+    assert!(out.data.contains("3 atoms\n2 bonds\n1 angles\n"), "{}", out.data);
+    // Probes only on request.
+    assert!(!input.contains("write_dump"));
+}
+
+#[test]
+fn what_lammps_cannot_express_is_refused_by_name() {
+    let oblique = export(&deck("external slope all wall nx 1 nz 1 k 20\n").plan(), ExportOptions::default()).unwrap_err();
+    assert!(oblique.contains("external `slope`") && oblique.contains("oblique normal (1, 0, 1)"), "{oblique}");
+    let periodic = export(&deck("external side all wall nx 1 nz 0 k 20\n").plan(), ExportOptions::default()).unwrap_err();
+    assert!(periodic.contains("periodic axis x"), "{periodic}");
+    let minimize = export(&deck("timestep 0.001\nminimize\n").plan(), ExportOptions::default()).unwrap_err();
+    assert!(minimize.contains("`minimize`"), "{minimize}");
+}
+
+#[test]
+fn cli_exports_files_and_exits_2_on_an_unexportable_deck() {
+    let case = deck("");
+    let out = case.path("lmp");
+    let status = std::process::Command::new(env!("CARGO_BIN_EXE_cellmd"))
+        .args(["export-lammps", case.path("deck.in").to_str().unwrap(), out.to_str().unwrap(), "--probes"])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let input = std::fs::read_to_string(out.join("in.lammps")).unwrap();
+    assert!(input.contains("read_data data.lammps") && input.contains("write_dump all custom cellmd_probe_init.dump"));
+    assert!(out.join("data.lammps").exists());
+    let bad = deck("external slope all wall nx 1 nz 1 k 20\n");
+    let result = std::process::Command::new(env!("CARGO_BIN_EXE_cellmd"))
+        .args(["export-lammps", bad.path("deck.in").to_str().unwrap(), bad.path("lmp").to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert_eq!(result.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&result.stderr).contains("oblique normal"));
+}

@@ -1,0 +1,136 @@
+//! cellmd against the golden reference files in `reference/` (LAMMPS' answers
+//! recorded by `reference/regenerate`), with no Python or LAMMPS needed.
+//!
+//! Each `reference/NAME.yaml` holds one document per case (`small`: 1–3
+//! particles; `random`: ≥ 100 particles, periodic where the type allows).
+//! Energies, forces and virial at step 0 must agree within the file's
+//! `epsilon`, positions, forces and energies after the run within its
+//! `run_epsilon` (figures defined in `cellmd::compare::Agreement`).
+
+use std::path::{Path, PathBuf};
+
+use cellmd::compare::{cellmd_probes, golden, Agreement, Probes};
+use cellmd::deck::validate_file;
+use cellmd::interactions::REGISTRY;
+
+fn documents(path: &Path) -> Vec<golden::Document> {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    golden::parse(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+fn golden_files() -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> =
+        std::fs::read_dir("reference").unwrap().map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|e| e == "yaml")).collect();
+    files.sort();
+    files
+}
+
+/// Checks one document; returns the worst relative errors (start, end).
+fn check(path: &Path, doc: &golden::Document) -> (f64, f64) {
+    let deck = Path::new("reference").join(doc.get("deck").expect("deck"));
+    let tol = golden::tolerance_of(doc).unwrap();
+    let reference = golden::probes_of(doc).unwrap();
+    let plan = validate_file(&deck, &[]).unwrap_or_else(|e| panic!("{e}"));
+    let ours = cellmd_probes(&plan).unwrap();
+    let agreement = Agreement::new(&ours, &reference).unwrap_or_else(|e| panic!("{}: {e}", deck.display()));
+    assert!(
+        agreement.agrees(tol),
+        "{} ({}): cellmd disagrees with {}\n{}",
+        path.display(),
+        deck.display(),
+        doc.get("generator").unwrap(),
+        agreement.table("golden", tol)
+    );
+    (agreement.init.worst(), agreement.last.map_or(0.0, |l| l.worst()))
+}
+
+#[test]
+fn cellmd_matches_every_golden_file() {
+    let files = golden_files();
+    assert!(!files.is_empty(), "no golden files under reference/");
+    for path in files {
+        let docs = documents(&path);
+        let cases: Vec<&str> = docs.iter().map(|d| d.get("case").unwrap()).collect();
+        assert_eq!(cases, ["random", "small"], "{}: expected the cases random and small", path.display());
+        for doc in &docs {
+            for key in ["generator", "date", "epsilon_reason", "run_epsilon_reason"] {
+                assert!(doc.get(key).is_some_and(|v| !v.is_empty()), "{}: header lacks `{key}`", path.display());
+            }
+            let (start, end) = check(&path, doc);
+            println!(
+                "{} {}: worst relative error {start:.1e} at step 0, {end:.1e} after the run",
+                path.display(),
+                doc.get("case").unwrap()
+            );
+        }
+    }
+}
+
+#[test]
+fn random_cases_are_not_toys() {
+    for path in golden_files() {
+        for doc in documents(&path).iter().filter(|d| d.get("case") == Some("random")) {
+            let probes = golden::probes_of(doc).unwrap();
+            assert!(probes.init.ids.len() >= 100, "{}: only {} particles", path.display(), probes.init.ids.len());
+            let deck = Path::new("reference").join(doc.get("deck").unwrap());
+            let plan = validate_file(&deck, &[]).unwrap();
+            let name = path.file_stem().unwrap().to_str().unwrap();
+            // Periodic wherever the type allows it (walls need a fixed axis).
+            let periodic = plan.sim_box.periodic.iter().filter(|&&p| p).count();
+            assert!(periodic >= if name == "wall" { 1 } else { 3 }, "{}: periodic axes {:?}", path.display(), plan.sim_box.periodic);
+            // The interaction acts, and the run moves the particles.
+            let energy: f64 = probes.init.energies.iter().filter(|(k, _)| k.split('+').any(|p| p == name)).map(|(_, e)| e.abs()).sum();
+            assert!(energy > 0.0, "{}: `{name}` has no energy", path.display());
+            let last = probes.last.as_ref().expect("a run");
+            assert!(
+                last.positions.iter().zip(&probes.init.positions).any(|(a, b)| (*a - *b).length() > 1e-3),
+                "{}: nothing moved",
+                path.display()
+            );
+        }
+    }
+}
+
+/// Every registered type has a golden file, or is listed in
+/// reference/NO_REFERENCE.md with the reason and the test that covers it.
+#[test]
+fn every_interaction_has_a_golden_file_or_a_stated_reason() {
+    let listed = std::fs::read_to_string("reference/NO_REFERENCE.md").unwrap();
+    let sources: String =
+        std::fs::read_dir("src/interactions").unwrap().map(|e| std::fs::read_to_string(e.unwrap().path()).unwrap()).collect();
+    for i in REGISTRY {
+        if Path::new(&format!("reference/{}.yaml", i.name())).exists() {
+            assert!(!listed.contains(&format!("| `{}` |", i.name())), "{} has a golden file and is listed as lacking one", i.name());
+            continue;
+        }
+        let row = listed
+            .lines()
+            .find(|l| l.starts_with(&format!("| `{}` |", i.name())))
+            .unwrap_or_else(|| panic!("{} has no reference/{}.yaml and no row in reference/NO_REFERENCE.md", i.name(), i.name()));
+        let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+        // | `name` | reason | `test_name` |
+        assert!(cells.len() >= 4 && !cells[2].is_empty(), "{}: no reason given", i.name());
+        let test = cells[3].trim_matches('`');
+        assert!(sources.contains(&format!("fn {test}(")), "{}: the covering test `{test}` does not exist", i.name());
+    }
+}
+
+/// `reference/regenerate --check` sets CELLMD_GOLDEN_NEW=require: every
+/// freshly regenerated NAME.yaml.new must match the committed NAME.yaml.
+#[test]
+fn regenerated_data_matches_the_committed_golden_files() {
+    let Some(mode) = std::env::var_os("CELLMD_GOLDEN_NEW") else { return };
+    assert_eq!(mode, "require");
+    for path in golden_files() {
+        let new = path.with_extension("yaml.new");
+        assert!(new.exists(), "{} was not regenerated", new.display());
+        let (old_docs, new_docs) = (documents(&path), documents(&new));
+        assert_eq!(old_docs.len(), new_docs.len(), "{}: the number of cases changed", new.display());
+        for (old, new_doc) in old_docs.iter().zip(&new_docs) {
+            let tol = golden::tolerance_of(old).unwrap();
+            let (a, b): (Probes, Probes) = (golden::probes_of(new_doc).unwrap(), golden::probes_of(old).unwrap());
+            let agreement = Agreement::new(&a, &b).unwrap();
+            assert!(agreement.agrees(tol), "{} drifted from {}:\n{}", new.display(), path.display(), agreement.table("committed", tol));
+        }
+    }
+}
