@@ -374,6 +374,10 @@ impl Writer<'_> {
         let seed = (self.seed % 900_000_000).max(1);
         for t in 0..self.model.type_names.len() {
             let gamma = self.model.type_drag[t];
+            if gamma.is_infinite() {
+                // A `fixed` type gets no integrator: it never moves.
+                continue;
+            }
             self.line(format!(
                 "fix cellmd_bd{} cellmd_t{} brownian {} {seed} gamma_t {} rng {rng}",
                 t + 1,
@@ -452,6 +456,7 @@ impl Writer<'_> {
                 Action::Neighbor(_) => {}
                 Action::Thermo { every, .. } => self.line(format!("thermo {every}")),
                 Action::ThermoFile(path) => self.line(format!("# thermo_file {}: the LAMMPS log holds the thermo table", path.display())),
+                Action::EventFile(path) => self.line(format!("# events {}: bond kinetics are not exported", path.display())),
                 Action::Dump(spec) => self.line(format!(
                     "dump {} all custom {} {} id type xu yu zu",
                     ident("d_", &spec.name),
@@ -499,6 +504,14 @@ impl Writer<'_> {
 /// are errors naming them.
 pub fn export(plan: &Plan, options: ExportOptions) -> Result<LammpsDeck, String> {
     let model = plan.model.clone();
+    if let Some((t, kinetics)) = model.bond_kinetics.iter().enumerate().find(|(_, k)| !k.rules.is_empty()) {
+        let rules: Vec<&str> = kinetics.rules.iter().map(|r| r.rule.name()).collect();
+        return Err(format!(
+            "bond type `{}` has kinetic rules ({}): LAMMPS has no force-dependent bond kinetics (only `fix bond/break` by length); export the deck without them",
+            model.bond_types[t].label.text,
+            rules.join(", ")
+        ));
+    }
     let bonds = Hybrid::new(&model.bond_types, styles::bond)?;
     let angles = Hybrid::new(&model.angle_types, styles::angle)?;
     let pairs = Pairs::new(&model)?;
