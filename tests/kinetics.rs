@@ -201,3 +201,159 @@ fn fibre_bundle_with_uniform_thresholds_peaks_at_a_quarter() {
     assert!((peak_load - 0.25).abs() < 0.01, "peak load per fibre {peak_load}");
     assert!((peak_strain - 0.5).abs() < 0.03, "strain at peak {peak_strain}");
 }
+
+/// Reads the bond state saved by `write_state`.
+fn saved_bonds(case: &Case, file: &str) -> (cellmd::system::State, cellmd::kinetics::BondState) {
+    let state = cellmd::output::restart::read_state(&case.path(file)).unwrap().to_state();
+    let bonds = state.bonds.clone().unwrap();
+    (state, bonds)
+}
+
+/// A motor pulling a free bead against a load f: the motor's law is linear
+/// in the tension F it carries, v = v0·(1 − F/Fs), stalling at Fs. The
+/// moving cargo adds its drag, F = f + γ·v, so the bead walks at
+/// v = v0·(1 − f/Fs)/(1 + γ·v0/Fs) below stall and stands still beyond it.
+/// Beads anchored by motor bonds, each pulled away by its own force, kT = 0.
+#[test]
+fn motor_force_velocity_is_linear_to_stall() {
+    let (v0, fs, k, gamma): (f64, f64, f64, f64) = (0.5, 2.0, 200.0, 1.0);
+    let loads = [0.0, 0.5, 1.0, 1.5, 2.0, 2.5];
+    let mut top = String::from("[ particles ]\n");
+    let mut bonds = String::from("[ bonds ]\n");
+    let mut deck = String::from("timestep 1e-4\n");
+    for (m, f) in loads.iter().enumerate() {
+        let x = 10.0 * m as f64;
+        // Start at the loaded length so the bond already carries f.
+        top += &format!("{} a {x} 0 0\n{} bead {x} 0 {}\n", 2 * m + 1, 2 * m + 2, 5.0 + f / k);
+        bonds += &format!("b {} {}\n", 2 * m + 1, 2 * m + 2);
+        deck += &format!("group g{m} id {}\nexternal pull{m} g{m} constant_force fz {f}\n", 2 * m + 2);
+    }
+    deck += "run 2000\nwrite_state a.state\nrun 10000\nwrite_state b.state\n";
+    let ff = format!("particle a fixed\nparticle bead drag {gamma}\nbond b harmonic k {k} r0 5 kinetics motor v0 {v0} fs {fs}\n");
+    let full = format!("units lj\ntopology t.top\nforcefield f.ff\nbox x -10 100 f y -10 10 f z -10 10 f\n{deck}");
+    let c = Case::new(&[("t.top", &(top + &bonds)), ("f.ff", &ff), ("deck.in", &full)]);
+    c.run();
+    let (a, _) = saved_bonds(&c, "a.state");
+    let (b, _) = saved_bonds(&c, "b.state");
+    let elapsed = b.time - a.time;
+    for (m, f) in loads.iter().enumerate() {
+        let v = (b.positions[2 * m + 1].z - a.positions[2 * m + 1].z) / elapsed;
+        let expected = -v0 * (1.0 - f / fs).max(0.0) / (1.0 + gamma * v0 / fs);
+        assert!((v - expected).abs() < 1e-9 * v0, "load {f}: bead velocity {v}, expected {expected}");
+    }
+}
+
+/// A ratchet's rest length grows at v0·exp(−f·δ/kT) against the compressive
+/// load f its bond carries: between fixed ends the load rises as it grows,
+/// and f(t) = k·y with y(t) = ln(e^(a·y0) + a·v0·t)/a, a = k·δ/kT.
+#[test]
+fn ratchet_growth_slows_exponentially_with_load() {
+    let (v0, delta, kt, k) = (1.0, 0.05, 1.0, 20.0);
+    let a = k * delta / kt;
+    let compressions = [0.0, 0.5, 1.0, 2.0];
+    // Fixed ends at 3 − y0 with rest length 3: compression y0, load k·y0.
+    let lengths: Vec<f64> = compressions.iter().map(|y| 3.0 - y).collect();
+    let dt = 1e-4;
+    let bond = format!("bond b harmonic k {k} r0 3 kinetics ratchet v0 {v0} delta {delta}");
+    let c = case(
+        &fixed_pairs(compressions.len(), &lengths),
+        &bond,
+        &format!("temperature {kt}\ntimestep {dt}\nrun 1\nwrite_state one.state\nrun 9999\nwrite_state end.state\n"),
+    );
+    c.run();
+    let (_, one) = saved_bonds(&c, "one.state");
+    let (end_state, end) = saved_bonds(&c, "end.state");
+    for (m, &y0) in compressions.iter().enumerate() {
+        // One step: the growth rate at the initial load.
+        let v = (one.rest[m].unwrap() - 3.0) / dt;
+        let expected = v0 * (-k * y0 * delta / kt).exp();
+        // Δr0 = (3 + v·dt) − 3 cancels digits: its round-off is ≤ 2ε·3/(v·dt).
+        let roundoff = 2.0 * f64::EPSILON * 3.0 / (expected * dt);
+        assert!((v / expected - 1.0).abs() < roundoff, "load {}: growth {v}, expected {expected}", k * y0);
+        // After t = 1: the exact solution of dy/dt = v0·e^(−a·y), to O(dt).
+        let t = end_state.time;
+        let y = end.rest[m].unwrap() - lengths[m];
+        let exact = ((a * y0).exp() + a * v0 * t).ln() / a;
+        assert!((y - exact).abs() < 1e-3 * exact.max(1.0), "y0 = {y0}: compression {y} at t = {t}, exact {exact}");
+    }
+}
+
+/// Plastic reset under a constant pull: between resets the extension x
+/// relaxes as x' = (F − k·x)/γ, and a reset (L0 ← L) happens when x
+/// reaches s·L0, so the n-th interval lasts −(γ/k)·ln(1 − k·s·L0ₙ/F) with
+/// L0ₙ₊₁ = (1 + s)·L0ₙ.
+#[test]
+fn plastic_resets_follow_the_exact_time_course() {
+    let (k, gamma, f, s, dt): (f64, f64, f64, f64, f64) = (1.0, 1.0, 1.0, 0.2, 1e-5);
+    let top = "[ particles ]\n1 a 0 0 0\n2 bead 0 0 1\n[ bonds ]\nb 1 2\n";
+    let ff = format!("particle a fixed\nparticle bead drag {gamma}\nbond b harmonic k {k} r0 1 kinetics plastic threshold {s}\n");
+    let deck = format!(
+        "units lj\ntopology t.top\nforcefield f.ff\nbox x -10 10 f y -10 10 f z -10 100 f\ntimestep {dt}\ngroup bead id 2\n\
+         external pull bead constant_force fz {f}\nevents events.csv\nrun 200000\n"
+    );
+    let c = Case::new(&[("t.top", top), ("f.ff", &ff), ("deck.in", &deck)]);
+    c.run();
+    let resets: Vec<f64> = events(&c).iter().filter(|e| e.1 == "reset").map(|e| e.0 as f64 * dt).collect();
+    let (mut t, mut l0) = (0.0, 1.0);
+    for (n, &measured) in resets.iter().take(5).enumerate() {
+        t += -(gamma / k) * (1.0 - k * s * l0 / f).ln();
+        l0 *= 1.0 + s;
+        // Euler error O(dt) per interval plus the one-step lag of a reset.
+        assert!((measured - t).abs() < 10.0 * dt * (n + 1) as f64, "reset {n} at t = {measured}, exact {t}");
+    }
+    assert!(resets.len() >= 5, "only {} resets", resets.len());
+}
+
+/// Maturation: a bond's energy is E_full·(1 − exp(−age/τ)) at every step.
+#[test]
+fn maturation_follows_its_exact_time_course() {
+    let (k, tau, dt) = (4.0, 0.05, 1e-3);
+    let bond = format!("bond b harmonic k {k} r0 1 kinetics maturation tau {tau}");
+    let c = case(&fixed_pairs(3, &[1.5]), &bond, &format!("timestep {dt}\nthermo 10 step pe/harmonic\nthermo_file t.csv\nrun 200\n"));
+    c.run();
+    let full = 3.0 * 0.5 * k * 0.25;
+    for line in std::fs::read_to_string(c.path("t.csv")).unwrap().lines().skip(1) {
+        let v: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
+        let expected = full * (1.0 - (-v[0] * dt / tau).exp());
+        assert!((v[1] - expected).abs() <= 1e-12 * full, "step {}: E = {}, expected {expected}", v[0], v[1]);
+    }
+}
+
+/// Kinetics (unbinding, rebinding, motors) with thermal noise: the same bits
+/// on one and two threads, events included.
+#[test]
+fn kinetics_runs_are_bit_identical_across_thread_counts() {
+    let mut top = String::from("[ particles ]\n");
+    let mut bonds = String::from("[ bonds ]\n");
+    for m in 0..300 {
+        let (x, y) = ((m % 20) as f64 * 2.0, (m / 20) as f64 * 2.0);
+        top += &format!("{} a {x} {y} 0\n{} bead {x} {y} 0.5\n", 2 * m + 1, 2 * m + 2);
+        bonds += &format!("b {} {}\n", 2 * m + 1, 2 * m + 2);
+    }
+    let ff = "particle a fixed\nparticle bead drag 1\nbond b harmonic k 20 r0 0.5 kinetics slip k0 0.5 x_beta 0.2 kinetics rebind k_on 2 capture 1 kinetics motor v0 0.1 fs 3\npair bead bead wca epsilon 1 sigma 0.3\n";
+    let deck = "units lj\ntopology t.top\nforcefield f.ff\nbox x -5 45 f y -5 35 f z -5 5 f\nneighbor skin 0.2\ntemperature 1\ntimestep 2e-4\nseed 3\nevents events.csv\nrun 3000\n";
+    let run = |threads: usize| {
+        let c = Case::new(&[("t.top", &(top.clone() + &bonds)), ("f.ff", ff), ("deck.in", deck)]);
+        let plan = c.plan();
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        let sim = pool.install(|| {
+            cellmd::run::Simulation::execute(
+                &plan,
+                cellmd::run::RunOptions { output_dir: c.output_dir().to_path_buf(), ..Default::default() },
+            )
+            .unwrap()
+        });
+        let log = std::fs::read(c.path("events.csv")).unwrap();
+        (
+            sim.state.positions.iter().map(|x| x.to_array().map(f64::to_bits)).collect::<Vec<_>>(),
+            sim.state.bonds.clone().unwrap(),
+            log,
+            sim.kinetics.breaks,
+        )
+    };
+    let (one, two) = (run(1), run(2));
+    assert!(one.3 > 100, "too few events to test: {}", one.3);
+    assert_eq!(one.0, two.0);
+    assert_eq!(one.1, two.1);
+    assert_eq!(one.2, two.2);
+}
