@@ -10,6 +10,7 @@ use cellmd::compare::{cellmd_probes, golden, run_lammps, Agreement, Lmp, Toleran
 use cellmd::deck::validate_file;
 use cellmd::export::{self, ExportOptions};
 use cellmd::interactions::{documentation, lookup, REGISTRY};
+use cellmd::kinetics::{lookup_rule, rule_documentation, RULES};
 use cellmd::run::{RunOptions, Simulation};
 use cellmd::units::UnitSystem;
 
@@ -79,7 +80,7 @@ enum Command {
         #[arg(long = "golden-header", value_name = "KEY=VALUE", value_parser = parse_var)]
         golden_header: Vec<(String, String)>,
     },
-    /// List interaction types, or print one type's documentation.
+    /// List interaction types and kinetic rules, or print one's documentation.
     List {
         name: Option<String>,
         /// Show units of the `lj` system instead of `cell`.
@@ -110,12 +111,16 @@ fn main() -> ExitCode {
                     for i in REGISTRY {
                         println!("{:<16} {:<9} {}", i.name(), i.kind().keyword(), i.summary());
                     }
+                    for r in RULES {
+                        println!("{:<16} {:<9} {}", r.name(), "kinetics", r.summary());
+                    }
                 }
-                Some(name) => match lookup(&name) {
-                    Some(i) => println!("{}", documentation(i, units)),
-                    None => {
-                        let names: Vec<&str> = REGISTRY.iter().map(|i| i.name()).collect();
-                        eprintln!("error: unknown interaction `{name}`; expected one of: {}", names.join(", "));
+                Some(name) => match (lookup(&name), lookup_rule(&name)) {
+                    (Some(i), _) => println!("{}", documentation(i, units)),
+                    (None, Some(r)) => println!("{}", rule_documentation(r, units)),
+                    (None, None) => {
+                        let names: Vec<&str> = REGISTRY.iter().map(|i| i.name()).chain(RULES.iter().map(|r| r.name())).collect();
+                        eprintln!("error: unknown interaction or kinetic rule `{name}`; expected one of: {}", names.join(", "));
                         return ExitCode::from(2);
                     }
                 },
