@@ -357,3 +357,108 @@ fn kinetics_runs_are_bit_identical_across_thread_counts() {
     assert_eq!(one.1, two.1);
     assert_eq!(one.2, two.2);
 }
+
+/// Pairs of fixed sites that meet within the capture radius form bonds at
+/// k_on; formed bonds unbind at k_off and the same pair binds again through
+/// the same bond: the bound fraction reaches k_on/(k_on + k_off), and the
+/// bond list holds one bond per pair however often it rebinds.
+#[test]
+fn bond_formation_reaches_the_steady_state_and_reuses_bonds() {
+    let (k_on, k_off, dt) = (2.0, 3.0, 0.002);
+    let n = 5_000;
+    let mut top = String::from("[ particles ]\n");
+    for p in 0..n {
+        let (x, y) = ((p % 100) as f64 * 3.0, (p / 100) as f64 * 3.0);
+        top += &format!("{} a {x} {y} 0\n{} b {x} {y} 0.5\n", 2 * p + 1, 2 * p + 2);
+    }
+    let ff = format!(
+        "particle a fixed\nparticle b fixed\nbond link harmonic k 1 r0 0.5 kinetics slip k0 {k_off} x_beta 0\nbind a b link k_on {k_on} capture 1\n"
+    );
+    let relax = (1.0 / ((k_on + k_off) * dt)) as u64;
+    let deck = format!(
+        "units lj\ntopology t.top\nforcefield f.ff\nbox x -1 301 f y -1 151 f z -1 1 f\ntemperature 1\ntimestep {dt}\nseed 21\n\
+         thermo {relax} step nbound/link\nthermo_file t.csv\nrun {}\n",
+        60 * relax
+    );
+    let c = Case::new(&[("t.top", &top), ("f.ff", &ff), ("deck.in", &deck)]);
+    let sim = c.run();
+    assert_eq!(sim.model.bonds.len(), n, "one bond per pair, reused");
+    assert_eq!(sim.kinetics.forms as usize, n);
+    assert!(sim.kinetics.rebinds > 10 * n as u64);
+    let rows: Vec<f64> =
+        std::fs::read_to_string(c.path("t.csv")).unwrap().lines().skip(1).map(|l| l.split(',').nth(1).unwrap().parse().unwrap()).collect();
+    let samples = &rows[10..];
+    let fraction = samples.iter().sum::<f64>() / (samples.len() as f64 * n as f64);
+    // Within a step unbinding is decided before binding, so the discrete
+    // chain's stationary fraction differs from the continuous
+    // k_on/(k_on + k_off) by O((k_on + k_off)·dt): allow the statistical
+    // error plus that bias bound.
+    let continuous = k_on / (k_on + k_off);
+    let e1 = (-1.0f64).exp();
+    let error = (continuous * (1.0 - continuous) / n as f64).sqrt() * ((1.0 + e1) / (1.0 - e1)).sqrt() / (samples.len() as f64).sqrt();
+    let bias = (k_on + k_off) * dt;
+    assert!((fraction - continuous).abs() < 4.0 * error + bias * continuous, "bound fraction {fraction}, expected {continuous} ± {error}");
+}
+
+/// No particle exceeds `max_bonds`, and the capacity fills when binding is fast.
+#[test]
+fn bond_formation_respects_max_bonds() {
+    // Hubs with 6 partners each within capture; a hub takes at most 2.
+    let mut top = String::from("[ particles ]\n");
+    let mut id = 1;
+    for h in 0..200 {
+        let (x, y) = ((h % 20) as f64 * 5.0, (h / 20) as f64 * 5.0);
+        top += &format!("{id} hub {x} {y} 0\n");
+        id += 1;
+        for k in 0..6 {
+            let a = k as f64 * std::f64::consts::PI / 3.0;
+            top += &format!("{id} leg {} {} 0\n", x + 0.5 * a.cos(), y + 0.5 * a.sin());
+            id += 1;
+        }
+    }
+    let ff = "particle hub fixed\nparticle leg fixed\nbond link harmonic k 1 r0 0.5\nbind hub leg link k_on 100 capture 0.6 max_bonds 2\n";
+    let deck = "units lj\ntopology t.top\nforcefield f.ff\nbox x -2 100 f y -2 50 f z -1 1 f\ntimestep 0.01\nseed 2\nrun 50\n";
+    let c = Case::new(&[("t.top", &top), ("f.ff", ff), ("deck.in", deck)]);
+    let sim = c.run();
+    let mut per_particle = vec![0; sim.model.len()];
+    for &[i, j] in &sim.model.bonds {
+        per_particle[i as usize] += 1;
+        per_particle[j as usize] += 1;
+    }
+    for (p, &n) in per_particle.iter().enumerate() {
+        let limit = if sim.model.type_names[sim.model.types[p] as usize] == "hub" { 2 } else { 1 };
+        assert!(n <= limit, "particle {} has {n} bonds", sim.model.ids[p]);
+    }
+    assert_eq!(sim.model.bonds.len(), 2 * 200, "every hub reached its capacity");
+}
+
+/// A run with bond formation split by a restart is bit-identical to an
+/// uninterrupted one: formed bonds are part of the restart.
+#[test]
+fn restart_resumes_formed_bonds_bit_identically() {
+    let mut top = String::from("[ particles ]\n");
+    for p in 0..400 {
+        let (x, y) = ((p % 20) as f64 * 1.2, (p / 20) as f64 * 1.2);
+        top += &format!("{} s {x} {y} 0\n", p + 1);
+    }
+    let ff = "particle s drag 1\nbond link harmonic k 5 r0 0.8 kinetics slip k0 1 x_beta 0.2\nbind s s link k_on 5 capture 1.3 max_bonds 3\npair s s soft_repulsion k 20 sigma 0.6\n";
+    let deck = |body: &str| {
+        format!("units lj\ntopology t.top\nforcefield f.ff\nbox x -2 26 p y -2 26 p z -2 2 f\nneighbor skin 0.3\ntemperature 0.2\ntimestep 2e-3\nseed 8\n{body}")
+    };
+    let run = |body: &str, copy_from: Option<&Case>| {
+        let c = Case::new(&[("t.top", &top), ("f.ff", ff), ("deck.in", &deck(body))]);
+        if let Some(src) = copy_from {
+            std::fs::copy(src.path("half.state"), c.path("half.state")).unwrap();
+        }
+        let sim = c.run();
+        (c, sim)
+    };
+    let (_, whole) = run("run 400\nrun 400\n", None);
+    let (first, _) = run("run 400\nwrite_state half.state\n", None);
+    let (_, resumed) = run("read_state half.state\nrun 400\n", Some(&first));
+    assert!(whole.kinetics.forms > 50, "too few bonds formed: {}", whole.kinetics.forms);
+    assert_eq!(whole.model.bonds, resumed.model.bonds);
+    assert_eq!(whole.state.bonds, resumed.state.bonds);
+    let bits = |s: &cellmd::run::Simulation| s.state.positions.iter().map(|x| x.to_array().map(f64::to_bits)).collect::<Vec<_>>();
+    assert_eq!(bits(&whole), bits(&resumed));
+}

@@ -36,6 +36,8 @@ pub struct ForceField {
     pub bond_kinetics: Vec<BondTypeKinetics>,
     pub angle_types: Vec<TermType>,
     pub pair_rules: Vec<PairRule>,
+    /// Bond formation rules (`bind` lines).
+    pub bind_lines: Vec<crate::kinetics::BindLine>,
 }
 
 impl ForceField {
@@ -166,7 +168,8 @@ pub fn load_forcefield(
                 let term = parse_params(&t[1], &t[3], &t[4..], Kind::Pair, units)?;
                 ff.pair_rules.push(PairRule { type_a: t[1].clone(), type_b: t[2].clone(), term });
             }
-            other => return Err(kw.error(format!("found `{other}`, expected `include`, `particle`, `bond`, `angle` or `pair`"))),
+            "bind" => ff.bind_lines.push(crate::kinetics::parse_bind(kw, &t[1..], units)?),
+            other => return Err(kw.error(format!("found `{other}`, expected `include`, `particle`, `bond`, `angle`, `pair` or `bind`"))),
         }
     }
     stack.pop();
@@ -175,8 +178,9 @@ pub fn load_forcefield(
 
 /// Checks that pair rules name defined particle types (after all files are read).
 pub fn check_pair_types(ff: &ForceField) -> Result<(), InputError> {
-    for rule in &ff.pair_rules {
-        for t in [&rule.type_a, &rule.type_b] {
+    let pairs = ff.pair_rules.iter().map(|r| [&r.type_a, &r.type_b]).chain(ff.bind_lines.iter().map(|b| [&b.type_a, &b.type_b]));
+    for types in pairs {
+        for t in types {
             if ff.particle_type(&t.text).is_none() {
                 let names: Vec<&str> = ff.particle_types.iter().map(|p| p.name.text.as_str()).collect();
                 return Err(t.error(format!("found particle type `{}`, expected a defined particle type: {}", t.text, names.join(", "))));
@@ -227,5 +231,6 @@ mod tests {
             .unwrap_err()
             .contains("is a bond interaction, expected an angle interaction"));
         assert!(load(&[("m.ff", "bnd x harmonic\n")]).unwrap_err().contains("expected `include`, `particle`"));
+        assert!(load(&[("m.ff", "particle a drag 1\nbind a b s k_on 1 capture 1\n")]).unwrap_err().contains("found particle type `b`"));
     }
 }

@@ -16,10 +16,11 @@
 use rayon::prelude::*;
 
 use super::events::{Event, EventKind};
-use super::state::BondState;
+use super::formation::Binding;
+use super::state::{BondState, FormedBond};
 use super::Effect;
 use crate::integrate::rng::block;
-use crate::system::{Model, State};
+use crate::system::{Model, SimBox, State};
 
 /// Philox stream of per-step kinetic decisions.
 const STREAM_KINETICS: u32 = 2;
@@ -155,6 +156,55 @@ impl Kinetics {
         }
         self.outcomes = outcomes;
         report
+    }
+}
+
+impl Kinetics {
+    /// Applies the bindings decided at `step`: new bonds are appended to the
+    /// model and the bond state (the backend must then be rebuilt), known
+    /// pairs rebind. Returns their events.
+    pub fn apply_bindings(
+        &mut self,
+        model: &mut Model,
+        state: &mut State,
+        sim_box: &SimBox,
+        bindings: Vec<Binding>,
+        step: u64,
+        dt: f64,
+    ) -> Vec<Event> {
+        let bonds = state.bonds.as_mut().expect("bond state exists with bind rules");
+        let mut events = Vec::with_capacity(bindings.len());
+        for binding in bindings {
+            let (b, kind) = match binding {
+                Binding::New(t, [i, j]) => {
+                    model.bonds.push([i, j]);
+                    model.bond_type.push(t);
+                    bonds.push(model.evolving_rest_length(t as usize), maturation_scale(model, t as usize, 0.0));
+                    bonds.formed.push(FormedBond { bond_type: t, particles: [i, j] });
+                    self.forms += 1;
+                    (model.bonds.len() - 1, EventKind::Form)
+                }
+                Binding::Again(b) => {
+                    bonds.bound[b] = true;
+                    bonds.age[b] = 0.0;
+                    bonds.scale[b] = maturation_scale(model, model.bond_type[b] as usize, 0.0);
+                    self.rebinds += 1;
+                    (b, EventKind::Rebind)
+                }
+            };
+            let [i, j] = model.bonds[b];
+            events.push(Event {
+                step,
+                time: step as f64 * dt,
+                kind,
+                bond: b,
+                bond_type: model.bond_types[model.bond_type[b] as usize].label.text.clone(),
+                particles: [model.ids[i as usize], model.ids[j as usize]],
+                force: 0.0,
+                length: sim_box.minimum_image(state.positions[j as usize] - state.positions[i as usize]).length(),
+            });
+        }
+        events
     }
 }
 

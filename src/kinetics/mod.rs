@@ -26,6 +26,7 @@ use crate::interactions::ParamSpec;
 
 mod engine;
 mod events;
+mod formation;
 mod state;
 
 mod cadherin;
@@ -40,7 +41,8 @@ mod threshold;
 
 pub use self::engine::{initial_bond_state, Kinetics, KineticsReport};
 pub use self::events::{Event, EventKind, EventLog};
-pub use self::state::BondState;
+pub use self::formation::{parse_bind, BindLine, BindRule, Binding, Formation};
+pub use self::state::{BondState, FormedBond};
 
 /// Every registered kinetic rule.
 pub static RULES: &[&dyn KineticRule] = &[

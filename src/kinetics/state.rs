@@ -12,13 +12,24 @@ pub struct BondState {
     pub rest: Vec<Option<f64>>,
     /// Stiffness scale (maturation); 1 otherwise.
     pub scale: Vec<f64>,
+    /// Bonds formed during the run (by `bind` rules), appended after the
+    /// topology's bonds in this order.
+    #[serde(default)]
+    pub formed: Vec<FormedBond>,
+}
+
+/// A bond created by a `bind` rule (internal particle indices).
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct FormedBond {
+    pub bond_type: u32,
+    pub particles: [u32; 2],
 }
 
 impl BondState {
     /// All bonds bound, age 0, rest lengths from `initial_rest`.
     pub fn new(initial_rest: Vec<Option<f64>>) -> Self {
         let n = initial_rest.len();
-        Self { bound: vec![true; n], age: vec![0.0; n], rest: initial_rest, scale: vec![1.0; n] }
+        Self { bound: vec![true; n], age: vec![0.0; n], rest: initial_rest, scale: vec![1.0; n], formed: Vec::new() }
     }
 
     pub fn len(&self) -> usize {

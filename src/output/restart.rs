@@ -237,6 +237,7 @@ mod tests {
                 age: vec![0.1 + 0.2, 5e-324],
                 rest: vec![Some(0.8), None],
                 scale: vec![1e-17, 1.0],
+                formed: Vec::new(),
             }),
         }
     }

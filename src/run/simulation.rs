@@ -11,7 +11,7 @@ use crate::backend::{CpuBackend, Forces};
 use crate::deck::{Action, CoeffTarget, DumpSpec, NeighborSettings, Plan};
 use crate::integrate::fire::{fire_minimize, FireReport, FireSettings};
 use crate::integrate::overdamped::{overdamped_step, Blowup, OverdampedSettings};
-use crate::kinetics::{initial_bond_state, EventLog, Kinetics};
+use crate::kinetics::{initial_bond_state, Binding, EventLog, Formation, Kinetics};
 use crate::output::restart::{read_state, write_state, RestartData};
 use crate::output::{open_writer, FrameView, TopologyView, TrajectoryWriter};
 use crate::system::{Model, SimBox, State};
@@ -57,6 +57,8 @@ pub struct Simulation {
     dumps: Vec<ActiveDump>,
     /// Bond kinetics: event counts and the CSV event log.
     pub kinetics: Kinetics,
+    /// Bond formation (when the force field has `bind` rules).
+    formation: Option<Formation>,
     event_log: Option<EventLog>,
     options: RunOptions,
     deck_stem: String,
@@ -89,6 +91,7 @@ impl Simulation {
             forces_current: false,
             dumps: Vec::new(),
             kinetics: Kinetics::default(),
+            formation: (!plan.model.bind_rules.is_empty()).then(|| Formation::new(&plan.model)),
             event_log: None,
             options,
             deck_stem,
@@ -225,8 +228,9 @@ impl Simulation {
         }
         self.sim_box = data.sim_box;
         self.state = data.to_state();
-        if self.state.bonds.is_none() {
-            self.state.bonds = initial_bond_state(&self.model);
+        match &self.state.bonds {
+            Some(bonds) => self.model.set_formed_bonds(&bonds.formed),
+            None => self.state.bonds = initial_bond_state(&self.model),
         }
         self.backend = None;
         self.forces_current = false;
@@ -364,11 +368,15 @@ impl Simulation {
             if self.state.bonds.is_some() {
                 self.kinetics_step()?;
             }
-            if self.state.step.is_multiple_of(self.neighbor.every) {
-                let backend = self.backend.as_mut().expect("backend built");
-                backend.update_neighbors(&self.state, &self.sim_box, self.neighbor.check).map_err(RunError::Setup)?;
+            match self.backend.as_mut() {
+                Some(backend) => {
+                    if self.state.step.is_multiple_of(self.neighbor.every) {
+                        backend.update_neighbors(&self.state, &self.sim_box, self.neighbor.check).map_err(RunError::Setup)?;
+                    }
+                    self.compute_forces()?;
+                }
+                None => self.ensure_forces()?,
             }
-            self.compute_forces()?;
             let final_step = self.state.step == last;
             self.outputs_at_step(&bar, final_step && (self.thermo.every == 0 || !self.state.step.is_multiple_of(self.thermo.every)))?;
             if let Some(b) = &bar {
@@ -388,9 +396,16 @@ impl Simulation {
         let step = self.state.step - 1;
         let backend = self.backend.as_ref().expect("backend built");
         let (tension, length) = backend.bond_tension_and_length();
-        let report = self.kinetics.step(&self.model, &mut self.state, tension, length, step, self.dt, self.kt, self.seed);
+        let mut report = self.kinetics.step(&self.model, &mut self.state, tension, length, step, self.dt, self.kt, self.seed);
         for warning in &report.warnings {
             eprintln!("{warning}");
+        }
+        let mut formed_any = false;
+        if let Some(formation) = &mut self.formation {
+            let bindings = formation.decide(&self.model, &self.state, &self.sim_box, step, self.dt, self.seed).map_err(RunError::Setup)?;
+            formed_any = bindings.iter().any(|b| matches!(b, Binding::New(..)));
+            report.bonds_changed |= !bindings.is_empty();
+            report.events.extend(self.kinetics.apply_bindings(&mut self.model, &mut self.state, &self.sim_box, bindings, step, self.dt));
         }
         if !report.events.is_empty() {
             if let Some(log) = &mut self.event_log {
@@ -401,7 +416,10 @@ impl Simulation {
                 dump.writer.write_bond_events(&report.events, bound)?;
             }
         }
-        if report.bonds_changed {
+        if formed_any {
+            // New bonds change every per-bond buffer: rebuild the backend.
+            self.backend = None;
+        } else if report.bonds_changed {
             let backend = self.backend.as_mut().expect("backend built");
             backend.bonds_changed(&self.model, &self.state, &self.sim_box).map_err(RunError::Setup)?;
         }

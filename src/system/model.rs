@@ -52,6 +52,10 @@ pub struct Model {
     pub bond_kinetics: Vec<BondTypeKinetics>,
     pub bonds: Vec<[u32; 2]>,
     pub bond_type: Vec<u32>,
+    /// How many of `bonds` come from the topology (the rest were formed).
+    pub topology_bonds: usize,
+    /// Bond formation rules (`bind` lines).
+    pub bind_rules: Vec<crate::kinetics::BindRule>,
     pub angle_types: Vec<TermType>,
     pub angles: Vec<[u32; 3]>,
     pub angle_type: Vec<u32>,
@@ -93,6 +97,21 @@ impl Model {
             types.push(t as u32);
         }
         let bond_type = topology.bonds.iter().map(|b| resolve(&b.type_name, &ff.bond_types, "bond")).collect::<Result<_, _>>()?;
+        let bind_rules = ff
+            .bind_lines
+            .iter()
+            .map(|line| {
+                let index = |t: &Token| ff.particle_type(&t.text).expect("checked by check_pair_types") as u32;
+                Ok(crate::kinetics::BindRule {
+                    type_a: index(&line.type_a),
+                    type_b: index(&line.type_b),
+                    bond_type: resolve(&line.bond_type, &ff.bond_types, "bond")?,
+                    k_on: line.k_on,
+                    capture: line.capture,
+                    max_bonds: line.max_bonds,
+                })
+            })
+            .collect::<Result<_, InputError>>()?;
         let angle_type = topology.angles.iter().map(|a| resolve(&a.type_name, &ff.angle_types, "angle")).collect::<Result<_, _>>()?;
         let nt = type_names.len();
         let mut pair_table = vec![Vec::new(); nt * nt];
@@ -116,6 +135,8 @@ impl Model {
             bond_types: ff.bond_types.clone(),
             bond_kinetics: ff.bond_kinetics.clone(),
             bonds: topology.bonds.iter().map(|b| b.particles).collect(),
+            topology_bonds: topology.bonds.len(),
+            bind_rules,
             bond_type,
             angle_types: ff.angle_types.clone(),
             angles: topology.angles.iter().map(|a| a.particles).collect(),
@@ -140,7 +161,17 @@ impl Model {
 
     /// Whether any bond type has kinetic rules (bonds then carry state).
     pub fn has_kinetics(&self) -> bool {
-        self.bond_kinetics.iter().any(|k| !k.rules.is_empty())
+        self.bond_kinetics.iter().any(|k| !k.rules.is_empty()) || !self.bind_rules.is_empty()
+    }
+
+    /// Makes the bond list the topology's plus the bonds `formed` in a run.
+    pub fn set_formed_bonds(&mut self, formed: &[crate::kinetics::FormedBond]) {
+        self.bonds.truncate(self.topology_bonds);
+        self.bond_type.truncate(self.topology_bonds);
+        for f in formed {
+            self.bonds.push(f.particles);
+            self.bond_type.push(f.bond_type);
+        }
     }
 
     /// The initial rest length of bonds of a type whose rules evolve it
