@@ -29,7 +29,7 @@ use crate::system::{Model, SimBox, State};
 use crate::units::{Dim, UnitSystem};
 
 /// Philox key salt separating formation decisions from every other stream.
-const FORMATION_SALT: u32 = 0x62_69_6e_64; // "bind"
+const FORMATION_SALT: u32 = 0x6269_6E64; // ASCII "bind"
 
 static PARAMS: [ParamSpec; 2] = [
     ParamSpec::new("k_on", Dim::Rate, "formation rate of a pair within capture").non_negative(),
