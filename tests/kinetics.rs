@@ -47,9 +47,9 @@ fn events(case: &Case) -> Vec<(u64, String, usize, f64)> {
 /// lifetime distribution is exponential, and the longest-lived force is F*.
 #[test]
 fn catch_slip_lifetimes_follow_the_two_pathway_law() {
-    let (kc0, xc, ks0, xs) = (1.0, 1.0, 0.01, 0.5);
+    let (kc0, xc, ks0, xs): (f64, f64, f64, f64) = (1.0, 1.0, 0.01, 0.5);
     let kt = 1.0;
-    let f_star = kt * (kc0 * xc / (ks0 * xs) as f64).ln() / (xc + xs);
+    let f_star: f64 = kt * (kc0 * xc / (ks0 * xs)).ln() / (xc + xs);
     let fractions = [0.5, 0.75, 1.0, 1.25, 1.5];
     let forces: Vec<f64> = fractions.iter().map(|a| a * f_star).collect();
     let k_bond = 10.0;
@@ -147,7 +147,7 @@ fn slip_bonds_under_a_force_ramp_rupture_at_the_bell_evans_force() {
 /// probabilities a = 1 − e^(−k_off·dt) and b = 1 − e^(−k_on·dt), stationary b/(a + b).
 #[test]
 fn binding_and_unbinding_reach_the_steady_state_fraction() {
-    let (k_on, k_off, dt) = (2.0, 3.0, 0.002);
+    let (k_on, k_off, dt): (f64, f64, f64) = (2.0, 3.0, 0.002);
     let n = 10_000;
     let bond = format!("bond b harmonic k 1 r0 1 kinetics slip k0 {k_off} x_beta 0 kinetics rebind k_on {k_on} capture 2");
     let relax = (1.0 / ((k_on + k_off) * dt)) as u64; // one correlation time in steps
@@ -162,7 +162,7 @@ fn binding_and_unbinding_reach_the_steady_state_fraction() {
     // Skip 10 correlation times, then average samples one correlation time apart.
     let samples = &rows[10..];
     let fraction = samples.iter().sum::<f64>() / (samples.len() as f64 * n as f64);
-    let (a, b) = (-(-k_off * dt as f64).exp_m1(), -(-k_on * dt as f64).exp_m1());
+    let (a, b): (f64, f64) = (-(-k_off * dt).exp_m1(), -(-k_on * dt).exp_m1());
     let discrete = b / (a + b);
     let continuous = k_on / (k_on + k_off);
     // Binomial error of one sample, samples correlated by e^(−1): inflate by √((1+e⁻¹)/(1−e⁻¹)).
@@ -364,7 +364,7 @@ fn kinetics_runs_are_bit_identical_across_thread_counts() {
 /// bond list holds one bond per pair however often it rebinds.
 #[test]
 fn bond_formation_reaches_the_steady_state_and_reuses_bonds() {
-    let (k_on, k_off, dt) = (2.0, 3.0, 0.002);
+    let (k_on, k_off, dt): (f64, f64, f64) = (2.0, 3.0, 0.002);
     let n = 5_000;
     let mut top = String::from("[ particles ]\n");
     for p in 0..n {
