@@ -313,6 +313,7 @@ impl Simulation {
             None => self.say(&header),
         }
         self.outputs_at_step(&bar, true)?;
+        let started = std::time::Instant::now();
         let last = self.state.step + steps;
         while self.state.step < last {
             let moved = overdamped_step(
@@ -346,6 +347,12 @@ impl Simulation {
             b.finish_and_clear();
         }
         self.thermo.flush()?;
+        let seconds = started.elapsed().as_secs_f64();
+        self.say(&format!(
+            "loop time {seconds:.6} s for {steps} steps with {} particles: {:.6e} particle-steps/s",
+            self.model.len(),
+            (steps as f64 * self.model.len() as f64) / seconds
+        ));
         Ok(())
     }
 
