@@ -4,6 +4,7 @@ use std::path::{Path, PathBuf};
 
 use glam::DVec3;
 use indicatif::{ProgressBar, ProgressStyle};
+use rayon::prelude::*;
 
 use super::blowup::{culprit, RunError};
 use super::thermo::{Thermo, ThermoInputs};
@@ -52,6 +53,8 @@ pub struct Simulation {
     pub neighbor: NeighborSettings,
     backend: Option<CpuBackend>,
     forces_current: bool,
+    /// Whether `forces` also holds the energies and virial of the current state.
+    energies_current: bool,
     thermo: Thermo,
     dumps: Vec<ActiveDump>,
     options: RunOptions,
@@ -82,6 +85,7 @@ impl Simulation {
             neighbor: NeighborSettings::default(),
             backend: None,
             forces_current: false,
+            energies_current: false,
             dumps: Vec::new(),
             options,
             deck_stem,
@@ -223,17 +227,23 @@ impl Simulation {
             self.backend = Some(backend);
             self.forces_current = false;
         }
-        if !self.forces_current {
-            self.compute_forces()?;
+        if !self.forces_current || !self.energies_current {
+            self.compute_forces(true)?;
         }
         Ok(())
     }
 
-    fn compute_forces(&mut self) -> Result<(), RunError> {
+    /// Forces at the current state, with energies and virial if `energies`.
+    fn compute_forces(&mut self, energies: bool) -> Result<(), RunError> {
         let backend = self.backend.as_mut().expect("backend built");
-        backend.compute(&self.model, &self.state, &self.sim_box, &mut self.forces);
+        if energies {
+            backend.compute(&self.model, &self.state, &self.sim_box, &mut self.forces);
+        } else {
+            backend.compute_forces(&self.model, &self.state, &self.sim_box, &mut self.forces);
+        }
         self.forces_current = true;
-        if let Some(i) = self.forces.forces.iter().position(|f| !f.is_finite()) {
+        self.energies_current = energies;
+        if let Some(i) = self.forces.forces.par_iter().position_first(|f| !f.is_finite()) {
             return Err(self.blowup(i, "non-finite force".into()));
         }
         Ok(())
@@ -336,9 +346,10 @@ impl Simulation {
                 let backend = self.backend.as_mut().expect("backend built");
                 backend.update_neighbors(&self.state, &self.sim_box, self.neighbor.check).map_err(RunError::Setup)?;
             }
-            self.compute_forces()?;
             let final_step = self.state.step == last;
-            self.outputs_at_step(&bar, final_step && (self.thermo.every == 0 || !self.state.step.is_multiple_of(self.thermo.every)))?;
+            let thermo_due = self.thermo.every > 0 && self.state.step.is_multiple_of(self.thermo.every);
+            self.compute_forces(thermo_due || final_step)?;
+            self.outputs_at_step(&bar, final_step && !thermo_due)?;
             if let Some(b) = &bar {
                 b.inc(1);
             }
@@ -371,6 +382,7 @@ impl Simulation {
         })?;
         self.state = state;
         self.forces_current = true;
+        self.energies_current = true;
         if let Some(i) = self.forces.forces.iter().position(|f| !f.is_finite()) {
             return Err(self.blowup(i, "non-finite force during minimisation".into()));
         }
