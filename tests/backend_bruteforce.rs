@@ -156,3 +156,23 @@ fn special_bonds_exclusions_match_brute_force() {
     compare(true, "special_bonds 0 0 0\n");
     compare(true, "special_bonds 1 1 1\n");
 }
+
+#[test]
+fn forces_only_pass_gives_the_same_bits_and_leaves_energies() {
+    let case = random_case(true, "");
+    let plan = validate_file(&case.path("deck.in"), &[]).unwrap();
+    let mut state = State::new(plan.positions.clone());
+    for (x, im) in state.positions.iter_mut().zip(state.images.iter_mut()) {
+        plan.sim_box.wrap(x, im);
+    }
+    let mut backend = CpuBackend::new(&plan.model, &state, &plan.sim_box, 0.4).unwrap();
+    let mut full = Forces::default();
+    backend.compute(&plan.model, &state, &plan.sim_box, &mut full);
+    let mut forces_only = full.clone();
+    forces_only.forces.iter_mut().for_each(|f| *f = DVec3::NAN);
+    backend.compute_forces(&plan.model, &state, &plan.sim_box, &mut forces_only);
+    let bits = |f: &Forces| f.forces.iter().map(|v| v.to_array().map(f64::to_bits)).collect::<Vec<_>>();
+    assert_eq!(bits(&full), bits(&forces_only));
+    assert_eq!(full.energy_by_interaction, forces_only.energy_by_interaction);
+    assert_eq!(full.virial, forces_only.virial);
+}

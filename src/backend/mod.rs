@@ -1,8 +1,11 @@
 //! Force backends. [`cpu`] is the reference (f64, deterministic, rayon); the
 //! GPU backend must match it within each interaction's declared epsilon.
 
+mod bonded;
 pub mod cpu;
+mod pair_table;
 mod sum;
+mod virial;
 
 pub use self::cpu::{CpuBackend, ForceBreakdown, Forces};
 pub use self::sum::ordered_sum;

@@ -1,17 +1,26 @@
 //! Deterministic parallel reduction.
 
+use std::ops::Range;
+
 use rayon::prelude::*;
 
-/// Chunk size of [`ordered_sum`]; fixed so the result never depends on the
-/// number of threads.
+/// Chunk size of [`ordered_sum`] and [`chunked`]; fixed so results never
+/// depend on the number of threads.
 const CHUNK: usize = 4096;
 
 /// Sum of `values` in an order fixed by the data alone (chunks of 4096 summed
 /// left to right in parallel, then the chunk sums left to right): bit-identical
 /// on any thread count.
 pub fn ordered_sum(values: &[f64]) -> f64 {
-    let partial: Vec<f64> = values.par_chunks(CHUNK).map(|c| c.iter().sum::<f64>()).collect();
-    partial.iter().sum()
+    chunked(values.len(), |r| values[r].iter().sum::<f64>()).iter().sum()
+}
+
+/// `fold(range)` for the ranges of items `0..n` cut into chunks of 4096, in
+/// parallel, returned in chunk order: the caller combines them left to right,
+/// so a reduction over per-item values computed on the fly is as
+/// deterministic as [`ordered_sum`] without storing the values.
+pub(super) fn chunked<A: Send>(n: usize, fold: impl Fn(Range<usize>) -> A + Sync + Send) -> Vec<A> {
+    (0..n.div_ceil(CHUNK)).into_par_iter().map(|c| fold(c * CHUNK..((c + 1) * CHUNK).min(n))).collect()
 }
 
 #[cfg(test)]

@@ -141,11 +141,12 @@ pub fn lex(file: &Arc<SourceFile>) -> Result<Vec<Statement>, InputError> {
             .into_iter()
             .map(|(span, quoted)| {
                 let token_offset = span.location_offset() - usize::from(quoted);
-                let (line, col) = (span.location_line(), span.get_utf8_column() as u32 - u32::from(quoted));
+                // The span knows its line; its column is counted from the line
+                // start only (`line_col` would rescan the file: O(N²) in all).
                 Token {
                     text: span.fragment().to_string(),
-                    line,
-                    col,
+                    line: span.location_line(),
+                    col: (span.get_utf8_column() - usize::from(quoted)) as u32,
                     offset: token_offset,
                     text_len: span.fragment().len() + 2 * usize::from(quoted),
                     file: file.clone(),

@@ -58,29 +58,37 @@ pub fn overdamped_step(
     scratch: &mut Vec<DVec3>,
 ) -> Result<(), Blowup> {
     let step = state.step;
+    let refused = |d: &DVec3| !d.is_finite() || d.length() > settings.max_displacement;
     scratch.resize(state.len(), DVec3::ZERO);
-    scratch.par_iter_mut().enumerate().for_each(|(i, dx)| {
-        let gamma = model.type_drag[model.types[i] as usize];
-        if gamma.is_infinite() {
-            // A `fixed` particle never moves (and draws no noise).
-            *dx = DVec3::ZERO;
-            return;
-        }
-        let mut d = forces[i] * (dt / gamma);
-        if kt > 0.0 {
-            let amplitude = (2.0 * kt * dt / gamma).sqrt();
-            let xi = noise3(seed, step, i as u32, settings.noise);
-            d += amplitude * DVec3::from_array(xi);
-        }
-        *dx = d;
-    });
-    if let Some((particle, d)) = scratch.iter().enumerate().find(|(_, d)| !d.is_finite() || d.length() > settings.max_displacement) {
-        return Err(Blowup { particle, displacement: d.length() });
+    let any_refused = scratch.par_iter_mut().enumerate().with_min_len(1024).fold(
+        || false,
+        |bad, (i, dx)| {
+            let gamma = model.type_drag[model.types[i] as usize];
+            if gamma.is_infinite() {
+                // A `fixed` particle never moves (and draws no noise).
+                *dx = DVec3::ZERO;
+                return bad;
+            }
+            let mut d = forces[i] * (dt / gamma);
+            if kt > 0.0 {
+                let amplitude = (2.0 * kt * dt / gamma).sqrt();
+                let xi = noise3(seed, step, i as u32, settings.noise);
+                d += amplitude * DVec3::from_array(xi);
+            }
+            *dx = d;
+            bad | refused(&d)
+        },
+    );
+    if any_refused.reduce(|| false, |a, b| a | b) {
+        let particle = scratch.iter().position(refused).expect("a refused displacement");
+        return Err(Blowup { particle, displacement: scratch[particle].length() });
     }
-    state.positions.par_iter_mut().zip(state.images.par_iter_mut()).zip(scratch.par_iter()).for_each(|((x, image), d)| {
-        *x += *d;
-        sim_box.wrap(x, image);
-    });
+    state.positions.par_iter_mut().zip(state.images.par_iter_mut()).zip(scratch.par_iter()).with_min_len(1024).for_each(
+        |((x, image), d)| {
+            *x += *d;
+            sim_box.wrap(x, image);
+        },
+    );
     state.step += 1;
     state.time += dt;
     Ok(())

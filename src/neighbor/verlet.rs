@@ -4,7 +4,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::Exclusions;
-use crate::system::SimBox;
+use crate::system::{Images, SimBox};
 
 const AXES: [char; 3] = ['x', 'y', 'z'];
 
@@ -105,8 +105,9 @@ impl NeighborList {
         }
         let half = 0.5 * self.skin;
         let limit2 = half * half;
+        let images = sim_box.images();
         positions.par_iter().zip(self.reference.par_iter()).with_min_len(4096).any(|(x, x0)| {
-            let d2 = sim_box.minimum_image(*x - *x0).length_squared();
+            let d2 = images.minimum_image(*x - *x0).length_squared();
             // A NaN displacement also forces a rebuild (which then reports it).
             d2.is_nan() || d2 > limit2
         })
@@ -163,8 +164,8 @@ impl NeighborList {
             self.grid = [0; 3];
         } else {
             let grid = CellGrid::new(range, sim_box, positions);
-            let lists = grid.gather(positions, sim_box, exclusions, range * range);
-            let total: usize = lists.iter().map(Vec::len).sum();
+            let chunks = grid.gather(positions, sim_box, exclusions, range * range);
+            let total: usize = chunks.iter().map(|(_, entries)| entries.len()).sum();
             if total > u32::MAX as usize {
                 return Err(format!("neighbour list: {total} entries exceed the u32 index range"));
             }
@@ -173,9 +174,13 @@ impl NeighborList {
             self.offsets.push(0);
             self.neighbors.clear();
             self.neighbors.reserve(total);
-            for list in &lists {
-                self.neighbors.extend_from_slice(list);
-                self.offsets.push(self.neighbors.len() as u32);
+            let mut end = 0u32;
+            for (lengths, entries) in &chunks {
+                self.neighbors.extend_from_slice(entries);
+                self.offsets.extend(lengths.iter().map(|&k| {
+                    end += k;
+                    end
+                }));
             }
             self.grid = grid.counts;
         }
@@ -319,39 +324,54 @@ impl CellGrid {
         }
     }
 
-    /// Each particle's sorted neighbour list.
-    fn gather(&self, positions: &[DVec3], sim_box: &SimBox, exclusions: &Exclusions, range2: f64) -> Vec<Vec<u32>> {
-        (0..positions.len())
+    /// The sorted neighbour lists of particles `0..n`, gathered in parallel
+    /// by chunks of 1024 particles: per chunk, each particle's list length
+    /// and the lists concatenated (one buffer per chunk, not per particle).
+    fn gather(&self, positions: &[DVec3], sim_box: &SimBox, exclusions: &Exclusions, range2: f64) -> Vec<(Vec<u32>, Vec<u32>)> {
+        const CHUNK: usize = 1024;
+        let images = sim_box.images();
+        let n = positions.len();
+        (0..n.div_ceil(CHUNK))
             .into_par_iter()
-            .with_min_len(256)
-            .map(|i| {
-                let xi = positions[i];
-                let c = self.coords(xi);
-                let (nx, kx) = self.axis_neighbours(0, c[0]);
-                let (ny, ky) = self.axis_neighbours(1, c[1]);
-                let (nz, kz) = self.axis_neighbours(2, c[2]);
-                let mut list = Vec::new();
-                for &cz in &nz[..kz] {
-                    for &cy in &ny[..ky] {
-                        for &cx in &nx[..kx] {
-                            let cell = self.flat([cx, cy, cz]) as usize;
-                            let members = &self.members[self.start[cell] as usize..self.start[cell + 1] as usize];
-                            for &j in members {
-                                if j as usize == i {
-                                    continue;
-                                }
-                                let d = sim_box.minimum_image(positions[j as usize] - xi);
-                                if d.length_squared() < range2 && !exclusions.is_excluded(i as u32, j) {
-                                    list.push(j);
-                                }
-                            }
+            .map(|chunk| {
+                let particles = chunk * CHUNK..((chunk + 1) * CHUNK).min(n);
+                let mut lengths = Vec::with_capacity(particles.len());
+                let mut entries = Vec::new();
+                for i in particles {
+                    let start = entries.len();
+                    self.partners_of(i, positions, &images, exclusions, range2, &mut entries);
+                    entries[start..].sort_unstable();
+                    lengths.push((entries.len() - start) as u32);
+                }
+                (lengths, entries)
+            })
+            .collect()
+    }
+
+    /// Appends the partners of particle `i` within the list radius, in cell order.
+    #[inline]
+    fn partners_of(&self, i: usize, positions: &[DVec3], images: &Images, exclusions: &Exclusions, range2: f64, out: &mut Vec<u32>) {
+        let xi = positions[i];
+        let c = self.coords(xi);
+        let (nx, kx) = self.axis_neighbours(0, c[0]);
+        let (ny, ky) = self.axis_neighbours(1, c[1]);
+        let (nz, kz) = self.axis_neighbours(2, c[2]);
+        for &cz in &nz[..kz] {
+            for &cy in &ny[..ky] {
+                for &cx in &nx[..kx] {
+                    let cell = self.flat([cx, cy, cz]) as usize;
+                    for &j in &self.members[self.start[cell] as usize..self.start[cell + 1] as usize] {
+                        if j as usize == i {
+                            continue;
+                        }
+                        let d = images.minimum_image(positions[j as usize] - xi);
+                        if d.length_squared() < range2 && !exclusions.is_excluded(i as u32, j) {
+                            out.push(j);
                         }
                     }
                 }
-                list.sort_unstable();
-                list
-            })
-            .collect()
+            }
+        }
     }
 }
 

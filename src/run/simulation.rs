@@ -4,6 +4,7 @@ use std::path::{Path, PathBuf};
 
 use glam::DVec3;
 use indicatif::{ProgressBar, ProgressStyle};
+use rayon::prelude::*;
 
 use super::blowup::{culprit, RunError};
 use super::thermo::{Thermo, ThermoInputs};
@@ -53,6 +54,8 @@ pub struct Simulation {
     pub neighbor: NeighborSettings,
     backend: Option<CpuBackend>,
     forces_current: bool,
+    /// Whether `forces` also holds the energies and virial of the current state.
+    energies_current: bool,
     thermo: Thermo,
     dumps: Vec<ActiveDump>,
     /// Bond kinetics: event counts and the CSV event log.
@@ -89,6 +92,7 @@ impl Simulation {
             neighbor: NeighborSettings::default(),
             backend: None,
             forces_current: false,
+            energies_current: false,
             dumps: Vec::new(),
             kinetics: Kinetics::default(),
             formation: (!plan.model.bind_rules.is_empty()).then(|| Formation::new(&plan.model)),
@@ -251,17 +255,23 @@ impl Simulation {
             self.backend = Some(backend);
             self.forces_current = false;
         }
-        if !self.forces_current {
-            self.compute_forces()?;
+        if !self.forces_current || !self.energies_current {
+            self.compute_forces(true)?;
         }
         Ok(())
     }
 
-    fn compute_forces(&mut self) -> Result<(), RunError> {
+    /// Forces at the current state, with energies and virial if `energies`.
+    fn compute_forces(&mut self, energies: bool) -> Result<(), RunError> {
         let backend = self.backend.as_mut().expect("backend built");
-        backend.compute(&self.model, &self.state, &self.sim_box, &mut self.forces);
+        if energies {
+            backend.compute(&self.model, &self.state, &self.sim_box, &mut self.forces);
+        } else {
+            backend.compute_forces(&self.model, &self.state, &self.sim_box, &mut self.forces);
+        }
         self.forces_current = true;
-        if let Some(i) = self.forces.forces.iter().position(|f| !f.is_finite()) {
+        self.energies_current = energies;
+        if let Some(i) = self.forces.forces.par_iter().position_first(|f| !f.is_finite()) {
             return Err(self.blowup(i, "non-finite force".into()));
         }
         Ok(())
@@ -347,6 +357,7 @@ impl Simulation {
             None => self.say(&header),
         }
         self.outputs_at_step(&bar, true)?;
+        let started = std::time::Instant::now();
         let last = self.state.step + steps;
         while self.state.step < last {
             let moved = overdamped_step(
@@ -368,17 +379,19 @@ impl Simulation {
             if self.state.bonds.is_some() {
                 self.kinetics_step()?;
             }
+            let final_step = self.state.step == last;
+            let thermo_due = self.thermo.every > 0 && self.state.step.is_multiple_of(self.thermo.every);
             match self.backend.as_mut() {
                 Some(backend) => {
                     if self.state.step.is_multiple_of(self.neighbor.every) {
                         backend.update_neighbors(&self.state, &self.sim_box, self.neighbor.check).map_err(RunError::Setup)?;
                     }
-                    self.compute_forces()?;
+                    self.compute_forces(thermo_due || final_step)?;
                 }
+                // Bonds formed: the backend is rebuilt for the new bond list.
                 None => self.ensure_forces()?,
             }
-            let final_step = self.state.step == last;
-            self.outputs_at_step(&bar, final_step && (self.thermo.every == 0 || !self.state.step.is_multiple_of(self.thermo.every)))?;
+            self.outputs_at_step(&bar, final_step && !thermo_due)?;
             if let Some(b) = &bar {
                 b.inc(1);
             }
@@ -387,6 +400,12 @@ impl Simulation {
             b.finish_and_clear();
         }
         self.thermo.flush()?;
+        let seconds = started.elapsed().as_secs_f64();
+        self.say(&format!(
+            "loop time {seconds:.6} s for {steps} steps with {} particles: {:.6e} particle-steps/s",
+            self.model.len(),
+            (steps as f64 * self.model.len() as f64) / seconds
+        ));
         Ok(())
     }
 
@@ -458,6 +477,7 @@ impl Simulation {
         })?;
         self.state = state;
         self.forces_current = true;
+        self.energies_current = true;
         if let Some(i) = self.forces.forces.iter().position(|f| !f.is_finite()) {
             return Err(self.blowup(i, "non-finite force during minimisation".into()));
         }

@@ -5,5 +5,5 @@ mod sim_box;
 mod state;
 
 pub use self::model::{registry_index, External, Model, SpecialBonds};
-pub use self::sim_box::SimBox;
+pub use self::sim_box::{Images, SimBox};
 pub use self::state::State;

@@ -32,16 +32,21 @@ impl SimBox {
         l.x * l.y * l.z
     }
 
-    /// Minimum-image form of a separation vector.
+    /// Minimum-image form of a separation vector (see [`Images`]).
     #[inline]
-    pub fn minimum_image(&self, mut d: DVec3) -> DVec3 {
+    pub fn minimum_image(&self, d: DVec3) -> DVec3 {
+        self.images().minimum_image(d)
+    }
+
+    /// The box's periodic images, prepared for many minimum-image calls.
+    #[inline]
+    pub fn images(&self) -> Images {
         let l = self.lengths();
-        for axis in 0..3 {
-            if self.periodic[axis] {
-                d[axis] -= l[axis] * (d[axis] / l[axis]).round();
-            }
+        let axis = |a: usize, v: f64| if self.periodic[a] { v } else { 0.0 };
+        Images {
+            lengths: DVec3::new(axis(0, l.x), axis(1, l.y), axis(2, l.z)),
+            inverse: DVec3::new(axis(0, 1.0 / l.x), axis(1, 1.0 / l.y), axis(2, 1.0 / l.z)),
         }
-        d
     }
 
     /// Wraps a position into the box on periodic axes, updating its image counter.
@@ -80,6 +85,28 @@ impl SimBox {
     }
 }
 
+/// Minimum-image arithmetic with the lengths and their inverses precomputed:
+/// `d − L·nearest(d/L)` on periodic axes (`L = 0`, `1/L = 0` on the others),
+/// with no division and no libm call, so the loop vectorises. `nearest`
+/// rounds half to even by the 1.5·2⁵² trick (exact for |d/L| < 2⁵¹); it is odd
+/// in its argument, so `minimum_image(−d) = −minimum_image(d)` bit for bit and
+/// a bond evaluated from either end gives exactly opposite forces.
+#[derive(Clone, Copy, Debug)]
+pub struct Images {
+    lengths: DVec3,
+    inverse: DVec3,
+}
+
+impl Images {
+    #[inline(always)]
+    pub fn minimum_image(&self, d: DVec3) -> DVec3 {
+        const SHIFT: f64 = 6_755_399_441_055_744.0; // 1.5·2⁵²
+        let q = d * self.inverse;
+        let nearest = (q + DVec3::splat(SHIFT)) - DVec3::splat(SHIFT);
+        d - self.lengths * nearest
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -93,6 +120,10 @@ mod tests {
         let b = periodic_box();
         let d = b.minimum_image(DVec3::new(9.0, -7.0, 9.0));
         assert_eq!(d, DVec3::new(-1.0, 3.0, 9.0));
+        let far = b.minimum_image(DVec3::new(-23.5, 46.0, -1e6));
+        assert_eq!(far, DVec3::new(-3.5, -4.0, -1e6));
+        let e = DVec3::new(4.999, -7.3, 2.0);
+        assert_eq!(b.minimum_image(-e), -b.minimum_image(e), "odd, bit for bit");
     }
 
     #[test]

@@ -1,0 +1,239 @@
+//! Bonded terms on the CPU, gathered per particle.
+//!
+//! - **Bonds**: each particle evaluates its own bonds from its own side
+//!   (d = minimum_image(x_other − x_i)). A bond is thus evaluated twice, once
+//!   per end; the minimum image is odd in d ([`Images`]), so the two forces
+//!   are exact negatives. This needs no per-term scratch: slots would cost
+//!   2 × 24 bytes per bond (144 bytes per bead of a cubic network).
+//! - **Angles**: pass 1 evaluates every angle once, in parallel, into its
+//!   three slots; each particle then gathers its slots in term order.
+//! - **Energies and virial** (thermo steps only): every term once, in term
+//!   order, sequentially.
+//!
+//! Each particle's bonded force is the sum over its bonds (ascending bond
+//! index), then its angle slots (ascending), so the order is fixed by the data.
+//!
+//! With bond kinetics, each bond also has a state: an unbound bond carries no
+//! force, and a bond may have its own rest length and a stiffness scale
+//! ([`BondState`]).
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use super::virial::{add6, outer};
+use crate::interactions::{Law, Radial, ThreeBody};
+use crate::kinetics::BondState;
+use crate::system::{registry_index, Images, Model};
+
+/// Groups entries by owning particle: entry `s` belongs to `owner[s]`.
+/// Returns CSR offsets and, per particle, its entries in ascending order.
+fn by_particle(n: usize, owner: impl Iterator<Item = u32> + Clone) -> (Vec<u32>, Vec<u32>) {
+    let mut offsets = vec![0u32; n + 1];
+    for p in owner.clone() {
+        offsets[p as usize + 1] += 1;
+    }
+    for i in 0..n {
+        offsets[i + 1] += offsets[i];
+    }
+    let mut fill = offsets.clone();
+    let mut entries = vec![0u32; offsets[n] as usize];
+    for (s, p) in owner.enumerate() {
+        entries[fill[p as usize] as usize] = s as u32;
+        fill[p as usize] += 1;
+    }
+    (offsets, entries)
+}
+
+/// Per-particle bond and angle-slot lists, and the angle slots.
+#[derive(Default)]
+pub(super) struct Bonded {
+    /// Particle i's bond ends are `bond_ends[bond_offsets[i]..bond_offsets[i + 1]]`;
+    /// end `e` is end `e % 2` of bond `e / 2`.
+    bond_offsets: Vec<u32>,
+    bond_ends: Vec<u32>,
+    angle_offsets: Vec<u32>,
+    /// Slot `s` is the force of angle `s / 3` on its particle `s % 3`.
+    angle_slot_ids: Vec<u32>,
+    angle_slots: Vec<DVec3>,
+    /// Evaluator per bond type, re-resolved every evaluation.
+    bond_eval: Vec<fn(&[f64], f64) -> Radial>,
+}
+
+impl Bonded {
+    pub(super) fn new(model: &Model) -> Self {
+        let n = model.len();
+        let (bond_offsets, bond_ends) = by_particle(n, model.bonds.iter().flatten().copied());
+        let (angle_offsets, angle_slot_ids) = by_particle(n, model.angles.iter().flatten().copied());
+        Self {
+            bond_offsets,
+            bond_ends,
+            angle_offsets,
+            angle_slots: vec![DVec3::ZERO; angle_slot_ids.len()],
+            angle_slot_ids,
+            bond_eval: Vec::new(),
+        }
+    }
+
+    /// Pass 1: resolves bond evaluators and fills the angle slots.
+    pub(super) fn prepare(&mut self, model: &Model, x: &[DVec3], images: &Images) {
+        self.bond_eval.clear();
+        self.bond_eval.extend(model.bond_types.iter().map(|t| match t.interaction.law() {
+            Law::Radial { eval, .. } => eval,
+            _ => unreachable!("bond law is radial"),
+        }));
+        self.angle_slots.par_chunks_mut(3).enumerate().with_min_len(1024).for_each(|(a, slots)| {
+            slots.copy_from_slice(&eval_angle(model, a, x, images).1.forces);
+        });
+    }
+
+    /// Bond `b` of type `t` at length `r`, with its state if it has one
+    /// (`None` when it is unbound).
+    #[inline(always)]
+    fn bond_radial(&self, b: usize, t: usize, r: f64, model: &Model, state: Option<&BondState>) -> Option<Radial> {
+        let params = &model.bond_types[t].params;
+        let Some(s) = state else { return Some((self.bond_eval[t])(params, r)) };
+        if !s.bound[b] {
+            return None;
+        }
+        let mut radial = match (model.bond_kinetics[t].rest_index, s.rest[b]) {
+            (Some(k), Some(rest)) => {
+                let mut own = [0.0; MAX_BOND_PARAMS];
+                own[..params.len()].copy_from_slice(params);
+                own[k] = rest;
+                (self.bond_eval[t])(&own[..params.len()], r)
+            }
+            _ => (self.bond_eval[t])(params, r),
+        };
+        if s.scale[b] != 1.0 {
+            radial.energy *= s.scale[b];
+            radial.de_dr *= s.scale[b];
+            radial.d2e_dr2 *= s.scale[b];
+        }
+        Some(radial)
+    }
+
+    /// Bond end `e` (on particle `i`): its bond type and its force on `i`.
+    #[inline(always)]
+    fn bond_force(&self, e: u32, i: usize, model: &Model, x: &[DVec3], images: &Images, state: Option<&BondState>) -> (usize, DVec3) {
+        let b = e as usize / 2;
+        let other = model.bonds[b][1 - e as usize % 2] as usize;
+        let t = model.bond_type[b] as usize;
+        let d = images.minimum_image(x[other] - x[i]);
+        let r = d.length();
+        match self.bond_radial(b, t, r, model, state) {
+            Some(radial) => (t, d * (radial.de_dr / r)),
+            None => (t, DVec3::ZERO),
+        }
+    }
+
+    /// Tension (dE/dr; 0 when unbound) and length of every bond.
+    pub(super) fn tensions(
+        &self,
+        model: &Model,
+        x: &[DVec3],
+        images: &Images,
+        state: Option<&BondState>,
+        tension: &mut Vec<f64>,
+        length: &mut Vec<f64>,
+    ) {
+        tension.resize(model.bonds.len(), 0.0);
+        length.resize(model.bonds.len(), 0.0);
+        tension.par_iter_mut().zip(length.par_iter_mut()).enumerate().with_min_len(1024).for_each(|(b, (tension, length))| {
+            let [i, j] = model.bonds[b];
+            let r = images.minimum_image(x[j as usize] - x[i as usize]).length();
+            *length = r;
+            *tension = self.bond_radial(b, model.bond_type[b] as usize, r, model, state).map_or(0.0, |radial| radial.de_dr);
+        });
+    }
+
+    /// Bonded force on particle `i`: its bonds, then its angle slots.
+    #[inline]
+    pub(super) fn force_on(&self, i: usize, model: &Model, x: &[DVec3], images: &Images, state: Option<&BondState>) -> DVec3 {
+        let mut f = DVec3::ZERO;
+        for &e in &self.bond_ends[self.bond_offsets[i] as usize..self.bond_offsets[i + 1] as usize] {
+            f += self.bond_force(e, i, model, x, images, state).1;
+        }
+        for &s in &self.angle_slot_ids[self.angle_offsets[i] as usize..self.angle_offsets[i + 1] as usize] {
+            f += self.angle_slots[s as usize];
+        }
+        f
+    }
+
+    /// Bonded energies (per registry entry, added to `energy`) and virial
+    /// (added to `virial`), every term once in term order.
+    pub(super) fn energy(
+        &self,
+        model: &Model,
+        x: &[DVec3],
+        images: &Images,
+        state: Option<&BondState>,
+        energy: &mut [f64],
+        virial: &mut [f64; 6],
+    ) {
+        let bond_registry: Vec<usize> = model.bond_types.iter().map(registry_index).collect();
+        for (b, &[i, j]) in model.bonds.iter().enumerate() {
+            let t = model.bond_type[b] as usize;
+            let d = images.minimum_image(x[j as usize] - x[i as usize]);
+            let r = d.length();
+            let Some(radial) = self.bond_radial(b, t, r, model, state) else { continue };
+            energy[bond_registry[t]] += radial.energy;
+            add6(virial, outer(d, -(d * (radial.de_dr / r))));
+        }
+        let angle_registry: Vec<usize> = model.angle_types.iter().map(registry_index).collect();
+        for a in 0..model.angles.len() {
+            let ([xi, xj, xk], out) = eval_angle(model, a, x, images);
+            energy[angle_registry[model.angle_type[a] as usize]] += out.energy;
+            add6(virial, outer(xi - xj, out.forces[0]));
+            add6(virial, outer(xk - xj, out.forces[2]));
+        }
+    }
+
+    /// The bonded terms on particle `i` with their forces (diagnostics).
+    pub(super) fn terms_on(
+        &self,
+        i: usize,
+        model: &Model,
+        x: &[DVec3],
+        images: &Images,
+        state: Option<&BondState>,
+    ) -> Vec<(&'static str, usize, DVec3)> {
+        let mut parts = Vec::new();
+        for &e in &self.bond_ends[self.bond_offsets[i] as usize..self.bond_offsets[i + 1] as usize] {
+            let (t, f) = self.bond_force(e, i, model, x, images, state);
+            parts.push(("bond", t, f));
+        }
+        for &s in &self.angle_slot_ids[self.angle_offsets[i] as usize..self.angle_offsets[i + 1] as usize] {
+            parts.push(("angle", model.angle_type[s as usize / 3] as usize, self.angle_slots[s as usize]));
+        }
+        parts
+    }
+}
+
+/// Angle `a` at image-consistent positions (i and k at their minimum image around the vertex j).
+#[inline]
+fn eval_angle(model: &Model, a: usize, x: &[DVec3], images: &Images) -> ([DVec3; 3], ThreeBody) {
+    let [i, j, k] = model.angles[a];
+    let term = &model.angle_types[model.angle_type[a] as usize];
+    let Law::ThreeBody(eval) = term.interaction.law() else { unreachable!("angle law is three-body") };
+    let xj = x[j as usize];
+    let xi = xj + images.minimum_image(x[i as usize] - xj);
+    let xk = xj + images.minimum_image(x[k as usize] - xj);
+    let at = [xi, xj, xk];
+    (at, eval(&term.params, at))
+}
+
+/// Largest parameter count of a bond law (checked by a test).
+const MAX_BOND_PARAMS: usize = 8;
+
+#[cfg(test)]
+mod tests {
+    use super::MAX_BOND_PARAMS;
+    use crate::interactions::{Kind, REGISTRY};
+
+    #[test]
+    fn bond_laws_fit_the_stateful_parameter_buffer() {
+        for i in REGISTRY.iter().filter(|i| i.kind() == Kind::Bond) {
+            assert!(i.params().len() <= MAX_BOND_PARAMS, "{} has too many parameters", i.name());
+        }
+    }
+}

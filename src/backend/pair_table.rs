@@ -1,0 +1,131 @@
+//! Pair rules resolved per particle-type pair, once per force evaluation.
+//!
+//! The model keeps pair rules as force-field terms behind `dyn Interaction`;
+//! asking each term for its law, its range and its parameters per neighbour
+//! pair costs more than the physics. [`PairTable`] resolves them into a flat
+//! table of kernels (evaluator, parameters, cutoff, energy column) grouped by
+//! type pair, with the largest squared cutoff of each type pair, so the pair
+//! loop does one table look-up per neighbour and skips pairs beyond every
+//! cutoff before taking a square root.
+//!
+//! The kernels of a type pair keep the force field's rule order, and each
+//! particle sums over its neighbours in list order (ascending index), so the
+//! summation order, and therefore every bit of the result, is fixed by the
+//! data.
+
+use glam::DVec3;
+
+use super::virial::{add6, outer};
+use crate::interactions::{Law, Radial};
+use crate::neighbor::NeighborList;
+use crate::system::{Images, Model};
+
+/// One pair rule ready to evaluate.
+#[derive(Clone, Copy)]
+struct Kernel {
+    eval: fn(&[f64], f64) -> Radial,
+    /// Range of this rule's parameters in [`PairTable::params`].
+    params: (u32, u32),
+    cutoff: f64,
+    /// Column of this rule's interaction among the pair interactions in use.
+    column: u32,
+}
+
+/// What the pair loop reads: positions, types, the neighbour list, the box.
+pub(super) struct PairGeometry<'a> {
+    pub x: &'a [DVec3],
+    pub types: &'a [u32],
+    pub list: &'a NeighborList,
+    pub images: Images,
+}
+
+/// Pair kernels by particle-type pair; reused between evaluations.
+#[derive(Default)]
+pub(super) struct PairTable {
+    n_types: usize,
+    kernels: Vec<Kernel>,
+    /// Type pair `a·n_types + b` owns `kernels[start[p]..start[p + 1]]`.
+    start: Vec<u32>,
+    /// Per type pair: a bound above the largest cutoff², for a quick skip.
+    skip2: Vec<f64>,
+    params: Vec<f64>,
+}
+
+impl PairTable {
+    /// Re-resolves the table from `model` (no allocation once sized).
+    /// `rule_column[r]` is the energy column of pair rule `r`.
+    pub(super) fn update(&mut self, model: &Model, rule_column: &[usize]) {
+        let nt = model.type_names.len();
+        self.n_types = nt;
+        self.kernels.clear();
+        self.params.clear();
+        self.start.clear();
+        self.skip2.clear();
+        self.start.push(0);
+        for a in 0..nt as u32 {
+            for b in 0..nt as u32 {
+                let mut reach = 0.0f64;
+                for &rule in model.pair_rules_between(a, b) {
+                    let term = &model.pair_rules[rule as usize];
+                    let Law::Radial { eval, range } = term.interaction.law() else { unreachable!("pair law is radial") };
+                    let cutoff = range(&term.params);
+                    let first = self.params.len() as u32;
+                    self.params.extend_from_slice(&term.params);
+                    self.kernels.push(Kernel {
+                        eval,
+                        params: (first, self.params.len() as u32),
+                        cutoff,
+                        column: rule_column[rule as usize] as u32,
+                    });
+                    reach = reach.max(cutoff);
+                }
+                self.start.push(self.kernels.len() as u32);
+                // Slightly above cutoff², so that rounding in r² never skips a
+                // pair that the exact test `r < cutoff` would keep.
+                self.skip2.push(reach * reach * (1.0 + 1e-12));
+            }
+        }
+    }
+
+    /// Calls `visit(column, d, r, radial)` for every pair term acting on
+    /// particle `i` (d = x_j − x_i, minimum image), neighbours in list order
+    /// and rules in force-field order.
+    #[inline(always)]
+    fn for_each_term(&self, i: usize, g: &PairGeometry, mut visit: impl FnMut(usize, DVec3, f64, Radial)) {
+        let PairGeometry { x, types, list, images } = g;
+        let xi = x[i];
+        let row = types[i] as usize * self.n_types;
+        for &j in list.neighbors(i) {
+            let pair = row + types[j as usize] as usize;
+            let d = images.minimum_image(x[j as usize] - xi);
+            let r2 = d.length_squared();
+            if r2 >= self.skip2[pair] {
+                continue;
+            }
+            let r = r2.sqrt();
+            for k in &self.kernels[self.start[pair] as usize..self.start[pair + 1] as usize] {
+                if r < k.cutoff {
+                    visit(k.column as usize, d, r, (k.eval)(&self.params[k.params.0 as usize..k.params.1 as usize], r));
+                }
+            }
+        }
+    }
+
+    /// Sum of the pair forces on particle `i`.
+    #[inline]
+    pub(super) fn force_on(&self, i: usize, g: &PairGeometry) -> DVec3 {
+        let mut f = DVec3::ZERO;
+        self.for_each_term(i, g, |_, d, r, radial| f += d * (radial.de_dr / r));
+        f
+    }
+
+    /// Adds half the pair energy of particle `i` per column to `energy` and
+    /// half its pair virial to `virial` (thermo steps only).
+    pub(super) fn energy_of(&self, i: usize, g: &PairGeometry, energy: &mut [f64], virial: &mut [f64; 6]) {
+        self.for_each_term(i, g, |column, d, r, radial| {
+            energy[column] += 0.5 * radial.energy;
+            // r_ij ⊗ f_ij with r_ij = −d, counted half from each side.
+            add6(virial, outer(-0.5 * d, d * (radial.de_dr / r)));
+        });
+    }
+}
