@@ -8,4 +8,3 @@ mod sum;
 mod virial;
 
 pub use self::cpu::{CpuBackend, ForceBreakdown, Forces};
-pub use self::sum::ordered_sum;

@@ -4,21 +4,14 @@ use std::ops::Range;
 
 use rayon::prelude::*;
 
-/// Chunk size of [`ordered_sum`] and [`chunked`]; fixed so results never
-/// depend on the number of threads.
+/// Chunk size of [`chunked`]; fixed so results never depend on the number of
+/// threads.
 const CHUNK: usize = 4096;
-
-/// Sum of `values` in an order fixed by the data alone (chunks of 4096 summed
-/// left to right in parallel, then the chunk sums left to right): bit-identical
-/// on any thread count.
-pub fn ordered_sum(values: &[f64]) -> f64 {
-    chunked(values.len(), |r| values[r].iter().sum::<f64>()).iter().sum()
-}
 
 /// `fold(range)` for the ranges of items `0..n` cut into chunks of 4096, in
 /// parallel, returned in chunk order: the caller combines them left to right,
-/// so a reduction over per-item values computed on the fly is as
-/// deterministic as [`ordered_sum`] without storing the values.
+/// so a reduction over per-item values computed on the fly has an order fixed
+/// by the data alone, bit-identical on any thread count.
 pub(super) fn chunked<A: Send>(n: usize, fold: impl Fn(Range<usize>) -> A + Sync + Send) -> Vec<A> {
     (0..n.div_ceil(CHUNK)).into_par_iter().map(|c| fold(c * CHUNK..((c + 1) * CHUNK).min(n))).collect()
 }
@@ -26,6 +19,11 @@ pub(super) fn chunked<A: Send>(n: usize, fold: impl Fn(Range<usize>) -> A + Sync
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A sum in chunk order, as the backend's energy reductions do it.
+    fn ordered_sum(values: &[f64]) -> f64 {
+        chunked(values.len(), |r| values[r].iter().sum::<f64>()).iter().sum()
+    }
 
     #[test]
     fn same_bits_on_one_and_two_threads() {
