@@ -462,3 +462,28 @@ fn restart_resumes_formed_bonds_bit_identically() {
     let bits = |s: &cellmd::run::Simulation| s.state.positions.iter().map(|x| x.to_array().map(f64::to_bits)).collect::<Vec<_>>();
     assert_eq!(bits(&whole), bits(&resumed));
 }
+
+/// `partner nearest` binds mutual-nearest pairs only; `partner random`
+/// (the default) accepts candidates in (i, j) order. Triples at 0, 0.6 and
+/// 0.9 with certain binding: nearest bonds the last two (0.3 apart), random
+/// bonds the first pair it meets.
+#[test]
+fn bond_formation_partner_modes() {
+    let mut top = String::from("[ particles ]\n");
+    for t in 0..100 {
+        let y = 3.0 * t as f64;
+        top += &format!("{} s 0 {y} 0\n{} s 0.6 {y} 0\n{} s 0.9 {y} 0\n", 3 * t + 1, 3 * t + 2, 3 * t + 3);
+    }
+    for (mode, expected) in [("nearest", [2u32, 3]), ("random", [1, 2])] {
+        let ff = format!("particle s fixed\nbond link harmonic k 1 r0 0.5\nbind s s link k_on 1e9 capture 1 partner {mode}\n");
+        let deck = "units lj\ntopology t.top\nforcefield f.ff\nbox x -1 2 f y -1 301 f z -1 1 f\ntimestep 1\nrun 1\n";
+        let c = Case::new(&[("t.top", &top), ("f.ff", &ff), ("deck.in", deck)]);
+        let sim = c.run();
+        assert_eq!(sim.model.bonds.len(), 100, "{mode}: one bond per triple");
+        for &[i, j] in &sim.model.bonds {
+            let (a, b) = (sim.model.ids[i as usize], sim.model.ids[j as usize]);
+            let base = 3 * ((a - 1) / 3) as u32;
+            assert_eq!([a as u32 - base, b as u32 - base], expected, "{mode}: bond {a}-{b}");
+        }
+    }
+}

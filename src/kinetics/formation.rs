@@ -3,13 +3,16 @@
 //! A force-field line
 //!
 //! ```text
-//! bind TYPE_A TYPE_B BONDTYPE k_on K capture R [max_bonds N]
+//! bind TYPE_A TYPE_B BONDTYPE k_on K capture R [max_bonds N] [partner random|nearest]
 //! ```
 //!
 //! lets every pair of a TYPE_A and a TYPE_B particle closer than R (minimum
 //! image) form a bond of BONDTYPE at rate K (probability 1 − exp(−K·dt) per
 //! step), unless either particle already has N bound bonds of that type
 //! (default 1: one partner per site) or the two are already bound by one.
+//! With `partner nearest`, a pair is a candidate only if each is the other's
+//! nearest eligible partner with free capacity (mutual-nearest, as LAMMPS
+//! `fix bond/create` pairs closest candidates); ties go to the lower index.
 //! Candidate pairs are decided in parallel with Philox numbers keyed by
 //! (seed, step, i, j) and accepted in ascending (i, j) order, so a particle
 //! never exceeds its capacity and the outcome does not depend on threads.
@@ -45,6 +48,8 @@ pub struct BindRule {
     pub k_on: f64,
     pub capture: f64,
     pub max_bonds: u32,
+    /// Only mutual-nearest pairs are candidates.
+    pub nearest: bool,
 }
 
 /// A `bind` line as parsed (names resolved later against the model).
@@ -56,27 +61,49 @@ pub struct BindLine {
     pub k_on: f64,
     pub capture: f64,
     pub max_bonds: u32,
+    pub nearest: bool,
 }
 
-/// Parses `bind A B BONDTYPE k_on K capture R [max_bonds N]` (tokens after `bind`).
+/// Parses `bind A B BONDTYPE k_on K capture R [max_bonds N] [partner random|nearest]`
+/// (tokens after `bind`).
 pub fn parse_bind(keyword: &Token, t: &[Token], units: UnitSystem) -> Result<BindLine, InputError> {
+    const USAGE: &str = "bind TYPE_A TYPE_B BONDTYPE k_on K capture R [max_bonds N] [partner random|nearest]";
     if t.len() < 3 {
-        return Err(keyword.error("expected `bind TYPE_A TYPE_B BONDTYPE k_on K capture R [max_bonds N]`"));
+        return Err(keyword.error(format!("expected `{USAGE}`")));
     }
-    let max_at = t[3..].iter().position(|x| x.text == "max_bonds").map(|k| k + 3);
-    let (values_end, max_bonds) = match max_at {
-        Some(k) => {
-            let v = t.get(k + 1).ok_or_else(|| t[k].error("`max_bonds` has no value; expected `max_bonds N`"))?;
-            let n = parse_u64(v, "a maximum number of bonds per particle")?;
-            if n == 0 || k + 2 != t.len() {
-                return Err(v.error("expected `max_bonds N` with N >= 1 at the end of the line"));
+    let (mut max_bonds, mut nearest) = (1, false);
+    let mut values = Vec::new();
+    for pair in t[3..].chunks(2) {
+        let Some(value) = pair.get(1) else {
+            return Err(pair[0].error(format!("`{}` has no value; expected `{USAGE}`", pair[0].text)));
+        };
+        match pair[0].text.as_str() {
+            "max_bonds" => {
+                max_bonds = parse_u64(value, "a maximum number of bonds per particle")? as u32;
+                if max_bonds == 0 {
+                    return Err(value.error("found 0, expected `max_bonds` >= 1"));
+                }
             }
-            (k, n as u32)
+            "partner" => {
+                nearest = match value.text.as_str() {
+                    "random" => false,
+                    "nearest" => true,
+                    other => return Err(value.error(format!("found `{other}`, expected `random` or `nearest`"))),
+                }
+            }
+            _ => values.extend_from_slice(pair),
         }
-        None => (t.len(), 1),
-    };
-    let values = crate::forcefield::parse_values(&PARAMS, "bind", keyword, &t[3..values_end], units)?;
-    Ok(BindLine { type_a: t[0].clone(), type_b: t[1].clone(), bond_type: t[2].clone(), k_on: values[0], capture: values[1], max_bonds })
+    }
+    let values = crate::forcefield::parse_values(&PARAMS, "bind", keyword, &values, units)?;
+    Ok(BindLine {
+        type_a: t[0].clone(),
+        type_b: t[1].clone(),
+        bond_type: t[2].clone(),
+        k_on: values[0],
+        capture: values[1],
+        max_bonds,
+        nearest,
+    })
 }
 
 fn uniform_for_pair(seed: u64, step: u64, i: u32, j: u32) -> f64 {
@@ -121,22 +148,6 @@ impl Formation {
         self.neighbors.build(&state.positions, sim_box, &self.none)?;
         let bonds = state.bonds.as_ref().expect("bond state exists with bind rules");
         let x = &state.positions;
-        // Candidate pairs i < j with their rule, decided independently in parallel.
-        let candidates: Vec<(u32, u32, usize)> = (0..model.len())
-            .into_par_iter()
-            .flat_map_iter(|i| {
-                let neighbors = &self.neighbors;
-                neighbors.neighbors(i).iter().filter(move |&&j| (i as u32) < j).filter_map(move |&j| {
-                    let (ti, tj) = (model.types[i], model.types[j as usize]);
-                    let rule =
-                        model.bind_rules.iter().position(|r| (r.type_a, r.type_b) == (ti, tj) || (r.type_a, r.type_b) == (tj, ti))?;
-                    let r = &model.bind_rules[rule];
-                    let d = sim_box.minimum_image(x[j as usize] - x[i]).length();
-                    let p = -(-r.k_on * dt).exp_m1();
-                    (d < r.capture && uniform_for_pair(seed, step, i as u32, j) < p).then_some((i as u32, j, rule))
-                })
-            })
-            .collect();
         // Bound bonds per particle and rule, bound pairs, and unbound bonds to reuse.
         let rules = model.bind_rules.len();
         let mut count = vec![0u32; model.len() * rules];
@@ -156,6 +167,45 @@ impl Formation {
                 }
             }
         }
+        // Eligible partners of particle i within capture: (j, rule, distance).
+        let (neighbors, count_now, bound_now) = (&self.neighbors, &count, &bound_pairs);
+        let eligible = move |i: usize| {
+            neighbors.neighbors(i).iter().filter_map(move |&j| {
+                let (ti, tj) = (model.types[i], model.types[j as usize]);
+                let k = model.bind_rules.iter().position(|r| (r.type_a, r.type_b) == (ti, tj) || (r.type_a, r.type_b) == (tj, ti))?;
+                let r = &model.bind_rules[k];
+                let key = ((i as u32).min(j), (i as u32).max(j), r.bond_type);
+                let free = count_now[i * rules + k] < r.max_bonds && count_now[j as usize * rules + k] < r.max_bonds;
+                let d = sim_box.minimum_image(x[j as usize] - x[i]).length();
+                (d < r.capture && free && !bound_now.contains(&key)).then_some((j, k, d))
+            })
+        };
+        // For `partner nearest`: each particle's nearest eligible partner per rule.
+        let nearest: Vec<Vec<Option<u32>>> = (0..model.len())
+            .into_par_iter()
+            .map(|i| {
+                let mut best: Vec<Option<(u32, f64)>> = vec![None; rules];
+                for (j, k, d) in eligible(i) {
+                    if best[k].is_none_or(|(bj, bd)| d < bd || (d == bd && j < bj)) {
+                        best[k] = Some((j, d));
+                    }
+                }
+                best.into_iter().map(|b| b.map(|(j, _)| j)).collect()
+            })
+            .collect();
+        // Candidate pairs i < j, decided independently in parallel.
+        let candidates: Vec<(u32, u32, usize)> = (0..model.len())
+            .into_par_iter()
+            .flat_map_iter(|i| {
+                let nearest = &nearest;
+                eligible(i).filter(move |&(j, _, _)| (i as u32) < j).filter_map(move |(j, k, _)| {
+                    let r = &model.bind_rules[k];
+                    let mutual = nearest[i][k] == Some(j) && nearest[j as usize][k] == Some(i as u32);
+                    let p = -(-r.k_on * dt).exp_m1();
+                    ((!r.nearest || mutual) && uniform_for_pair(seed, step, i as u32, j) < p).then_some((i as u32, j, k))
+                })
+            })
+            .collect();
         let mut bindings = Vec::new();
         for (i, j, k) in candidates {
             let r = &model.bind_rules[k];

@@ -109,6 +109,7 @@ impl Model {
                     k_on: line.k_on,
                     capture: line.capture,
                     max_bonds: line.max_bonds,
+                    nearest: line.nearest,
                 })
             })
             .collect::<Result<_, InputError>>()?;
