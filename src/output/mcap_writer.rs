@@ -127,7 +127,6 @@ pub const FRAME_SCHEMA: &str = r#"{
   "required": ["step", "time", "box", "positions", "images"]
 }"#;
 
-/// JSON Schema of `cellmd.BondState`.
 /// JSON Schema of `cellmd.BondEvents`: the events of one step (see `crate::kinetics::Event`).
 pub const BOND_EVENTS_SCHEMA: &str = r#"{
   "title": "cellmd.BondEvents",
@@ -146,6 +145,7 @@ pub const BOND_EVENTS_SCHEMA: &str = r#"{
   }
 }"#;
 
+/// JSON Schema of `cellmd.BondState`.
 pub const BOND_STATE_SCHEMA: &str = r#"{
   "title": "cellmd.BondState",
   "description": "Which bonds of cellmd.Topology are currently bound",
