@@ -150,11 +150,7 @@ pub(crate) use kinetic_rule;
 
 /// Documentation page of a rule (what `cellmd list NAME` prints).
 pub fn rule_documentation(rule: &dyn KineticRule, units: crate::units::UnitSystem) -> String {
-    let mut page = format!("# {} (kinetic rule)\n\n{}\n\n", rule.name(), rule.summary());
-    page += &crate::interactions::parameter_table(rule.params(), units);
-    page += "\n";
-    page += rule.doc();
-    page
+    crate::interactions::documentation_page(rule.name(), "kinetic rule", rule.summary(), rule.params(), rule.doc(), units)
 }
 
 #[cfg(test)]
