@@ -289,13 +289,29 @@ pub fn param_index(interaction: &dyn Interaction, name: &str) -> Option<usize> {
 
 /// Full documentation page of an interaction type (what `cellmd list NAME` prints).
 pub fn documentation(interaction: &dyn Interaction, units: crate::units::UnitSystem) -> String {
-    documentation_page(interaction.name(), interaction.kind().keyword(), interaction.summary(), interaction.params(), interaction.doc(), units)
+    documentation_page(
+        interaction.name(),
+        interaction.kind().keyword(),
+        interaction.summary(),
+        interaction.params(),
+        interaction.doc(),
+        units,
+    )
 }
 
 /// A documentation page: title with its kind, summary, the `## Parameters`
 /// table (units of `units`, generated from the schema), then the module doc.
-pub fn documentation_page(name: &str, kind: &str, summary: &str, params: &[ParamSpec], doc: &str, units: crate::units::UnitSystem) -> String {
-    let mut page = format!("# {name} ({kind})\n\n{summary}\n\n## Parameters\n\n| name | unit | allowed | default | meaning |\n|---|---|---|---|---|\n");
+pub fn documentation_page(
+    name: &str,
+    kind: &str,
+    summary: &str,
+    params: &[ParamSpec],
+    doc: &str,
+    units: crate::units::UnitSystem,
+) -> String {
+    let mut page = format!(
+        "# {name} ({kind})\n\n{summary}\n\n## Parameters\n\n| name | unit | allowed | default | meaning |\n|---|---|---|---|---|\n"
+    );
     for p in params {
         let default = p.default.map_or("required".to_string(), |d| d.to_string());
         page += &format!("| `{}` | {} | {} | {} | {} |\n", p.name, units.label(p.dim), p.range_text(), default, p.doc);

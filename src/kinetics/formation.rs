@@ -127,9 +127,16 @@ pub struct Formation {
 }
 
 impl Formation {
-    pub fn new(model: &Model) -> Self {
+    /// The candidate list has a skin of 0.3 × capture (capped so the box
+    /// accepts it) and is rebuilt only when some particle moved more than
+    /// half of it; it is sorted and candidates are filtered by their actual
+    /// distance, so decisions do not depend on when it was rebuilt.
+    pub fn new(model: &Model, sim_box: &SimBox) -> Self {
         let capture = model.bind_rules.iter().map(|r| r.capture).fold(0.0, f64::max);
-        Self { neighbors: NeighborList::new(capture, 0.0), none: Exclusions::none() }
+        let lengths = sim_box.lengths();
+        let room = (0..3).filter(|&a| sim_box.periodic[a]).map(|a| 0.5 * lengths[a] - capture).fold(f64::INFINITY, f64::min);
+        let skin = (0.3 * capture).min(room.max(0.0));
+        Self { neighbors: NeighborList::new(capture, skin), none: Exclusions::none() }
     }
 
     /// The bindings decided at `step` from the positions of `state`.
@@ -145,7 +152,9 @@ impl Formation {
         if model.bind_rules.is_empty() {
             return Ok(Vec::new());
         }
-        self.neighbors.build(&state.positions, sim_box, &self.none)?;
+        if self.neighbors.needs_rebuild(&state.positions, sim_box) {
+            self.neighbors.build(&state.positions, sim_box, &self.none)?;
+        }
         let bonds = state.bonds.as_ref().expect("bond state exists with bind rules");
         let x = &state.positions;
         // Bound bonds per particle and rule, bound pairs, and unbound bonds to reuse.

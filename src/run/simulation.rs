@@ -95,7 +95,7 @@ impl Simulation {
             energies_current: false,
             dumps: Vec::new(),
             kinetics: Kinetics::default(),
-            formation: (!plan.model.bind_rules.is_empty()).then(|| Formation::new(&plan.model)),
+            formation: (!plan.model.bind_rules.is_empty()).then(|| Formation::new(&plan.model, &plan.sim_box)),
             event_log: None,
             options,
             deck_stem,
@@ -231,6 +231,9 @@ impl Simulation {
             )));
         }
         self.sim_box = data.sim_box;
+        if self.formation.is_some() {
+            self.formation = Some(Formation::new(&self.model, &self.sim_box));
+        }
         self.state = data.to_state();
         match &self.state.bonds {
             Some(bonds) => self.model.set_formed_bonds(&bonds.formed),
