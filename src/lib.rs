@@ -24,6 +24,7 @@ pub mod compare;
 pub mod deck;
 pub mod export;
 pub mod forcefield;
+pub mod gpu;
 pub mod input;
 pub mod integrate;
 pub mod interactions;

@@ -9,6 +9,7 @@ use clap::{Parser, Subcommand};
 use cellmd::compare::{cellmd_probes, golden, run_lammps, Agreement, Lmp, Tolerance};
 use cellmd::deck::validate_file;
 use cellmd::export::{self, ExportOptions};
+use cellmd::gpu::DevicePreference;
 use cellmd::interactions::{documentation, lookup, REGISTRY};
 use cellmd::kinetics::{lookup_rule, rule_documentation, RULES};
 use cellmd::run::{RunOptions, Simulation};
@@ -38,6 +39,9 @@ enum Command {
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
+        /// Backend for the steps, overriding the deck's `device`: cpu, gpu or auto.
+        #[arg(long, value_parser = parse_device)]
+        device: Option<DevicePreference>,
     },
     /// Validate a deck (and its topology and force fields) without running it.
     Check {
@@ -87,6 +91,10 @@ enum Command {
         #[arg(long)]
         lj: bool,
     },
+}
+
+fn parse_device(s: &str) -> Result<DevicePreference, String> {
+    DevicePreference::from_keyword(s).ok_or_else(|| format!("found `{s}`, expected cpu, gpu or auto"))
 }
 
 fn parse_var(s: &str) -> Result<(String, String), String> {
@@ -177,7 +185,7 @@ fn main() -> ExitCode {
                 }
             }
         }
-        Command::Run { deck, output_dir, vars, threads, quiet } => {
+        Command::Run { deck, output_dir, vars, threads, quiet, device } => {
             if let Some(n) = threads {
                 if let Err(e) = rayon::ThreadPoolBuilder::new().num_threads(n).build_global() {
                     eprintln!("error: cannot start {n} threads: {e}");
@@ -193,9 +201,9 @@ fn main() -> ExitCode {
                 return ExitCode::from(1);
             }
             let interactive = std::io::stderr().is_terminal() && std::env::var_os("CI").is_none();
-            let options = RunOptions { output_dir, progress: interactive && !quiet, echo: true };
+            let options = RunOptions { output_dir, progress: interactive && !quiet, echo: true, device };
             println!(
-                "cellmd {}: {} — {} particles, {} bonds, {} angles, {} pair rules; CPU reference backend, {} threads",
+                "cellmd {}: {} — {} particles, {} bonds, {} angles, {} pair rules; {} CPU threads",
                 env!("CARGO_PKG_VERSION"),
                 deck.display(),
                 plan.model.len(),

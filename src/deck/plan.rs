@@ -74,6 +74,8 @@ pub enum Action {
     Temperature(f64),
     Timestep(f64),
     Seed(u64),
+    /// Which backend runs the steps (`device cpu|gpu|auto`).
+    Device(crate::gpu::DevicePreference),
     Integrator(OverdampedSettings),
     Neighbor(NeighborSettings),
     Thermo {

@@ -8,6 +8,7 @@ use glam::DVec3;
 use super::plan::{Action, CoeffTarget, DumpSpec, Group, NeighborSettings, Plan, ThermoColumn};
 use super::variables::Variables;
 use crate::forcefield::{load_forcefield, parse_params, ForceField};
+use crate::gpu::DevicePreference;
 use crate::input::{lex, parse_f64, parse_u64, InputError, SourceFile, Statement, Token};
 use crate::integrate::fire::FireSettings;
 use crate::integrate::overdamped::OverdampedSettings;
@@ -20,7 +21,7 @@ use crate::topology::{parse_box_axis, parse_topology, BoxAxis, Topology};
 use crate::units::UnitSystem;
 
 /// The commands a deck understands (for "expected ..." messages).
-const COMMANDS: &str = "units, variable, topology, forcefield, box, special_bonds, temperature, timestep, seed, integrator, neighbor, thermo, thermo_file, events, dump, undump, group, external, unexternal, coeff, minimize, run, write_state, read_state, print";
+const COMMANDS: &str = "units, variable, topology, forcefield, box, special_bonds, temperature, timestep, seed, device, integrator, neighbor, thermo, thermo_file, events, dump, undump, group, external, unexternal, coeff, minimize, run, write_state, read_state, print";
 
 /// Commands that define the system and must come before it is first used.
 const SETUP: [&str; 5] = ["units", "topology", "forcefield", "box", "special_bonds"];
@@ -398,6 +399,12 @@ impl Validator {
             "seed" => {
                 expect_len(s, 1..=1, "seed N")?;
                 self.actions.push(Action::Seed(parse_u64(&s[1], "a random seed")?));
+            }
+            "device" => {
+                expect_len(s, 1..=1, "device cpu|gpu|auto")?;
+                let device = DevicePreference::from_keyword(&s[1].text)
+                    .ok_or_else(|| s[1].error(format!("found device `{}`, expected `cpu`, `gpu` or `auto`", s[1].text)))?;
+                self.actions.push(Action::Device(device));
             }
             "integrator" => {
                 expect_len(s, 1..=5, "integrator overdamped [noise uniform|gaussian] [max_displacement D]")?;

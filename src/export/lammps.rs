@@ -453,7 +453,7 @@ impl Writer<'_> {
                 }
                 Action::Seed(seed) => self.seed = *seed,
                 Action::Integrator(s) => self.noise = s.noise,
-                Action::Neighbor(_) => {}
+                Action::Neighbor(_) | Action::Device(_) => {}
                 Action::Thermo { every, .. } => self.line(format!("thermo {every}")),
                 Action::ThermoFile(path) => self.line(format!("# thermo_file {}: the LAMMPS log holds the thermo table", path.display())),
                 Action::EventFile(path) => self.line(format!("# events {}: bond kinetics are not exported", path.display())),

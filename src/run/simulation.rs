@@ -10,12 +10,17 @@ use super::blowup::{culprit, RunError};
 use super::thermo::{Thermo, ThermoInputs};
 use crate::backend::{CpuBackend, Forces};
 use crate::deck::{Action, CoeffTarget, DumpSpec, NeighborSettings, Plan};
+use crate::gpu::backend::StepSettings;
+use crate::gpu::{DevicePreference, GpuBackend, GpuContext, GpuHalt};
 use crate::integrate::fire::{fire_minimize, FireReport, FireSettings};
 use crate::integrate::overdamped::{overdamped_step, Blowup, OverdampedSettings};
 use crate::kinetics::{initial_bond_state, Binding, EventLog, Formation, Kinetics};
 use crate::output::restart::{read_state, write_state, RestartData};
 use crate::output::{open_writer, FrameView, TopologyView, TrajectoryWriter};
 use crate::system::{Model, SimBox, State};
+
+/// The longest GPU segment between read-backs when no output is due.
+const GPU_SYNC_STEPS: u64 = 1000;
 
 /// How to run: where outputs go and how to report progress.
 #[derive(Clone, Debug)]
@@ -26,11 +31,13 @@ pub struct RunOptions {
     pub progress: bool,
     /// Print thermo and messages to stdout.
     pub echo: bool,
+    /// Overrides the deck's `device` (the CLI's `--device`).
+    pub device: Option<DevicePreference>,
 }
 
 impl Default for RunOptions {
     fn default() -> Self {
-        Self { output_dir: PathBuf::from("."), progress: false, echo: false }
+        Self { output_dir: PathBuf::from("."), progress: false, echo: false, device: None }
     }
 }
 
@@ -68,6 +75,10 @@ pub struct Simulation {
     scratch: Vec<DVec3>,
     /// The last minimisation's outcome.
     pub last_minimize: Option<FireReport>,
+    /// The deck's `device` setting.
+    pub device: DevicePreference,
+    /// The opened GPU (kept across `run` commands), or why it could not be used.
+    gpu: Option<Result<GpuContext, String>>,
 }
 
 impl Simulation {
@@ -101,6 +112,8 @@ impl Simulation {
             deck_stem,
             scratch: Vec::new(),
             last_minimize: None,
+            device: DevicePreference::Cpu,
+            gpu: None,
         }
     }
 
@@ -134,6 +147,7 @@ impl Simulation {
             Action::Temperature(kt) => self.kt = *kt,
             Action::Timestep(dt) => self.dt = *dt,
             Action::Seed(seed) => self.seed = *seed,
+            Action::Device(device) => self.device = *device,
             Action::Integrator(settings) => self.integrator = *settings,
             Action::Neighbor(settings) => {
                 self.neighbor = *settings;
@@ -345,10 +359,11 @@ impl Simulation {
         Ok(())
     }
 
-    /// `run N`: N overdamped steps.
+    /// `run N`: N overdamped steps, on the CPU backend or the GPU.
     pub fn run(&mut self, steps: u64) -> Result<(), RunError> {
         self.check_kinetics_temperature()?;
         self.ensure_forces()?;
+        let gpu = self.gpu_for_run()?;
         let bar = (self.options.progress && steps >= 1000).then(|| {
             let bar = ProgressBar::new(steps);
             bar.set_style(ProgressStyle::with_template("{bar:40} {pos}/{len} steps  {per_sec}  ETA {eta}").expect("valid template"));
@@ -362,6 +377,24 @@ impl Simulation {
         self.outputs_at_step(&bar, true)?;
         let started = std::time::Instant::now();
         let last = self.state.step + steps;
+        match gpu {
+            Some(context) => self.run_gpu(&context, last, &bar)?,
+            None => self.run_cpu(last, &bar)?,
+        }
+        if let Some(b) = bar {
+            b.finish_and_clear();
+        }
+        self.thermo.flush()?;
+        let seconds = started.elapsed().as_secs_f64();
+        self.say(&format!(
+            "loop time {seconds:.6} s for {steps} steps with {} particles: {:.6e} particle-steps/s",
+            self.model.len(),
+            (steps as f64 * self.model.len() as f64) / seconds
+        ));
+        Ok(())
+    }
+
+    fn run_cpu(&mut self, last: u64, bar: &Option<ProgressBar>) -> Result<(), RunError> {
         while self.state.step < last {
             let moved = overdamped_step(
                 &self.model,
@@ -375,9 +408,7 @@ impl Simulation {
                 &mut self.scratch,
             );
             if let Err(Blowup { particle, displacement }) = moved {
-                let what =
-                    format!("displacement {displacement:e} in one step exceeds max_displacement {:e}", self.integrator.max_displacement);
-                return Err(self.blowup(particle, what));
+                return Err(self.blowup(particle, self.displacement_message(displacement)));
             }
             if self.state.bonds.is_some() {
                 self.kinetics_step()?;
@@ -394,22 +425,121 @@ impl Simulation {
                 // Bonds formed: the backend is rebuilt for the new bond list.
                 None => self.ensure_forces()?,
             }
-            self.outputs_at_step(&bar, final_step && !thermo_due)?;
-            if let Some(b) = &bar {
+            self.outputs_at_step(bar, final_step && !thermo_due)?;
+            if let Some(b) = bar {
                 b.inc(1);
             }
         }
-        if let Some(b) = bar {
-            b.finish_and_clear();
-        }
-        self.thermo.flush()?;
-        let seconds = started.elapsed().as_secs_f64();
-        self.say(&format!(
-            "loop time {seconds:.6} s for {steps} steps with {} particles: {:.6e} particle-steps/s",
-            self.model.len(),
-            (steps as f64 * self.model.len() as f64) / seconds
-        ));
         Ok(())
+    }
+
+    fn displacement_message(&self, displacement: f64) -> String {
+        format!("displacement {displacement:e} in one step exceeds max_displacement {:e}", self.integrator.max_displacement)
+    }
+
+    /// The GPU to run on, per the effective `device` setting (None: the CPU).
+    /// The adapter is opened once and announced.
+    fn gpu_for_run(&mut self) -> Result<Option<GpuContext>, RunError> {
+        let device = self.options.device.unwrap_or(self.device);
+        if device == DevicePreference::Cpu {
+            return Ok(None);
+        }
+        let kinetics = self.state.bonds.is_some() || !self.model.bind_rules.is_empty();
+        if kinetics {
+            let why = "bond kinetics (`kinetics`, `bind`) run on the CPU backend only";
+            return match device {
+                DevicePreference::Gpu => Err(RunError::Setup(format!("device gpu: {why}; use `device cpu` or `device auto`"))),
+                _ => {
+                    self.say(&format!("device auto: {why}; running on the CPU"));
+                    Ok(None)
+                }
+            };
+        }
+        if self.gpu.is_none() {
+            let opened = GpuContext::open(device == DevicePreference::Auto);
+            match &opened {
+                Ok(context) => self.say(&format!("device: GPU {}", context.describe())),
+                Err(e) if device == DevicePreference::Auto => self.say(&format!("device auto: {e}; running on the CPU")),
+                Err(_) => {}
+            }
+            self.gpu = Some(opened);
+        }
+        match self.gpu.as_ref().expect("opened above") {
+            Ok(context) => Ok(Some(context.clone())),
+            Err(_) if device == DevicePreference::Auto => Ok(None),
+            Err(e) => Err(RunError::Setup(format!("device gpu: {e}"))),
+        }
+    }
+
+    /// The steps up to `last` on the GPU. The state is read back where an
+    /// output is due (thermo, dump, the end) and at least every
+    /// [`GPU_SYNC_STEPS`] steps (progress, blow-up checks); thermo quantities
+    /// are then computed by the CPU backend at the read-back positions.
+    fn run_gpu(&mut self, context: &GpuContext, last: u64, bar: &Option<ProgressBar>) -> Result<(), RunError> {
+        let settings = StepSettings {
+            dt: self.dt,
+            kt: self.kt,
+            seed: self.seed,
+            skin: self.neighbor.skin,
+            neighbor_every: self.neighbor.every,
+            neighbor_check: self.neighbor.check,
+            integrator: self.integrator,
+        };
+        let mut gpu = GpuBackend::new(context, &self.model, &self.state, &self.sim_box, &settings).map_err(RunError::Setup)?;
+        while self.state.step < last {
+            let next_output = self.next_output_step(last).min(self.state.step + GPU_SYNC_STEPS);
+            let steps = next_output - self.state.step;
+            let outcome = gpu.run(self.state.step, steps);
+            let done = match &outcome {
+                Ok(done) => *done,
+                Err(GpuHalt::Blowup { step, .. }) => step - self.state.step,
+            };
+            gpu.download(&mut self.state);
+            for _ in 0..done {
+                self.state.step += 1;
+                self.state.time += self.dt;
+            }
+            self.forces_current = false;
+            if let Err(GpuHalt::Blowup { particle, .. }) = outcome {
+                self.refresh_cpu_forces(false)?;
+                let what = format!(
+                    "its GPU step was non-finite or longer than max_displacement {:e} (force here {:e})",
+                    self.integrator.max_displacement,
+                    self.forces.forces[particle].length()
+                );
+                return Err(self.blowup(particle, what));
+            }
+            let final_step = self.state.step == last;
+            let thermo_due = self.thermo.every > 0 && self.state.step.is_multiple_of(self.thermo.every);
+            if thermo_due || final_step {
+                self.refresh_cpu_forces(true)?;
+            }
+            self.outputs_at_step(bar, final_step && !thermo_due)?;
+            if let Some(b) = bar {
+                b.inc(done);
+            }
+        }
+        Ok(())
+    }
+
+    /// The first step after the current one at which thermo or a dump is due (or `last`).
+    fn next_output_step(&self, last: u64) -> u64 {
+        let after = |every: u64| (self.state.step / every + 1) * every;
+        let mut next = last;
+        if self.thermo.every > 0 {
+            next = next.min(after(self.thermo.every));
+        }
+        for dump in &self.dumps {
+            next = next.min(after(dump.spec.every));
+        }
+        next
+    }
+
+    /// CPU forces (and energies) at the current state, after a GPU segment.
+    fn refresh_cpu_forces(&mut self, energies: bool) -> Result<(), RunError> {
+        let backend = self.backend.as_mut().expect("backend built");
+        backend.update_neighbors(&self.state, &self.sim_box, true).map_err(RunError::Setup)?;
+        self.compute_forces(energies)
     }
 
     /// Bond kinetics of the step just integrated, decided from the tensions of

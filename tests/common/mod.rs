@@ -55,3 +55,36 @@ pub fn grid_topology(n_side: usize, a: f64) -> String {
     }
     top
 }
+
+/// 400 particles of two types in a box of edge 8 (some right at the faces),
+/// with bonds, angles and three pair rules; `special` is inserted into the deck.
+pub fn random_case(periodic: bool, special: &str) -> Case {
+    let mut seed = 0x9E3779B97F4A7C15u64;
+    let mut next = || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let (n, l) = (400, 8.0);
+    let mut top = String::from("[ particles ]\n");
+    for id in 1..=n {
+        let ty = if id % 3 == 0 { "b" } else { "a" };
+        // Some particles sit right at the box faces.
+        let x = if id % 50 == 0 { l - 1e-9 } else { next() * l };
+        top += &format!("{id} {ty} {x} {} {}\n", next() * l, next() * l);
+    }
+    top += "[ bonds ]\n";
+    for id in (1..n).step_by(2) {
+        top += &format!("s {id} {}\n", id + 1);
+    }
+    top += "[ angles ]\n";
+    for id in (1..n - 2).step_by(4) {
+        top += &format!("t {id} {} {}\n", id + 1, id + 2);
+    }
+    let ff = "particle a drag 1\nparticle b drag 2\nbond s harmonic k 2 r0 0.5\nangle t cosine_angle K 0.3\n\
+              pair a a lj epsilon 1 sigma 0.3 rc 0.9\npair a b soft A 1 rc 0.7\npair a b soft_repulsion k 5 sigma 0.5\n";
+    let b = if periodic { "p" } else { "f" };
+    let deck = format!("units lj\ntopology t.top\nforcefield f.ff\n{special}box x 0 {l} {b} y 0 {l} {b} z 0 {l} {b}\nneighbor skin 0.4\n");
+    Case::new(&[("t.top", &top), ("f.ff", ff), ("deck.in", &deck)])
+}

@@ -1,0 +1,87 @@
+// Force on each particle as the sum of its own terms (no float atomics, no
+// write conflicts; the order is fixed by the data, so a run repeats bit for
+// bit): pairs from the neighbour list, its bonds from its own side, its
+// angle slots, and the external fields acting on it. `force[i].w` is the
+// particle's share of the potential energy (half of each pair and bond,
+// a third of each angle, all of its externals).
+//
+// `radial_law`, `three_body_law` and `one_body_law` dispatch on the
+// registry index of the term's interaction type; they are generated from the
+// registry when the shader is composed.
+
+@compute @workgroup_size(256)
+fn forces(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    let i = linear_index(wg, local);
+    if i >= P.n || halted() {
+        return;
+    }
+    let ti = topo[i];
+    var f = vec3<f32>(0.0);
+    var e = 0.0;
+
+    // Pairs.
+    let count = min(nlist[i], P.nlist_cap);
+    let base = P.n + i * P.nlist_cap;
+    for (var k = 0u; k < count; k++) {
+        let j = nlist[base + k];
+        let pair = ti * P.n_types + topo[j];
+        let d = separation(i, j);
+        let r2 = dot(d, d);
+        if r2 >= fparams[P.off_skip2 + pair] {
+            continue;
+        }
+        let r = sqrt(r2);
+        let rules_end = topo[P.off_pair_start + pair + 1u];
+        for (var q = topo[P.off_pair_start + pair]; q < rules_end; q++) {
+            let term = topo[P.off_pair_terms + q];
+            let radial = radial_law(topo[P.off_term_kind + term], term_params(term), r);
+            f += (radial.de_dr / r) * d;
+            e += 0.5 * radial.energy;
+        }
+    }
+
+    // Bonds, from this particle's side.
+    let bonds_end = topo[P.off_bond_offsets + i + 1u];
+    for (var b = topo[P.off_bond_offsets + i]; b < bonds_end; b++) {
+        let other = topo[P.off_bond_ends + 2u * b];
+        let term = topo[P.off_bond_ends + 2u * b + 1u];
+        let d = separation(i, other);
+        let r = length(d);
+        let radial = radial_law(topo[P.off_term_kind + term], term_params(term), r);
+        f += (radial.de_dr / r) * d;
+        e += 0.5 * radial.energy;
+    }
+
+    // Angles: evaluated around the vertex j with i and k at their minimum images.
+    let angles_end = topo[P.off_angle_offsets + i + 1u];
+    for (var a = topo[P.off_angle_offsets + i]; a < angles_end; a++) {
+        let slot = P.off_angle_slots + 5u * a;
+        let pi = topo[slot];
+        let pj = topo[slot + 1u];
+        let pk = topo[slot + 2u];
+        let term = topo[slot + 3u];
+        let role = topo[slot + 4u];
+        let three = three_body_law(topo[P.off_term_kind + term], term_params(term), separation(pj, pi), vec3<f32>(0.0), separation(pj, pk));
+        if role == 0u {
+            f += three.fi;
+        } else if role == 1u {
+            f += three.fj;
+        } else {
+            f += three.fk;
+        }
+        e += three.energy / 3.0;
+    }
+
+    // External fields, on the unwrapped position.
+    let externals_end = topo[P.off_ext_offsets + i + 1u];
+    if externals_end > topo[P.off_ext_offsets + i] {
+        let x = unwrapped(i);
+        for (var t = topo[P.off_ext_offsets + i]; t < externals_end; t++) {
+            let term = topo[P.off_ext_terms + t];
+            let one = one_body_law(topo[P.off_term_kind + term], term_params(term), x);
+            f += one.force;
+            e += one.energy;
+        }
+    }
+    force[i] = vec4<f32>(f, e);
+}

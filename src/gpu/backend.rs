@@ -1,0 +1,520 @@
+//! Buffers, pipelines and the GPU-resident step loop.
+//!
+//! [`GpuBackend::run`] encodes `steps` steps — neighbour check and rebuild
+//! (indirect dispatches sized on the GPU), forces, integration, commit —
+//! and reads back only the status words at the end. Overflow of the
+//! neighbour list halts the remaining kernels; the host grows the list and
+//! resumes from the last completed step, so the result is the same as with a
+//! large enough list. A refused step (blow-up) halts too, leaving the state
+//! of the last completed step in place.
+
+use glam::DVec3;
+use wgpu::util::DeviceExt;
+
+use super::context::GpuContext;
+use super::pack::{cell_grid, pack, split, Params};
+use super::shader;
+use crate::integrate::overdamped::OverdampedSettings;
+use crate::neighbor::Exclusions;
+use crate::system::{Model, SimBox, State};
+
+const WORKGROUP: u32 = 256;
+const STATUS_WORDS: usize = 8;
+const ST_HALTED: usize = 0;
+const ST_OVERFLOW_NEED: usize = 1;
+const ST_BUILDS: usize = 3;
+const ST_STEPS_DONE: usize = 4;
+const ST_BLOWUP_PARTICLE: usize = 5;
+const ST_FORCE_REBUILD: usize = 6;
+const HALT_OVERFLOW: u32 = 1;
+const HALT_BLOWUP: u32 = 2;
+/// Steps per command buffer.
+const STEPS_PER_SUBMIT: u64 = 64;
+
+/// How a run on the GPU stopped early.
+#[derive(Clone, Debug, PartialEq)]
+pub enum GpuHalt {
+    /// The step of `particle` (internal index) was refused at `step`; the
+    /// state is that of `step`.
+    Blowup { step: u64, particle: usize },
+}
+
+/// Settings the kernels need besides the model.
+#[derive(Clone, Copy, Debug)]
+pub struct StepSettings {
+    pub dt: f64,
+    pub kt: f64,
+    pub seed: u64,
+    pub skin: f64,
+    pub neighbor_every: u64,
+    pub neighbor_check: bool,
+    pub integrator: OverdampedSettings,
+}
+
+struct Kernels {
+    displacement: wgpu::ComputePipeline,
+    decide: wgpu::ComputePipeline,
+    clear: wgpu::ComputePipeline,
+    count: wgpu::ComputePipeline,
+    scan_blocks: wgpu::ComputePipeline,
+    scan_totals: wgpu::ComputePipeline,
+    scan_add: wgpu::ComputePipeline,
+    scatter: wgpu::ComputePipeline,
+    sort: wgpu::ComputePipeline,
+    build: wgpu::ComputePipeline,
+    forces: wgpu::ComputePipeline,
+    integrate: wgpu::ComputePipeline,
+    commit: wgpu::ComputePipeline,
+    advance: wgpu::ComputePipeline,
+}
+
+/// The GPU force engine and integrator for one model.
+pub struct GpuBackend {
+    ctx: GpuContext,
+    params: Params,
+    has_pairs: bool,
+    sim_box: SimBox,
+    uniform: wgpu::Buffer,
+    state: wgpu::Buffer,
+    next: wgpu::Buffer,
+    reference: wgpu::Buffer,
+    topo: wgpu::Buffer,
+    fparams: wgpu::Buffer,
+    cell_count: wgpu::Buffer,
+    cell_data: wgpu::Buffer,
+    nlist: wgpu::Buffer,
+    force: wgpu::Buffer,
+    status: wgpu::Buffer,
+    args: wgpu::Buffer,
+    layout: wgpu::BindGroupLayout,
+    main_group: wgpu::BindGroup,
+    args_group: wgpu::BindGroup,
+    kernels: Kernels,
+    builds: u64,
+    grown: u32,
+}
+
+fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+fn words<T: bytemuck::Pod>(data: &[T]) -> &[u8] {
+    bytemuck::cast_slice(data)
+}
+
+impl GpuBackend {
+    /// Uploads the model and state and compiles the kernels.
+    pub fn new(ctx: &GpuContext, model: &Model, state: &State, sim_box: &SimBox, settings: &StepSettings) -> Result<Self, String> {
+        if state.bonds.is_some() || !model.bind_rules.is_empty() {
+            return Err("the GPU backend does not run bond kinetics yet; use `device cpu` for decks with `kinetics` or `bind`".into());
+        }
+        let n = model.len();
+        if n == 0 {
+            return Err("the GPU backend needs at least one particle".into());
+        }
+        let exclusions = Exclusions::from_pairs(n, &model.excluded_pairs(None));
+        let packed = pack(model, &exclusions, settings.dt, settings.kt)?;
+        let cutoff = model.max_pair_cutoff();
+        let has_pairs = !model.pair_rules.is_empty() && cutoff > 0.0;
+        let range = cutoff + settings.skin;
+        let (grid, inv_width) = if has_pairs { cell_grid(sim_box, range, n) } else { ([1, 1, 1], [0.0; 3]) };
+        let cells = grid.iter().product::<u32>();
+        let scan_blocks = cells.div_ceil(WORKGROUP);
+        let lengths = sim_box.lengths();
+        let (len_hi, len_lo): (Vec<f32>, Vec<f32>) = (0..3).map(|a| split(lengths[a])).unzip();
+        let groups_x = ctx.limits.max_compute_workgroups_per_dimension.min(65_535);
+        let params = Params {
+            box_len_hi: [len_hi[0], len_hi[1], len_hi[2], 0.0],
+            box_len_lo: [len_lo[0], len_lo[1], len_lo[2], 0.0],
+            box_lo: [sim_box.lo.x as f32, sim_box.lo.y as f32, sim_box.lo.z as f32, 0.0],
+            periodic: [sim_box.periodic[0] as u32, sim_box.periodic[1] as u32, sim_box.periodic[2] as u32, 0],
+            grid: [grid[0], grid[1], grid[2], cells],
+            cell_inv_width: [inv_width[0], inv_width[1], inv_width[2], 0.0],
+            n: n as u32,
+            nlist_cap: initial_capacity(n, sim_box, range, has_pairs),
+            n_types: model.type_names.len() as u32,
+            steps_wanted: 0,
+            range2: (range * range) as f32,
+            half_skin2: (0.25 * settings.skin * settings.skin) as f32,
+            max_disp2: (settings.integrator.max_displacement * settings.integrator.max_displacement) as f32,
+            neighbor_every: settings.neighbor_every.max(1) as u32,
+            seed_lo: settings.seed as u32,
+            seed_hi: (settings.seed >> 32) as u32,
+            step_lo: 0,
+            step_hi: 0,
+            neighbor_check: settings.neighbor_check as u32,
+            scan_blocks,
+            groups_x,
+            pad0: 0,
+            topo_offsets: packed.topo_offsets,
+            fparam_offsets: packed.fparam_offsets,
+        };
+        let device = &ctx.device;
+        let init = |label: &str, contents: &[u8], usage: wgpu::BufferUsages| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
+        };
+        let rw = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
+        let zeros = |label: &str, bytes: u64, usage: wgpu::BufferUsages| {
+            device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size: bytes.max(16), usage, mapped_at_creation: false })
+        };
+        let particle_bytes = 3 * 16 * n as u64;
+        let uniform = init("params", words(&[params]), wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST);
+        let state_buffer = zeros("state", particle_bytes, rw);
+        let next = zeros("next", particle_bytes, rw);
+        let reference = zeros("reference", particle_bytes, rw);
+        let topo = init("topo", words(&pad16(packed.topo)), wgpu::BufferUsages::STORAGE);
+        let fparams = init("fparams", words(&pad16(packed.fparams)), wgpu::BufferUsages::STORAGE);
+        let cell_count = zeros("cell_count", 4 * cells as u64, rw);
+        let cell_data = zeros("cell_data", 4 * (cells as u64 + 1 + scan_blocks as u64 + n as u64), rw);
+        let nlist = zeros("nlist", 4 * (n as u64) * (1 + params.nlist_cap as u64), rw);
+        let force = zeros("force", 16 * n as u64, rw);
+        let status = zeros("status", 4 * STATUS_WORDS as u64, rw);
+        let args = zeros("dispatch_args", 4 * 9, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT);
+
+        let mut entries = vec![wgpu::BindGroupLayoutEntry {
+            binding: 0,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Uniform, has_dynamic_offset: false, min_binding_size: None },
+            count: None,
+        }];
+        entries.extend((1..=10).map(|b| storage_entry(b, b == 4 || b == 5)));
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("cellmd main"), entries: &entries });
+        let args_layout = device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("cellmd args"), entries: &[storage_entry(0, false)] });
+        let args_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("cellmd args"),
+            layout: &args_layout,
+            entries: &[wgpu::BindGroupEntry { binding: 0, resource: args.as_entire_binding() }],
+        });
+        let program = shader::compose();
+        let module = device
+            .create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("cellmd"), source: wgpu::ShaderSource::Wgsl(program.into()) });
+        let main_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("cellmd main"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let decide_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("cellmd decide"),
+            bind_group_layouts: &[Some(&layout), Some(&args_layout)],
+            immediate_size: 0,
+        });
+        let pipeline = |entry: &str, layout: &wgpu::PipelineLayout| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: Some(layout),
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        let kernels = Kernels {
+            displacement: pipeline("nb_displacement", &main_layout),
+            decide: pipeline("nb_decide", &decide_layout),
+            clear: pipeline("nb_clear", &main_layout),
+            count: pipeline("nb_count", &main_layout),
+            scan_blocks: pipeline("nb_scan_blocks", &main_layout),
+            scan_totals: pipeline("nb_scan_totals", &main_layout),
+            scan_add: pipeline("nb_scan_add", &main_layout),
+            scatter: pipeline("nb_scatter", &main_layout),
+            sort: pipeline("nb_sort", &main_layout),
+            build: pipeline("nb_build", &main_layout),
+            forces: pipeline("forces", &main_layout),
+            integrate: pipeline("integrate", &main_layout),
+            commit: pipeline("commit", &main_layout),
+            advance: pipeline("advance", &main_layout),
+        };
+        let main_group = bind_main(
+            device,
+            &layout,
+            [&uniform, &state_buffer, &next, &reference, &topo, &fparams, &cell_count, &cell_data, &nlist, &force, &status],
+        );
+        let mut backend = Self {
+            params,
+            has_pairs,
+            sim_box: *sim_box,
+            uniform,
+            state: state_buffer,
+            next,
+            reference,
+            topo,
+            fparams,
+            cell_count,
+            cell_data,
+            nlist,
+            force,
+            status,
+            args,
+            layout,
+            main_group,
+            args_group,
+            kernels,
+            builds: 0,
+            grown: 0,
+            ctx: ctx.clone(),
+        };
+        backend.upload(state);
+        Ok(backend)
+    }
+
+    fn bind_main(&self) -> wgpu::BindGroup {
+        let s = self;
+        let buffers =
+            [&s.uniform, &s.state, &s.next, &s.reference, &s.topo, &s.fparams, &s.cell_count, &s.cell_data, &s.nlist, &s.force, &s.status];
+        bind_main(&self.ctx.device, &self.layout, buffers)
+    }
+
+    /// The adapter this backend runs on.
+    pub fn context(&self) -> &GpuContext {
+        &self.ctx
+    }
+
+    /// Neighbour-list builds so far.
+    pub fn neighbor_builds(&self) -> u64 {
+        self.builds
+    }
+
+    /// How many times the neighbour list had to grow (overflow and retry).
+    pub fn neighbor_list_growths(&self) -> u32 {
+        self.grown
+    }
+
+    /// Neighbour-list capacity per particle.
+    pub fn neighbor_capacity(&self) -> u32 {
+        self.params.nlist_cap
+    }
+
+    /// Uploads positions and images (and asks for a neighbour rebuild).
+    pub fn upload(&mut self, state: &State) {
+        let n = state.len();
+        let mut data = vec![[0f32; 4]; 3 * n];
+        for (i, (x, image)) in state.positions.iter().zip(&state.images).enumerate() {
+            let rel = *x - self.sim_box.lo;
+            for a in 0..3 {
+                let (hi, lo) = split(rel[a]);
+                data[i][a] = hi;
+                data[n + i][a] = lo;
+                data[2 * n + i][a] = f32::from_bits(image[a] as u32);
+            }
+        }
+        self.ctx.queue.write_buffer(&self.state, 0, words(&data));
+        self.reset_status(true);
+    }
+
+    fn reset_status(&self, force_rebuild: bool) {
+        let mut status = [0u32; STATUS_WORDS];
+        status[ST_BLOWUP_PARTICLE] = u32::MAX;
+        status[ST_FORCE_REBUILD] = force_rebuild as u32;
+        self.ctx.queue.write_buffer(&self.status, 0, words(&status));
+    }
+
+    /// Positions (wrapped, f64) and images of the current GPU state.
+    pub fn download(&self, state: &mut State) {
+        let n = state.len();
+        let data: Vec<[f32; 4]> = bytemuck::cast_slice(&self.read(&self.state, 48 * n as u64)).to_vec();
+        for i in 0..n {
+            let mut x = DVec3::ZERO;
+            for a in 0..3 {
+                x[a] = self.sim_box.lo[a] + (data[i][a] as f64 + data[n + i][a] as f64);
+                state.images[i][a] = data[2 * n + i][a].to_bits() as i32;
+            }
+            state.positions[i] = x;
+        }
+    }
+
+    /// Forces (f32, widened) and per-particle energy shares from the last force pass.
+    pub fn forces_and_energies(&self) -> Vec<(DVec3, f64)> {
+        let n = self.params.n as u64;
+        let data: Vec<[f32; 4]> = bytemuck::cast_slice(&self.read(&self.force, 16 * n)).to_vec();
+        data.iter().map(|f| (DVec3::new(f[0] as f64, f[1] as f64, f[2] as f64), f[3] as f64)).collect()
+    }
+
+    /// The neighbour list of the last build, each particle's list sorted.
+    pub fn neighbor_lists(&self) -> Vec<Vec<u32>> {
+        let n = self.params.n as usize;
+        let cap = self.params.nlist_cap as usize;
+        let data: Vec<u32> = bytemuck::cast_slice(&self.read(&self.nlist, 4 * (n * (1 + cap)) as u64)).to_vec();
+        (0..n)
+            .map(|i| {
+                let mut row = data[n + i * cap..n + i * cap + (data[i] as usize).min(cap)].to_vec();
+                row.sort_unstable();
+                row
+            })
+            .collect()
+    }
+
+    fn read(&self, buffer: &wgpu::Buffer, bytes: u64) -> Vec<u8> {
+        let device = &self.ctx.device;
+        let staging = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size: bytes.max(4),
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, bytes);
+        self.ctx.queue.submit([encoder.finish()]);
+        let slice = staging.slice(..);
+        slice.map_async(wgpu::MapMode::Read, |r| r.expect("mapping a readback buffer"));
+        device.poll(wgpu::PollType::wait_indefinitely()).expect("waiting for the GPU");
+        let out = slice.get_mapped_range().expect("mapped readback").to_vec();
+        staging.unmap();
+        out
+    }
+
+    fn write_params(&self) {
+        self.ctx.queue.write_buffer(&self.uniform, 0, words(&[self.params]));
+    }
+
+    /// Encodes one neighbour check/rebuild and force pass, and optionally the
+    /// integration of one step.
+    fn encode_step(&self, pass: &mut wgpu::ComputePass, integrate: bool) {
+        let particles = (self.params.n).div_ceil(WORKGROUP);
+        let k = &self.kernels;
+        let direct = |pass: &mut wgpu::ComputePass, pipeline: &wgpu::ComputePipeline, groups: u32| {
+            pass.set_pipeline(pipeline);
+            let gx = groups.min(self.params.groups_x);
+            pass.dispatch_workgroups(gx, groups.div_ceil(self.params.groups_x), 1);
+        };
+        pass.set_bind_group(0, &self.main_group, &[]);
+        if self.has_pairs {
+            direct(pass, &k.displacement, particles);
+            pass.set_pipeline(&k.decide);
+            pass.set_bind_group(1, &self.args_group, &[]);
+            pass.dispatch_workgroups(1, 1, 1);
+            let indirect = |pass: &mut wgpu::ComputePass, pipeline: &wgpu::ComputePipeline, slot: u64| {
+                pass.set_pipeline(pipeline);
+                pass.dispatch_workgroups_indirect(&self.args, 12 * slot);
+            };
+            indirect(pass, &k.clear, 1);
+            indirect(pass, &k.count, 0);
+            indirect(pass, &k.scan_blocks, 1);
+            indirect(pass, &k.scan_totals, 2);
+            indirect(pass, &k.scan_add, 1);
+            indirect(pass, &k.scatter, 0);
+            indirect(pass, &k.sort, 1);
+            indirect(pass, &k.build, 0);
+        }
+        direct(pass, &k.forces, particles);
+        if integrate {
+            direct(pass, &k.integrate, particles);
+            direct(pass, &k.commit, particles);
+            direct(pass, &k.advance, 1);
+        }
+    }
+
+    fn status(&self) -> [u32; STATUS_WORDS] {
+        bytemuck::cast_slice(&self.read(&self.status, 4 * STATUS_WORDS as u64)).try_into().expect("status words")
+    }
+
+    /// Handles an overflow: grows the list and clears the halt. Returns
+    /// whether there was one.
+    fn grow_if_overflowed(&mut self, status: &[u32; STATUS_WORDS]) -> bool {
+        if status[ST_HALTED] & HALT_OVERFLOW == 0 {
+            return false;
+        }
+        let need = status[ST_OVERFLOW_NEED] as u64;
+        let cap = (need + need / 4 + 8).next_multiple_of(8) as u32;
+        self.params.nlist_cap = cap;
+        let n = self.params.n as u64;
+        self.nlist = self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("nlist"),
+            size: 4 * n * (1 + cap as u64),
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        self.main_group = self.bind_main();
+        self.grown += 1;
+        true
+    }
+
+    /// Forces at the current state (neighbour list rebuilt first).
+    pub fn evaluate(&mut self) {
+        loop {
+            self.reset_status(true);
+            self.write_params();
+            let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+            {
+                let mut pass = encoder.begin_compute_pass(&Default::default());
+                self.encode_step(&mut pass, false);
+            }
+            self.ctx.queue.submit([encoder.finish()]);
+            let status = self.status();
+            self.builds += status[ST_BUILDS] as u64;
+            if !self.grow_if_overflowed(&status) {
+                return;
+            }
+        }
+    }
+
+    /// Runs `steps` steps from step number `first_step`, GPU-resident.
+    /// Returns the number of steps done (all of them unless halted).
+    pub fn run(&mut self, first_step: u64, steps: u64) -> Result<u64, GpuHalt> {
+        let mut done = 0u64;
+        let mut force_rebuild = false;
+        while done < steps {
+            let step = first_step + done;
+            let chunk = (steps - done).min(u32::MAX as u64 / 2);
+            self.params.step_lo = step as u32;
+            self.params.step_hi = (step >> 32) as u32;
+            self.params.steps_wanted = chunk as u32;
+            self.write_params();
+            self.reset_status(force_rebuild);
+            let mut encoded = 0;
+            while encoded < chunk {
+                let batch = (chunk - encoded).min(STEPS_PER_SUBMIT);
+                let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+                {
+                    let mut pass = encoder.begin_compute_pass(&Default::default());
+                    for _ in 0..batch {
+                        self.encode_step(&mut pass, true);
+                    }
+                }
+                self.ctx.queue.submit([encoder.finish()]);
+                encoded += batch;
+            }
+            let status = self.status();
+            self.builds += status[ST_BUILDS] as u64;
+            done += status[ST_STEPS_DONE] as u64;
+            if status[ST_HALTED] & HALT_BLOWUP != 0 {
+                return Err(GpuHalt::Blowup { step: first_step + done, particle: status[ST_BLOWUP_PARTICLE] as usize });
+            }
+            force_rebuild = self.grow_if_overflowed(&status);
+        }
+        Ok(done)
+    }
+}
+
+/// The main bind group: the eleven buffers of layout.wgsl, in binding order.
+fn bind_main(device: &wgpu::Device, layout: &wgpu::BindGroupLayout, buffers: [&wgpu::Buffer; 11]) -> wgpu::BindGroup {
+    let entries: Vec<wgpu::BindGroupEntry> =
+        buffers.iter().enumerate().map(|(b, buf)| wgpu::BindGroupEntry { binding: b as u32, resource: buf.as_entire_binding() }).collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("cellmd main"), layout, entries: &entries })
+}
+
+fn pad16<T: bytemuck::Pod + Default>(mut v: Vec<T>) -> Vec<T> {
+    let per = 16 / std::mem::size_of::<T>();
+    v.resize(v.len().next_multiple_of(per).max(per), T::default());
+    v
+}
+
+/// A first neighbour-list capacity from the mean density (twice the mean
+/// count in a sphere of the list range, at least 32); overflow grows it.
+fn initial_capacity(n: usize, sim_box: &SimBox, range: f64, has_pairs: bool) -> u32 {
+    if !has_pairs {
+        return 1;
+    }
+    let volume = sim_box.volume();
+    let mean = if volume > 0.0 { n as f64 / volume * 4.0 / 3.0 * std::f64::consts::PI * range.powi(3) } else { n as f64 };
+    ((2.0 * mean).ceil() as u32).clamp(32, n.max(32) as u32).next_multiple_of(8)
+}

@@ -1,0 +1,194 @@
+//! The model flattened into the GPU's buffers (layout: shaders/common/layout.wgsl).
+//!
+//! - `topo` (u32): particle types, then sections for each term's registry
+//!   index, the pair rules per type pair (CSR), each particle's bond ends
+//!   `(other, term)`, its angle slots `(i, j, k, term, role)`, its external
+//!   terms, and its excluded partners (all CSR by particle, in the same order
+//!   as the CPU backend).
+//! - `fparams` (f32): eight parameter slots per term, the squared reach of
+//!   each type pair, and per particle type the mobility dt/γ and the noise
+//!   amplitude √(2kT·dt/γ) (computed in f64; both 0 for a `fixed` type).
+//!
+//! Terms are numbered bond types, then angle types, then pair rules, then
+//! externals.
+
+use bytemuck::{Pod, Zeroable};
+
+use crate::neighbor::Exclusions;
+use crate::system::{registry_index, Model, SimBox};
+
+/// Parameter slots per term on the GPU.
+pub const PARAM_SLOTS: usize = 8;
+
+/// The uniform block (must match `Params` in layout.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct Params {
+    pub box_len_hi: [f32; 4],
+    pub box_len_lo: [f32; 4],
+    pub box_lo: [f32; 4],
+    pub periodic: [u32; 4],
+    pub grid: [u32; 4],
+    pub cell_inv_width: [f32; 4],
+    pub n: u32,
+    pub nlist_cap: u32,
+    pub n_types: u32,
+    pub steps_wanted: u32,
+    pub range2: f32,
+    pub half_skin2: f32,
+    pub max_disp2: f32,
+    pub neighbor_every: u32,
+    pub seed_lo: u32,
+    pub seed_hi: u32,
+    pub step_lo: u32,
+    pub step_hi: u32,
+    pub neighbor_check: u32,
+    pub scan_blocks: u32,
+    pub groups_x: u32,
+    pub pad0: u32,
+    /// Offsets of the `topo` sections, in layout.wgsl's order.
+    pub topo_offsets: [u32; 12],
+    /// Offsets of the `fparams` sections: params, skip2, mobility, amplitude.
+    pub fparam_offsets: [u32; 4],
+}
+
+/// A double-single split of an f64: `hi + lo ≈ x` to about 48 bits.
+pub fn split(x: f64) -> (f32, f32) {
+    let hi = x as f32;
+    (hi, (x - hi as f64) as f32)
+}
+
+/// The static buffers and the parts of [`Params`] they determine.
+pub struct Packed {
+    pub topo: Vec<u32>,
+    pub fparams: Vec<f32>,
+    pub topo_offsets: [u32; 12],
+    pub fparam_offsets: [u32; 4],
+}
+
+/// Appends a CSR section (`offsets` for n + 1 entries, then rows flattened).
+fn push_csr<T: Copy>(rows: &[Vec<T>], offsets: &mut Vec<u32>, flat: &mut Vec<T>) {
+    offsets.push(flat.len() as u32);
+    for row in rows {
+        flat.extend_from_slice(row);
+        offsets.push(flat.len() as u32);
+    }
+}
+
+/// Packs the model for `dt` and `kt` (mobilities and noise amplitudes depend on them).
+pub fn pack(model: &Model, exclusions: &Exclusions, dt: f64, kt: f64) -> Result<Packed, String> {
+    let n = model.len();
+    let nt = model.type_names.len();
+    let terms: Vec<_> =
+        model.bond_types.iter().chain(&model.angle_types).chain(&model.pair_rules).chain(model.externals.iter().map(|e| &e.term)).collect();
+    let angle_base = model.bond_types.len();
+    let pair_base = angle_base + model.angle_types.len();
+    let external_base = pair_base + model.pair_rules.len();
+
+    let mut fparams = Vec::with_capacity(terms.len() * PARAM_SLOTS);
+    for term in &terms {
+        if term.params.len() > PARAM_SLOTS {
+            return Err(format!("`{}` has {} parameters; the GPU backend holds {PARAM_SLOTS}", term.label.text, term.params.len()));
+        }
+        let start = fparams.len();
+        fparams.extend(term.params.iter().map(|&p| p as f32));
+        fparams.resize(start + PARAM_SLOTS, 0.0);
+    }
+    let skip2_offset = fparams.len();
+    for a in 0..nt as u32 {
+        for b in 0..nt as u32 {
+            let reach = model.pair_rules_between(a, b).iter().map(|&r| pair_range(model, r as usize)).fold(0.0f64, f64::max);
+            // Slightly above reach² so that f32 rounding of r² never drops a pair the CPU keeps.
+            fparams.push((reach * reach * (1.0 + 1e-6)) as f32);
+        }
+    }
+    let mobility_offset = fparams.len();
+    let finite = |g: f64| g.is_finite();
+    fparams.extend(model.type_drag.iter().map(|&g| if finite(g) { (dt / g) as f32 } else { 0.0 }));
+    let amplitude_offset = fparams.len();
+    fparams.extend(model.type_drag.iter().map(|&g| if finite(g) && kt > 0.0 { (2.0 * kt * dt / g).sqrt() as f32 } else { 0.0 }));
+
+    let mut topo: Vec<u32> = model.types.clone();
+    let mut offsets = [0u32; 12];
+    offsets[0] = topo.len() as u32;
+    topo.extend(terms.iter().map(|t| registry_index(t) as u32));
+    // Pair rules per type pair.
+    offsets[1] = topo.len() as u32;
+    let pair_rows: Vec<Vec<u32>> =
+        (0..nt * nt).map(|ab| model.pair_table[ab].iter().map(|&r| (pair_base + r as usize) as u32).collect()).collect();
+    let (mut starts, mut rules) = (Vec::new(), Vec::new());
+    push_csr(&pair_rows, &mut starts, &mut rules);
+    topo.extend(&starts);
+    offsets[2] = topo.len() as u32;
+    topo.extend(&rules);
+    // Bond ends, angle slots and externals by particle, in term order.
+    let mut bond_rows = vec![Vec::new(); n];
+    for (b, &[i, j]) in model.bonds.iter().enumerate() {
+        let term = model.bond_type[b];
+        bond_rows[i as usize].push([j, term]);
+        bond_rows[j as usize].push([i, term]);
+    }
+    let mut angle_rows = vec![Vec::new(); n];
+    for (a, &[i, j, k]) in model.angles.iter().enumerate() {
+        let term = (angle_base + model.angle_type[a] as usize) as u32;
+        for (role, p) in [i, j, k].into_iter().enumerate() {
+            angle_rows[p as usize].push([i, j, k, term, role as u32]);
+        }
+    }
+    let mut external_rows = vec![Vec::new(); n];
+    for (e, external) in model.externals.iter().enumerate() {
+        for &m in &external.members {
+            external_rows[m as usize].push((external_base + e) as u32);
+        }
+    }
+    let exclusion_rows: Vec<Vec<u32>> = (0..n as u32).map(|i| exclusions.partners(i).to_vec()).collect();
+    let flatten = |rows: Vec<Vec<[u32; 2]>>| rows.into_iter().map(|r| r.concat()).collect::<Vec<Vec<u32>>>();
+    let angle_flat: Vec<Vec<u32>> = angle_rows.into_iter().map(|r| r.concat()).collect();
+    for (slot, rows, width) in [(3, flatten(bond_rows), 2), (5, angle_flat, 5), (7, external_rows, 1), (9, exclusion_rows, 1)] {
+        let (mut row_offsets, mut flat) = (Vec::new(), Vec::new());
+        push_csr(&rows, &mut row_offsets, &mut flat);
+        // Offsets count entries of `width` words.
+        row_offsets.iter_mut().for_each(|o| *o /= width);
+        offsets[slot] = topo.len() as u32;
+        topo.extend(&row_offsets);
+        offsets[slot + 1] = topo.len() as u32;
+        topo.extend(&flat);
+    }
+    if topo.len() > u32::MAX as usize / 2 {
+        return Err(format!("the model needs {} words of GPU topology, more than the u32 index range", topo.len()));
+    }
+    Ok(Packed {
+        topo,
+        fparams,
+        topo_offsets: offsets,
+        fparam_offsets: [0, skip2_offset as u32, mobility_offset as u32, amplitude_offset as u32],
+    })
+}
+
+fn pair_range(model: &Model, rule: usize) -> f64 {
+    let term = &model.pair_rules[rule];
+    match term.interaction.law() {
+        crate::interactions::Law::Radial { range, .. } => range(&term.params),
+        _ => unreachable!("pair law is radial"),
+    }
+}
+
+/// The cell grid for a neighbour range: cells at least `range` wide, at most
+/// about 8 per particle (halving the finest axis until it fits).
+pub fn cell_grid(sim_box: &SimBox, range: f64, n: usize) -> ([u32; 3], [f32; 3]) {
+    let lengths = sim_box.lengths();
+    let mut counts = [1u32; 3];
+    if range > 0.0 {
+        for a in 0..3 {
+            // A hair wider than `range`, so f32 rounding of 1/width never makes a cell narrower.
+            counts[a] = ((lengths[a] / (range * (1.0 + 1e-6))).floor() as u64).clamp(1, 1 << 20) as u32;
+        }
+    }
+    let limit = (8 * n as u64).max(64);
+    while counts.iter().map(|&c| c as u64).product::<u64>() > limit {
+        let a = (0..3).max_by_key(|&a| counts[a]).expect("three axes");
+        counts[a] = (counts[a] / 2).max(1);
+    }
+    let inv = [0, 1, 2].map(|a| if lengths[a] > 0.0 { (counts[a] as f64 / lengths[a]) as f32 } else { 0.0 });
+    (counts, inv)
+}

@@ -1,0 +1,108 @@
+//! Composes the WGSL program from `shaders/` at start time.
+//!
+//! The program is the common layout and helpers, the Philox generator, every
+//! interaction type's evaluator file (`shaders/interactions/NAME.wgsl`, which
+//! defines `NAME_radial`, `NAME_three` or `NAME_one` by its law family), the
+//! generated dispatch functions `radial_law`, `three_body_law` and
+//! `one_body_law` (a `switch` on the registry index), and the kernels
+//! (neighbour list, forces, integrator). One module holds every entry point.
+
+use std::fmt::Write;
+
+use crate::interactions::{Law, REGISTRY};
+
+mod embedded {
+    include!(concat!(env!("OUT_DIR"), "/shaders.rs"));
+}
+
+pub use embedded::{COMMON_SHADERS, INTERACTION_SHADERS};
+
+/// The common files in the order they must appear (declarations first).
+const COMMON_ORDER: [&str; 5] = ["layout", "philox", "neighbor", "forces", "integrate"];
+
+fn common(name: &str) -> &'static str {
+    COMMON_SHADERS.iter().find(|(stem, _)| *stem == name).map(|(_, src)| *src).unwrap_or_else(|| panic!("shaders/common/{name}.wgsl"))
+}
+
+/// The evaluator file of a registered interaction type.
+pub fn interaction_source(name: &str) -> Option<&'static str> {
+    INTERACTION_SHADERS.iter().find(|(stem, _)| *stem == name).map(|(_, src)| *src)
+}
+
+/// The dispatch functions over the registry.
+fn dispatch() -> String {
+    let mut radial = String::from("fn radial_law(kind: u32, p: array<f32, 8>, r: f32) -> Radial {\n    switch kind {\n");
+    let mut three = String::from(
+        "fn three_body_law(kind: u32, p: array<f32, 8>, ri: vec3<f32>, rj: vec3<f32>, rk: vec3<f32>) -> ThreeBody {\n    switch kind {\n",
+    );
+    let mut one = String::from("fn one_body_law(kind: u32, p: array<f32, 8>, x: vec3<f32>) -> OneBody {\n    switch kind {\n");
+    for (index, interaction) in REGISTRY.iter().enumerate() {
+        let name = interaction.name();
+        let (out, call) = match interaction.law() {
+            Law::Radial { .. } => (&mut radial, format!("{name}_radial(p, r)")),
+            Law::ThreeBody(_) => (&mut three, format!("{name}_three(p, ri, rj, rk)")),
+            Law::OneBody(_) => (&mut one, format!("{name}_one(p, x)")),
+        };
+        writeln!(out, "        case {index}u: {{ return {call}; }}").unwrap();
+    }
+    radial.push_str("        default: { return RADIAL_ZERO; }\n    }\n}\n");
+    three.push_str("        default: { return ThreeBody(0.0, vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0)); }\n    }\n}\n");
+    one.push_str("        default: { return OneBody(0.0, vec3<f32>(0.0)); }\n    }\n}\n");
+    radial + &three + &one
+}
+
+/// The whole program.
+pub fn compose() -> String {
+    let mut program = String::new();
+    for name in &COMMON_ORDER[..2] {
+        program.push_str(common(name));
+    }
+    for interaction in REGISTRY {
+        let source = interaction_source(interaction.name())
+            .unwrap_or_else(|| panic!("interaction `{}` has no shaders/interactions/{0}.wgsl", interaction.name()));
+        program.push_str(source);
+    }
+    program.push_str(&dispatch());
+    for name in &COMMON_ORDER[2..] {
+        program.push_str(common(name));
+    }
+    program
+}
+
+/// Parses and validates the composed program with naga (no GPU needed).
+pub fn validate(program: &str) -> Result<(), String> {
+    let module = naga::front::wgsl::parse_str(program).map_err(|e| e.emit_to_string(program))?;
+    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::empty())
+        .validate(&module)
+        .map_err(|e| e.emit_to_string(program))?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_interaction_has_exactly_one_shader_file() {
+        for interaction in REGISTRY {
+            assert!(interaction_source(interaction.name()).is_some(), "{} has no WGSL evaluator", interaction.name());
+        }
+        for (stem, _) in INTERACTION_SHADERS {
+            assert!(crate::interactions::lookup(stem).is_some(), "shaders/interactions/{stem}.wgsl names no registered interaction");
+        }
+    }
+
+    #[test]
+    fn composed_program_validates_with_naga() {
+        let program = compose();
+        if let Err(e) = validate(&program) {
+            panic!("{e}");
+        }
+    }
+
+    #[test]
+    fn a_broken_program_is_rejected() {
+        let broken = compose().replace("fn forces(", "fn forces(oops");
+        assert!(validate(&broken).is_err());
+    }
+}
