@@ -5,7 +5,8 @@
 mod common;
 
 use cellmd::backend::{CpuBackend, Forces};
-use cellmd::deck::Plan;
+use cellmd::deck::{Action, Plan};
+use cellmd::run::{RunOptions, Simulation};
 use cellmd::gpu::backend::StepSettings;
 use cellmd::gpu::{GpuBackend, GpuContext};
 use cellmd::integrate::overdamped::OverdampedSettings;
@@ -113,5 +114,62 @@ fn gpu_forces_match_cpu_on_the_mixed_random_system() {
         eprintln!("periodic {periodic}: force error {force_error:e}, energy error {energy_error:e}");
         assert!(force_error < 1e-5, "periodic {periodic}: force error {force_error:e}");
         assert!(energy_error < 1e-5, "periodic {periodic}: energy error {energy_error:e}");
+    }
+}
+
+fn golden_documents() -> Vec<(std::path::PathBuf, cellmd::compare::golden::Document)> {
+    let mut files: Vec<_> = std::fs::read_dir("reference")
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "yaml"))
+        .collect();
+    files.sort();
+    files
+        .into_iter()
+        .flat_map(|path| {
+            let text = std::fs::read_to_string(&path).unwrap();
+            cellmd::compare::golden::parse(&text).unwrap().into_iter().map(move |d| (path.clone(), d))
+        })
+        .collect()
+}
+
+/// The model with the deck's `external` and `coeff` commands before its first `run` applied.
+fn model_before_first_run(plan: &Plan) -> cellmd::system::Model {
+    let mut sim = Simulation::new(plan, RunOptions::default());
+    for action in plan.actions.iter().take_while(|a| !matches!(a, Action::Run(_))) {
+        if matches!(action, Action::External(_) | Action::Unexternal(_) | Action::Coeff { .. }) {
+            sim.apply(action).unwrap();
+        }
+    }
+    sim.model
+}
+
+/// Every interaction type's golden cases (LAMMPS-checked configurations):
+/// GPU forces and energies against the CPU f64 backend within the
+/// `gpu_epsilon` declared in its reference file.
+#[test]
+fn gpu_matches_cpu_on_every_golden_case() {
+    let context = context();
+    let docs = golden_documents();
+    assert!(docs.len() >= 28, "expected two cases for each of 14 interaction types");
+    for (path, doc) in docs {
+        let deck = std::path::Path::new("reference").join(doc.get("deck").unwrap());
+        let epsilon: f64 = doc
+            .get("gpu_epsilon")
+            .unwrap_or_else(|| panic!("{}: no gpu_epsilon", path.display()))
+            .parse()
+            .unwrap();
+        assert!(doc.get("gpu_epsilon_reason").is_some_and(|r| !r.is_empty()), "{}: no gpu_epsilon_reason", path.display());
+        let plan = cellmd::deck::validate_file(&deck, &[]).unwrap();
+        let model = model_before_first_run(&plan);
+        let state = initial_state(&plan);
+        let mut cpu = CpuBackend::new(&model, &state, &plan.sim_box, 0.3).unwrap();
+        let mut forces = Forces::default();
+        cpu.compute(&model, &state, &plan.sim_box, &mut forces);
+        let mut gpu = GpuBackend::new(&context, &model, &state, &plan.sim_box, &settings(0.3, 1e-3, 0.0)).unwrap();
+        gpu.evaluate();
+        let (force_error, energy_error) = compare_forces(&forces, &gpu.forces_and_energies());
+        println!("{:40} force {force_error:.2e}  energy {energy_error:.2e}  (gpu_epsilon {epsilon:e})", deck.display());
+        assert!(force_error <= epsilon && energy_error <= epsilon, "{}: GPU differs from the CPU: force {force_error:e}, energy {energy_error:e} > {epsilon:e}", deck.display());
     }
 }
