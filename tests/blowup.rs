@@ -70,3 +70,20 @@ fn non_finite_force_names_the_bond() {
     // Dumped at step 0, then the frame at which the force became non-finite.
     assert_eq!(mcap_frame_steps(&case.path("traj.mcap")), vec![0, 1]);
 }
+
+/// Two particles that meet on a slack cable (bonded, so no pair repulsion)
+/// feel no force from it: r = 0 with dE/dr = 0 is not a blow-up. The same
+/// pair on a harmonic bond with r0 > 0 has no defined direction and stops.
+#[test]
+fn coincident_particles_on_a_slack_bond_are_not_a_blowup() {
+    let top = "[ particles ]\n1 a 1 1 1\n2 a 1 1 1\n[ bonds ]\ns 1 2\n";
+    let deck = "units lj\ntopology t.top\nforcefield f.ff\nbox x 0 5 f y 0 5 f z 0 5 f\ntimestep 0.01\nrun 5\n";
+    let slack = Case::new(&[("t.top", top), ("f.ff", "particle a drag 1\nbond s cable k 10 r0 1\n"), ("deck.in", deck)]);
+    let sim = slack.run();
+    assert!(sim.state.positions.iter().all(|x| *x == glam::DVec3::ONE), "{:?}", sim.state.positions);
+    let stretched = Case::new(&[("t.top", top), ("f.ff", "particle a drag 1\nbond s harmonic k 10 r0 1\n"), ("deck.in", deck)]);
+    let plan = stretched.plan();
+    let options = RunOptions { output_dir: stretched.output_dir().to_path_buf(), ..Default::default() };
+    let error = Simulation::execute(&plan, options).err().expect("a blow-up").to_string();
+    assert!(error.contains("non-finite force") && error.contains("harmonic"), "{error}");
+}

@@ -6,10 +6,10 @@ mod common;
 
 use cellmd::backend::{CpuBackend, Forces};
 use cellmd::deck::{Action, Plan};
-use cellmd::run::{RunOptions, Simulation};
 use cellmd::gpu::backend::StepSettings;
-use cellmd::gpu::{GpuBackend, GpuContext};
+use cellmd::gpu::{DevicePreference, GpuBackend, GpuContext};
 use cellmd::integrate::overdamped::OverdampedSettings;
+use cellmd::run::{RunOptions, Simulation};
 use cellmd::system::State;
 use common::random_case;
 use glam::DVec3;
@@ -118,11 +118,8 @@ fn gpu_forces_match_cpu_on_the_mixed_random_system() {
 }
 
 fn golden_documents() -> Vec<(std::path::PathBuf, cellmd::compare::golden::Document)> {
-    let mut files: Vec<_> = std::fs::read_dir("reference")
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "yaml"))
-        .collect();
+    let mut files: Vec<_> =
+        std::fs::read_dir("reference").unwrap().map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|e| e == "yaml")).collect();
     files.sort();
     files
         .into_iter()
@@ -154,11 +151,7 @@ fn gpu_matches_cpu_on_every_golden_case() {
     assert!(docs.len() >= 28, "expected two cases for each of 14 interaction types");
     for (path, doc) in docs {
         let deck = std::path::Path::new("reference").join(doc.get("deck").unwrap());
-        let epsilon: f64 = doc
-            .get("gpu_epsilon")
-            .unwrap_or_else(|| panic!("{}: no gpu_epsilon", path.display()))
-            .parse()
-            .unwrap();
+        let epsilon: f64 = doc.get("gpu_epsilon").unwrap_or_else(|| panic!("{}: no gpu_epsilon", path.display())).parse().unwrap();
         assert!(doc.get("gpu_epsilon_reason").is_some_and(|r| !r.is_empty()), "{}: no gpu_epsilon_reason", path.display());
         let plan = cellmd::deck::validate_file(&deck, &[]).unwrap();
         let model = model_before_first_run(&plan);
@@ -170,6 +163,281 @@ fn gpu_matches_cpu_on_every_golden_case() {
         gpu.evaluate();
         let (force_error, energy_error) = compare_forces(&forces, &gpu.forces_and_energies());
         println!("{:40} force {force_error:.2e}  energy {energy_error:.2e}  (gpu_epsilon {epsilon:e})", deck.display());
-        assert!(force_error <= epsilon && energy_error <= epsilon, "{}: GPU differs from the CPU: force {force_error:e}, energy {energy_error:e} > {epsilon:e}", deck.display());
+        assert!(
+            force_error <= epsilon && energy_error <= epsilon,
+            "{}: GPU differs from the CPU: force {force_error:e}, energy {energy_error:e} > {epsilon:e}",
+            deck.display()
+        );
     }
+}
+
+#[test]
+fn dispatches_split_along_y_give_the_same_list() {
+    let case = random_case(true, "");
+    let plan = case.plan();
+    let state = initial_state(&plan);
+    let mut wide = GpuBackend::new(&context(), &plan.model, &state, &plan.sim_box, &settings(0.4, 1e-3, 0.0)).unwrap();
+    wide.evaluate();
+    let mut narrow = GpuBackend::new(&context(), &plan.model, &state, &plan.sim_box, &settings(0.4, 1e-3, 0.0)).unwrap();
+    narrow.limit_dispatch_width(1); // 400 particles: 2 workgroups, dispatched as 1 × 2
+    narrow.evaluate();
+    assert_eq!(wide.neighbor_lists(), narrow.neighbor_lists());
+    assert_eq!(wide.forces_and_energies(), narrow.forces_and_energies());
+}
+
+/// A dense cluster in a large box: the first list capacity, sized from the
+/// mean density, overflows; the backend grows it and loses no neighbour.
+#[test]
+fn neighbour_list_overflow_grows_the_list_and_drops_nothing() {
+    let mut top = String::from("[ particles ]\n");
+    let mut seed = 12345u64;
+    let mut next = || {
+        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    for id in 1..=600 {
+        top += &format!("{id} a {} {} {}\n", 1.0 + 1.5 * next(), 1.0 + 1.5 * next(), 1.0 + 1.5 * next());
+    }
+    let ff = "particle a drag 1\npair a a soft A 0.01 rc 0.5\n";
+    let deck = "units lj\ntopology t.top\nforcefield f.ff\nbox x 0 40 p y 0 40 p z 0 40 p\nneighbor skin 0.2\n";
+    let case = common::Case::new(&[("t.top", &top), ("f.ff", ff), ("deck.in", deck)]);
+    let plan = case.plan();
+    let state = initial_state(&plan);
+    let mut gpu = GpuBackend::new(&context(), &plan.model, &state, &plan.sim_box, &settings(0.2, 1e-3, 0.0)).unwrap();
+    let first_capacity = gpu.neighbor_capacity();
+    gpu.evaluate();
+    assert!(gpu.neighbor_list_growths() >= 1, "capacity {first_capacity} did not overflow: the test would be vacuous");
+    let range = 0.7;
+    assert_same_pairs(&gpu.neighbor_lists(), &brute_force_pairs(&plan, &state, range), range, "clustered");
+    let most = gpu.neighbor_lists().iter().map(|l| l.len()).max().unwrap();
+    assert!(most as u32 > first_capacity, "largest list {most} fits the first capacity {first_capacity}");
+    assert!(most as u32 <= gpu.neighbor_capacity());
+}
+
+/// Particles diffuse across the periodic faces; the list rebuilt on the GPU
+/// still equals the brute-force pair set at the read-back positions.
+/// The random mixture with soft pairs only (its LJ overlaps would blow a run up).
+fn soft_random_case() -> common::Case {
+    let case = random_case(true, "");
+    let ff = "particle a drag 1\nparticle b drag 2\nbond s harmonic k 2 r0 0.5\nangle t cosine_angle K 0.3\n\
+              pair a a soft A 1 rc 0.9\npair a b soft A 1 rc 0.7\npair a b soft_repulsion k 5 sigma 0.5\n";
+    std::fs::write(case.path("f.ff"), ff).unwrap();
+    case
+}
+
+#[test]
+fn neighbour_list_after_particles_cross_the_boundaries() {
+    let case = soft_random_case();
+    let plan = case.plan();
+    let mut state = initial_state(&plan);
+    let mut gpu = GpuBackend::new(&context(), &plan.model, &state, &plan.sim_box, &settings(0.4, 1e-3, 1.0)).unwrap();
+    assert_eq!(gpu.run(0, 300), Ok(300));
+    gpu.download(&mut state);
+    let crossed = state.images.iter().filter(|i| i.iter().any(|&k| k != 0)).count();
+    assert!(crossed >= 10, "only {crossed} particles crossed a face");
+    assert!(gpu.neighbor_builds() >= 3, "{} builds: the displacement trigger never fired", gpu.neighbor_builds());
+    gpu.evaluate();
+    let range = plan.model.max_pair_cutoff() + 0.4;
+    assert_same_pairs(&gpu.neighbor_lists(), &brute_force_pairs(&plan, &state, range), range, "after crossing");
+}
+
+#[test]
+fn the_same_gpu_run_twice_gives_the_same_bits() {
+    let case = soft_random_case();
+    let plan = case.plan();
+    let run = || {
+        let mut state = initial_state(&plan);
+        let mut gpu = GpuBackend::new(&context(), &plan.model, &state, &plan.sim_box, &settings(0.4, 1e-3, 0.5)).unwrap();
+        assert_eq!(gpu.run(0, 400), Ok(400));
+        gpu.download(&mut state);
+        (state.positions, state.images, gpu.forces_and_energies())
+    };
+    let (a, b) = (run(), run());
+    assert!(a.0.iter().zip(&b.0).all(|(x, y)| x.to_array().map(f64::to_bits) == y.to_array().map(f64::to_bits)), "positions differ");
+    assert_eq!(a.1, b.1);
+    assert!(a
+        .2
+        .iter()
+        .zip(&b.2)
+        .all(|(x, y)| x.0.to_array().map(f64::to_bits) == y.0.to_array().map(f64::to_bits) && x.1.to_bits() == y.1.to_bits()));
+}
+
+/// Runs a deck's actions with every `temperature` set to 0 and every `run`
+/// made `steps` long, on the given device; returns the final state.
+fn run_deck_deterministic(
+    deck: &std::path::Path,
+    device: DevicePreference,
+    steps: u64,
+    round_start_to_f32: bool,
+) -> Result<(State, State), String> {
+    let plan = cellmd::deck::validate_file(deck, &[("steps".into(), "10".into()), ("fire_iterations".into(), "100".into())])
+        .map_err(|e| e.to_string())?;
+    let dir = tempfile::tempdir().unwrap();
+    let options = RunOptions { output_dir: dir.path().to_path_buf(), device: Some(device), ..Default::default() };
+    let mut sim = Simulation::new(&plan, options);
+    if round_start_to_f32 {
+        sim.state.positions.iter_mut().for_each(|x| *x = x.as_vec3().as_dvec3());
+    }
+    let start = sim.state.clone();
+    for action in &plan.actions {
+        let action = match action {
+            Action::Temperature(_) => Action::Temperature(0.0),
+            Action::Run(_) => Action::Run(steps),
+            other => other.clone(),
+        };
+        sim.apply(&action).map_err(|e| e.to_string())?;
+    }
+    sim.close_outputs().map_err(|e| e.to_string())?;
+    Ok((start, sim.state))
+}
+
+/// Every `inputs/` deck that the GPU runs (all but the bond-kinetics decks,
+/// which it refuses with a message): at kT = 0, GPU positions stay within
+/// 1e-5 of the distance the particles travelled, after 10⁴ steps per `run`
+/// (measured on llvmpipe: ≤ 2.7e-6, about the spread between two CPU runs
+/// whose starts differ by f32 rounding).
+#[test]
+fn every_input_deck_runs_on_the_gpu_like_on_the_cpu() {
+    let mut decks: Vec<_> =
+        std::fs::read_dir("inputs").unwrap().map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|e| e == "in")).collect();
+    decks.sort();
+    let mut compared = 0;
+    for deck in decks {
+        let plan = cellmd::deck::validate_file(&deck, &[("steps".into(), "10".into()), ("fire_iterations".into(), "10".into())]).unwrap();
+        if plan.model.bond_kinetics.iter().any(|k| !k.rules.is_empty()) || !plan.model.bind_rules.is_empty() {
+            let dir = tempfile::tempdir().unwrap();
+            let options = RunOptions { output_dir: dir.path().to_path_buf(), device: Some(DevicePreference::Gpu), ..Default::default() };
+            let refusal = Simulation::execute(&plan, options).err().map(|e| e.to_string()).unwrap_or_default();
+            assert!(refusal.contains("bond kinetics"), "{}: expected the GPU to refuse bond kinetics, got {refusal:?}", deck.display());
+            continue;
+        }
+        match run_deck_deterministic(&deck, DevicePreference::Gpu, 10_000, false) {
+            Ok((_, gpu)) => {
+                let (start, cpu) = run_deck_deterministic(&deck, DevicePreference::Cpu, 10_000, false).unwrap();
+                let (_, cpu32) = run_deck_deterministic(&deck, DevicePreference::Cpu, 10_000, true).unwrap();
+                let sim_box = cellmd::deck::validate_file(&deck, &[("steps".into(), "10".into())]).unwrap().sim_box;
+                let unwrap = |s: &State, i: usize| sim_box.unwrap(s.positions[i], s.images[i]);
+                let travelled = (0..start.len()).map(|i| (unwrap(&cpu, i) - unwrap(&start, i)).length()).fold(0.0, f64::max);
+                let deviation = (0..start.len()).map(|i| (unwrap(&cpu, i) - unwrap(&gpu, i)).length()).fold(0.0, f64::max);
+                let sensitivity = (0..start.len()).map(|i| (unwrap(&cpu, i) - unwrap(&cpu32, i)).length()).fold(0.0, f64::max);
+                println!("{:40} {} particles: GPU − CPU {deviation:.3e} after travelling up to {travelled:.3e}; CPU from f32-rounded start − CPU {sensitivity:.3e}", deck.display(), start.len());
+                assert_eq!(cpu.step, gpu.step);
+                assert!(travelled > 0.0, "{}: nothing moved", deck.display());
+                assert!(deviation <= 1e-5 * travelled, "{}: GPU − CPU {deviation:e} > 1e-5 × {travelled:e}", deck.display());
+                compared += 1;
+            }
+            Err(e) => panic!("{}: {e}", deck.display()),
+        }
+    }
+    assert!(compared >= 5, "only {compared} decks compared");
+}
+
+/// Double-single positions: a particle pushed by a constant force takes 10⁴
+/// equal f32 steps; its position must be their exact sum (an f32 position
+/// would drift by up to ½ ulp per step: ~1e-3 here).
+#[test]
+fn positions_do_not_drift_through_f32_rounding() {
+    let top = "[ particles ]\n1 a 3.3 7.1 0.7\n2 a 9.9 1.3 5.5\n";
+    let ff = "particle a drag 3\n";
+    let deck = "units lj\ntopology t.top\nforcefield f.ff\nbox x 0 20 p y 0 20 p z 0 20 p\n";
+    let case = common::Case::new(&[("t.top", top), ("f.ff", ff), ("deck.in", deck)]);
+    let plan = case.plan();
+    let mut sim = Simulation::new(&plan, RunOptions::default());
+    let external = "external push all constant_force fx 0.37 fy -0.011 fz 0.0123\n";
+    std::fs::write(case.path("deck.in"), format!("{deck}{external}")).unwrap();
+    let plan = case.plan();
+    let Action::External(push) = plan.actions.last().unwrap().clone() else { panic!("external action") };
+    sim.model.externals.push(push);
+    let mut state = initial_state(&plan);
+    let start = state.clone();
+    let dt = 1e-3;
+    let mut gpu = GpuBackend::new(&context(), &sim.model, &state, &plan.sim_box, &settings(0.0, dt, 0.0)).unwrap();
+    let steps = 10_000;
+    assert_eq!(gpu.run(0, steps), Ok(steps));
+    gpu.download(&mut state);
+    let step_f32 = [0.37f32 * (dt / 3.0) as f32, -0.011f32 * (dt / 3.0) as f32, 0.0123f32 * (dt / 3.0) as f32];
+    let mut worst: f64 = 0.0;
+    for i in 0..2 {
+        let expected = start.positions[i] + steps as f64 * DVec3::new(step_f32[0] as f64, step_f32[1] as f64, step_f32[2] as f64);
+        let got = plan.sim_box.unwrap(state.positions[i], state.images[i]);
+        worst = worst.max((got - expected).length());
+    }
+    println!("double-single drift after {steps} steps: {worst:e}");
+    assert!(worst < 1e-9, "position drift {worst:e} after {steps} steps");
+}
+
+/// Free particles and particles tethered to fixed anchors (harmonic, r0 = 0)
+/// at kT > 0, for `steps` steps on the CPU or the GPU.
+fn thermal_case() -> common::Case {
+    let mut top = String::from("[ particles ]\n");
+    let mut bonds = String::from("[ bonds ]\n");
+    let n = 1500;
+    for k in 0..n {
+        let (x, y, z) = ((k % 15) as f64 * 4.0 + 2.0, ((k / 15) % 10) as f64 * 4.0 + 2.0, (k / 150) as f64 * 4.0 + 2.0);
+        top += &format!("{} free {x} {y} {z}\n", 3 * k + 1);
+        top += &format!("{} bead {} {y} {z}\n", 3 * k + 2, x + 1.0);
+        top += &format!("{} anchor {} {y} {z}\n", 3 * k + 3, x + 1.0 + 1e-3);
+        bonds += &format!("tether {} {}\n", 3 * k + 2, 3 * k + 3);
+    }
+    let ff = "particle free drag 2\nparticle bead drag 2\nparticle anchor fixed\nbond tether harmonic k 40 r0 0\n";
+    let deck = "units lj\ntopology t.top\nforcefield f.ff\nbox x 0 60 p y 0 40 p z 0 40 p\n";
+    common::Case::new(&[("t.top", &(top + &bonds)), ("f.ff", ff), ("deck.in", deck)])
+}
+
+/// Mean squared displacement of the free particles and mean squared
+/// extension of the tethers after `steps` steps.
+fn thermal_statistics(device: DevicePreference, steps: u64, kt: f64, dt: f64) -> (f64, f64, State) {
+    let case = thermal_case();
+    let plan = case.plan();
+    let start = initial_state(&plan);
+    let mut state = start.clone();
+    match device {
+        DevicePreference::Gpu => {
+            let mut gpu = GpuBackend::new(&context(), &plan.model, &state, &plan.sim_box, &settings(0.5, dt, kt)).unwrap();
+            assert_eq!(gpu.run(0, steps), Ok(steps));
+            gpu.download(&mut state);
+        }
+        _ => {
+            let mut sim = Simulation::new(&plan, RunOptions::default());
+            for action in [Action::Temperature(kt), Action::Timestep(dt), Action::Seed(7), Action::Run(steps)] {
+                sim.apply(&action).unwrap();
+            }
+            state = sim.state;
+        }
+    }
+    let unwrap = |s: &State, i: usize| plan.sim_box.unwrap(s.positions[i], s.images[i]);
+    let n = state.len() / 3;
+    let msd = (0..n).map(|k| (unwrap(&state, 3 * k) - unwrap(&start, 3 * k)).length_squared()).sum::<f64>() / n as f64;
+    let extension = (0..n).map(|k| (unwrap(&state, 3 * k + 1) - unwrap(&state, 3 * k + 2)).length_squared()).sum::<f64>() / n as f64;
+    (msd, extension, state)
+}
+
+/// kT > 0: the GPU and the CPU reproduce the same statistics (free MSD = 6Dt;
+/// tether ⟨d²⟩ = 3 × the exact variance of the discrete Ornstein–Uhlenbeck
+/// step), and their first steps are the same numbers: the Philox words are
+/// identical, the f32 noise differs from the CPU's f64 noise by < 2⁻²⁴·√12.
+#[test]
+fn thermal_runs_have_the_same_statistics_and_the_same_first_steps() {
+    let (kt, dt, gamma, k): (f64, f64, f64, f64) = (0.5, 1e-3, 2.0, 40.0);
+    let steps = 400;
+    let a = k * dt / gamma;
+    let per_axis = (2.0 * kt * dt / gamma) / (1.0 - (1.0 - a) * (1.0 - a));
+    // Tethers start at 1e-3 and relax for 400 steps: (1 − a)^800 ≈ 3e-4 of the start remains.
+    let expected_extension = 3.0 * per_axis * (1.0 - (1.0 - a).powi(2 * steps as i32));
+    let expected_msd = 6.0 * kt / gamma * dt * steps as f64;
+    let n: f64 = 1500.0;
+    for device in [DevicePreference::Cpu, DevicePreference::Gpu] {
+        let (msd, extension, _) = thermal_statistics(device, steps, kt, dt);
+        // Relative standard error of a mean of n squared Gaussian norms (3 dof): √(2/3n).
+        let sigma = (2.0 / (3.0 * n)).sqrt();
+        println!("{device:?}: MSD {msd:.5} (6Dt = {expected_msd:.5}), ⟨d²⟩ {extension:.6} (exact {expected_extension:.6}), σ {sigma:.3}");
+        assert!((msd / expected_msd - 1.0).abs() < 4.0 * sigma, "{device:?}: MSD {msd} vs {expected_msd}");
+        assert!((extension / expected_extension - 1.0).abs() < 4.0 * sigma, "{device:?}: ⟨d²⟩ {extension} vs {expected_extension}");
+    }
+    let (_, _, cpu) = thermal_statistics(DevicePreference::Cpu, 3, kt, dt);
+    let (_, _, gpu) = thermal_statistics(DevicePreference::Gpu, 3, kt, dt);
+    let amplitude = (2.0 * kt * dt / gamma).sqrt();
+    let worst = cpu.positions.iter().zip(&gpu.positions).map(|(c, g)| (*c - *g).abs().max_element()).fold(0.0, f64::max);
+    println!("first 3 steps: largest GPU − CPU component {worst:e} (noise amplitude {amplitude:e})");
+    assert!(worst < 3.0 * 4.0 * amplitude * 2f64.powi(-22), "GPU − CPU after 3 steps {worst:e}: the noise streams differ");
 }

@@ -35,7 +35,7 @@ fn forces(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index)
         for (var q = topo[P.off_pair_start + pair]; q < rules_end; q++) {
             let term = topo[P.off_pair_terms + q];
             let radial = radial_law(topo[P.off_term_kind + term], term_params(term), r);
-            f += (radial.de_dr / r) * d;
+            f += force_along(radial, d, r);
             e += 0.5 * radial.energy;
         }
     }
@@ -48,7 +48,7 @@ fn forces(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index)
         let d = separation(i, other);
         let r = length(d);
         let radial = radial_law(topo[P.off_term_kind + term], term_params(term), r);
-        f += (radial.de_dr / r) * d;
+        f += force_along(radial, d, r);
         e += 0.5 * radial.energy;
     }
 

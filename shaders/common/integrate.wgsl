@@ -30,26 +30,30 @@ fn integrate(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_ind
         atomicOr(&status[ST_HALTED], HALT_BLOWUP);
         return;
     }
-    var hi = state[i].xyz;
-    var lo = state[P.n + i].xyz;
+    // The displacement in fixed point: q is a power of two, so |dx|/q is exact
+    // in f32 and splits exactly into an integer and a 32-bit fraction (bits
+    // below q·2⁻³² of very small steps are dropped: < 1e-15 of the box); the
+    // sign is applied in fixed point, so no rounding depends on it.
+    let v = abs(dx) / P.box_len.w;
+    let whole = floor(v);
+    let magnitude = Fixed3(vec3<i32>(whole), vec3<u32>((v - whole) * 4294967296.0));
+    let negated = fixed_sub(Fixed3(vec3<i32>(0), vec3<u32>(0u)), magnitude);
+    let negative = dx < vec3<f32>(0.0);
+    let step = Fixed3(select(magnitude.h, negated.h, negative), select(magnitude.f, negated.f, negative));
+    var x = fixed_add(fixed_of(i), step);
     var img = image_of(i);
-    for (var a = 0u; a < 3u; a++) {
-        var x = ds_add(hi[a], lo[a], dx[a], 0.0);
-        if P.periodic[a] == 1u {
-            if x.x + x.y >= P.box_len_hi[a] + P.box_len_lo[a] {
-                x = ds_add(x.x, x.y, -P.box_len_hi[a], -P.box_len_lo[a]);
-                img[a] += 1;
-            } else if x.x + x.y < 0.0 {
-                x = ds_add(x.x, x.y, P.box_len_hi[a], P.box_len_lo[a]);
-                img[a] -= 1;
-            }
-        }
-        hi[a] = x.x;
-        lo[a] = x.y;
-    }
-    next[i] = vec4<f32>(hi, 0.0);
-    next[P.n + i] = vec4<f32>(lo, 0.0);
-    next[2u * P.n + i] = vec4<f32>(bitcast<vec3<f32>>(img), 0.0);
+    let l = box_fixed();
+    let zero = vec3<i32>(0);
+    let per = P.periodic.xyz == vec3<u32>(1u);
+    let from_top = fixed_sub(x, l);
+    let wrap_down = per & (from_top.h >= zero); // x ≥ L
+    let wrap_up = per & (x.h < zero); // x < 0
+    let from_bottom = fixed_add(x, l);
+    x = Fixed3(select(select(x.h, from_bottom.h, wrap_up), from_top.h, wrap_down), select(select(x.f, from_bottom.f, wrap_up), from_top.f, wrap_down));
+    img += vec3<i32>(wrap_down) - vec3<i32>(wrap_up);
+    next[i] = vec4<u32>(bitcast<vec3<u32>>(x.h), 0u);
+    next[P.n + i] = vec4<u32>(x.f, 0u);
+    next[2u * P.n + i] = vec4<u32>(bitcast<vec3<u32>>(img), 0u);
 }
 
 @compute @workgroup_size(256)

@@ -1,19 +1,25 @@
 // Bindings and helpers shared by every cellmd kernel.
 //
-// Positions are double-single numbers relative to the box's lower corner:
-// x − box_lo = hi + lo with |lo| ≤ ulp(hi)/2 (about 48 bits of mantissa), so
-// a trajectory does not drift from the f64 CPU one by f32 rounding of the
-// positions; separations and forces are f32. A particle's state occupies
-// three entries of `state`: hi at i, lo at n + i, image counters (bitcast
-// i32) at 2n + i.
+// Positions are 64-bit fixed-point numbers relative to the box's lower
+// corner: x − box_lo = (H + F·2⁻³²)·q per axis, with H an i32, F a u32 and
+// q = 2^e a power-of-two length chosen so that the box spans at most 2²⁰·q.
+// Integer arithmetic is exact and cannot be reassociated by a shader
+// compiler (WGSL lets compilers rewrite float expressions as if they were
+// real numbers, which defeats double-single tricks), so positions do not
+// drift from the f64 CPU trajectory through rounding; only separations,
+// forces and each step's displacement are f32. Periodic wrapping subtracts
+// the box length L_X = L/q in the same fixed point. A particle's state
+// occupies three entries of `state`: H at i, F at n + i, image counters
+// (i32) at 2n + i.
 
 struct Params {
-    box_len_hi: vec4<f32>,      // box edge lengths L (double-single high part)
-    box_len_lo: vec4<f32>,      // … low part
+    box_len_h: vec4<u32>,       // box edge lengths in fixed point: integer part (units of q)
+    box_len_f: vec4<u32>,       // … fraction (units of q·2⁻³²)
     box_lo: vec4<f32>,          // lower corner (f32; unwrapped positions for externals)
     periodic: vec4<u32>,        // 1 on periodic axes
     grid: vec4<u32>,            // cells along x, y, z; w = total cells
     cell_inv_width: vec4<f32>,  // cells per unit length
+    box_len: vec4<f32>,         // box edge lengths L (f32); w = q, the fixed-point unit
     // n, nlist capacity, particle types, steps this call
     n: u32, nlist_cap: u32, n_types: u32, steps_wanted: u32,
     // (cutoff + skin)², (skin/2)², max displacement², neighbour `every`
@@ -30,9 +36,9 @@ struct Params {
 }
 
 @group(0) @binding(0) var<uniform> P: Params;
-@group(0) @binding(1) var<storage, read_write> state: array<vec4<f32>>;
-@group(0) @binding(2) var<storage, read_write> next: array<vec4<f32>>;
-@group(0) @binding(3) var<storage, read_write> reference: array<vec4<f32>>;
+@group(0) @binding(1) var<storage, read_write> state: array<vec4<u32>>;
+@group(0) @binding(2) var<storage, read_write> next: array<vec4<u32>>;
+@group(0) @binding(3) var<storage, read_write> reference: array<vec4<u32>>;
 @group(0) @binding(4) var<storage, read> topo: array<u32>;
 @group(0) @binding(5) var<storage, read> fparams: array<f32>;
 @group(0) @binding(6) var<storage, read_write> cell_count: array<atomic<u32>>;
@@ -64,42 +70,64 @@ fn halted() -> bool {
     return atomicLoad(&status[ST_HALTED]) != 0u;
 }
 
-// Error-free sum of two f32: s + e = a + b exactly (Knuth's two-sum).
-fn two_sum(a: f32, b: f32) -> vec2<f32> {
-    let s = a + b;
-    let bb = s - a;
-    let e = (a - (s - bb)) + (b - bb);
-    return vec2<f32>(s, e);
+// 64-bit fixed point per axis: (h, f) = h·2³² + f with h signed.
+struct Fixed3 {
+    h: vec3<i32>,
+    f: vec3<u32>,
 }
 
-// (hi, lo) + (b_hi, b_lo), renormalised.
-fn ds_add(a_hi: f32, a_lo: f32, b_hi: f32, b_lo: f32) -> vec2<f32> {
-    let s = two_sum(a_hi, b_hi);
-    let e = s.y + a_lo + b_lo;
-    let hi = s.x + e;
-    return vec2<f32>(hi, e - (hi - s.x));
+fn fixed_of(i: u32) -> Fixed3 {
+    return Fixed3(bitcast<vec3<i32>>(state[i].xyz), state[P.n + i].xyz);
+}
+
+fn fixed_add(a: Fixed3, b: Fixed3) -> Fixed3 {
+    let f = a.f + b.f;
+    let carry = vec3<i32>(f < a.f);
+    return Fixed3(a.h + b.h + carry, f);
+}
+
+fn fixed_sub(a: Fixed3, b: Fixed3) -> Fixed3 {
+    let borrow = vec3<i32>(a.f < b.f);
+    return Fixed3(a.h - b.h - borrow, a.f - b.f);
+}
+
+// The fixed-point number as a length (f32).
+fn fixed_to_length(a: Fixed3) -> vec3<f32> {
+    return (vec3<f32>(a.h) + vec3<f32>(a.f) * 2.3283064365386963e-10) * P.box_len.w;
+}
+
+fn box_fixed() -> Fixed3 {
+    return Fixed3(bitcast<vec3<i32>>(P.box_len_h.xyz), P.box_len_f.xyz);
 }
 
 fn image_of(i: u32) -> vec3<i32> {
     return bitcast<vec3<i32>>(state[2u * P.n + i].xyz);
 }
 
-// Separation x_j − x_i by the minimum image on periodic axes, from the
-// double-single positions (the high parts cancel exactly for close pairs).
+// Separation x_j − x_i, exact in fixed point (minimum image on periodic
+// axes: the box length is subtracted or added in fixed point too), then
+// rounded once to f32.
 fn separation(i: u32, j: u32) -> vec3<f32> {
-    let hi_i = state[i].xyz;
-    let hi_j = state[j].xyz;
-    let lo_i = state[P.n + i].xyz;
-    let lo_j = state[P.n + j].xyz;
-    let per = vec3<f32>(P.periodic.xyz);
-    let shift = round((hi_j - hi_i) / P.box_len_hi.xyz) * per;
-    return ((hi_j - shift * P.box_len_hi.xyz) - hi_i) + ((lo_j - shift * P.box_len_lo.xyz) - lo_i);
+    var d = fixed_sub(fixed_of(j), fixed_of(i));
+    let l = box_fixed();
+    let half = vec3<i32>(l.h / 2);
+    let per = P.periodic.xyz == vec3<u32>(1u);
+    let above = per & (d.h >= half);
+    let below = per & (d.h < -half);
+    let minus = fixed_sub(d, l);
+    let plus = fixed_add(d, l);
+    d = Fixed3(select(select(d.h, plus.h, below), minus.h, above), select(select(d.f, plus.f, below), minus.f, above));
+    return fixed_to_length(d);
+}
+
+// Position relative to the box corner (f32), for cell binning.
+fn relative_position(i: u32) -> vec3<f32> {
+    return fixed_to_length(fixed_of(i));
 }
 
 // Unwrapped position in f32 (for external fields).
 fn unwrapped(i: u32) -> vec3<f32> {
-    let img = vec3<f32>(image_of(i));
-    return P.box_lo.xyz + (state[i].xyz + img * P.box_len_hi.xyz) + (state[P.n + i].xyz + img * P.box_len_lo.xyz);
+    return P.box_lo.xyz + relative_position(i) + vec3<f32>(image_of(i)) * P.box_len.xyz;
 }
 
 // Parameters of a force-field term (eight slots, in schema order).
@@ -130,3 +158,8 @@ struct OneBody {
 }
 
 const RADIAL_ZERO: Radial = Radial(0.0, 0.0);
+
+// (dE/dr)·d/r, exactly zero for a term that exerts no force (also at r = 0).
+fn force_along(radial: Radial, d: vec3<f32>, r: f32) -> vec3<f32> {
+    return select((radial.de_dr / r) * d, vec3<f32>(0.0), radial.de_dr == 0.0);
+}

@@ -22,8 +22,7 @@ fn off_members() -> u32 { return P.grid.w + 1u + P.scan_blocks; }
 @group(1) @binding(0) var<storage, read_write> dispatch_args: array<u32>;
 
 fn cell_coords(i: u32) -> vec3<u32> {
-    let x = state[i].xyz;
-    let c = floor(x * P.cell_inv_width.xyz);
+    let c = floor(relative_position(i) * P.cell_inv_width.xyz);
     let top = vec3<f32>(P.grid.xyz) - 1.0;
     return vec3<u32>(clamp(c, vec3<f32>(0.0), top));
 }
@@ -41,7 +40,8 @@ fn nb_displacement(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocati
         return;
     }
     let dimg = vec3<f32>(image_of(i) - bitcast<vec3<i32>>(reference[2u * P.n + i].xyz));
-    let d = ((state[i].xyz - reference[i].xyz) + dimg * P.box_len_hi.xyz) + ((state[P.n + i].xyz - reference[P.n + i].xyz) + dimg * P.box_len_lo.xyz);
+    let then = Fixed3(bitcast<vec3<i32>>(reference[i].xyz), reference[P.n + i].xyz);
+    let d = fixed_to_length(fixed_sub(fixed_of(i), then)) + dimg * P.box_len.xyz;
     let d2 = dot(d, d);
     if d2 > P.half_skin2 {
         atomicMax(&status[ST_MAX_DISP2], bitcast<u32>(d2));

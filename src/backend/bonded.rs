@@ -121,7 +121,7 @@ impl Bonded {
         let d = images.minimum_image(x[other] - x[i]);
         let r = d.length();
         match self.bond_radial(b, t, r, model, state) {
-            Some(radial) => (t, d * (radial.de_dr / r)),
+            Some(radial) => (t, radial.force_along(d, r)),
             None => (t, DVec3::ZERO),
         }
     }
@@ -177,7 +177,7 @@ impl Bonded {
             let r = d.length();
             let Some(radial) = self.bond_radial(b, t, r, model, state) else { continue };
             energy[bond_registry[t]] += radial.energy;
-            add6(virial, outer(d, -(d * (radial.de_dr / r))));
+            add6(virial, outer(d, -radial.force_along(d, r)));
         }
         let angle_registry: Vec<usize> = model.angle_types.iter().map(registry_index).collect();
         for a in 0..model.angles.len() {

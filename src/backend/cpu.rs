@@ -233,7 +233,7 @@ impl CpuBackend {
                             kind: "pair",
                             label,
                             interaction: term.interaction.name(),
-                            force: d * (radial.de_dr / r),
+                            force: radial.force_along(d, r),
                         });
                     }
                 }

@@ -115,7 +115,7 @@ impl PairTable {
     #[inline]
     pub(super) fn force_on(&self, i: usize, g: &PairGeometry) -> DVec3 {
         let mut f = DVec3::ZERO;
-        self.for_each_term(i, g, |_, d, r, radial| f += d * (radial.de_dr / r));
+        self.for_each_term(i, g, |_, d, r, radial| f += radial.force_along(d, r));
         f
     }
 
@@ -125,7 +125,7 @@ impl PairTable {
         self.for_each_term(i, g, |column, d, r, radial| {
             energy[column] += 0.5 * radial.energy;
             // r_ij ⊗ f_ij with r_ij = −d, counted half from each side.
-            add6(virial, outer(-0.5 * d, d * (radial.de_dr / r)));
+            add6(virial, outer(-0.5 * d, radial.force_along(d, r)));
         });
     }
 }

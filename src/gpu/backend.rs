@@ -12,7 +12,7 @@ use glam::DVec3;
 use wgpu::util::DeviceExt;
 
 use super::context::GpuContext;
-use super::pack::{cell_grid, pack, split, Params};
+use super::pack::{cell_grid, pack, FixedPoint, Params};
 use super::shader;
 use crate::integrate::overdamped::OverdampedSettings;
 use crate::neighbor::Exclusions;
@@ -74,6 +74,7 @@ pub struct GpuBackend {
     params: Params,
     has_pairs: bool,
     sim_box: SimBox,
+    fixed: FixedPoint,
     uniform: wgpu::Buffer,
     state: wgpu::Buffer,
     next: wgpu::Buffer,
@@ -130,11 +131,13 @@ impl GpuBackend {
         let cells = grid.iter().product::<u32>();
         let scan_blocks = cells.div_ceil(WORKGROUP);
         let lengths = sim_box.lengths();
-        let (len_hi, len_lo): (Vec<f32>, Vec<f32>) = (0..3).map(|a| split(lengths[a])).unzip();
+        let fixed = FixedPoint::for_box(sim_box);
+        let box_fixed = [0, 1, 2].map(|a| fixed.encode(lengths[a]));
         let groups_x = ctx.limits.max_compute_workgroups_per_dimension.min(65_535);
         let params = Params {
-            box_len_hi: [len_hi[0], len_hi[1], len_hi[2], 0.0],
-            box_len_lo: [len_lo[0], len_lo[1], len_lo[2], 0.0],
+            box_len_h: [box_fixed[0].0, box_fixed[1].0, box_fixed[2].0, 0],
+            box_len_f: [box_fixed[0].1, box_fixed[1].1, box_fixed[2].1, 0],
+            box_len: [lengths.x as f32, lengths.y as f32, lengths.z as f32, fixed.q as f32],
             box_lo: [sim_box.lo.x as f32, sim_box.lo.y as f32, sim_box.lo.z as f32, 0.0],
             periodic: [sim_box.periodic[0] as u32, sim_box.periodic[1] as u32, sim_box.periodic[2] as u32, 0],
             grid: [grid[0], grid[1], grid[2], cells],
@@ -243,6 +246,7 @@ impl GpuBackend {
             params,
             has_pairs,
             sim_box: *sim_box,
+            fixed,
             uniform,
             state: state_buffer,
             next,
@@ -289,6 +293,13 @@ impl GpuBackend {
         self.grown
     }
 
+    /// Caps the workgroups per dispatch along x (the adapter's limit, at most
+    /// 65 535, by default); wider dispatches are split along y. Lowering it
+    /// exercises the split on small systems.
+    pub fn limit_dispatch_width(&mut self, groups: u32) {
+        self.params.groups_x = groups.clamp(1, self.params.groups_x);
+    }
+
     /// Neighbour-list capacity per particle.
     pub fn neighbor_capacity(&self) -> u32 {
         self.params.nlist_cap
@@ -297,14 +308,12 @@ impl GpuBackend {
     /// Uploads positions and images (and asks for a neighbour rebuild).
     pub fn upload(&mut self, state: &State) {
         let n = state.len();
-        let mut data = vec![[0f32; 4]; 3 * n];
+        let mut data = vec![[0u32; 4]; 3 * n];
         for (i, (x, image)) in state.positions.iter().zip(&state.images).enumerate() {
             let rel = *x - self.sim_box.lo;
             for a in 0..3 {
-                let (hi, lo) = split(rel[a]);
-                data[i][a] = hi;
-                data[n + i][a] = lo;
-                data[2 * n + i][a] = f32::from_bits(image[a] as u32);
+                (data[i][a], data[n + i][a]) = self.fixed.encode(rel[a]);
+                data[2 * n + i][a] = image[a] as u32;
             }
         }
         self.ctx.queue.write_buffer(&self.state, 0, words(&data));
@@ -321,12 +330,12 @@ impl GpuBackend {
     /// Positions (wrapped, f64) and images of the current GPU state.
     pub fn download(&self, state: &mut State) {
         let n = state.len();
-        let data: Vec<[f32; 4]> = bytemuck::cast_slice(&self.read(&self.state, 48 * n as u64)).to_vec();
+        let data: Vec<[u32; 4]> = bytemuck::cast_slice(&self.read(&self.state, 48 * n as u64)).to_vec();
         for i in 0..n {
             let mut x = DVec3::ZERO;
             for a in 0..3 {
-                x[a] = self.sim_box.lo[a] + (data[i][a] as f64 + data[n + i][a] as f64);
-                state.images[i][a] = data[2 * n + i][a].to_bits() as i32;
+                x[a] = self.sim_box.lo[a] + self.fixed.decode(data[i][a], data[n + i][a]);
+                state.images[i][a] = data[2 * n + i][a] as i32;
             }
             state.positions[i] = x;
         }

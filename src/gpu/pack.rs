@@ -24,12 +24,13 @@ pub const PARAM_SLOTS: usize = 8;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct Params {
-    pub box_len_hi: [f32; 4],
-    pub box_len_lo: [f32; 4],
+    pub box_len_h: [u32; 4],
+    pub box_len_f: [u32; 4],
     pub box_lo: [f32; 4],
     pub periodic: [u32; 4],
     pub grid: [u32; 4],
     pub cell_inv_width: [f32; 4],
+    pub box_len: [f32; 4],
     pub n: u32,
     pub nlist_cap: u32,
     pub n_types: u32,
@@ -52,10 +53,30 @@ pub struct Params {
     pub fparam_offsets: [u32; 4],
 }
 
-/// A double-single split of an f64: `hi + lo ≈ x` to about 48 bits.
-pub fn split(x: f64) -> (f32, f32) {
-    let hi = x as f32;
-    (hi, (x - hi as f64) as f32)
+/// The GPU's 64-bit fixed point (layout.wgsl): a length x is the integer
+/// X = round(x/q·2³²), stored as its high i32 and low u32 words, with q a
+/// power of two such that the longest box edge is at most 2²⁰·q.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FixedPoint {
+    pub q: f64,
+}
+
+impl FixedPoint {
+    pub fn for_box(sim_box: &SimBox) -> Self {
+        let longest = sim_box.lengths().max_element().max(f64::MIN_POSITIVE);
+        Self { q: 2f64.powi(longest.log2().ceil() as i32 - 20) }
+    }
+
+    /// (high word, low word) of x.
+    pub fn encode(&self, x: f64) -> (u32, u32) {
+        let scaled = (x / self.q * 4_294_967_296.0).round() as i64;
+        ((scaled >> 32) as i32 as u32, scaled as u32)
+    }
+
+    pub fn decode(&self, high: u32, low: u32) -> f64 {
+        let whole = ((high as i32 as i64) << 32) | low as i64;
+        whole as f64 / 4_294_967_296.0 * self.q
+    }
 }
 
 /// The static buffers and the parts of [`Params`] they determine.

@@ -142,6 +142,19 @@ pub struct Radial {
 
 impl Radial {
     pub const ZERO: Radial = Radial { energy: 0.0, de_dr: 0.0, d2e_dr2: 0.0 };
+
+    /// The force on the particle at the origin of `d` (the separation to its
+    /// partner, length `r`): `(dE/dr)·d/r`. A term that exerts no force gives
+    /// exactly zero, even for coincident particles (r = 0), where `d/r` is
+    /// undefined: a slack cable between two particles that met is no blow-up.
+    #[inline(always)]
+    pub fn force_along(&self, d: DVec3, r: f64) -> DVec3 {
+        if self.de_dr == 0.0 {
+            DVec3::ZERO
+        } else {
+            d * (self.de_dr / r)
+        }
+    }
 }
 
 /// Energy and the force on each of three particles.
