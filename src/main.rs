@@ -9,7 +9,8 @@ use clap::{Parser, Subcommand};
 use cellmd::compare::{cellmd_probes, golden, run_lammps, Agreement, Lmp, Tolerance};
 use cellmd::deck::validate_file;
 use cellmd::export::{self, ExportOptions};
-use cellmd::gpu::DevicePreference;
+use cellmd::gpu::backend::StepSettings;
+use cellmd::gpu::{DevicePreference, GpuBackend, GpuContext};
 use cellmd::interactions::{documentation, lookup, REGISTRY};
 use cellmd::kinetics::{lookup_rule, rule_documentation, RULES};
 use cellmd::run::{RunOptions, Simulation};
@@ -42,6 +43,20 @@ enum Command {
         /// Backend for the steps, overriding the deck's `device`: cpu, gpu or auto.
         #[arg(long, value_parser = parse_device)]
         device: Option<DevicePreference>,
+    },
+    /// Time each phase of a GPU step on a deck's initial system (neighbour
+    /// check, rebuild, forces, integration, read-back) and print the shares.
+    ProfileGpu {
+        deck: PathBuf,
+        #[arg(long = "var", value_name = "NAME=VALUE", value_parser = parse_var)]
+        vars: Vec<(String, String)>,
+        /// Calls of each phase to average over.
+        #[arg(long, default_value_t = 20)]
+        repetitions: u32,
+        /// Neighbour-list rebuilds per step to weight the rebuild cost by
+        /// (default: from 200 GPU steps of the deck).
+        #[arg(long)]
+        rebuild_rate: Option<f64>,
     },
     /// Validate a deck (and its topology and force fields) without running it.
     Check {
@@ -135,6 +150,19 @@ fn main() -> ExitCode {
             }
             ExitCode::SUCCESS
         }
+        Command::ProfileGpu { deck, vars, repetitions, rebuild_rate } => {
+            let plan = match validate_file(&deck, &vars) {
+                Ok(plan) => plan,
+                Err(e) => return report(e),
+            };
+            match profile_gpu(&plan, repetitions, rebuild_rate) {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::from(3)
+                }
+            }
+        }
         Command::Check { deck, vars } => match validate_file(&deck, &vars) {
             Ok(plan) => {
                 println!(
@@ -225,6 +253,49 @@ fn main() -> ExitCode {
             }
         }
     }
+}
+
+/// `cellmd profile-gpu`: the GPU phase times on the deck's initial system.
+fn profile_gpu(plan: &cellmd::deck::Plan, repetitions: u32, rebuild_rate: Option<f64>) -> Result<(), String> {
+    let sim = Simulation::before_first_run(plan, RunOptions::default()).map_err(|e| e.to_string())?;
+    let context = GpuContext::open(false)?;
+    let settings = StepSettings {
+        dt: sim.dt,
+        kt: sim.kt,
+        seed: sim.seed,
+        skin: sim.neighbor.skin,
+        neighbor_every: sim.neighbor.every,
+        neighbor_check: sim.neighbor.check,
+        integrator: sim.integrator,
+    };
+    let mut gpu = GpuBackend::new(&context, &sim.model, &sim.state, &sim.sim_box, &settings)?;
+    let rate = match rebuild_rate {
+        Some(rate) => rate,
+        None => {
+            let mut probe = GpuBackend::new(&context, &sim.model, &sim.state, &sim.sim_box, &settings)?;
+            let before = probe.neighbor_builds();
+            let done = probe.run(0, 200).map_err(|e| format!("{e:?}"))?;
+            (probe.neighbor_builds() - before).saturating_sub(1) as f64 / done.max(1) as f64
+        }
+    };
+    let t = gpu.profile(repetitions);
+    let step = t.check + rate * t.neighbor_build + t.forces + t.integrate;
+    let n = sim.model.len() as f64;
+    println!("device: {}", context.describe());
+    println!("{} particles; {rate:.4} neighbour rebuilds per step", sim.model.len());
+    println!("{:<26} {:>14} {:>12}", "phase", "µs per call", "share/step");
+    let rows = [
+        ("neighbour check", t.check, t.check),
+        ("neighbour rebuild", t.neighbor_build, rate * t.neighbor_build),
+        ("forces", t.forces, t.forces),
+        ("integration", t.integrate, t.integrate),
+    ];
+    for (name, per_call, per_step) in rows {
+        println!("{name:<26} {:>14.1} {:>11.1}%", per_call * 1e6, 100.0 * per_step / step);
+    }
+    println!("{:<26} {:>14.1} {:>12}", "read-back of positions", t.readback * 1e6, "per output");
+    println!("GPU step: {:.1} µs = {:.3e} particle-steps/s (kernels only, no read-back)", step * 1e6, n / step);
+    Ok(())
 }
 
 /// `cellmd compare`: prints the table; returns whether the engines agree.

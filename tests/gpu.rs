@@ -130,17 +130,6 @@ fn golden_documents() -> Vec<(std::path::PathBuf, cellmd::compare::golden::Docum
         .collect()
 }
 
-/// The model with the deck's `external` and `coeff` commands before its first `run` applied.
-fn model_before_first_run(plan: &Plan) -> cellmd::system::Model {
-    let mut sim = Simulation::new(plan, RunOptions::default());
-    for action in plan.actions.iter().take_while(|a| !matches!(a, Action::Run(_))) {
-        if matches!(action, Action::External(_) | Action::Unexternal(_) | Action::Coeff { .. }) {
-            sim.apply(action).unwrap();
-        }
-    }
-    sim.model
-}
-
 /// Every interaction type's golden cases (LAMMPS-checked configurations):
 /// GPU forces and energies against the CPU f64 backend within the
 /// `gpu_epsilon` declared in its reference file.
@@ -154,7 +143,7 @@ fn gpu_matches_cpu_on_every_golden_case() {
         let epsilon: f64 = doc.get("gpu_epsilon").unwrap_or_else(|| panic!("{}: no gpu_epsilon", path.display())).parse().unwrap();
         assert!(doc.get("gpu_epsilon_reason").is_some_and(|r| !r.is_empty()), "{}: no gpu_epsilon_reason", path.display());
         let plan = cellmd::deck::validate_file(&deck, &[]).unwrap();
-        let model = model_before_first_run(&plan);
+        let model = Simulation::before_first_run(&plan, RunOptions::default()).unwrap().model;
         let state = initial_state(&plan);
         let mut cpu = CpuBackend::new(&model, &state, &plan.sim_box, 0.3).unwrap();
         let mut forces = Forces::default();

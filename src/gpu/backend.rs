@@ -39,6 +39,22 @@ pub enum GpuHalt {
     Blowup { step: u64, particle: usize },
 }
 
+/// Seconds per call of each phase of a step, each timed alone
+/// ([`GpuBackend::profile`]).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PhaseTimes {
+    /// Displacement check and rebuild decision (every step).
+    pub check: f64,
+    /// A full neighbour-list rebuild (binning, scan, scatter, sort, list).
+    pub neighbor_build: f64,
+    /// Pair, bonded and external forces.
+    pub forces: f64,
+    /// Integration, commit and step counter.
+    pub integrate: f64,
+    /// Reading positions back to the host (thermo, dump, end of run).
+    pub readback: f64,
+}
+
 /// Settings the kernels need besides the model.
 #[derive(Clone, Copy, Debug)]
 pub struct StepSettings {
@@ -383,6 +399,66 @@ impl GpuBackend {
 
     fn write_params(&self) {
         self.ctx.queue.write_buffer(&self.uniform, 0, words(&[self.params]));
+    }
+
+    /// Times each phase alone, `repetitions` times in one submission (after a
+    /// warm-up), waiting for the GPU at the end; seconds per call. The state
+    /// is left as it was (integration is timed on a copy of the positions).
+    pub fn profile(&mut self, repetitions: u32) -> PhaseTimes {
+        self.evaluate();
+        let saved = self.read(&self.state, 48 * self.params.n as u64);
+        let particles = self.params.n.div_ceil(WORKGROUP);
+        let cells = self.params.grid[3].div_ceil(WORKGROUP);
+        let k = &self.kernels;
+        let mut build: Vec<(&wgpu::ComputePipeline, u32)> = Vec::new();
+        if self.has_pairs {
+            build = vec![
+                (&k.clear, cells),
+                (&k.count, particles),
+                (&k.scan_blocks, cells),
+                (&k.scan_totals, 1),
+                (&k.scan_add, cells),
+                (&k.scatter, particles),
+                (&k.sort, cells),
+                (&k.build, particles),
+            ];
+        }
+        let time = |this: &Self, kernels: &[(&wgpu::ComputePipeline, u32)], decide: bool| {
+            let run = |reps: u32| {
+                let started = std::time::Instant::now();
+                let mut encoder = this.ctx.device.create_command_encoder(&Default::default());
+                {
+                    let mut pass = encoder.begin_compute_pass(&Default::default());
+                    pass.set_bind_group(0, &this.main_group, &[]);
+                    if decide {
+                        pass.set_bind_group(1, &this.args_group, &[]);
+                    }
+                    for _ in 0..reps {
+                        for (pipeline, groups) in kernels {
+                            pass.set_pipeline(pipeline);
+                            pass.dispatch_workgroups((*groups).min(this.params.groups_x), groups.div_ceil(this.params.groups_x), 1);
+                        }
+                    }
+                }
+                this.ctx.queue.submit([encoder.finish()]);
+                this.ctx.device.poll(wgpu::PollType::wait_indefinitely()).expect("waiting for the GPU");
+                started.elapsed().as_secs_f64()
+            };
+            run(1);
+            run(repetitions) / repetitions as f64
+        };
+        let check = if self.has_pairs { time(self, &[(&k.displacement, particles), (&k.decide, 1)], true) } else { 0.0 };
+        let neighbor_build = if self.has_pairs { time(self, &build, false) } else { 0.0 };
+        let forces = time(self, &[(&k.forces, particles)], false);
+        let integrate = time(self, &[(&k.integrate, particles), (&k.commit, particles), (&k.advance, 1)], false);
+        let started = std::time::Instant::now();
+        for _ in 0..repetitions {
+            self.read(&self.state, 48 * self.params.n as u64);
+        }
+        let readback = started.elapsed().as_secs_f64() / repetitions as f64;
+        self.ctx.queue.write_buffer(&self.state, 0, &saved);
+        self.reset_status(true);
+        PhaseTimes { check, neighbor_build, forces, integrate, readback }
     }
 
     /// Encodes one neighbour check/rebuild and force pass, and optionally the

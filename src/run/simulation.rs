@@ -127,6 +127,29 @@ impl Simulation {
         Ok(sim)
     }
 
+    /// The simulation as the deck sets it up before its first `run` or
+    /// `minimize`: settings, externals, coefficient edits and restarts are
+    /// applied; outputs are not opened. For tools that inspect or time the
+    /// initial system (`cellmd profile-gpu`, tests).
+    pub fn before_first_run(plan: &Plan, options: RunOptions) -> Result<Simulation, RunError> {
+        let mut sim = Simulation::new(plan, options);
+        for action in plan.actions.iter().take_while(|a| !matches!(a, Action::Run(_) | Action::Minimize(_))) {
+            let output = matches!(
+                action,
+                Action::Dump(_)
+                    | Action::Undump(_)
+                    | Action::ThermoFile(_)
+                    | Action::EventFile(_)
+                    | Action::WriteState(_)
+                    | Action::Print(_)
+            );
+            if !output {
+                sim.apply(action)?;
+            }
+        }
+        Ok(sim)
+    }
+
     fn say(&self, message: &str) {
         if self.options.echo {
             println!("{message}");
