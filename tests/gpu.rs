@@ -9,6 +9,7 @@ use cellmd::deck::{Action, Plan};
 use cellmd::gpu::backend::StepSettings;
 use cellmd::gpu::{DevicePreference, GpuBackend, GpuContext};
 use cellmd::integrate::overdamped::OverdampedSettings;
+use cellmd::integrate::rng::Noise;
 use cellmd::run::{RunOptions, Simulation};
 use cellmd::system::State;
 use common::random_case;
@@ -375,20 +376,22 @@ fn thermal_case() -> common::Case {
 
 /// Mean squared displacement of the free particles and mean squared
 /// extension of the tethers after `steps` steps.
-fn thermal_statistics(device: DevicePreference, steps: u64, kt: f64, dt: f64) -> (f64, f64, State) {
+fn thermal_statistics(device: DevicePreference, steps: u64, kt: f64, dt: f64, noise: Noise) -> (f64, f64, State) {
+    let integrator = OverdampedSettings { noise, ..Default::default() };
     let case = thermal_case();
     let plan = case.plan();
     let start = initial_state(&plan);
     let mut state = start.clone();
     match device {
         DevicePreference::Gpu => {
-            let mut gpu = GpuBackend::new(&context(), &plan.model, &state, &plan.sim_box, &settings(0.5, dt, kt)).unwrap();
+            let settings = StepSettings { integrator, ..settings(0.5, dt, kt) };
+            let mut gpu = GpuBackend::new(&context(), &plan.model, &state, &plan.sim_box, &settings).unwrap();
             assert_eq!(gpu.run(0, steps), Ok(steps));
             gpu.download(&mut state);
         }
         _ => {
             let mut sim = Simulation::new(&plan, RunOptions::default());
-            for action in [Action::Temperature(kt), Action::Timestep(dt), Action::Seed(7), Action::Run(steps)] {
+            for action in [Action::Temperature(kt), Action::Timestep(dt), Action::Seed(7), Action::Integrator(integrator), Action::Run(steps)] {
                 sim.apply(&action).unwrap();
             }
             state = sim.state;
@@ -401,7 +404,7 @@ fn thermal_statistics(device: DevicePreference, steps: u64, kt: f64, dt: f64) ->
     (msd, extension, state)
 }
 
-/// kT > 0: the GPU and the CPU reproduce the same statistics (free MSD = 6Dt;
+/// kT > 0, uniform and Gaussian noise: the GPU and the CPU reproduce the same statistics (free MSD = 6Dt;
 /// tether ⟨d²⟩ = 3 × the exact variance of the discrete Ornstein–Uhlenbeck
 /// step), and their first steps are the same numbers: the Philox words are
 /// identical, the f32 noise differs from the CPU's f64 noise by < 2⁻²⁴·√12.
@@ -415,16 +418,21 @@ fn thermal_runs_have_the_same_statistics_and_the_same_first_steps() {
     let expected_extension = 3.0 * per_axis * (1.0 - (1.0 - a).powi(2 * steps as i32));
     let expected_msd = 6.0 * kt / gamma * dt * steps as f64;
     let n: f64 = 1500.0;
-    for device in [DevicePreference::Cpu, DevicePreference::Gpu] {
-        let (msd, extension, _) = thermal_statistics(device, steps, kt, dt);
+    for (device, noise) in [
+        (DevicePreference::Cpu, Noise::Uniform),
+        (DevicePreference::Gpu, Noise::Uniform),
+        (DevicePreference::Cpu, Noise::Gaussian),
+        (DevicePreference::Gpu, Noise::Gaussian),
+    ] {
+        let (msd, extension, _) = thermal_statistics(device, steps, kt, dt, noise);
         // Relative standard error of a mean of n squared Gaussian norms (3 dof): √(2/3n).
         let sigma = (2.0 / (3.0 * n)).sqrt();
-        println!("{device:?}: MSD {msd:.5} (6Dt = {expected_msd:.5}), ⟨d²⟩ {extension:.6} (exact {expected_extension:.6}), σ {sigma:.3}");
+        println!("{device:?} {noise:?}: MSD {msd:.5} (6Dt = {expected_msd:.5}), ⟨d²⟩ {extension:.6} (exact {expected_extension:.6}), σ {sigma:.3}");
         assert!((msd / expected_msd - 1.0).abs() < 4.0 * sigma, "{device:?}: MSD {msd} vs {expected_msd}");
         assert!((extension / expected_extension - 1.0).abs() < 4.0 * sigma, "{device:?}: ⟨d²⟩ {extension} vs {expected_extension}");
     }
-    let (_, _, cpu) = thermal_statistics(DevicePreference::Cpu, 3, kt, dt);
-    let (_, _, gpu) = thermal_statistics(DevicePreference::Gpu, 3, kt, dt);
+    let (_, _, cpu) = thermal_statistics(DevicePreference::Cpu, 3, kt, dt, Noise::Uniform);
+    let (_, _, gpu) = thermal_statistics(DevicePreference::Gpu, 3, kt, dt, Noise::Uniform);
     let amplitude = (2.0 * kt * dt / gamma).sqrt();
     let worst = cpu.positions.iter().zip(&gpu.positions).map(|(c, g)| (*c - *g).abs().max_element()).fold(0.0, f64::max);
     println!("first 3 steps: largest GPU − CPU component {worst:e} (noise amplitude {amplitude:e})");

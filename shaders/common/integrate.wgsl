@@ -22,7 +22,12 @@ fn integrate(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_ind
     var dx = force[i].xyz * fparams[P.off_mobility + t];
     let amplitude = fparams[P.off_amplitude + t];
     if amplitude > 0.0 {
-        dx += amplitude * noise3(vec2<u32>(P.seed_lo, P.seed_hi), current_step(), i);
+        let seed = vec2<u32>(P.seed_lo, P.seed_hi);
+        if P.gaussian == 1u {
+            dx += amplitude * gaussian3(seed, current_step(), i);
+        } else {
+            dx += amplitude * noise3(seed, current_step(), i);
+        }
     }
     let d2 = dot(dx, dx);
     if !(d2 <= P.max_disp2) {

@@ -25,8 +25,8 @@ struct Params {
     // (cutoff + skin)², (skin/2)², max displacement², neighbour `every`
     range2: f32, half_skin2: f32, max_disp2: f32, neighbor_every: u32,
     seed_lo: u32, seed_hi: u32, step_lo: u32, step_hi: u32,
-    // neighbour `check`, scan blocks over cells, dispatch width (workgroups along x), unused
-    neighbor_check: u32, scan_blocks: u32, groups_x: u32, pad0: u32,
+    // neighbour `check`, scan blocks over cells, dispatch width (workgroups along x), 1 for `noise gaussian`
+    neighbor_check: u32, scan_blocks: u32, groups_x: u32, gaussian: u32,
     // offsets of the sections of `topo`
     off_term_kind: u32, off_pair_start: u32, off_pair_terms: u32, off_bond_offsets: u32,
     off_bond_ends: u32, off_angle_offsets: u32, off_angle_slots: u32, off_ext_offsets: u32,

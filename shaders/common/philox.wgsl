@@ -46,3 +46,20 @@ fn noise3(seed: vec2<u32>, step: vec2<u32>, id: u32) -> vec3<f32> {
     let u = (vec3<f32>(vec3<u32>(w.x, w.y, w.z) >> vec3<u32>(8u)) + 0.5) * (1.0 / 16777216.0) - 0.5;
     return u * 3.4641016151377544;
 }
+
+// A uniform on (0, 1) from the top 24 bits of a word (never 0 or 1).
+fn open_unit(word: u32) -> f32 {
+    return (f32(word >> 8u) + 0.5) * (1.0 / 16777216.0);
+}
+
+// Three standard normals by Box–Muller from streams 0 and 1, as `noise
+// gaussian` on the CPU (same words; f32 and WGSL's ln/sin/cos, so the same
+// distribution but not the same bits).
+fn gaussian3(seed: vec2<u32>, step: vec2<u32>, id: u32) -> vec3<f32> {
+    let a = philox4x32_10(vec4<u32>(id, 0u, step.x, step.y), seed);
+    let b = philox4x32_10(vec4<u32>(id, 1u, step.x, step.y), seed);
+    let r = sqrt(-2.0 * log(open_unit(a.x)));
+    let angle = 6.283185307179586 * open_unit(a.z);
+    let r2 = sqrt(-2.0 * log(open_unit(b.x)));
+    return vec3<f32>(r * cos(angle), r * sin(angle), r2 * cos(6.283185307179586 * open_unit(b.z)));
+}

@@ -46,7 +46,8 @@ pub struct Params {
     pub neighbor_check: u32,
     pub scan_blocks: u32,
     pub groups_x: u32,
-    pub pad0: u32,
+    /// 1 for `noise gaussian`.
+    pub gaussian: u32,
     /// Offsets of the `topo` sections, in layout.wgsl's order.
     pub topo_offsets: [u32; 12],
     /// Offsets of the `fparams` sections: params, skip2, mobility, amplitude.
