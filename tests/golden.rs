@@ -171,28 +171,51 @@ fn committed_lammps_inputs_are_current_exports() {
     }
 }
 
-/// Every registered type has a golden file, or is listed in
-/// reference/NO_REFERENCE.md with the reason and the test that covers it.
-#[test]
-fn every_interaction_has_a_golden_file_or_a_stated_reason() {
+/// Each name has `reference/NAME.yaml` or a row `| `NAME` | reason | `test` |`
+/// in reference/NO_REFERENCE.md naming a test found in `sources`.
+fn golden_file_or_stated_reason(names: &[&str], sources: &str) {
     let listed = std::fs::read_to_string("reference/NO_REFERENCE.md").unwrap();
-    let sources: String =
-        std::fs::read_dir("src/interactions").unwrap().map(|e| std::fs::read_to_string(e.unwrap().path()).unwrap()).collect();
-    for i in REGISTRY {
-        if Path::new(&format!("reference/{}.yaml", i.name())).exists() {
-            assert!(!listed.contains(&format!("| `{}` |", i.name())), "{} has a golden file and is listed as lacking one", i.name());
+    for name in names {
+        if Path::new(&format!("reference/{name}.yaml")).exists() {
+            assert!(!listed.contains(&format!("| `{name}` |")), "{name} has a golden file and is listed as lacking one");
             continue;
         }
         let row = listed
             .lines()
-            .find(|l| l.starts_with(&format!("| `{}` |", i.name())))
-            .unwrap_or_else(|| panic!("{} has no reference/{}.yaml and no row in reference/NO_REFERENCE.md", i.name(), i.name()));
+            .find(|l| l.starts_with(&format!("| `{name}` |")))
+            .unwrap_or_else(|| panic!("{name} has no reference/{name}.yaml and no row in reference/NO_REFERENCE.md"));
         let cells: Vec<&str> = row.split('|').map(str::trim).collect();
         // | `name` | reason | `test_name` |
-        assert!(cells.len() >= 4 && !cells[2].is_empty(), "{}: no reason given", i.name());
+        assert!(cells.len() >= 4 && !cells[2].is_empty(), "{name}: no reason given");
         let test = cells[3].trim_matches('`');
-        assert!(sources.contains(&format!("fn {test}(")), "{}: the covering test `{test}` does not exist", i.name());
+        assert!(sources.contains(&format!("fn {test}(")), "{name}: the covering test `{test}` does not exist");
     }
+}
+
+fn read_sources(dirs: &[&str]) -> String {
+    dirs.iter()
+        .flat_map(|d| std::fs::read_dir(d).unwrap())
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "rs"))
+        .map(|p| std::fs::read_to_string(p).unwrap())
+        .collect()
+}
+
+/// Every registered type has a golden file, or is listed in
+/// reference/NO_REFERENCE.md with the reason and the test that covers it.
+#[test]
+fn every_interaction_has_a_golden_file_or_a_stated_reason() {
+    let names: Vec<&str> = REGISTRY.iter().map(|i| i.name()).collect();
+    golden_file_or_stated_reason(&names, &read_sources(&["src/interactions"]));
+}
+
+/// Likewise every kinetic rule, and bond formation (`bind`): LAMMPS can
+/// express only a few, the others name their test against exact results.
+#[test]
+fn every_kinetic_rule_has_a_golden_file_or_a_stated_reason() {
+    let mut names: Vec<&str> = cellmd::kinetics::RULES.iter().map(|r| r.name()).collect();
+    names.push("bind");
+    golden_file_or_stated_reason(&names, &read_sources(&["src/kinetics", "tests"]));
 }
 
 /// `reference/regenerate --check` sets CELLMD_GOLDEN_NEW=require: every
