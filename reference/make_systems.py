@@ -3,8 +3,11 @@
 reference/NAME/NAME.ff and two cases, `small` (1-3 particles) and `random`
 (>= 100 particles, periodic where the type allows, with images, exclusions
 and two particle types exercised), each a topology and an ordinary cellmd deck
-in `units lj`. Deterministic (fixed seeds); rerun only to change the systems,
-then `reference/regenerate` to record LAMMPS' answers.
+in `units lj`. Likewise for the bond kinetics LAMMPS can express:
+reference/threshold (deterministic strain threshold = fix bond/break) and
+reference/bind (certain mutual-nearest binding = fix bond/create), on frozen
+particles (see kinetics()). Deterministic (fixed seeds); rerun only to change
+the systems, then `reference/regenerate` to record LAMMPS' answers.
 """
 import math
 import os
@@ -175,6 +178,127 @@ def externals():
     })
 
 
+def random_points(rng, n, box, dmin):
+    """n points in a periodic cube, no two closer than dmin."""
+    pts = []
+    while len(pts) < n:
+        p = [rng.uniform(0, box) for _ in range(3)]
+        if all(math.dist(min_image(p, q, box), [0, 0, 0]) > dmin for q in pts):
+            pts.append([round(c, 6) for c in p])
+    return pts
+
+
+def pair_distances(pts, box):
+    n = len(pts)
+    return {(i, j): math.dist(min_image(pts[i], pts[j], box), [0, 0, 0]) for i in range(n) for j in range(i + 1, n)}
+
+
+KINETIC_TYPES = "particle a fixed\nparticle b fixed\n"
+
+
+def kinetics():
+    """Frozen random networks (every particle type `fixed`, as LAMMPS atoms with
+    no integrator): only the bond kinetics change the system, so the final bond
+    sets of both engines must agree although LAMMPS decides per step
+    differently (see README, *Checking against LAMMPS*)."""
+    # threshold: bonds of types s (r0 1, breaks beyond 1.2) and t (r0 1.1,
+    # beyond 1.265) at random lengths on both sides of their threshold, never
+    # compressed beyond it (cellmd breaks those too; LAMMPS only stretched
+    # ones); bonds of type u never break. Many particles carry several
+    # over-threshold bonds, which LAMMPS breaks one per step.
+    rng = random.Random(51)
+    box, n = 6.0, 150
+    pts = random_points(rng, n, box, 0.7)
+    types = ["b" if k % 3 == 0 else "a" for k in range(n)]
+    d = pair_distances(pts, box)
+    law = {"s": (1.0, 0.2, 0.85, 1.5), "t": (1.1, 0.15, 0.96, 1.55), "u": (1.2, None, 0.8, 1.6)}
+    degree = [0] * n
+    bonds = []
+    pairs = sorted(d)
+    rng.shuffle(pairs)
+    for (i, j) in pairs:
+        if degree[i] >= 5 or degree[j] >= 5:
+            continue
+        name = rng.choice("sstu")
+        r0, strain, lo, hi = law[name]
+        if not lo <= d[i, j] <= hi:
+            continue
+        if strain is not None and abs(d[i, j] - r0 * (1 + strain)) < 1e-3:
+            continue
+        bonds.append((name, i, j))
+        degree[i] += 1
+        degree[j] += 1
+    ff = (KINETIC_TYPES
+          + "bond s harmonic k 50 r0 1.0 kinetics threshold strain 0.2\n"
+          + "bond t spring k 30 r0 1.1 tau 0.05 kinetics threshold strain 0.15\n"
+          + "bond u harmonic k 20 r0 1.2\n"
+          # Broken bonds stop excluding their pair: these energies follow the exclusions.
+          + "pair a a soft_repulsion k 20 sigma 1.0\npair a b soft_repulsion k 5 sigma 1.6\n")
+    rtop = f"[ box ]\nx 0 {box} p\ny 0 {box} p\nz 0 {box} p\n" + particles_block(pts, types)
+    rtop += "[ bonds ]\n" + "".join(f"{t} {i + 1} {j + 1}\n" for t, i, j in bonds)
+    # small: a chain 1.5, 1.3, 1.1 long: LAMMPS breaks 1-2 (the longest) in
+    # its first step and 2-3 in its second; 3-4 stays.
+    small = [[0, 0, 0], [1.5, 0, 0], [1.5, 1.3, 0], [1.5, 1.3, 1.1]]
+    stop = particles_block(small, ["a", "a", "b", "a"]) + "[ bonds ]\ns 1 2\ns 2 3\ns 3 4\n"
+    write("threshold", {
+        "threshold.ff": ff,
+        "small.top": stop,
+        "random.top": rtop,
+        "small.in": deck("small.top", "threshold.ff", "x -5 5 f y -5 5 f z -5 5 f", 0.01, steps=5),
+        "random.in": deck("random.top", "threshold.ff", f"x 0 {box} p y 0 {box} p z 0 {box} p", 0.01, steps=20),
+    })
+
+    # bind: a-b pairs closer than 1.0 form `link` bonds (at most 2 per
+    # particle, counting the topology's links), b-b pairs closer than 0.8
+    # form `glue` bonds (at most 1), each particle with its nearest free
+    # partner when that choice is mutual. `s` bonds join a-a pairs only, so no
+    # bindable pair is already bonded by another type (LAMMPS would refuse it).
+    rng = random.Random(52)
+    box, n = 6.5, 160
+    pts = random_points(rng, n, box, 0.45)
+    types = ["a" if k % 2 else "b" for k in range(n)]
+    d = pair_distances(pts, box)
+    capture = {("a", "b"): 1.0, ("b", "b"): 0.8}
+    near = sorted(v for (i, j), v in d.items() if (tuple(sorted((types[i], types[j]))) in capture))
+    assert all(b - a > 1e-9 for a, b in zip(near, near[1:])), "tied distances"
+    assert all(abs(v - capture[tuple(sorted((types[i], types[j])))]) > 1e-6
+               for (i, j), v in d.items() if tuple(sorted((types[i], types[j]))) in capture)
+    pairs = sorted(d)
+    rng.shuffle(pairs)
+    links, chains = [], []
+    used = [0] * n
+    for (i, j) in pairs:
+        kind = "".join(sorted((types[i], types[j])))
+        if kind == "ab" and d[i, j] < 1.2 and used[i] < 1 and used[j] < 1 and len(links) < 12:
+            links.append((i, j))
+        elif kind == "aa" and d[i, j] < 1.3 and used[i] < 2 and used[j] < 2 and len(chains) < 30:
+            chains.append((i, j))
+        else:
+            continue
+        used[i] += 1
+        used[j] += 1
+    ff = (KINETIC_TYPES
+          + "bond s harmonic k 20 r0 1.0\nbond link harmonic k 10 r0 0.8\nbond glue harmonic k 40 r0 0.5\n"
+          + "bind a b link k_on 1e9 capture 1.0 max_bonds 2 partner nearest\n"
+          + "bind b b glue k_on 1e9 capture 0.8 max_bonds 1 partner nearest\n"
+          # Formed bonds exclude their pair: this energy follows the exclusions.
+          + "pair a b soft_repulsion k 10 sigma 0.7\n")
+    rtop = f"[ box ]\nx 0 {box} p\ny 0 {box} p\nz 0 {box} p\n" + particles_block(pts, types)
+    rtop += "[ bonds ]\n" + "".join(f"link {i + 1} {j + 1}\n" for i, j in links) + "".join(f"s {i + 1} {j + 1}\n" for i, j in chains)
+    # small: a at 0, b at 0.6 and 0.9 on a line, all b: the pair 0.3 apart
+    # binds first, then 1-2 (0.6), then 1-3 (0.9), one bond per particle and step.
+    small = [[0.0, 0.0, 0.0], [0.6, 0.0, 0.0], [0.9, 0.0, 0.0]]
+    sff = KINETIC_TYPES + "bond link harmonic k 10 r0 0.8\nbind b b link k_on 1e9 capture 1.0 max_bonds 2 partner nearest\n"
+    write("bind", {
+        "bind.ff": ff,
+        "small.ff": sff,
+        "small.top": particles_block(small, ["b", "b", "b"]),
+        "random.top": rtop,
+        "small.in": deck("small.top", "small.ff", "x -5 5 f y -5 5 f z -5 5 f", 0.01, steps=5),
+        "random.in": deck("random.top", "bind.ff", f"x 0 {box} p y 0 {box} p z 0 {box} p", 0.01, steps=10),
+    })
+
+
 if __name__ == "__main__":
     for name, ff in BOND_FF.items():
         bonded(name, ff, "bond")
@@ -183,3 +307,4 @@ if __name__ == "__main__":
     for name, ff in PAIR_FF.items():
         pairs(name, ff)
     externals()
+    kinetics()

@@ -71,3 +71,77 @@ fn cli_exports_files_and_exits_2_on_an_unexportable_deck() {
     assert_eq!(result.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&result.stderr).contains("oblique normal"));
 }
+
+/// A deck with bond kinetics on three fixed particles: `ff` is the force
+/// field after the particle line, `extra` goes before the first run.
+fn kinetic_deck(ff: &str, extra: &str) -> Case {
+    let top = "[ particles ]\n1 a 0 0 0\n2 a 1.1 0 0\n3 a 1.1 0.5 0\n[ bonds ]\ns 1 2\n";
+    let deck = format!("units lj\ntopology t.top\nforcefield f.ff\nbox x -5 5 f y -5 5 f z -5 5 f\ntimestep 0.01\n{extra}run 5\n");
+    Case::new(&[("t.top", top), ("f.ff", &format!("particle a fixed\n{ff}")), ("deck.in", &deck)])
+}
+
+/// A strain `threshold` alone is `fix bond/break` at r0·(1 + S); certain
+/// mutual-nearest binding is `fix bond/create` (with a `zero` pair style
+/// reaching the capture radius, and room for the new bonds); the probes list
+/// the bonds.
+#[test]
+fn expressible_kinetics_map_to_bond_break_and_bond_create() {
+    let ff = "bond s harmonic k 5 r0 1.0 kinetics threshold strain 0.25\nbond link harmonic k 1 r0 0.5\n\
+              bind a a link k_on 1e9 capture 0.8 max_bonds 2 partner nearest\n";
+    let out = export(&kinetic_deck(ff, "").plan(), ExportOptions { probes: true }).unwrap();
+    let input = out.input;
+    for line in [
+        "read_data data.lammps extra/bond/per/atom 2 extra/special/per/atom 21",
+        "pair_style zero 0.8",
+        "pair_coeff * *",
+        "fix cellmd_break1 all bond/break 1 1 1.25",
+        "fix cellmd_bind1 all bond/create 1 1 1 0.8 2 iparam 2 1 jparam 2 1",
+        "compute cellmd_bonds all property/local btype batom1 batom2",
+        "write_dump all local cellmd_probe_final.bonds index c_cellmd_bonds[1] c_cellmd_bonds[2] c_cellmd_bonds[3]",
+    ] {
+        assert!(input.lines().any(|l| l == line), "in.lammps lacks `{line}`:\n{input}");
+    }
+    // With other pair styles, `zero` joins the overlay.
+    let with_pairs =
+        export(&kinetic_deck(&format!("{ff}pair a a wca epsilon 1 sigma 0.5\n"), "").plan(), ExportOptions::default()).unwrap();
+    assert!(with_pairs
+        .input
+        .contains("pair_style hybrid/overlay lj/cut 0.5612310241546865 zero 0.8\npair_coeff * * none\npair_coeff * * zero\n"));
+    // A new r0 moves the break length.
+    let coeff = export(&kinetic_deck(ff, "run 1\ncoeff bond s r0 2\n").plan(), ExportOptions::default()).unwrap();
+    assert!(coeff.input.contains("unfix cellmd_break1\nfix cellmd_break1 all bond/break 1 1 2.5\n"), "{}", coeff.input);
+}
+
+#[test]
+fn kinetics_lammps_cannot_express_are_refused_with_the_reason() {
+    let link = "bond link harmonic k 1 r0 0.5\n";
+    for (ff, extra, expected) in [
+        ("bond s harmonic k 5 r0 1 kinetics slip k0 1 x_beta 0.1\n", "temperature 1\n", "no force-dependent bond kinetics"),
+        ("bond s harmonic k 5 r0 1 kinetics threshold force 3\n", "", "only a `threshold` with a `strain` alone"),
+        ("bond s harmonic k 5 r0 1 kinetics threshold strain 0.2 rate 5\n", "", "only a `threshold` with a `strain` alone"),
+        ("bond s fene K 30 R0 1.5 epsilon 1 sigma 1 kinetics threshold strain 0.2\n", "", "has no `r0`"),
+        ("bond s harmonic k 5 r0 1\nbind a a link k_on 1e9 capture 0.8\n", "", "`partner random`"),
+        ("bond s harmonic k 5 r0 1\nbind a a link k_on 10 capture 0.8 partner nearest\n", "", "not certain within a step"),
+        (
+            "bond s harmonic k 5 r0 1\nbind a a link k_on 1e9 capture 0.8 partner nearest\n",
+            "special_bonds 0 0 1\n",
+            "`special_bonds` excludes",
+        ),
+        ("bond s harmonic k 5 r0 1\nbind a a s k_on 1e9 capture 0.8 partner nearest\n", "", ""),
+        (
+            "bond s harmonic k 5 r0 1 kinetics threshold strain 0.2\nbind a a s k_on 1e9 capture 0.8 partner nearest\n",
+            "",
+            "also has kinetic rules",
+        ),
+    ] {
+        let ff = if ff.contains("bind a a link") { format!("{ff}{link}") } else { ff.to_string() };
+        let result = export(&kinetic_deck(&ff, extra).plan(), ExportOptions::default());
+        match expected {
+            "" => assert!(result.is_ok(), "{ff}: {result:?}"),
+            _ => {
+                let err = result.unwrap_err();
+                assert!(err.contains(expected), "{ff}: expected `{expected}` in `{err}`");
+            }
+        }
+    }
+}

@@ -6,6 +6,10 @@
 //! Energies, forces and virial at step 0 must agree within the file's
 //! `epsilon`, positions, forces and energies after the run within its
 //! `run_epsilon` (figures defined in `cellmd::compare::Agreement`).
+//!
+//! The golden files of bond kinetics (`threshold.yaml`: LAMMPS `fix
+//! bond/break`; `bind.yaml`: `fix bond/create`) also record the bound bonds
+//! at the start and after the run, and cellmd must end with the same set.
 
 use std::path::{Path, PathBuf};
 
@@ -16,6 +20,13 @@ use cellmd::interactions::REGISTRY;
 fn documents(path: &Path) -> Vec<golden::Document> {
     let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     golden::parse(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// Whether a golden file checks bond kinetics (named after a kinetic rule,
+/// or `bind` for formation) rather than an interaction.
+fn is_kinetics(path: &Path) -> bool {
+    let name = path.file_stem().unwrap().to_str().unwrap();
+    name == "bind" || cellmd::kinetics::lookup_rule(name).is_some()
 }
 
 fn golden_files() -> Vec<PathBuf> {
@@ -78,10 +89,24 @@ fn random_cases_are_not_toys() {
             // Periodic wherever the type allows it (walls need a fixed axis).
             let periodic = plan.sim_box.periodic.iter().filter(|&&p| p).count();
             assert!(periodic >= if name == "wall" { 1 } else { 3 }, "{}: periodic axes {:?}", path.display(), plan.sim_box.periodic);
+            let last = probes.last.as_ref().expect("a run");
+            if is_kinetics(&path) {
+                // Kinetics act: many bonds break or form, and many do not.
+                let (before, after) = (probes.init.bonds.as_ref().unwrap(), last.bonds.as_ref().unwrap());
+                let changed = before.iter().filter(|b| !after.contains(b)).count() + after.iter().filter(|b| !before.contains(b)).count();
+                let kept = before.iter().filter(|b| after.contains(b)).count();
+                println!(
+                    "{}: {} bonds at the start, {} after the run: {changed} changed, {kept} kept",
+                    path.display(),
+                    before.len(),
+                    after.len()
+                );
+                assert!(changed >= 50 && kept >= 20, "{}: {changed} bonds changed and {kept} kept: not a test of kinetics", path.display());
+                continue;
+            }
             // The interaction acts, and the run moves the particles.
             let energy: f64 = probes.init.energies.iter().filter(|(k, _)| k.split('+').any(|p| p == name)).map(|(_, e)| e.abs()).sum();
             assert!(energy > 0.0, "{}: `{name}` has no energy", path.display());
-            let last = probes.last.as_ref().expect("a run");
             assert!(
                 last.positions.iter().zip(&probes.init.positions).any(|(a, b)| (*a - *b).length() > 1e-3),
                 "{}: nothing moved",
@@ -91,28 +116,106 @@ fn random_cases_are_not_toys() {
     }
 }
 
-/// Every registered type has a golden file, or is listed in
-/// reference/NO_REFERENCE.md with the reason and the test that covers it.
+/// The kinetics golden files can fail: cellmd with a strain threshold 5 %
+/// lower, or with `partner random` instead of mutual-nearest partners, ends
+/// with other bonds than LAMMPS.
 #[test]
-fn every_interaction_has_a_golden_file_or_a_stated_reason() {
+fn kinetics_golden_files_tell_a_different_rule_apart() {
+    let mut checked = 0;
+    for path in golden_files().into_iter().filter(|p| is_kinetics(p)) {
+        for doc in documents(&path).iter().filter(|d| d.get("case") == Some("random")) {
+            let deck = Path::new("reference").join(doc.get("deck").unwrap());
+            let reference = golden::probes_of(doc).unwrap();
+            let mut plan = validate_file(&deck, &[]).unwrap();
+            for k in &mut plan.model.bond_kinetics {
+                for r in k.rules.iter_mut().filter(|r| r.rule.name() == "threshold") {
+                    r.params[0] *= 0.95;
+                }
+            }
+            for r in &mut plan.model.bind_rules {
+                r.nearest = false;
+            }
+            let ours = cellmd_probes(&plan).unwrap();
+            let agreement = Agreement::new(&ours, &reference).unwrap();
+            let mismatches = agreement.last.as_ref().unwrap().bonds.as_ref().unwrap().mismatches();
+            println!("{}: the altered rule leaves {mismatches} bonds bound in only one engine", path.display());
+            assert!(mismatches > 0, "{}: an altered rule still matches LAMMPS ({mismatches} mismatches)", path.display());
+            assert!(!agreement.agrees(golden::tolerance_of(doc).unwrap()));
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, 2, "expected the threshold and bind golden files");
+}
+
+/// The LAMMPS inputs committed beside each case are what `cellmd
+/// export-lammps` writes for its deck today (`reference/regenerate` copies
+/// them there): the golden data came from these decks.
+#[test]
+fn committed_lammps_inputs_are_current_exports() {
+    for path in golden_files() {
+        for doc in documents(&path) {
+            let deck = Path::new("reference").join(doc.get("deck").unwrap());
+            let plan = validate_file(&deck, &[]).unwrap();
+            let exported = cellmd::export::export(&plan, cellmd::export::ExportOptions { probes: true }).unwrap();
+            let dir = deck.parent().unwrap().join("lammps").join(doc.get("case").unwrap());
+            for (file, text) in [("in.lammps", &exported.input), ("data.lammps", &exported.data)] {
+                let committed = std::fs::read_to_string(dir.join(file)).unwrap_or_else(|e| panic!("{}: {e}", dir.join(file).display()));
+                assert!(
+                    &committed == text,
+                    "{}/{file} is not the current export of {}: rerun reference/regenerate",
+                    dir.display(),
+                    deck.display()
+                );
+            }
+        }
+    }
+}
+
+/// Each name has `reference/NAME.yaml` or a row `| `NAME` | reason | `test` |`
+/// in reference/NO_REFERENCE.md naming a test found in `sources`.
+fn golden_file_or_stated_reason(names: &[&str], sources: &str) {
     let listed = std::fs::read_to_string("reference/NO_REFERENCE.md").unwrap();
-    let sources: String =
-        std::fs::read_dir("src/interactions").unwrap().map(|e| std::fs::read_to_string(e.unwrap().path()).unwrap()).collect();
-    for i in REGISTRY {
-        if Path::new(&format!("reference/{}.yaml", i.name())).exists() {
-            assert!(!listed.contains(&format!("| `{}` |", i.name())), "{} has a golden file and is listed as lacking one", i.name());
+    for name in names {
+        if Path::new(&format!("reference/{name}.yaml")).exists() {
+            assert!(!listed.contains(&format!("| `{name}` |")), "{name} has a golden file and is listed as lacking one");
             continue;
         }
         let row = listed
             .lines()
-            .find(|l| l.starts_with(&format!("| `{}` |", i.name())))
-            .unwrap_or_else(|| panic!("{} has no reference/{}.yaml and no row in reference/NO_REFERENCE.md", i.name(), i.name()));
+            .find(|l| l.starts_with(&format!("| `{name}` |")))
+            .unwrap_or_else(|| panic!("{name} has no reference/{name}.yaml and no row in reference/NO_REFERENCE.md"));
         let cells: Vec<&str> = row.split('|').map(str::trim).collect();
         // | `name` | reason | `test_name` |
-        assert!(cells.len() >= 4 && !cells[2].is_empty(), "{}: no reason given", i.name());
+        assert!(cells.len() >= 4 && !cells[2].is_empty(), "{name}: no reason given");
         let test = cells[3].trim_matches('`');
-        assert!(sources.contains(&format!("fn {test}(")), "{}: the covering test `{test}` does not exist", i.name());
+        assert!(sources.contains(&format!("fn {test}(")), "{name}: the covering test `{test}` does not exist");
     }
+}
+
+fn read_sources(dirs: &[&str]) -> String {
+    dirs.iter()
+        .flat_map(|d| std::fs::read_dir(d).unwrap())
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "rs"))
+        .map(|p| std::fs::read_to_string(p).unwrap())
+        .collect()
+}
+
+/// Every registered type has a golden file, or is listed in
+/// reference/NO_REFERENCE.md with the reason and the test that covers it.
+#[test]
+fn every_interaction_has_a_golden_file_or_a_stated_reason() {
+    let names: Vec<&str> = REGISTRY.iter().map(|i| i.name()).collect();
+    golden_file_or_stated_reason(&names, &read_sources(&["src/interactions"]));
+}
+
+/// Likewise every kinetic rule, and bond formation (`bind`): LAMMPS can
+/// express only a few, the others name their test against exact results.
+#[test]
+fn every_kinetic_rule_has_a_golden_file_or_a_stated_reason() {
+    let mut names: Vec<&str> = cellmd::kinetics::RULES.iter().map(|r| r.name()).collect();
+    names.push("bind");
+    golden_file_or_stated_reason(&names, &read_sources(&["src/kinetics", "tests"]));
 }
 
 /// `reference/regenerate --check` sets CELLMD_GOLDEN_NEW=require: every

@@ -9,13 +9,15 @@
 //! - virial: max_k |ΔW_k| / max_k |W_ref,k|;
 //! - after the run: max_i |Δx_i| / max_i |x_ref,i(end) − x_ref,i(start)|, the
 //!   position error relative to the largest displacement of the run (and the
-//!   positions RMSD, absolute).
+//!   positions RMSD, absolute);
+//! - bonds (decks with kinetics): the bound bond sets must be identical; the
+//!   figure is the number of bonds bound in one engine and not the other.
 
 use std::fmt::Write;
 
 use glam::DVec3;
 
-use super::probe::{Probes, Snapshot};
+use super::probe::{BondRecord, Probes, Snapshot};
 
 /// Tolerances of a comparison.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -66,6 +68,43 @@ pub struct PointAgreement {
     pub position_max_diff: f64,
     pub position_rmsd: f64,
     pub displacement_scale: f64,
+    /// Bound bonds (decks with kinetics).
+    pub bonds: Option<BondAgreement>,
+}
+
+/// The bound bonds of both engines at one configuration.
+#[derive(Clone, Debug, Default)]
+pub struct BondAgreement {
+    pub cellmd: usize,
+    pub reference: usize,
+    /// Bound in cellmd only.
+    pub only_cellmd: Vec<BondRecord>,
+    /// Bound in the reference only.
+    pub only_reference: Vec<BondRecord>,
+}
+
+impl BondAgreement {
+    /// Compares two bond lists as multisets (a bond listed twice counts twice).
+    fn new(cellmd: &[BondRecord], reference: &[BondRecord]) -> Self {
+        let mut count: std::collections::BTreeMap<&BondRecord, i64> = std::collections::BTreeMap::new();
+        for r in cellmd {
+            *count.entry(r).or_default() += 1;
+        }
+        for r in reference {
+            *count.entry(r).or_default() -= 1;
+        }
+        let mut out = Self { cellmd: cellmd.len(), reference: reference.len(), ..Default::default() };
+        for (r, n) in count {
+            let list = if n > 0 { &mut out.only_cellmd } else { &mut out.only_reference };
+            list.extend(std::iter::repeat_n(r.clone(), n.unsigned_abs() as usize));
+        }
+        out
+    }
+
+    /// Bonds bound in one engine and not the other.
+    pub fn mismatches(&self) -> usize {
+        self.only_cellmd.len() + self.only_reference.len()
+    }
 }
 
 fn ratio(a: f64, scale: f64) -> f64 {
@@ -92,6 +131,10 @@ impl PointAgreement {
     /// The largest of all relative errors.
     pub fn worst(&self) -> f64 {
         self.force_error().max(self.virial_error()).max(self.position_error()).max(self.energy_error())
+    }
+    /// Whether both engines have the same bound bonds (or neither lists them).
+    pub fn same_bonds(&self) -> bool {
+        self.bonds.as_ref().is_none_or(|b| b.mismatches() == 0)
     }
 }
 
@@ -141,6 +184,14 @@ fn point(cellmd: &Snapshot, reference: &Snapshot, start: Option<&Snapshot>) -> R
     let dx: Vec<f64> = cellmd.positions.iter().zip(&reference.positions).map(|(a, b)| (*a - *b).length()).collect();
     let n = df.len().max(1) as f64;
     let displacement_scale = start.map_or(0.0, |s| max_norm(reference.positions.iter().zip(&s.positions).map(|(a, b)| *a - *b)));
+    let bonds = match (&cellmd.bonds, &reference.bonds) {
+        (Some(a), Some(b)) => Some(BondAgreement::new(a, b)),
+        (None, None) => None,
+        (Some(_), None) => {
+            return Err(format!("step {}: the reference has no bond list (re-record it: the deck has kinetics)", reference.step))
+        }
+        (None, Some(_)) => return Err(format!("step {}: the reference lists bonds but the deck has no kinetics", reference.step)),
+    };
     Ok(PointAgreement {
         step: reference.step,
         energies,
@@ -152,6 +203,7 @@ fn point(cellmd: &Snapshot, reference: &Snapshot, start: Option<&Snapshot>) -> R
         position_max_diff: if start.is_some() { dx.iter().copied().fold(0.0, f64::max) } else { 0.0 },
         position_rmsd: (dx.iter().map(|d| d * d).sum::<f64>() / n).sqrt(),
         displacement_scale,
+        bonds,
     })
 }
 
@@ -167,9 +219,11 @@ impl Agreement {
         Ok(Self { init, last })
     }
 
-    /// Whether every figure is within tolerance.
+    /// Whether every figure is within tolerance and the bond sets are identical.
     pub fn agrees(&self, tol: Tolerance) -> bool {
-        self.init.worst() <= tol.single_point && self.last.as_ref().is_none_or(|l| l.worst() <= tol.run)
+        self.init.worst() <= tol.single_point
+            && self.init.same_bonds()
+            && self.last.as_ref().is_none_or(|l| l.worst() <= tol.run && l.same_bonds())
     }
 
     /// The table `cellmd compare` prints, ending in the verdict.
@@ -203,6 +257,22 @@ impl Agreement {
                 l.position_error(),
                 l.energy_error()
             );
+        }
+        for (name, p) in std::iter::once(("start", &self.init)).chain(self.last.iter().map(|l| ("end", l))) {
+            let Some(b) = &p.bonds else { continue };
+            let _ = writeln!(
+                s,
+                "bonds at the {name} (step {}): {} bound in cellmd, {} in {reference}; {} bound in only one",
+                p.step,
+                b.cellmd,
+                b.reference,
+                b.mismatches()
+            );
+            for (who, list) in [("cellmd", &b.only_cellmd), (reference, &b.only_reference)] {
+                for r in list.iter().take(10) {
+                    let _ = writeln!(s, "  only in {who}: {} {} {}", r.bond_type, r.ids[0], r.ids[1]);
+                }
+            }
         }
         let verdict = if self.agrees(tol) { "AGREE" } else { "DISAGREE" };
         let _ = writeln!(s, "verdict: {verdict} (tolerance {:.0e} at one configuration, {:.0e} after the run)", tol.single_point, tol.run);

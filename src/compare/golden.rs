@@ -2,7 +2,8 @@
 //! LAMMPS' force-style test files, written and read in a small YAML subset:
 //! documents start with `---`; entries are `key: value` or a literal block
 //! `key: ! |` followed by lines indented by two blanks; `#` starts a comment
-//! line. One document per reference case.
+//! line. One document per reference case. Decks whose bonds break or form
+//! also record the bound bonds (`init_bonds`, `run_bonds`: `type id id`).
 //!
 //! ```text
 //! ---
@@ -27,7 +28,7 @@ use nom::sequence::{delimited, preceded, terminated};
 use nom::{IResult, Parser};
 
 use super::agreement::Tolerance;
-use super::probe::{Probes, Snapshot};
+use super::probe::{BondRecord, Probes, Snapshot};
 
 /// One document: its entries in file order.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -98,7 +99,8 @@ pub fn write(docs: &[Document]) -> String {
     for d in docs {
         s += "---\n";
         for (k, v) in &d.entries {
-            if v.contains('\n') {
+            // Multi-line values, and empty ones (an empty bond list), as blocks.
+            if v.contains('\n') || v.is_empty() {
                 s += &format!("{k}: ! |\n");
                 for line in v.lines() {
                     s += &format!("  {line}\n");
@@ -122,6 +124,12 @@ fn put_snapshot(d: &mut Document, prefix: &str, s: &Snapshot) {
     d.push(&format!("{prefix}_stress"), format!("{}\n", s.virial.iter().map(|w| format!("{w:?}")).collect::<Vec<_>>().join(" ")));
     d.push(&format!("{prefix}_forces"), vectors_block(&s.ids, &s.forces));
     d.push(&format!("{prefix}_positions"), vectors_block(&s.ids, &s.positions));
+    if let Some(bonds) = &s.bonds {
+        d.push(
+            &format!("{prefix}_bonds"),
+            bonds.iter().map(|b| format!("{} {} {}\n", b.bond_type, b.ids[0], b.ids[1])).collect::<String>(),
+        );
+    }
 }
 
 /// A golden document holding a reference run's probes. `header` comes first
@@ -179,7 +187,22 @@ fn get_snapshot(d: &Document, prefix: &str) -> Result<Snapshot, String> {
         return Err(format!("`{}` and `{}` list different ids", key("forces"), key("positions")));
     }
     let step = d.number(&key("step"))? as u64;
-    Ok(Snapshot { step, energies, virial, ids, positions, forces })
+    let bonds = match d.get(&key("bonds")) {
+        None => None,
+        Some(block) => Some(
+            block
+                .lines()
+                .map(|line| {
+                    let bad = || format!("`{}`: expected `type id id`, found `{line}`", key("bonds"));
+                    match line.split_whitespace().collect::<Vec<_>>()[..] {
+                        [t, a, b] => Ok(BondRecord::new(t, a.parse().map_err(|_| bad())?, b.parse().map_err(|_| bad())?)),
+                        _ => Err(bad()),
+                    }
+                })
+                .collect::<Result<Vec<_>, _>>()?,
+        ),
+    };
+    Ok(Snapshot { step, energies, virial, ids, positions, forces, bonds })
 }
 
 /// The probes stored in a golden document.
@@ -201,7 +224,10 @@ mod tests {
         s.forces = vec![DVec3::new(0.1, -2.5e-17, 3.0), DVec3::new(1.0 / 3.0, 0.0, -0.0)];
         s.positions = vec![DVec3::new(1.0, 2.0, 3.0), DVec3::new(-4.0, 5.5, 1e10)];
         s.virial = [1.0, 2.0, 3.0, -0.1, 0.2, 0.3];
-        let probes = Probes { init: s.clone(), last: Some(s) };
+        let mut last = s.clone();
+        s.bonds = Some(vec![BondRecord::new("link", 7, 1)]);
+        last.bonds = Some(Vec::new());
+        let probes = Probes { init: s, last: Some(last) };
         let doc = document_of(&[("generator", "test".into()), ("epsilon", "1e-10".into())], &probes);
         let text = format!("# a comment\n{}{}", write(std::slice::from_ref(&doc)), write(&[doc]));
         let docs = parse(&text).unwrap();

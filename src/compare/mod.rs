@@ -2,8 +2,9 @@
 //!
 //! The deck is exported with probes ([`crate::export`]), LAMMPS runs it in a
 //! scratch directory, and both engines are probed before the first `run` and
-//! after the last: energy per interaction type, forces, virial, and (after
-//! the run) positions. [`Agreement`] turns the two into relative errors and a
+//! after the last: energy per interaction type, forces, virial, (after the
+//! run) positions, and for decks whose bonds break or form the list of bound
+//! bonds, which must be identical. [`Agreement`] turns the two into relative errors and a
 //! verdict. The golden files under `reference/` ([`golden`]) store LAMMPS'
 //! probes so that `cargo test` checks cellmd against them without LAMMPS.
 //!
@@ -17,8 +18,8 @@ mod probe;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-pub use self::agreement::{Agreement, EnergyRow, PointAgreement, Tolerance};
-pub use self::probe::{cellmd_probes, lammps_probes, Probes, Snapshot};
+pub use self::agreement::{Agreement, BondAgreement, EnergyRow, PointAgreement, Tolerance};
+pub use self::probe::{cellmd_probes, lammps_probes, BondRecord, Probes, Snapshot};
 use crate::deck::Plan;
 use crate::export::lammps::{self, ExportOptions};
 
@@ -80,5 +81,6 @@ pub fn run_lammps(plan: &Plan, lmp: &Lmp, dir: &Path) -> Result<(Probes, String)
     let deck = lammps::export(plan, ExportOptions { probes: true })?;
     lammps::write(&deck, dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let version = lmp.run(dir)?;
-    Ok((lammps_probes(dir)?, version))
+    let bond_types: Vec<String> = plan.model.bond_types.iter().map(|t| t.label.text.clone()).collect();
+    Ok((lammps_probes(dir, &bond_types)?, version))
 }

@@ -24,6 +24,22 @@ pub struct Snapshot {
     /// Unwrapped positions.
     pub positions: Vec<DVec3>,
     pub forces: Vec<DVec3>,
+    /// The bound bonds, sorted, for decks whose bonds break or form
+    /// (kinetics); `None` when the bond list is fixed.
+    pub bonds: Option<Vec<BondRecord>>,
+}
+
+/// A bound bond: its type name and its particles' ids (smaller first).
+#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct BondRecord {
+    pub bond_type: String,
+    pub ids: [u64; 2],
+}
+
+impl BondRecord {
+    pub fn new(bond_type: &str, a: u64, b: u64) -> Self {
+        Self { bond_type: bond_type.to_string(), ids: [a.min(b), a.max(b)] }
+    }
 }
 
 impl Snapshot {
@@ -57,7 +73,23 @@ fn snapshot(sim: &mut Simulation) -> Result<Snapshot, String> {
         ids: order.iter().map(|&i| sim.model.ids[i]).collect(),
         positions: order.iter().map(|&i| sim.sim_box.unwrap(sim.state.positions[i], sim.state.images[i])).collect(),
         forces: order.iter().map(|&i| f.forces[i]).collect(),
+        bonds: sim.model.has_kinetics().then(|| bound_bonds(sim)),
     })
+}
+
+/// The bonds bound now, sorted.
+fn bound_bonds(sim: &Simulation) -> Vec<BondRecord> {
+    let m = &sim.model;
+    let bound = sim.state.bonds.as_ref().map(|b| &b.bound);
+    let mut bonds: Vec<BondRecord> = (0..m.bonds.len())
+        .filter(|&b| bound.is_none_or(|bound| bound[b]))
+        .map(|b| {
+            let [i, j] = m.bonds[b];
+            BondRecord::new(&m.bond_types[m.bond_type[b] as usize].label.text, m.ids[i as usize], m.ids[j as usize])
+        })
+        .collect();
+    bonds.sort();
+    bonds
 }
 
 /// Runs a deck in cellmd (without writing any output) and probes it before
@@ -74,6 +106,7 @@ pub fn cellmd_probes(plan: &Plan) -> Result<Probes, String> {
             Action::Dump(_)
             | Action::Undump(_)
             | Action::ThermoFile(_)
+            | Action::EventFile(_)
             | Action::WriteState(_)
             | Action::Print(_)
             | Action::Thermo { .. } => {}
@@ -110,8 +143,27 @@ fn read_dump(path: &Path, snapshot: &mut Snapshot) -> Result<(), String> {
     Ok(())
 }
 
-/// Reads the probe files a LAMMPS run of an exported deck wrote into `dir`.
-pub fn lammps_probes(dir: &Path) -> Result<Probes, String> {
+/// Reads a LAMMPS `write_dump ... local ... index btype batom1 batom2` file;
+/// `names` are the bond type names by LAMMPS type number − 1.
+fn read_bonds(path: &Path, names: &[String]) -> Result<Vec<BondRecord>, String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let (_, body) = text.split_once("ITEM: ENTRIES").ok_or_else(|| format!("{}: no ENTRIES section", path.display()))?;
+    let mut bonds = Vec::new();
+    for line in body.lines().skip(1) {
+        let bad = || format!("{}: expected `index type atom1 atom2`, found `{line}`", path.display());
+        let v: Vec<u64> = line.split_whitespace().map(|w| w.parse::<u64>()).collect::<Result<_, _>>().map_err(|_| bad())?;
+        let [_, t, a, b] = v[..] else { return Err(bad()) };
+        let name = names.get((t as usize).wrapping_sub(1)).ok_or_else(bad)?;
+        bonds.push(BondRecord::new(name, a, b));
+    }
+    bonds.sort();
+    Ok(bonds)
+}
+
+/// Reads the probe files a LAMMPS run of an exported deck wrote into `dir`;
+/// `bond_types` names LAMMPS' bond types 1, 2, … (for the bond lists that
+/// decks with kinetics probe).
+pub fn lammps_probes(dir: &Path, bond_types: &[String]) -> Result<Probes, String> {
     let path = dir.join(PROBE_FILE);
     let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
     let mut snapshots: Vec<(String, Snapshot)> = Vec::new();
@@ -139,6 +191,10 @@ pub fn lammps_probes(dir: &Path) -> Result<Probes, String> {
     let mut last = None;
     for (tag, mut s) in snapshots {
         read_dump(&dir.join(format!("cellmd_probe_{tag}.dump")), &mut s)?;
+        let bonds = dir.join(format!("cellmd_probe_{tag}.bonds"));
+        if bonds.exists() {
+            s.bonds = Some(read_bonds(&bonds, bond_types)?);
+        }
         match tag.as_str() {
             "init" => init = Some(s),
             _ => last = Some(s),

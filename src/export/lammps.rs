@@ -13,7 +13,29 @@
 //! the script writes `cellmd_probe.txt` (step, energy by interaction, virial
 //! W = P·V) and `cellmd_probe_init.dump` / `cellmd_probe_final.dump` (id,
 //! unwrapped positions and forces, 17 digits) before the first and after the
-//! last run; [`crate::compare`] reads them back.
+//! last run; [`crate::compare`] reads them back. Decks with kinetics also
+//! get `cellmd_probe_init.bonds` / `cellmd_probe_final.bonds` (the bound
+//! bonds: type, atom, atom).
+//!
+//! Bond kinetics: LAMMPS has no force-dependent bond kinetics, but two
+//! cellmd rules have an exact counterpart, and only these are exported:
+//! - a `threshold` with a `strain` S only (no `force`, `spread` or `rate`) on
+//!   a law with `r0` becomes `fix bond/break 1 TYPE r0·(1 + S)`;
+//! - `bind A B TYPE … partner nearest` whose binding is certain in one step
+//!   (1 − exp(−k_on·dt) = 1 in f64, k_on·dt ≳ 37) becomes `fix bond/create 1
+//!   A B capture TYPE iparam N A jparam N B` (N = `max_bonds`), with a `zero`
+//!   pair style reaching the capture radius so that LAMMPS sees the pairs.
+//!
+//! The final bond sets agree when the bonded particles do not move (`fixed`
+//! types, as in `reference/threshold` and `reference/bind`); what differs
+//! per step is documented with the reference cases: LAMMPS breaks at most one
+//! bond per atom per step (the longest, if it is its partner's longest too)
+//! and only stretched ones, while cellmd breaks every bond beyond its
+//! threshold at once, compressed ones included; LAMMPS tests lengths after the
+//! step's move, cellmd those of the step's force pass. Formation is the same
+//! rule in both (each particle's nearest eligible partner, bonded when that
+//! choice is mutual, one new bond per particle and rule per step), except
+//! that LAMMPS never bonds a pair already bonded by another bond type.
 
 use std::collections::BTreeMap;
 use std::fmt::Write;
@@ -22,6 +44,7 @@ use super::styles::{self, num, PairStyled, Styled};
 use crate::deck::{Action, CoeffTarget, Plan};
 use crate::forcefield::TermType;
 use crate::integrate::rng::Noise;
+use crate::kinetics::deterministic_strain;
 use crate::system::{External, Model};
 use crate::units::UnitSystem;
 
@@ -216,6 +239,106 @@ fn bonded_extent(plan: &Plan) -> f64 {
     bonds.chain(angles).fold(0.0, f64::max)
 }
 
+/// The LAMMPS fixes that stand for a deck's bond kinetics.
+#[derive(Clone, Debug, Default)]
+struct KineticFixes {
+    /// Bond types broken by `fix bond/break`.
+    breaks: Vec<usize>,
+    /// Bind rules done by `fix bond/create`.
+    creates: Vec<usize>,
+}
+
+impl KineticFixes {
+    /// The largest capture radius of the exported bind rules (0: none).
+    fn capture(&self, model: &Model) -> f64 {
+        self.creates.iter().map(|&k| model.bind_rules[k].capture).fold(0.0, f64::max)
+    }
+}
+
+/// The `fix bond/break` length Rmax = r0·(1 + S) of a bond type whose only
+/// rule is a deterministic strain threshold; any other kinetics is refused.
+fn bond_break_length(model: &Model, t: usize) -> Result<f64, String> {
+    let kinetics = &model.bond_kinetics[t];
+    let label = &model.bond_types[t].label.text;
+    let names: Vec<&str> = kinetics.rules.iter().map(|r| r.rule.name()).collect();
+    match kinetics.rules.as_slice() {
+        [r] if r.rule.name() == "threshold" => {
+            let strain = deterministic_strain(&r.params).ok_or_else(|| {
+                format!("bond type `{label}`: only a `threshold` with a `strain` alone (no `force`, `spread` or `rate`) maps to LAMMPS `fix bond/break`; export the deck without it")
+            })?;
+            let r0 = kinetics.rest_index.map(|k| model.bond_types[t].params[k]).ok_or_else(|| {
+                format!("bond type `{label}`: its law `{}` has no `r0`, so its strain threshold has no LAMMPS length", model.bond_types[t].interaction.name())
+            })?;
+            Ok(r0 * (1.0 + strain))
+        }
+        _ => Err(format!(
+            "bond type `{label}` has kinetic rules ({}): LAMMPS has no force-dependent bond kinetics; it expresses only a strain `threshold` (fix bond/break) and certain `bind ... partner nearest` (fix bond/create); export the deck without them",
+            names.join(", ")
+        )),
+    }
+}
+
+/// The fixes for a deck's kinetics, or why LAMMPS cannot express them.
+fn kinetic_fixes(plan: &Plan) -> Result<KineticFixes, String> {
+    let m = &plan.model;
+    let mut fixes = KineticFixes::default();
+    for (t, kinetics) in m.bond_kinetics.iter().enumerate() {
+        if !kinetics.rules.is_empty() {
+            bond_break_length(m, t)?;
+            fixes.breaks.push(t);
+        }
+    }
+    let steps: Vec<f64> = plan.actions.iter().filter_map(|a| if let Action::Timestep(dt) = a { Some(*dt) } else { None }).collect();
+    for (k, r) in m.bind_rules.iter().enumerate() {
+        let bond = &m.bond_types[r.bond_type as usize].label.text;
+        let name = format!("`bind {} {} {bond}`", m.type_names[r.type_a as usize], m.type_names[r.type_b as usize]);
+        if !r.nearest {
+            return Err(format!(
+                "{name} has `partner random`: LAMMPS `fix bond/create` binds mutual-nearest partners only (`partner nearest`)"
+            ));
+        }
+        if let Some(dt) = steps.iter().find(|&&dt| -(-r.k_on * dt).exp_m1() < 1.0) {
+            return Err(format!(
+                "{name}: binding is not certain within a step (k_on·dt = {:e}); LAMMPS `fix bond/create` binds every eligible pair at once: export it with k_on·dt ≥ 40",
+                r.k_on * dt
+            ));
+        }
+        if !m.bond_kinetics[r.bond_type as usize].rules.is_empty() {
+            return Err(format!(
+                "{name}: bond type `{bond}` also has kinetic rules; LAMMPS `fix bond/create` does not count bonds that other fixes break"
+            ));
+        }
+        if m.bind_rules.iter().filter(|o| o.bond_type == r.bond_type).count() > 1 {
+            return Err(format!(
+                "{name}: several `bind` lines form `{bond}`; each LAMMPS `fix bond/create` counts only the bonds it made itself"
+            ));
+        }
+        let sb = m.special_bonds;
+        if sb.exclude_13 || sb.exclude_14 {
+            return Err(format!(
+                "{name}: `special_bonds` excludes 1-3 or 1-4 neighbours, which LAMMPS leaves out of `fix bond/create`'s neighbour list while cellmd binds them"
+            ));
+        }
+        fixes.creates.push(k);
+    }
+    Ok(fixes)
+}
+
+/// `read_data` room for the bonds `fix bond/create` adds: per atom, the
+/// new bonds, and the special list of 1-2, 1-3 and 1-4 neighbours they can
+/// make (m + m(m − 1) + m(m − 1)² for m bonds per atom).
+fn extra_per_atom(model: &Model, fixes: &KineticFixes) -> (usize, usize) {
+    let new: usize = fixes.creates.iter().map(|&k| model.bind_rules[k].max_bonds as usize).sum();
+    let mut count = vec![0usize; model.len()];
+    for &[i, j] in &model.bonds {
+        count[i as usize] += 1;
+        count[j as usize] += 1;
+    }
+    let m = count.iter().copied().max().unwrap_or(0) + new;
+    let fan = m.saturating_sub(1);
+    (new, m + m * fan + m * fan * fan)
+}
+
 /// State of the script being written.
 struct Writer<'a> {
     plan: &'a Plan,
@@ -227,6 +350,8 @@ struct Writer<'a> {
     pairs: Pairs,
     /// Active externals: LAMMPS fix id and cellmd interaction name.
     fixes: Vec<(String, &'static str)>,
+    /// `fix bond/break` and `fix bond/create` standing for the kinetics.
+    kinetic: KineticFixes,
     kt: f64,
     seed: u64,
     noise: Noise,
@@ -245,7 +370,12 @@ impl Writer<'_> {
         self.line("units lj");
         self.line("atom_style angle");
         self.line(format!("boundary {}", letters.join(" ")));
-        self.line(format!("read_data {DATA_FILE}"));
+        if self.kinetic.creates.is_empty() {
+            self.line(format!("read_data {DATA_FILE}"));
+        } else {
+            let (bonds, special) = extra_per_atom(&self.model, &self.kinetic);
+            self.line(format!("read_data {DATA_FILE} extra/bond/per/atom {bonds} extra/special/per/atom {special}"));
+        }
         let sb = self.model.special_bonds;
         let w = |excluded: bool| if excluded { "0.0" } else { "1.0" };
         self.line(format!("special_bonds lj {} {} {}", w(sb.exclude_12), w(sb.exclude_13), w(sb.exclude_14)));
@@ -263,16 +393,29 @@ impl Writer<'_> {
                 self.out += &format!("angle_coeff {} {} {}\n", t + 1, s.style, s.coeffs);
             }
         }
+        // `fix bond/create` looks for partners in a pair neighbour list: a
+        // `zero` style (no forces) makes it reach the capture radius.
+        let capture = self.kinetic.capture(&self.model);
+        if self.pairs.instances.is_empty() && capture > 0.0 {
+            self.line(format!("pair_style zero {}", num(capture)));
+            self.line("pair_coeff * *");
+        }
         if !self.pairs.instances.is_empty() {
             let cut = num(self.pairs.max_cutoff);
-            let list: Vec<String> = self
+            let mut list: Vec<String> = self
                 .pairs
                 .instances
                 .iter()
                 .map(|i| if i.style == "harmonic/cut" { i.style.to_string() } else { format!("{} {cut}", i.style) })
                 .collect();
+            if capture > 0.0 {
+                list.push(format!("zero {}", num(capture)));
+            }
             self.line(format!("pair_style hybrid/overlay {}", list.join(" ")));
             self.line("pair_coeff * * none");
+            if capture > 0.0 {
+                self.line("pair_coeff * * zero");
+            }
             for (rule, term) in self.model.pair_rules.clone().iter().enumerate() {
                 let line = self.pairs.coeff_line(&self.model, rule, term)?;
                 self.line(line);
@@ -284,10 +427,18 @@ impl Writer<'_> {
         let skin = self.plan_skin();
         self.line(format!("neighbor {} bin", num(skin)));
         self.line("neigh_modify every 1 delay 0 check yes");
-        let ghost = (self.pairs.max_cutoff + skin).max(2.0 * bonded_extent(self.plan) + skin);
+        let ghost = (self.pairs.max_cutoff.max(capture) + skin).max(2.0 * bonded_extent(self.plan) + skin);
         self.line(format!("comm_modify cutoff {}", num(ghost)));
         for t in 0..self.model.type_names.len() {
             self.line(format!("group cellmd_t{} type {}", t + 1, t + 1));
+        }
+        for t in self.kinetic.breaks.clone() {
+            self.bond_break(t)?;
+        }
+        for k in self.kinetic.creates.clone() {
+            let r = &self.model.bind_rules[k];
+            let (a, b, bt, n) = (r.type_a + 1, r.type_b + 1, r.bond_type + 1, r.max_bonds);
+            self.line(format!("fix cellmd_bind{} all bond/create 1 {a} {b} {} {bt} iparam {n} {a} jparam {n} {b}", k + 1, num(r.capture)));
         }
         if self.options.probes {
             if !self.bonds.styles.is_empty() {
@@ -300,6 +451,9 @@ impl Writer<'_> {
                 self.line(format!("compute cellmd_pair{k} all pair {inst}"));
             }
             self.line("compute cellmd_virial all pressure NULL virial");
+            if self.model.has_kinetics() {
+                self.line("compute cellmd_bonds all property/local btype batom1 batom2");
+            }
         }
         self.thermo_style();
         Ok(())
@@ -357,6 +511,16 @@ impl Writer<'_> {
             self.line(format!("print \"{text}\" {mode} {PROBE_FILE} screen no"));
         }
         self.line(format!("write_dump all custom cellmd_probe_{tag}.dump id xu yu zu fx fy fz modify format float %.17g sort id"));
+        if self.model.has_kinetics() {
+            self.line(format!("write_dump all local cellmd_probe_{tag}.bonds index c_cellmd_bonds[1] c_cellmd_bonds[2] c_cellmd_bonds[3]"));
+        }
+    }
+
+    /// `fix bond/break` for bond type `t` at its current r0.
+    fn bond_break(&mut self, t: usize) -> Result<(), String> {
+        let rmax = bond_break_length(&self.model, t)?;
+        self.line(format!("fix cellmd_break{} all bond/break 1 {} {}", t + 1, t + 1, num(rmax)));
+        Ok(())
     }
 
     fn brownian(&mut self) {
@@ -421,6 +585,11 @@ impl Writer<'_> {
                 self.model.bond_types[*k].params[param] = value;
                 let s = styles::bond(&self.model.bond_types[*k])?;
                 self.line(format!("bond_coeff {} {} {}", k + 1, s.style, s.coeffs));
+                if self.kinetic.breaks.contains(k) {
+                    // A new r0 moves the break length.
+                    self.line(format!("unfix cellmd_break{}", k + 1));
+                    self.bond_break(*k)?;
+                }
             }
             CoeffTarget::AngleType(k) => {
                 self.model.angle_types[*k].params[param] = value;
@@ -504,14 +673,7 @@ impl Writer<'_> {
 /// are errors naming them.
 pub fn export(plan: &Plan, options: ExportOptions) -> Result<LammpsDeck, String> {
     let model = plan.model.clone();
-    if let Some((t, kinetics)) = model.bond_kinetics.iter().enumerate().find(|(_, k)| !k.rules.is_empty()) {
-        let rules: Vec<&str> = kinetics.rules.iter().map(|r| r.rule.name()).collect();
-        return Err(format!(
-            "bond type `{}` has kinetic rules ({}): LAMMPS has no force-dependent bond kinetics (only `fix bond/break` by length); export the deck without them",
-            model.bond_types[t].label.text,
-            rules.join(", ")
-        ));
-    }
+    let kinetic = kinetic_fixes(plan)?;
     let bonds = Hybrid::new(&model.bond_types, styles::bond)?;
     let angles = Hybrid::new(&model.angle_types, styles::angle)?;
     let pairs = Pairs::new(&model)?;
@@ -526,6 +688,7 @@ pub fn export(plan: &Plan, options: ExportOptions) -> Result<LammpsDeck, String>
         angles,
         pairs,
         fixes: Vec::new(),
+        kinetic,
         kt: 0.0,
         seed: 1,
         noise: Noise::Uniform,

@@ -43,6 +43,7 @@ pub use self::engine::{initial_bond_state, Kinetics, KineticsReport};
 pub use self::events::{Event, EventKind, EventLog};
 pub use self::formation::{parse_bind, BindLine, BindRule, Binding, Formation};
 pub use self::state::{BondState, FormedBond};
+pub(crate) use self::threshold::deterministic_strain;
 
 /// Every registered kinetic rule.
 pub static RULES: &[&dyn KineticRule] = &[

@@ -27,6 +27,13 @@ pub(crate) fn beyond(p: &[f64], force: f64, strain: f64, u: f64) -> Option<f64> 
     (over_strain || over_force).then(|| if p[RATE] > 0.0 { p[RATE] } else { f64::INFINITY })
 }
 
+/// The strain threshold of a deterministic strain-only rule (no force
+/// criterion, no spread, breaking at once), which LAMMPS `fix bond/break`
+/// can express; `None` otherwise.
+pub(crate) fn deterministic_strain(p: &[f64]) -> Option<f64> {
+    (p[STRAIN] > 0.0 && p[FORCE] == 0.0 && p[SPREAD] == 0.0 && p[RATE] == 0.0).then_some(p[STRAIN])
+}
+
 fn validate(p: &[f64]) -> Result<(), String> {
     if p[STRAIN] == 0.0 && p[FORCE] == 0.0 {
         return Err("a `strain` or `force` threshold > 0".into());
@@ -58,5 +65,8 @@ mod tests {
         let r = [0.0, 3.0, 0.0, 7.0];
         assert_eq!(beyond(&r, 3.5, 0.0, 0.5), Some(7.0));
         assert!(validate(&[0.0, 0.0, 0.0, 0.0]).is_err());
+        assert_eq!(deterministic_strain(&p), Some(0.5));
+        assert_eq!(deterministic_strain(&q), None);
+        assert_eq!(deterministic_strain(&r), None);
     }
 }
