@@ -494,10 +494,11 @@ impl Simulation {
         }
     }
 
-    /// The steps up to `last` on the GPU. The state is read back where an
+    /// The steps up to `last` on the GPU. The host synchronises where an
     /// output is due (thermo, dump, the end) and at least every
-    /// [`GPU_SYNC_STEPS`] steps (progress, blow-up checks); thermo quantities
-    /// are then computed by the CPU backend at the read-back positions.
+    /// [`GPU_SYNC_STEPS`] steps (progress, blow-up checks), reading back the
+    /// positions only where an output needs them; thermo quantities are then
+    /// computed by the CPU backend at the read-back positions.
     fn run_gpu(&mut self, context: &GpuContext, last: u64, bar: &Option<ProgressBar>) -> Result<(), RunError> {
         let settings = StepSettings {
             dt: self.dt,
@@ -517,12 +518,19 @@ impl Simulation {
                 Ok(done) => *done,
                 Err(GpuHalt::Blowup { step, .. }) => step - self.state.step,
             };
-            gpu.download(&mut self.state);
             for _ in 0..done {
                 self.state.step += 1;
                 self.state.time += self.dt;
             }
             self.forces_current = false;
+            let final_step = self.state.step == last;
+            let thermo_due = self.thermo.every > 0 && self.state.step.is_multiple_of(self.thermo.every);
+            let dump_due = self.dumps.iter().any(|d| self.state.step.is_multiple_of(d.spec.every));
+            // Positions come back only when something reads them; between
+            // outputs the sync only reads the GPU's status words.
+            if final_step || thermo_due || dump_due || outcome.is_err() {
+                gpu.download(&mut self.state);
+            }
             if let Err(GpuHalt::Blowup { particle, .. }) = outcome {
                 self.refresh_cpu_forces(false)?;
                 let what = format!(
@@ -532,8 +540,6 @@ impl Simulation {
                 );
                 return Err(self.blowup(particle, what));
             }
-            let final_step = self.state.step == last;
-            let thermo_due = self.thermo.every > 0 && self.state.step.is_multiple_of(self.thermo.every);
             if thermo_due || final_step {
                 self.refresh_cpu_forces(true)?;
             }
