@@ -278,7 +278,7 @@ fn profile_gpu(plan: &cellmd::deck::Plan, repetitions: u32, rebuild_rate: Option
             (probe.neighbor_builds() - before).saturating_sub(1) as f64 / done.max(1) as f64
         }
     };
-    let t = gpu.profile(repetitions);
+    let t = gpu.profile(repetitions)?;
     let step = t.check + rate * t.neighbor_build + t.forces + t.integrate;
     let n = sim.model.len() as f64;
     println!("device: {}", context.describe());

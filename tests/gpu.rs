@@ -81,7 +81,7 @@ fn gpu_neighbour_list_equals_brute_force_pair_set() {
             let state = initial_state(&plan);
             let skin = 0.4;
             let mut gpu = GpuBackend::new(&context(), &plan.model, &state, &plan.sim_box, &settings(skin, 1e-3, 0.0)).unwrap();
-            gpu.evaluate();
+            gpu.evaluate().unwrap();
             let range = plan.model.max_pair_cutoff() + skin;
             let pairs =
                 assert_same_pairs(&gpu.neighbor_lists(), &brute_force_pairs(&plan, &state, range), range, &format!("periodic {periodic}"));
@@ -110,7 +110,7 @@ fn gpu_forces_match_cpu_on_the_mixed_random_system() {
         let mut forces = Forces::default();
         cpu.compute(&plan.model, &state, &plan.sim_box, &mut forces);
         let mut gpu = GpuBackend::new(&context(), &plan.model, &state, &plan.sim_box, &settings(0.4, 1e-3, 0.0)).unwrap();
-        gpu.evaluate();
+        gpu.evaluate().unwrap();
         let (force_error, energy_error) = compare_forces(&forces, &gpu.forces_and_energies());
         eprintln!("periodic {periodic}: force error {force_error:e}, energy error {energy_error:e}");
         assert!(force_error < 1e-5, "periodic {periodic}: force error {force_error:e}");
@@ -155,7 +155,7 @@ fn gpu_matches_cpu_on_every_golden_case() {
         let mut forces = Forces::default();
         cpu.compute(&model, &state, &plan.sim_box, &mut forces);
         let mut gpu = GpuBackend::new(&context, &model, &state, &plan.sim_box, &settings(0.3, 1e-3, 0.0)).unwrap();
-        gpu.evaluate();
+        gpu.evaluate().unwrap();
         let (force_error, energy_error) = compare_forces(&forces, &gpu.forces_and_energies());
         println!("{:40} force {force_error:.2e}  energy {energy_error:.2e}  (gpu_epsilon {epsilon:e})", deck.display());
         assert!(
@@ -174,10 +174,10 @@ fn dispatches_split_along_y_give_the_same_list() {
     let plan = case.plan();
     let state = initial_state(&plan);
     let mut wide = GpuBackend::new(&context(), &plan.model, &state, &plan.sim_box, &settings(0.4, 1e-3, 0.0)).unwrap();
-    wide.evaluate();
+    wide.evaluate().unwrap();
     let mut narrow = GpuBackend::new(&context(), &plan.model, &state, &plan.sim_box, &settings(0.4, 1e-3, 0.0)).unwrap();
     narrow.limit_dispatch_width(1); // 400 particles: 2 workgroups, dispatched as 1 × 2
-    narrow.evaluate();
+    narrow.evaluate().unwrap();
     assert_eq!(wide.neighbor_lists(), narrow.neighbor_lists());
     assert_eq!(wide.forces_and_energies(), narrow.forces_and_energies());
 }
@@ -202,7 +202,7 @@ fn neighbour_list_overflow_grows_the_list_and_drops_nothing() {
     let state = initial_state(&plan);
     let mut gpu = GpuBackend::new(&context(), &plan.model, &state, &plan.sim_box, &settings(0.2, 1e-3, 0.0)).unwrap();
     let first_capacity = gpu.neighbor_capacity();
-    gpu.evaluate();
+    gpu.evaluate().unwrap();
     assert!(gpu.neighbor_list_growths() >= 1, "capacity {first_capacity} did not overflow: the test would be vacuous");
     let range = 0.7;
     assert_same_pairs(&gpu.neighbor_lists(), &brute_force_pairs(&plan, &state, range), range, "clustered");
@@ -233,7 +233,7 @@ fn neighbour_list_after_particles_cross_the_boundaries() {
     let crossed = state.images.iter().filter(|i| i.iter().any(|&k| k != 0)).count();
     assert!(crossed >= 10, "only {crossed} particles crossed a face");
     assert!(gpu.neighbor_builds() >= 3, "{} builds: the displacement trigger never fired", gpu.neighbor_builds());
-    gpu.evaluate();
+    gpu.evaluate().unwrap();
     let range = plan.model.max_pair_cutoff() + 0.4;
     assert_same_pairs(&gpu.neighbor_lists(), &brute_force_pairs(&plan, &state, range), range, "after crossing");
 }
@@ -446,4 +446,37 @@ fn thermal_runs_have_the_same_statistics_and_the_same_first_steps() {
     let worst = cpu.positions.iter().zip(&gpu.positions).map(|(c, g)| (*c - *g).abs().max_element()).fold(0.0, f64::max);
     println!("first 3 steps: largest GPU − CPU component {worst:e} (noise amplitude {amplitude:e})");
     assert!(worst < 3.0 * 4.0 * amplitude * 2f64.powi(-22), "GPU − CPU after 3 steps {worst:e}: the noise streams differ");
+}
+
+/// A neighbour list larger than the adapter can bind is refused with a
+/// message (wgpu would abort the process). On llvmpipe (128 MiB bindings) the
+/// 100 000 dense particles below need about 150 MiB.
+#[test]
+fn a_neighbour_list_beyond_the_binding_limit_is_an_error_not_an_abort() {
+    let context = context();
+    let n = 100_000;
+    let (l, range) = (10.0f64, 1.0f64);
+    let mut top = String::from("[ particles ]\n");
+    let mut seed = 99u64;
+    let mut next = || {
+        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64 * l
+    };
+    for id in 1..=n {
+        top += &format!("{id} a {} {} {}\n", next(), next(), next());
+    }
+    let deck = format!("units lj\ntopology t.top\nforcefield f.ff\nbox x 0 {l} p y 0 {l} p z 0 {l} p\n");
+    let case = common::Case::new(&[("t.top", &top), ("f.ff", "particle a drag 1\npair a a soft A 1 rc 0.9\n"), ("deck.in", &deck)]);
+    let plan = case.plan();
+    let state = initial_state(&plan);
+    let mean = n as f64 / l.powi(3) * 4.0 / 3.0 * std::f64::consts::PI * range.powi(3);
+    let needed = 4.0 * n as f64 * (1.25 * mean + 9.0);
+    let limit = context.limits.max_storage_buffer_binding_size as f64;
+    match GpuBackend::new(&context, &plan.model, &state, &plan.sim_box, &settings(0.1, 1e-3, 0.0)) {
+        Err(e) => {
+            assert!(needed > limit, "refused although {needed} bytes fit in {limit}: {e}");
+            assert!(e.contains("neighbour list") && e.contains("MiB"), "{e}");
+        }
+        Ok(_) => assert!(needed <= limit, "accepted {needed} bytes beyond the limit {limit}"),
+    }
 }

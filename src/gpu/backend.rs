@@ -37,6 +37,9 @@ pub enum GpuHalt {
     /// The step of `particle` (internal index) was refused at `step`; the
     /// state is that of `step`.
     Blowup { step: u64, particle: usize },
+    /// The neighbour list had to grow beyond what the adapter can bind; the
+    /// state is that of `step`.
+    Capacity { step: u64, message: String },
 }
 
 /// Seconds per call of each phase of a step, each timed alone
@@ -109,6 +112,25 @@ pub struct GpuBackend {
     kernels: Kernels,
     builds: u64,
     grown: u32,
+}
+
+/// Refuses a storage buffer the adapter cannot bind (wgpu would abort).
+fn check_binding(ctx: &GpuContext, what: &str, bytes: u64) -> Result<(), String> {
+    let limit = ctx.limits.max_storage_buffer_binding_size.min(ctx.limits.max_buffer_size);
+    if bytes > limit {
+        return Err(format!(
+            "{what} needs {:.0} MiB, more than the largest storage buffer {} can bind ({:.0} MiB); \
+             reduce the particle count, the cutoff or the neighbour skin, use a GPU with a larger limit, or `device cpu`",
+            bytes as f64 / 1048576.0,
+            ctx.info.name,
+            limit as f64 / 1048576.0
+        ));
+    }
+    Ok(())
+}
+
+fn nlist_bytes(n: u32, cap: u32) -> u64 {
+    4 * n as u64 * (1 + cap as u64)
 }
 
 fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
@@ -186,6 +208,10 @@ impl GpuBackend {
             device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size: bytes.max(16), usage, mapped_at_creation: false })
         };
         let particle_bytes = 3 * 16 * n as u64;
+        check_binding(ctx, "the particle state", particle_bytes)?;
+        check_binding(ctx, "the neighbour list", nlist_bytes(n as u32, params.nlist_cap))?;
+        check_binding(ctx, "the cell list", 4 * (cells as u64 + 1 + scan_blocks as u64 + n as u64))?;
+        check_binding(ctx, "the topology", 4 * packed.topo.len() as u64)?;
         let uniform = init("params", words(&[params]), wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST);
         let state_buffer = zeros("state", particle_bytes, rw);
         let next = zeros("next", particle_bytes, rw);
@@ -194,7 +220,7 @@ impl GpuBackend {
         let fparams = init("fparams", words(&pad16(packed.fparams)), wgpu::BufferUsages::STORAGE);
         let cell_count = zeros("cell_count", 4 * cells as u64, rw);
         let cell_data = zeros("cell_data", 4 * (cells as u64 + 1 + scan_blocks as u64 + n as u64), rw);
-        let nlist = zeros("nlist", 4 * (n as u64) * (1 + params.nlist_cap as u64), rw);
+        let nlist = zeros("nlist", nlist_bytes(n as u32, params.nlist_cap), rw);
         let force = zeros("force", 16 * n as u64, rw);
         let status = zeros("status", 4 * STATUS_WORDS as u64, rw);
         let args = zeros("dispatch_args", 4 * 9, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT);
@@ -404,8 +430,8 @@ impl GpuBackend {
     /// Times each phase alone, `repetitions` times in one submission (after a
     /// warm-up), waiting for the GPU at the end; seconds per call. The state
     /// is left as it was (integration is timed on a copy of the positions).
-    pub fn profile(&mut self, repetitions: u32) -> PhaseTimes {
-        self.evaluate();
+    pub fn profile(&mut self, repetitions: u32) -> Result<PhaseTimes, String> {
+        self.evaluate()?;
         let saved = self.read(&self.state, 48 * self.params.n as u64);
         let particles = self.params.n.div_ceil(WORKGROUP);
         let cells = self.params.grid[3].div_ceil(WORKGROUP);
@@ -458,7 +484,7 @@ impl GpuBackend {
         let readback = started.elapsed().as_secs_f64() / repetitions as f64;
         self.ctx.queue.write_buffer(&self.state, 0, &saved);
         self.reset_status(true);
-        PhaseTimes { check, neighbor_build, forces, integrate, readback }
+        Ok(PhaseTimes { check, neighbor_build, forces, integrate, readback })
     }
 
     /// Encodes one neighbour check/rebuild and force pass, and optionally the
@@ -503,28 +529,29 @@ impl GpuBackend {
     }
 
     /// Handles an overflow: grows the list and clears the halt. Returns
-    /// whether there was one.
-    fn grow_if_overflowed(&mut self, status: &[u32; STATUS_WORDS]) -> bool {
+    /// whether there was one, or why the list cannot grow.
+    fn grow_if_overflowed(&mut self, status: &[u32; STATUS_WORDS]) -> Result<bool, String> {
         if status[ST_HALTED] & HALT_OVERFLOW == 0 {
-            return false;
+            return Ok(false);
         }
         let need = status[ST_OVERFLOW_NEED] as u64;
         let cap = (need + need / 4 + 8).next_multiple_of(8) as u32;
+        check_binding(&self.ctx, &format!("the neighbour list ({need} neighbours for some particle)"), nlist_bytes(self.params.n, cap))?;
         self.params.nlist_cap = cap;
-        let n = self.params.n as u64;
         self.nlist = self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("nlist"),
-            size: 4 * n * (1 + cap as u64),
+            size: nlist_bytes(self.params.n, cap),
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         self.main_group = self.bind_main();
         self.grown += 1;
-        true
+        Ok(true)
     }
 
-    /// Forces at the current state (neighbour list rebuilt first).
-    pub fn evaluate(&mut self) {
+    /// Forces at the current state (neighbour list rebuilt first); an error
+    /// if the neighbour list cannot grow to hold every neighbour.
+    pub fn evaluate(&mut self) -> Result<(), String> {
         loop {
             self.reset_status(true);
             self.write_params();
@@ -536,8 +563,8 @@ impl GpuBackend {
             self.ctx.queue.submit([encoder.finish()]);
             let status = self.status();
             self.builds += status[ST_BUILDS] as u64;
-            if !self.grow_if_overflowed(&status) {
-                return;
+            if !self.grow_if_overflowed(&status)? {
+                return Ok(());
             }
         }
     }
@@ -574,7 +601,7 @@ impl GpuBackend {
             if status[ST_HALTED] & HALT_BLOWUP != 0 {
                 return Err(GpuHalt::Blowup { step: first_step + done, particle: status[ST_BLOWUP_PARTICLE] as usize });
             }
-            force_rebuild = self.grow_if_overflowed(&status);
+            force_rebuild = self.grow_if_overflowed(&status).map_err(|message| GpuHalt::Capacity { step: first_step + done, message })?;
         }
         Ok(done)
     }
@@ -593,13 +620,13 @@ fn pad16<T: bytemuck::Pod + Default>(mut v: Vec<T>) -> Vec<T> {
     v
 }
 
-/// A first neighbour-list capacity from the mean density (twice the mean
-/// count in a sphere of the list range, at least 32); overflow grows it.
+/// A first neighbour-list capacity from the mean density (1.25 × the mean
+/// count in a sphere of the list range, plus 8, at least 32); overflow grows it.
 fn initial_capacity(n: usize, sim_box: &SimBox, range: f64, has_pairs: bool) -> u32 {
     if !has_pairs {
         return 1;
     }
     let volume = sim_box.volume();
     let mean = if volume > 0.0 { n as f64 / volume * 4.0 / 3.0 * std::f64::consts::PI * range.powi(3) } else { n as f64 };
-    ((2.0 * mean).ceil() as u32).clamp(32, n.max(32) as u32).next_multiple_of(8)
+    ((1.25 * mean + 8.0).ceil() as u32).clamp(32, n.max(32) as u32).next_multiple_of(8)
 }

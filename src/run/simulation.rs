@@ -516,7 +516,7 @@ impl Simulation {
             let outcome = gpu.run(self.state.step, steps);
             let done = match &outcome {
                 Ok(done) => *done,
-                Err(GpuHalt::Blowup { step, .. }) => step - self.state.step,
+                Err(GpuHalt::Blowup { step, .. } | GpuHalt::Capacity { step, .. }) => step - self.state.step,
             };
             for _ in 0..done {
                 self.state.step += 1;
@@ -530,6 +530,9 @@ impl Simulation {
             // outputs the sync only reads the GPU's status words.
             if final_step || thermo_due || dump_due || outcome.is_err() {
                 gpu.download(&mut self.state);
+            }
+            if let Err(GpuHalt::Capacity { message, .. }) = outcome {
+                return Err(RunError::Setup(format!("device gpu at step {}: {message}", self.state.step)));
             }
             if let Err(GpuHalt::Blowup { particle, .. }) = outcome {
                 self.refresh_cpu_forces(false)?;
