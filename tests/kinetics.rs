@@ -58,6 +58,22 @@ fn events(case: &Case) -> Vec<(u64, String, usize, f64)> {
 /// Lifetimes at fixed force across a sweep spanning the catch-slip maximum:
 /// mean lifetime = 1/k(F) within 2 % with ≥ 10⁴ bonds per force, the
 /// lifetime distribution is exponential, and the longest-lived force is F*.
+/// Kolmogorov–Smirnov statistic D·√N of break steps against the exact law
+/// P(s ≤ m) = 1 − exp(−k·dt·(m + 1)), compared at each distinct step (the
+/// data are discrete); the critical value at α = 0.001 is 1.95.
+fn ks_exponential_steps(steps: &[u64], rate_dt: f64) -> f64 {
+    let mut s = steps.to_vec();
+    s.sort_unstable();
+    let nn = s.len() as f64;
+    let mut d: f64 = 0.0;
+    for (i, &m) in s.iter().enumerate() {
+        if s.get(i + 1) != Some(&m) {
+            d = d.max(((i + 1) as f64 / nn - (1.0 - (-rate_dt * (m as f64 + 1.0)).exp())).abs());
+        }
+    }
+    d * nn.sqrt()
+}
+
 #[test]
 fn catch_slip_lifetimes_follow_the_two_pathway_law() {
     let (kc0, xc, ks0, xs): (f64, f64, f64, f64) = (1.0, 1.0, 0.01, 0.5);
@@ -95,20 +111,8 @@ fn catch_slip_lifetimes_follow_the_two_pathway_law() {
         let expected = 1.0 / rate(f);
         assert!((mean / expected - 1.0).abs() < 0.02, "F = {f}: mean lifetime {mean}, 1/k = {expected}");
         measured.push(mean);
-        // Kolmogorov–Smirnov against the exact law of the break step,
-        // P(s ≤ m) = 1 − exp(−k·dt·(m + 1)), compared at each distinct step
-        // (the data are discrete); critical value 1.95/√N (α = 0.001).
-        let mut s = steps_of[g].clone();
-        s.sort_unstable();
-        let nn = s.len() as f64;
-        let mut d: f64 = 0.0;
-        for (i, &m) in s.iter().enumerate() {
-            if s.get(i + 1) != Some(&m) {
-                let cdf = 1.0 - (-rate(f) * dt * (m as f64 + 1.0)).exp();
-                d = d.max(((i + 1) as f64 / nn - cdf).abs());
-            }
-        }
-        assert!(d * nn.sqrt() < 1.95, "F = {f}: lifetimes not exponential, KS D√N = {}", d * nn.sqrt());
+        let ks = ks_exponential_steps(&steps_of[g], rate(f) * dt);
+        assert!(ks < 1.95, "F = {f}: lifetimes not exponential, KS D√N = {ks}");
     }
     // The longest-lived force of the sweep is F*, and lifetimes fall on both sides.
     let best = (0..forces.len()).max_by(|&a, &b| measured[a].total_cmp(&measured[b])).unwrap();
@@ -185,17 +189,9 @@ fn cadherin_lifetimes_follow_the_sliding_rebinding_chain() {
         );
         assert!((mean / exact - 1.0).abs() < 0.02, "F = {f}: mean lifetime {mean}, exact mean first-passage time {exact}");
         measured.push(mean);
-        // The runtime's single rate: exponential break steps, P(s ≤ m) = 1 − exp(−k·dt·(m + 1)).
-        let mut s = steps_of[g].clone();
-        s.sort_unstable();
-        let nn = s.len() as f64;
-        let mut d: f64 = 0.0;
-        for (i, &m) in s.iter().enumerate() {
-            if s.get(i + 1) != Some(&m) {
-                d = d.max(((i + 1) as f64 / nn - (1.0 - (-rate(f) * dt * (m as f64 + 1.0)).exp())).abs());
-            }
-        }
-        assert!(d * nn.sqrt() < 1.95, "F = {f}: lifetimes not exponential, KS D√N = {}", d * nn.sqrt());
+        // The runtime's single rate: exponential break steps.
+        let ks = ks_exponential_steps(&steps_of[g], rate(f) * dt);
+        assert!(ks < 1.95, "F = {f}: lifetimes not exponential, KS D√N = {ks}");
     }
     // Catch below the maximum (each force lives longer than the one before),
     // slip beyond it: the longest-lived force of the sweep is F_max.

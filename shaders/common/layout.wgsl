@@ -152,6 +152,24 @@ struct ThreeBody {
     fk: vec3<f32>,
 }
 
+// The arms of an angle at its vertex j: unit vectors û = (ri − rj)/|u|,
+// v̂ = (rk − rj)/|v|, their lengths and cos θ = û·v̂.
+struct AngleArms {
+    uh: vec3<f32>,
+    vh: vec3<f32>,
+    lu: f32,
+    lv: f32,
+    c: f32,
+}
+
+fn angle_arms(ri: vec3<f32>, rj: vec3<f32>, rk: vec3<f32>) -> AngleArms {
+    let u = ri - rj;
+    let v = rk - rj;
+    let lu = length(u);
+    let lv = length(v);
+    return AngleArms(u / lu, v / lv, lu, lv, dot(u / lu, v / lv));
+}
+
 struct OneBody {
     energy: f32,
     force: vec3<f32>,

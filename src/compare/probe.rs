@@ -102,15 +102,8 @@ pub fn cellmd_probes(plan: &Plan) -> Result<Probes, String> {
         if Some(k) == first_run {
             init = Some(snapshot(&mut sim)?);
         }
-        match action {
-            Action::Dump(_)
-            | Action::Undump(_)
-            | Action::ThermoFile(_)
-            | Action::EventFile(_)
-            | Action::WriteState(_)
-            | Action::Print(_)
-            | Action::Thermo { .. } => {}
-            other => sim.apply(other).map_err(|e| e.to_string())?,
+        if !action.is_output() {
+            sim.apply(action).map_err(|e| e.to_string())?;
         }
     }
     let last = match init {

@@ -102,6 +102,23 @@ pub enum Action {
     Print(String),
 }
 
+impl Action {
+    /// Whether the action only opens, closes or writes output (thermo,
+    /// dumps, event log, restarts, prints) and leaves the physics alone.
+    pub fn is_output(&self) -> bool {
+        matches!(
+            self,
+            Action::Thermo { .. }
+                | Action::ThermoFile(_)
+                | Action::EventFile(_)
+                | Action::Dump(_)
+                | Action::Undump(_)
+                | Action::WriteState(_)
+                | Action::Print(_)
+        )
+    }
+}
+
 /// What a `coeff` command changes: an index into the model's tables.
 #[derive(Clone, Debug, PartialEq)]
 pub enum CoeffTarget {

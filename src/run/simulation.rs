@@ -134,16 +134,7 @@ impl Simulation {
     pub fn before_first_run(plan: &Plan, options: RunOptions) -> Result<Simulation, RunError> {
         let mut sim = Simulation::new(plan, options);
         for action in plan.actions.iter().take_while(|a| !matches!(a, Action::Run(_) | Action::Minimize(_))) {
-            let output = matches!(
-                action,
-                Action::Dump(_)
-                    | Action::Undump(_)
-                    | Action::ThermoFile(_)
-                    | Action::EventFile(_)
-                    | Action::WriteState(_)
-                    | Action::Print(_)
-            );
-            if !output {
+            if !action.is_output() {
                 sim.apply(action)?;
             }
         }
