@@ -89,7 +89,7 @@ impl Bonded {
     /// Bond `b` of type `t` at length `r`, with its state if it has one
     /// (`None` when it is unbound).
     #[inline(always)]
-    fn bond_radial(&self, b: usize, t: usize, r: f64, model: &Model, state: Option<&BondState>) -> Option<Radial> {
+    pub(super) fn bond_radial(&self, b: usize, t: usize, r: f64, model: &Model, state: Option<&BondState>) -> Option<Radial> {
         let params = &model.bond_types[t].params;
         let Some(s) = state else { return Some((self.bond_eval[t])(params, r)) };
         if !s.bound[b] {
@@ -211,7 +211,7 @@ impl Bonded {
 
 /// Angle `a` at image-consistent positions (i and k at their minimum image around the vertex j).
 #[inline]
-fn eval_angle(model: &Model, a: usize, x: &[DVec3], images: &Images) -> ([DVec3; 3], ThreeBody) {
+pub(super) fn eval_angle(model: &Model, a: usize, x: &[DVec3], images: &Images) -> ([DVec3; 3], ThreeBody) {
     let [i, j, k] = model.angles[a];
     let term = &model.angle_types[model.angle_type[a] as usize];
     let Law::ThreeBody(eval) = term.interaction.law() else { unreachable!("angle law is three-body") };

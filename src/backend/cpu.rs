@@ -134,6 +134,15 @@ impl CpuBackend {
         Ok(true)
     }
 
+    pub(super) fn bonded(&self) -> &Bonded {
+        &self.bonded
+    }
+
+    /// The neighbour list, or None when the model has no pair terms.
+    pub(super) fn neighbor_list(&self) -> Option<&NeighborList> {
+        (!self.pair_interactions.is_empty()).then_some(&self.neighbors)
+    }
+
     /// Number of neighbour-list builds so far.
     pub fn neighbor_builds(&self) -> u64 {
         self.neighbors.builds()

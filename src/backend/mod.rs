@@ -4,6 +4,7 @@
 mod bonded;
 pub mod cpu;
 mod pair_table;
+pub mod stiffness;
 mod sum;
 mod virial;
 

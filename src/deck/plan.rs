@@ -49,6 +49,10 @@ pub enum ThermoColumn {
     Bound(usize),
     /// Summed tension of the bound bonds of a bond type (e.g. clutch traction).
     Tension(usize),
+    /// Iterations of the last implicit step's linear solve (`integrator implicit`).
+    SolverIterations,
+    /// Relative residual of the last implicit step's linear solve.
+    SolverResidual,
 }
 
 /// A named trajectory output.

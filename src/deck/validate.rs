@@ -11,6 +11,7 @@ use crate::forcefield::{load_forcefield, parse_params, ForceField};
 use crate::gpu::DevicePreference;
 use crate::input::{lex, parse_f64, parse_u64, InputError, SourceFile, Statement, Token};
 use crate::integrate::fire::FireSettings;
+use crate::integrate::implicit::{ImplicitSettings, LinearSolver};
 use crate::integrate::overdamped::OverdampedSettings;
 use crate::integrate::rng::Noise;
 use crate::interactions::{param_index, Kind, REGISTRY};
@@ -207,7 +208,7 @@ impl Validator {
 
     fn thermo_columns(&self, tokens: &[Token]) -> Result<Vec<ThermoColumn>, InputError> {
         const FIXED: &str =
-            "step, time, pe, pe/NAME, fmax, fnorm, press, pxx, pyy, pzz, pxy, pxz, pyz, nbuild, breaks, rebinds, forms, resets, nbound/BONDTYPE, tension/BONDTYPE";
+            "step, time, pe, pe/NAME, fmax, fnorm, press, pxx, pyy, pzz, pxy, pxz, pyz, nbuild, solver_iterations, solver_residual, breaks, rebinds, forms, resets, nbound/BONDTYPE, tension/BONDTYPE";
         let bond_type = |t: &Token, name: &str| {
             self.forcefield.bond_types.iter().position(|b| b.label.text == name).ok_or_else(|| {
                 let names: Vec<&str> = self.forcefield.bond_types.iter().map(|b| b.label.text.as_str()).collect();
@@ -231,6 +232,8 @@ impl Validator {
                     "pxz" => ThermoColumn::Pressure(4),
                     "pyz" => ThermoColumn::Pressure(5),
                     "nbuild" => ThermoColumn::Nbuild,
+                    "solver_iterations" => ThermoColumn::SolverIterations,
+                    "solver_residual" => ThermoColumn::SolverResidual,
                     "breaks" => ThermoColumn::Events(EventKind::Break),
                     "rebinds" => ThermoColumn::Events(EventKind::Rebind),
                     "forms" => ThermoColumn::Events(EventKind::Form),
@@ -407,15 +410,20 @@ impl Validator {
                 self.actions.push(Action::Device(device));
             }
             "integrator" => {
-                expect_len(s, 1..=5, "integrator overdamped [noise uniform|gaussian] [max_displacement D]")?;
-                if s[1].text != "overdamped" {
-                    return Err(s[1].error(format!("found integrator `{}`, expected `overdamped`", s[1].text)));
-                }
-                let opts = options(
-                    &s[2..],
-                    &["noise", "max_displacement"],
-                    "integrator overdamped [noise uniform|gaussian] [max_displacement D]",
-                )?;
+                const USAGE: &str = "integrator overdamped|implicit [noise uniform|gaussian] [max_displacement D] \
+                                     [solver cg|cholesky] [tolerance T] [max_iterations N]";
+                expect_len(s, 1..=11, USAGE)?;
+                let implicit = match s[1].text.as_str() {
+                    "overdamped" => false,
+                    "implicit" => true,
+                    other => return Err(s[1].error(format!("found integrator `{other}`, expected `overdamped` or `implicit`"))),
+                };
+                let keys: &[&str] = if implicit {
+                    &["noise", "max_displacement", "solver", "tolerance", "max_iterations"]
+                } else {
+                    &["noise", "max_displacement"]
+                };
+                let opts = options(&s[2..], keys, USAGE)?;
                 let mut settings = OverdampedSettings::default();
                 if let Some(t) = opts.get("noise") {
                     settings.noise = match t.text.as_str() {
@@ -426,6 +434,23 @@ impl Validator {
                 }
                 if let Some(t) = opts.get("max_displacement") {
                     settings.max_displacement = positive(t, "a maximum displacement per step")?;
+                }
+                if implicit {
+                    let mut solve = ImplicitSettings::default();
+                    if let Some(t) = opts.get("solver") {
+                        solve.solver = match t.text.as_str() {
+                            "cg" => LinearSolver::Cg,
+                            "cholesky" => LinearSolver::Cholesky,
+                            other => return Err(t.error(format!("found solver `{other}`, expected `cg` or `cholesky`"))),
+                        };
+                    }
+                    if let Some(t) = opts.get("tolerance") {
+                        solve.tolerance = positive(t, "a relative residual tolerance")?;
+                    }
+                    if let Some(t) = opts.get("max_iterations") {
+                        solve.max_iterations = parse_u64(t, "an iteration count")?.max(1) as usize;
+                    }
+                    settings.implicit = Some(solve);
                 }
                 self.actions.push(Action::Integrator(settings));
             }

@@ -621,7 +621,12 @@ impl Writer<'_> {
                     self.line(format!("timestep {}", num(*dt)));
                 }
                 Action::Seed(seed) => self.seed = *seed,
-                Action::Integrator(s) => self.noise = s.noise,
+                Action::Integrator(s) => {
+                    if s.implicit.is_some() {
+                        return Err("`integrator implicit` has no LAMMPS counterpart (LAMMPS' fix brownian is the explicit step)".into());
+                    }
+                    self.noise = s.noise;
+                }
                 Action::Neighbor(_) | Action::Device(_) => {}
                 Action::Thermo { every, .. } => self.line(format!("thermo {every}")),
                 Action::ThermoFile(path) => self.line(format!("# thermo_file {}: the LAMMPS log holds the thermo table", path.display())),

@@ -27,11 +27,14 @@ pub struct OverdampedSettings {
     /// Largest displacement allowed in one step (length units) before the run
     /// is stopped as blown up.
     pub max_displacement: f64,
+    /// `integrator implicit`: the linearly implicit step and its solver
+    /// ([`super::implicit`]); `None` for the explicit step.
+    pub implicit: Option<super::implicit::ImplicitSettings>,
 }
 
 impl Default for OverdampedSettings {
     fn default() -> Self {
-        Self { noise: Noise::Uniform, max_displacement: 1.0 }
+        Self { noise: Noise::Uniform, max_displacement: 1.0, implicit: None }
     }
 }
 

@@ -13,6 +13,7 @@ use crate::deck::{Action, CoeffTarget, DumpSpec, NeighborSettings, Plan};
 use crate::gpu::backend::StepSettings;
 use crate::gpu::{DevicePreference, GpuBackend, GpuContext, GpuHalt};
 use crate::integrate::fire::{fire_minimize, FireReport, FireSettings};
+use crate::integrate::implicit::{implicit_step, ImplicitError, ImplicitSettings, SolveReport};
 use crate::integrate::overdamped::{overdamped_step, Blowup, OverdampedSettings};
 use crate::kinetics::{initial_bond_state, Binding, EventLog, Formation, Kinetics};
 use crate::output::restart::{read_state, write_state, RestartData};
@@ -77,6 +78,8 @@ pub struct Simulation {
     pub last_minimize: Option<FireReport>,
     /// The deck's `device` setting.
     pub device: DevicePreference,
+    /// The last implicit step's linear solve.
+    pub last_solve: SolveReport,
     /// The opened GPU (kept across `run` commands), or why it could not be used.
     gpu: Option<Result<GpuContext, String>>,
 }
@@ -113,6 +116,7 @@ impl Simulation {
             scratch: Vec::new(),
             last_minimize: None,
             device: DevicePreference::Cpu,
+            last_solve: SolveReport::default(),
             gpu: None,
         }
     }
@@ -363,6 +367,7 @@ impl Simulation {
                 kt: self.kt,
                 volume: self.sim_box.volume(),
                 neighbor_builds: self.backend.as_ref().map_or(0, |b| b.neighbor_builds()),
+                solve: self.last_solve,
             };
             let line = self.thermo.row(&inputs)?;
             match bar {
@@ -410,17 +415,20 @@ impl Simulation {
 
     fn run_cpu(&mut self, last: u64, bar: &Option<ProgressBar>) -> Result<(), RunError> {
         while self.state.step < last {
-            let moved = overdamped_step(
-                &self.model,
-                &mut self.state,
-                &self.forces.forces,
-                &self.sim_box,
-                self.dt,
-                self.kt,
-                self.seed,
-                &self.integrator,
-                &mut self.scratch,
-            );
+            let moved = match self.integrator.implicit {
+                Some(implicit) => self.implicit_step(&implicit)?,
+                None => overdamped_step(
+                    &self.model,
+                    &mut self.state,
+                    &self.forces.forces,
+                    &self.sim_box,
+                    self.dt,
+                    self.kt,
+                    self.seed,
+                    &self.integrator,
+                    &mut self.scratch,
+                ),
+            };
             if let Err(Blowup { particle, displacement }) = moved {
                 return Err(self.blowup(particle, self.displacement_message(displacement)));
             }
@@ -447,6 +455,24 @@ impl Simulation {
         Ok(())
     }
 
+    /// One linearly implicit step from the current forces; a failed solve
+    /// stops the run, a refused displacement is returned like the explicit one.
+    fn implicit_step(&mut self, implicit: &ImplicitSettings) -> Result<Result<(), Blowup>, RunError> {
+        let backend = self.backend.as_ref().expect("backend built");
+        let stiffness = backend.stiffness(&self.model, &self.state, &self.sim_box);
+        let (model, forces, sim_box) = (&self.model, &self.forces.forces, &self.sim_box);
+        let outcome =
+            implicit_step(model, &mut self.state, forces, &stiffness, sim_box, self.dt, self.kt, self.seed, &self.integrator, implicit);
+        match outcome {
+            Ok(report) => {
+                self.last_solve = report;
+                Ok(Ok(()))
+            }
+            Err(ImplicitError::Blowup(blowup)) => Ok(Err(blowup)),
+            Err(ImplicitError::Solve(why)) => Err(RunError::Setup(format!("integrator implicit at step {}: {why}", self.state.step))),
+        }
+    }
+
     fn displacement_message(&self, displacement: f64) -> String {
         format!("displacement {displacement:e} in one step exceeds max_displacement {:e}", self.integrator.max_displacement)
     }
@@ -459,8 +485,13 @@ impl Simulation {
             return Ok(None);
         }
         let kinetics = self.state.bonds.is_some() || !self.model.bind_rules.is_empty();
-        if kinetics {
-            let why = "bond kinetics (`kinetics`, `bind`) run on the CPU backend only";
+        let implicit = self.integrator.implicit.is_some();
+        if kinetics || implicit {
+            let why = if implicit {
+                "`integrator implicit` runs on the CPU backend only"
+            } else {
+                "bond kinetics (`kinetics`, `bind`) run on the CPU backend only"
+            };
             return match device {
                 DevicePreference::Gpu => Err(RunError::Setup(format!("device gpu: {why}; use `device cpu` or `device auto`"))),
                 _ => {

@@ -13,6 +13,7 @@
 //! | `fnorm` | √(Σ|F|²) | pN |
 //! | `press`, `pxx` … `pyz` | pressure tensor P = (N·kT/V)·I + W/V | Pa |
 //! | `nbuild` | neighbour-list builds so far | – |
+//! | `solver_iterations`, `solver_residual` | CG iterations and relative residual of the last implicit step (0 for explicit steps) | – |
 //! | `breaks`, `rebinds`, `forms`, `resets` | bond events so far | – |
 //! | `nbound/TYPE` | bound bonds of bond type TYPE | – |
 //! | `tension/TYPE` | summed tension of TYPE's bound bonds (clutch traction) | pN |
@@ -39,6 +40,8 @@ pub struct ThermoInputs<'a> {
     pub kt: f64,
     pub volume: f64,
     pub neighbor_builds: u64,
+    /// The last implicit step's linear solve.
+    pub solve: crate::integrate::implicit::SolveReport,
 }
 
 /// A column's header name (bond-type columns name their type).
@@ -56,12 +59,19 @@ pub fn column_label(c: &ThermoColumn, model: &crate::system::Model) -> String {
         ThermoColumn::Events(kind) => format!("{}s", kind.name()),
         ThermoColumn::Bound(t) => format!("nbound/{}", model.bond_types[*t].label.text),
         ThermoColumn::Tension(t) => format!("tension/{}", model.bond_types[*t].label.text),
+        ThermoColumn::SolverIterations => "solver_iterations".into(),
+        ThermoColumn::SolverResidual => "solver_residual".into(),
     }
 }
 
 pub fn column_unit(c: &ThermoColumn, units: UnitSystem) -> &'static str {
     match c {
-        ThermoColumn::Step | ThermoColumn::Nbuild | ThermoColumn::Events(_) | ThermoColumn::Bound(_) => "-",
+        ThermoColumn::Step
+        | ThermoColumn::Nbuild
+        | ThermoColumn::Events(_)
+        | ThermoColumn::Bound(_)
+        | ThermoColumn::SolverIterations
+        | ThermoColumn::SolverResidual => "-",
         ThermoColumn::Tension(_) => units.label(Dim::Force),
         ThermoColumn::Time => units.label(Dim::Time),
         ThermoColumn::Pe | ThermoColumn::PeOf(_) => units.label(Dim::Energy),
@@ -87,6 +97,8 @@ pub fn column_value(c: &ThermoColumn, t: &ThermoInputs) -> f64 {
         ThermoColumn::Events(kind) => t.kinetics.count(*kind) as f64,
         ThermoColumn::Bound(ty) => bonds_of_type(t, *ty).count() as f64,
         ThermoColumn::Tension(ty) => bonds_of_type(t, *ty).map(|b| t.bond_tension[b]).sum(),
+        ThermoColumn::SolverIterations => t.solve.iterations as f64,
+        ThermoColumn::SolverResidual => t.solve.relative_residual,
     }
 }
 
@@ -96,7 +108,10 @@ fn bonds_of_type<'a>(t: &'a ThermoInputs, ty: usize) -> impl Iterator<Item = usi
 }
 
 fn is_integer(c: &ThermoColumn) -> bool {
-    matches!(c, ThermoColumn::Step | ThermoColumn::Nbuild | ThermoColumn::Events(_) | ThermoColumn::Bound(_))
+    matches!(
+        c,
+        ThermoColumn::Step | ThermoColumn::Nbuild | ThermoColumn::Events(_) | ThermoColumn::Bound(_) | ThermoColumn::SolverIterations
+    )
 }
 
 /// Thermo state of a running deck.

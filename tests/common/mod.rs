@@ -88,3 +88,16 @@ pub fn random_case(periodic: bool, special: &str) -> Case {
     let deck = format!("units lj\ntopology t.top\nforcefield f.ff\n{special}box x 0 {l} {b} y 0 {l} {b} z 0 {l} {b}\nneighbor skin 0.4\n");
     Case::new(&[("t.top", &top), ("f.ff", ff), ("deck.in", &deck)])
 }
+
+/// The positions of [`grid_topology`], in id order.
+pub fn grid_positions(n_side: usize, a: f64) -> Vec<glam::DVec3> {
+    let mut out = Vec::new();
+    for i in 0..n_side {
+        for j in 0..n_side {
+            for k in 0..n_side {
+                out.push(glam::DVec3::new(i as f64 * a, j as f64 * a, k as f64 * a));
+            }
+        }
+    }
+    out
+}
