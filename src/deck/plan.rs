@@ -53,6 +53,8 @@ pub enum ThermoColumn {
     SolverIterations,
     /// Relative residual of the last implicit step's linear solve.
     SolverResidual,
+    /// Summed constraint tension of a constrained bond type (index into `Model::bond_types`).
+    ConstraintTension(usize),
 }
 
 /// A named trajectory output.
@@ -99,6 +101,14 @@ pub enum Action {
         param: usize,
         value: f64,
     },
+    /// Holds the bonds of a bond type at their rest length (`constrain`).
+    Constrain {
+        bond_type: usize,
+        tolerance: f64,
+        max_iterations: usize,
+    },
+    /// Releases a constrained bond type (`unconstrain`).
+    Unconstrain(usize),
     Minimize(FireSettings),
     Run(u64),
     WriteState(PathBuf),

@@ -22,7 +22,7 @@ use crate::topology::{parse_box_axis, parse_topology, BoxAxis, Topology};
 use crate::units::UnitSystem;
 
 /// The commands a deck understands (for "expected ..." messages).
-const COMMANDS: &str = "units, variable, topology, forcefield, box, special_bonds, temperature, timestep, seed, device, integrator, neighbor, thermo, thermo_file, events, dump, undump, group, external, unexternal, coeff, minimize, run, write_state, read_state, print";
+const COMMANDS: &str = "units, variable, topology, forcefield, box, special_bonds, temperature, timestep, seed, device, integrator, neighbor, thermo, thermo_file, events, dump, undump, group, external, unexternal, coeff, constrain, unconstrain, minimize, run, write_state, read_state, print";
 
 /// Commands that define the system and must come before it is first used.
 const SETUP: [&str; 5] = ["units", "topology", "forcefield", "box", "special_bonds"];
@@ -208,7 +208,7 @@ impl Validator {
 
     fn thermo_columns(&self, tokens: &[Token]) -> Result<Vec<ThermoColumn>, InputError> {
         const FIXED: &str =
-            "step, time, pe, pe/NAME, fmax, fnorm, press, pxx, pyy, pzz, pxy, pxz, pyz, nbuild, solver_iterations, solver_residual, breaks, rebinds, forms, resets, nbound/BONDTYPE, tension/BONDTYPE";
+            "step, time, pe, pe/NAME, fmax, fnorm, press, pxx, pyy, pzz, pxy, pxz, pyz, nbuild, solver_iterations, solver_residual, ctension/BONDTYPE, breaks, rebinds, forms, resets, nbound/BONDTYPE, tension/BONDTYPE";
         let bond_type = |t: &Token, name: &str| {
             self.forcefield.bond_types.iter().position(|b| b.label.text == name).ok_or_else(|| {
                 let names: Vec<&str> = self.forcefield.bond_types.iter().map(|b| b.label.text.as_str()).collect();
@@ -246,6 +246,7 @@ impl Validator {
                         })?),
                         Some(("nbound", name)) => ThermoColumn::Bound(bond_type(t, name)?),
                         Some(("tension", name)) => ThermoColumn::Tension(bond_type(t, name)?),
+                        Some(("ctension", name)) => ThermoColumn::ConstraintTension(bond_type(t, name)?),
                         _ => return Err(t.error(format!("found thermo column `{other}`, expected one of: {FIXED}"))),
                     },
                 })
@@ -538,6 +539,43 @@ impl Validator {
                 self.actions.push(Action::Unexternal(s[1].text.clone()));
             }
             "coeff" => self.coeff(s)?,
+            "constrain" | "unconstrain" => {
+                let usage =
+                    if kw.text == "constrain" { "constrain BONDTYPE [tolerance T] [max_iterations N]" } else { "unconstrain BONDTYPE" };
+                expect_len(s, 1..=5, usage)?;
+                let opts = if kw.text == "constrain" {
+                    options(&s[2..], &["tolerance", "max_iterations"], usage)?
+                } else {
+                    options(&s[2..], &[], usage)?
+                };
+                let model = self.model(kw)?;
+                let bond_type = model
+                    .bond_types
+                    .iter()
+                    .position(|t| t.label.text == s[1].text)
+                    .ok_or_else(|| s[1].error(format!("found bond type `{}`, expected one defined in the force field", s[1].text)))?;
+                let term = &model.bond_types[bond_type];
+                if param_index(term.interaction, "r0").is_none() {
+                    return Err(s[1].error(format!(
+                        "bond type `{}` uses `{}`, which has no rest length r0; expected a bond type whose law has one",
+                        s[1].text,
+                        term.interaction.name()
+                    )));
+                }
+                if !model.bond_kinetics[bond_type].rules.is_empty() {
+                    return Err(
+                        s[1].error(format!("bond type `{}` has kinetics; expected a bond type whose bonds never change", s[1].text))
+                    );
+                }
+                if kw.text == "unconstrain" {
+                    self.actions.push(Action::Unconstrain(bond_type));
+                } else {
+                    let tolerance = opts.get("tolerance").map(|t| positive(t, "a relative length tolerance")).transpose()?.unwrap_or(1e-10);
+                    let max_iterations =
+                        opts.get("max_iterations").map(|t| parse_u64(t, "a sweep count")).transpose()?.unwrap_or(1000).max(1) as usize;
+                    self.actions.push(Action::Constrain { bond_type, tolerance, max_iterations });
+                }
+            }
             "minimize" => {
                 let usage = "minimize [ftol F] [maxiter N] [dmax D]";
                 let opts = options(&s[1..], &["ftol", "maxiter", "dmax"], usage)?;

@@ -628,6 +628,9 @@ impl Writer<'_> {
                     self.noise = s.noise;
                 }
                 Action::Neighbor(_) | Action::Device(_) => {}
+                Action::Constrain { .. } | Action::Unconstrain(_) => {
+                    return Err("`constrain` (overdamped SHAKE) is not exported: LAMMPS' fix shake needs velocities and masses".into())
+                }
                 Action::Thermo { every, .. } => self.line(format!("thermo {every}")),
                 Action::ThermoFile(path) => self.line(format!("# thermo_file {}: the LAMMPS log holds the thermo table", path.display())),
                 Action::EventFile(path) => self.line(format!("# events {}: bond kinetics are not exported", path.display())),

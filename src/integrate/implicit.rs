@@ -19,6 +19,14 @@
 //! (infinite drag) has Δx = 0: its row is the identity and its couplings are
 //! dropped. Both solvers run sequentially, so the step is the same on any
 //! thread count.
+//!
+//! With constrained bonds (`constrain`), the step solves the constrained
+//! linear system instead — (γ/dt·I + K̃)·Δx = b + Jᵀλ with JΔx = 0 — by
+//! projected conjugate gradients (whatever `solver` says), so its fixed point
+//! is the constrained equilibrium; SHAKE then removes the second-order drift
+//! of the lengths. Projecting an unconstrained implicit step instead would
+//! stop short of equilibrium wherever K̃ couples the constrained directions to
+//! the free ones (measured: 1.1e-3 µm off on a bent 1 µm filament).
 
 use faer::linalg::solvers::Solve;
 use faer::matrix_free::conjugate_gradient::{conjugate_gradient, conjugate_gradient_scratch, CgParams};
@@ -85,6 +93,7 @@ pub fn implicit_step(
     seed: u64,
     settings: &OverdampedSettings,
     implicit: &ImplicitSettings,
+    constrained: &mut ConstrainedBonds,
 ) -> Result<SolveReport, ImplicitError> {
     let n = state.len();
     let dim = 3 * n;
@@ -119,6 +128,14 @@ pub fn implicit_step(
         }
     }
     let report = match implicit.solver {
+        _ if !constrained.pairs.is_empty() => {
+            let mobile: Vec<bool> = (0..n).map(|i| !fixed(i)).collect();
+            let solve = projected_cg(&matrix, &rhs, &mobile, constrained, &state.positions, sim_box, implicit)?;
+            guess = solve.x;
+            constrained.tension.clear();
+            constrained.tension.extend(solve.lambda.iter().map(|l| -l));
+            solve.report
+        }
         LinearSolver::Cholesky => {
             let llt = matrix.sp_cholesky(Side::Lower).map_err(|e| ImplicitError::Solve(format!("sparse Cholesky: {e:?}")))?;
             guess = llt.solve(rhs.as_mat());
@@ -160,6 +177,139 @@ pub fn implicit_step(
     state.step += 1;
     state.time += dt;
     Ok(report)
+}
+
+/// Constrained bonds for the implicit step: the particle pairs whose
+/// distances the step must keep (to first order), and on return the
+/// constraint tension each needed (force units, positive pulling together).
+#[derive(Clone, Debug, Default)]
+pub struct ConstrainedBonds {
+    pub pairs: Vec<[u32; 2]>,
+    pub tension: Vec<f64>,
+}
+
+struct ProjectedSolve {
+    x: Mat<f64>,
+    lambda: Vec<f64>,
+    report: SolveReport,
+}
+
+/// min ½ΔxᵀAΔx − bᵀΔx subject to JΔx = 0 (J: the constraint gradients
+/// û_ij at the current positions) by conjugate gradients with the projected
+/// Jacobi preconditioner P = D⁻¹ − D⁻¹Jᵀ(JD⁻¹Jᵀ)⁻¹JD⁻¹ (Gould, Hribar &
+/// Nocedal 2001): the iterates stay in the null space of J, and the answer
+/// is the step of the constrained linear system AΔx = b + Jᵀλ, JΔx = 0;
+/// λ = (JD⁻¹Jᵀ)⁻¹JD⁻¹(AΔx − b) are the constraint forces. JD⁻¹Jᵀ is
+/// factorised once per step by sparse Cholesky. Fixed particles have
+/// D⁻¹ = 0, so they never move; a bond with both ends fixed is skipped.
+fn projected_cg(
+    matrix: &SparseColMat<usize, f64>,
+    rhs: &Col<f64>,
+    mobile: &[bool],
+    constrained: &ConstrainedBonds,
+    positions: &[DVec3],
+    sim_box: &SimBox,
+    implicit: &ImplicitSettings,
+) -> Result<ProjectedSolve, ImplicitError> {
+    let dim = rhs.nrows();
+    let dinv: Vec<f64> = (0..dim).map(|k| if mobile[k / 3] { 1.0 / matrix.get(k, k).copied().unwrap_or(1.0) } else { 0.0 }).collect();
+    let images = sim_box.images();
+    let rows: Vec<(usize, usize, DVec3)> = constrained
+        .pairs
+        .iter()
+        .map(|&[i, j]| (i as usize, j as usize, images.minimum_image(positions[j as usize] - positions[i as usize]).normalize_or_zero()))
+        .collect();
+    let active: Vec<bool> = rows.iter().map(|&(i, j, _)| mobile[i] || mobile[j]).collect();
+    let m = rows.len();
+    // S = J D⁻¹ Jᵀ; rows of inactive constraints are the identity.
+    let mut by_particle: std::collections::BTreeMap<usize, Vec<(usize, f64)>> = Default::default();
+    for (k, &(i, j, _)) in rows.iter().enumerate().filter(|(k, _)| active[*k]) {
+        by_particle.entry(i).or_default().push((k, -1.0));
+        by_particle.entry(j).or_default().push((k, 1.0));
+    }
+    let mut triplets = Vec::new();
+    for k in (0..m).filter(|&k| !active[k]) {
+        triplets.push(Triplet::new(k, k, 1.0));
+    }
+    for (&p, list) in &by_particle {
+        for &(k, sk) in list {
+            for &(l, sl) in list {
+                let dot: f64 = (0..3).map(|a| sk * rows[k].2[a] * dinv[3 * p + a] * sl * rows[l].2[a]).sum();
+                triplets.push(Triplet::new(k, l, dot));
+            }
+        }
+    }
+    let schur = SparseColMat::<usize, f64>::try_new_from_triplets(m, m, &triplets).map_err(|e| ImplicitError::Solve(format!("{e:?}")))?;
+    let schur = schur.sp_cholesky(Side::Lower).map_err(|e| ImplicitError::Solve(format!("constraint matrix JD⁻¹Jᵀ: {e:?}")))?;
+    // J·v and Jᵀ·μ.
+    let jv = |v: &Col<f64>| -> Col<f64> {
+        Col::from_fn(m, |k| {
+            let (i, j, u) = rows[k];
+            if !active[k] {
+                return 0.0;
+            }
+            (0..3).map(|a| u[a] * (v[3 * j + a] - v[3 * i + a])).sum()
+        })
+    };
+    let jt = |mu: &Col<f64>| -> Col<f64> {
+        let mut out = Col::<f64>::zeros(dim);
+        for (k, &(i, j, u)) in rows.iter().enumerate().filter(|(k, _)| active[*k]) {
+            for a in 0..3 {
+                out[3 * i + a] -= u[a] * mu[k];
+                out[3 * j + a] += u[a] * mu[k];
+            }
+        }
+        out
+    };
+    let dinv_times = |v: &Col<f64>| Col::from_fn(dim, |k| dinv[k] * v[k]);
+    // (JD⁻¹Jᵀ)⁻¹ J D⁻¹ v
+    let multipliers = |v: &Col<f64>| -> Col<f64> {
+        let mut mu = jv(&dinv_times(v));
+        schur.solve_in_place(mu.as_mat_mut());
+        mu
+    };
+    // The residual update of Gould, Hribar & Nocedal: r ← r − Jᵀ(JD⁻¹Jᵀ)⁻¹JD⁻¹r
+    // (a change of λ only) keeps r consistent with the null space, so the
+    // round-off of the projection does not stall the iteration; z = D⁻¹r is
+    // then the projected preconditioned residual.
+    let update = |r: &Col<f64>| -> Col<f64> { r - &jt(&multipliers(r)) };
+    let mut x = Col::<f64>::zeros(dim);
+    let mut r = update(rhs);
+    let mut z = dinv_times(&r);
+    let reference = z.norm_l2().max(f64::MIN_POSITIVE);
+    let mut p = z.clone();
+    let mut rz: f64 = r.transpose() * &z;
+    let mut iterations = 0;
+    let mut residual = z.norm_l2() / reference;
+    while residual > implicit.tolerance && iterations < implicit.max_iterations {
+        let ap = matrix * &p;
+        let curvature: f64 = p.transpose() * &ap;
+        if curvature <= 0.0 {
+            return Err(ImplicitError::Solve(format!("projected conjugate gradients: non-positive curvature {curvature:e}")));
+        }
+        let alpha = rz / curvature;
+        x += alpha * &p;
+        r -= alpha * &ap;
+        r = update(&r);
+        z = dinv_times(&r);
+        let rz_next: f64 = r.transpose() * &z;
+        p = &z + (rz_next / rz) * &p;
+        rz = rz_next;
+        iterations += 1;
+        residual = z.norm_l2() / reference;
+    }
+    if residual > implicit.tolerance {
+        return Err(ImplicitError::Solve(format!(
+            "projected conjugate gradients: relative residual {residual:e} after {iterations} iterations (tolerance {:e})",
+            implicit.tolerance
+        )));
+    }
+    let lambda = multipliers(&(matrix * &x - rhs));
+    Ok(ProjectedSolve {
+        x: Mat::from_fn(dim, 1, |k, _| x[k]),
+        lambda: (0..m).map(|k| lambda[k]).collect(),
+        report: SolveReport { iterations, relative_residual: residual },
+    })
 }
 
 fn relative_residual(matrix: &SparseColMat<usize, f64>, x: &Mat<f64>, rhs: &Col<f64>) -> f64 {

@@ -1,5 +1,6 @@
 //! Integrators and their random numbers.
 
+pub mod constraints;
 pub mod fire;
 pub mod implicit;
 pub mod overdamped;

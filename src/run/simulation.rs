@@ -12,8 +12,9 @@ use crate::backend::{CpuBackend, Forces};
 use crate::deck::{Action, CoeffTarget, DumpSpec, NeighborSettings, Plan};
 use crate::gpu::backend::StepSettings;
 use crate::gpu::{DevicePreference, GpuBackend, GpuContext, GpuHalt};
+use crate::integrate::constraints::{Constraint, Constraints};
 use crate::integrate::fire::{fire_minimize, FireReport, FireSettings};
-use crate::integrate::implicit::{implicit_step, ImplicitError, ImplicitSettings, SolveReport};
+use crate::integrate::implicit::{implicit_step, ConstrainedBonds, ImplicitError, ImplicitSettings, SolveReport};
 use crate::integrate::overdamped::{overdamped_step, Blowup, OverdampedSettings};
 use crate::kinetics::{initial_bond_state, Binding, EventLog, Formation, Kinetics};
 use crate::output::restart::{read_state, write_state, RestartData};
@@ -80,6 +81,10 @@ pub struct Simulation {
     pub device: DevicePreference,
     /// The last implicit step's linear solve.
     pub last_solve: SolveReport,
+    /// Constrained (inextensible) bonds.
+    pub constraints: Constraints,
+    /// Constraint tensions of the last implicit step's solve (added to SHAKE's).
+    implicit_tension: Vec<f64>,
     /// The opened GPU (kept across `run` commands), or why it could not be used.
     gpu: Option<Result<GpuContext, String>>,
 }
@@ -117,6 +122,8 @@ impl Simulation {
             last_minimize: None,
             device: DevicePreference::Cpu,
             last_solve: SolveReport::default(),
+            constraints: Constraints::default(),
+            implicit_tension: Vec::new(),
             gpu: None,
         }
     }
@@ -217,6 +224,21 @@ impl Simulation {
                 };
                 term.params[*param] = *value;
                 self.forces_current = false;
+            }
+            Action::Constrain { bond_type, tolerance, max_iterations } => {
+                self.constraints.list.retain(|c| self.model.bond_type[c.bond] as usize != *bond_type);
+                let term = &self.model.bond_types[*bond_type];
+                let r0 = term.params[crate::interactions::param_index(term.interaction, "r0").expect("checked by the deck")];
+                let bonds = (0..self.model.bonds.len()).filter(|&b| self.model.bond_type[b] as usize == *bond_type);
+                self.constraints.list.extend(bonds.map(|bond| Constraint { bond, length: r0 }));
+                self.constraints.list.sort_by_key(|c| c.bond);
+                self.constraints.tolerance = *tolerance;
+                self.constraints.max_iterations = *max_iterations;
+                self.constraints.tension.clear();
+            }
+            Action::Unconstrain(bond_type) => {
+                self.constraints.list.retain(|c| self.model.bond_type[c.bond] as usize != *bond_type);
+                self.constraints.tension.clear();
             }
             Action::Minimize(settings) => self.minimize(settings)?,
             Action::Run(steps) => self.run(*steps)?,
@@ -368,6 +390,7 @@ impl Simulation {
                 volume: self.sim_box.volume(),
                 neighbor_builds: self.backend.as_ref().map_or(0, |b| b.neighbor_builds()),
                 solve: self.last_solve,
+                constraints: &self.constraints,
             };
             let line = self.thermo.row(&inputs)?;
             match bar {
@@ -414,7 +437,11 @@ impl Simulation {
     }
 
     fn run_cpu(&mut self, last: u64, bar: &Option<ProgressBar>) -> Result<(), RunError> {
+        let mut before = Vec::new();
         while self.state.step < last {
+            if !self.constraints.list.is_empty() {
+                before.clone_from(&self.state.positions);
+            }
             let moved = match self.integrator.implicit {
                 Some(implicit) => self.implicit_step(&implicit)?,
                 None => overdamped_step(
@@ -431,6 +458,24 @@ impl Simulation {
             };
             if let Err(Blowup { particle, displacement }) = moved {
                 return Err(self.blowup(particle, self.displacement_message(displacement)));
+            }
+            if !self.constraints.list.is_empty() {
+                let projected = self.constraints.project(&self.model, &before, &mut self.state, &self.sim_box, self.dt);
+                if self.implicit_tension.len() == self.constraints.tension.len() {
+                    self.constraints.tension.iter_mut().zip(&self.implicit_tension).for_each(|(t, extra)| *t += extra);
+                }
+                if let Err(failure) = projected {
+                    let [i, j] = self.model.bonds[failure.bond];
+                    return Err(RunError::Setup(format!(
+                        "constraint of bond {}-{} not met after {} sweeps at step {}: |r − r0|/r0 = {:e} > tolerance {:e}",
+                        self.model.ids[i as usize],
+                        self.model.ids[j as usize],
+                        self.constraints.max_iterations,
+                        self.state.step,
+                        failure.relative_error,
+                        self.constraints.tolerance
+                    )));
+                }
             }
             if self.state.bonds.is_some() {
                 self.kinetics_step()?;
@@ -461,8 +506,22 @@ impl Simulation {
         let backend = self.backend.as_ref().expect("backend built");
         let stiffness = backend.stiffness(&self.model, &self.state, &self.sim_box);
         let (model, forces, sim_box) = (&self.model, &self.forces.forces, &self.sim_box);
-        let outcome =
-            implicit_step(model, &mut self.state, forces, &stiffness, sim_box, self.dt, self.kt, self.seed, &self.integrator, implicit);
+        let mut constrained =
+            ConstrainedBonds { pairs: self.constraints.list.iter().map(|c| model.bonds[c.bond]).collect(), tension: Vec::new() };
+        let outcome = implicit_step(
+            model,
+            &mut self.state,
+            forces,
+            &stiffness,
+            sim_box,
+            self.dt,
+            self.kt,
+            self.seed,
+            &self.integrator,
+            implicit,
+            &mut constrained,
+        );
+        self.implicit_tension = constrained.tension;
         match outcome {
             Ok(report) => {
                 self.last_solve = report;
@@ -486,9 +545,12 @@ impl Simulation {
         }
         let kinetics = self.state.bonds.is_some() || !self.model.bind_rules.is_empty();
         let implicit = self.integrator.implicit.is_some();
-        if kinetics || implicit {
+        let constrained = !self.constraints.list.is_empty();
+        if kinetics || implicit || constrained {
             let why = if implicit {
                 "`integrator implicit` runs on the CPU backend only"
+            } else if constrained {
+                "constrained bonds (`constrain`) run on the CPU backend only"
             } else {
                 "bond kinetics (`kinetics`, `bind`) run on the CPU backend only"
             };

@@ -13,6 +13,7 @@
 //! | `fnorm` | √(Σ|F|²) | pN |
 //! | `press`, `pxx` … `pyz` | pressure tensor P = (N·kT/V)·I + W/V | Pa |
 //! | `nbuild` | neighbour-list builds so far | – |
+//! | `ctension/TYPE` | summed constraint tension of TYPE's constrained bonds (`constrain`) | pN |
 //! | `solver_iterations`, `solver_residual` | CG iterations and relative residual of the last implicit step (0 for explicit steps) | – |
 //! | `breaks`, `rebinds`, `forms`, `resets` | bond events so far | – |
 //! | `nbound/TYPE` | bound bonds of bond type TYPE | – |
@@ -42,6 +43,8 @@ pub struct ThermoInputs<'a> {
     pub neighbor_builds: u64,
     /// The last implicit step's linear solve.
     pub solve: crate::integrate::implicit::SolveReport,
+    /// The constrained bonds and their last tensions.
+    pub constraints: &'a crate::integrate::constraints::Constraints,
 }
 
 /// A column's header name (bond-type columns name their type).
@@ -61,6 +64,7 @@ pub fn column_label(c: &ThermoColumn, model: &crate::system::Model) -> String {
         ThermoColumn::Tension(t) => format!("tension/{}", model.bond_types[*t].label.text),
         ThermoColumn::SolverIterations => "solver_iterations".into(),
         ThermoColumn::SolverResidual => "solver_residual".into(),
+        ThermoColumn::ConstraintTension(t) => format!("ctension/{}", model.bond_types[*t].label.text),
     }
 }
 
@@ -72,7 +76,7 @@ pub fn column_unit(c: &ThermoColumn, units: UnitSystem) -> &'static str {
         | ThermoColumn::Bound(_)
         | ThermoColumn::SolverIterations
         | ThermoColumn::SolverResidual => "-",
-        ThermoColumn::Tension(_) => units.label(Dim::Force),
+        ThermoColumn::Tension(_) | ThermoColumn::ConstraintTension(_) => units.label(Dim::Force),
         ThermoColumn::Time => units.label(Dim::Time),
         ThermoColumn::Pe | ThermoColumn::PeOf(_) => units.label(Dim::Energy),
         ThermoColumn::Fmax | ThermoColumn::Fnorm => units.label(Dim::Force),
@@ -99,6 +103,10 @@ pub fn column_value(c: &ThermoColumn, t: &ThermoInputs) -> f64 {
         ThermoColumn::Tension(ty) => bonds_of_type(t, *ty).map(|b| t.bond_tension[b]).sum(),
         ThermoColumn::SolverIterations => t.solve.iterations as f64,
         ThermoColumn::SolverResidual => t.solve.relative_residual,
+        ThermoColumn::ConstraintTension(ty) => {
+            let c = t.constraints;
+            c.list.iter().zip(&c.tension).filter(|(k, _)| t.model.bond_type[k.bond] as usize == *ty).map(|(_, tension)| tension).sum()
+        }
     }
 }
 
