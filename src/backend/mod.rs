@@ -5,6 +5,7 @@ mod bonded;
 pub mod cpu;
 mod pair_table;
 mod sum;
+mod surface;
 mod virial;
 
 pub use self::cpu::{CpuBackend, ForceBreakdown, Forces};

@@ -11,6 +11,11 @@
 //! Parameters reach an evaluator as a slice in schema order, already checked
 //! against the schema and by [`Interaction::validate`].
 //!
+//! Many-body terms of closed surfaces (cell shells) use [`Law::Surface`]: the
+//! evaluator sees one body's whole mesh ([`SurfaceMesh`]) with image-consistent
+//! node positions and adds a force to every node; the backend evaluates each
+//! body once per force pass into per-node slots that each particle gathers.
+//!
 //! Laws carry what later solvers need: [`Radial`] returns d²E/dr², from which
 //! the analytic pair Hessian `E''·ûûᵀ + (E'/r)(I − ûûᵀ)` follows; state that
 //! changes during a run (e.g. a rest length under kinetics) is a parameter
@@ -18,6 +23,7 @@
 
 use glam::DVec3;
 
+pub use crate::mesh::SurfaceMesh;
 use crate::units::Dim;
 
 /// Implements [`Interaction`] for a unit struct from its registration data:
@@ -105,6 +111,8 @@ pub enum Kind {
     Pair,
     /// One-particle external field on a group (deck `external` command).
     External,
+    /// Many-body term of a closed surface, by body type (`body` lines).
+    Body,
 }
 
 impl Kind {
@@ -115,6 +123,7 @@ impl Kind {
             Kind::Angle => "angle",
             Kind::Pair => "pair",
             Kind::External => "external",
+            Kind::Body => "body",
         }
     }
 
@@ -125,6 +134,7 @@ impl Kind {
             Kind::Angle => "an angle",
             Kind::Pair => "a pair",
             Kind::External => "an external",
+            Kind::Body => "a body",
         }
     }
 }
@@ -182,6 +192,20 @@ pub enum Law {
     ThreeBody(fn(&[f64], [DVec3; 3]) -> ThreeBody),
     /// E(r) of one particle in an external field; r is the unwrapped position.
     OneBody(fn(&[f64], DVec3) -> OneBody),
+    /// E(r_1 … r_n) of one closed surface: the evaluator gets the body's mesh
+    /// and its node positions (image-consistent, local numbering), adds the
+    /// force on each node to `forces` and returns the energy. The CPU backend
+    /// evaluates it; the GPU backend has no kernel for this family yet and
+    /// refuses decks that use it ([`Law::runs_on_gpu`]).
+    Surface(fn(params: &[f64], mesh: &SurfaceMesh, x: &[DVec3], forces: &mut [DVec3]) -> f64),
+}
+
+impl Law {
+    /// Whether the GPU backend has a kernel for this law family (and so each
+    /// interaction of the family a `shaders/interactions/NAME.wgsl` evaluator).
+    pub fn runs_on_gpu(&self) -> bool {
+        !matches!(self, Law::Surface(_))
+    }
 }
 
 /// Inclusive/exclusive numeric bound of a parameter.
@@ -376,7 +400,10 @@ mod tests {
             }
             // Kind and law agree.
             match (i.kind(), i.law()) {
-                (Kind::Bond | Kind::Pair, Law::Radial { .. }) | (Kind::Angle, Law::ThreeBody(_)) | (Kind::External, Law::OneBody(_)) => {}
+                (Kind::Bond | Kind::Pair, Law::Radial { .. })
+                | (Kind::Angle, Law::ThreeBody(_))
+                | (Kind::External, Law::OneBody(_))
+                | (Kind::Body, Law::Surface(_)) => {}
                 _ => panic!("{}: kind and law disagree", i.name()),
             }
         }

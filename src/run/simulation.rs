@@ -478,6 +478,16 @@ impl Simulation {
                 }
             };
         }
+        if self.model.has_surface_terms() {
+            let why = "surface terms of bodies (`body` lines) run on the CPU backend only";
+            return match device {
+                DevicePreference::Gpu => Err(RunError::Setup(format!("device gpu: {why}; use `device cpu` or `device auto`"))),
+                _ => {
+                    self.say(&format!("device auto: {why}; running on the CPU"));
+                    Ok(None)
+                }
+            };
+        }
         if self.gpu.is_none() {
             let opened = GpuContext::open(device == DevicePreference::Auto);
             match &opened {
