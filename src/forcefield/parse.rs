@@ -238,6 +238,22 @@ mod tests {
     }
 
     #[test]
+    fn body_lines_name_a_body_type_and_a_surface_interaction() {
+        let ff = load(&[("m.ff", "particle a drag 1\nbody cell turgor k 100 v0 4\nbody cell surface_tension gamma 2\n")]).unwrap();
+        assert_eq!(ff.body_rules.len(), 2);
+        assert_eq!(ff.body_rules[0].body_type.text, "cell");
+        assert_eq!(ff.body_rules[0].term.params, vec![100.0, 0.0, 4.0]);
+        assert_eq!(
+            load(&[("m.ff", "body cell harmonic k 1 r0 1\n")]).unwrap_err(),
+            "m.ff:1:11: `harmonic` is a bond interaction, expected a body interaction here"
+        );
+        assert!(load(&[("m.ff", "bond s turgor k 1 v0 1\n")])
+            .unwrap_err()
+            .contains("`turgor` is a body interaction, expected a bond interaction"));
+        assert!(load(&[("m.ff", "body cell\n")]).unwrap_err().contains("expected `body TYPE INTERACTION"));
+    }
+
+    #[test]
     fn errors() {
         assert_eq!(
             load(&[("m.ff", "particle a\n")]).unwrap_err(),

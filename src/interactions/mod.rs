@@ -61,6 +61,7 @@ macro_rules! interaction {
 
 pub mod testing;
 
+mod area_conservation;
 mod asymmetric;
 mod cable;
 mod constant_force;
@@ -68,10 +69,14 @@ mod cosine_angle;
 mod fene;
 mod harmonic;
 mod harmonic_angle;
+mod helfrich_bending;
 mod lj;
 mod soft;
 mod soft_repulsion;
 mod spring;
+mod surface_tension;
+mod turgor;
+mod turgor_log;
 mod wall;
 mod wca;
 mod wlc_bending;
@@ -93,6 +98,11 @@ pub static REGISTRY: &[&dyn Interaction] = &[
     &soft::Soft,
     &wall::Wall,
     &constant_force::ConstantForce,
+    &turgor::Turgor,
+    &turgor_log::TurgorLog,
+    &surface_tension::SurfaceTension,
+    &area_conservation::AreaConservation,
+    &helfrich_bending::HelfrichBending,
 ];
 
 /// Looks an interaction type up by its registered name.
