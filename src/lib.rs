@@ -18,9 +18,11 @@
 //! | [`output`] | MCAP, extended XYZ, LAMMPS dump, restart |
 //! | [`export`] | a deck as LAMMPS data + input (`cellmd export-lammps`) |
 //! | [`compare`] | cellmd vs LAMMPS probes, agreement table, golden reference files (`cellmd compare`) |
+//! | [`build`] | topology generators (`cellmd build icosphere`) |
 //! | [`run`] | executes a plan: run loop, thermo, blow-up diagnosis, minimise |
 
 pub mod backend;
+pub mod build;
 pub mod compare;
 pub mod deck;
 pub mod export;
