@@ -49,6 +49,10 @@ pub enum ThermoColumn {
     Bound(usize),
     /// Summed tension of the bound bonds of a bond type (e.g. clutch traction).
     Tension(usize),
+    /// Summed enclosed volume of the bodies of a body type (index into `Model::body_type_names`).
+    BodyVolume(usize),
+    /// Summed surface area of the bodies of a body type.
+    BodyArea(usize),
 }
 
 /// A named trajectory output.

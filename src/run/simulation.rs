@@ -372,6 +372,8 @@ impl Simulation {
                 kt: self.kt,
                 volume: self.sim_box.volume(),
                 neighbor_builds: self.backend.as_ref().map_or(0, |b| b.neighbor_builds()),
+                positions: &self.state.positions,
+                images: self.sim_box.images(),
             };
             let line = self.thermo.row(&inputs)?;
             match bar {

@@ -248,6 +248,15 @@ impl Model {
         self.bodies.iter().any(|b| self.body_rule_type.contains(&b.body_type))
     }
 
+    /// Enclosed volume and area of body `b` at positions `x` (made
+    /// image-consistent across periodic boundaries first).
+    pub fn body_volume_and_area(&self, b: usize, x: &[glam::DVec3], images: &super::Images) -> (f64, f64) {
+        let body = &self.bodies[b];
+        let mut local = Vec::with_capacity(body.nodes.len());
+        body.mesh.unwrap_into(|k| x[body.nodes[k as usize] as usize], |d| images.minimum_image(d), &mut local);
+        (body.mesh.volume(&local), body.mesh.area(&local))
+    }
+
     /// The surface terms (indices into `body_rules`) acting on body `b`, in force-field order.
     pub fn rules_of_body(&self, b: usize) -> impl Iterator<Item = usize> + '_ {
         let t = self.bodies[b].body_type;
