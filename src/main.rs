@@ -322,7 +322,7 @@ fn build(what: Build) -> ExitCode {
         eprintln!("error: expected --radius > 0, finite --centre and --level <= 8 (2 621 442 nodes); found radius {radius}, level {level}");
         return ExitCode::from(2);
     }
-    if box_half_width.is_some_and(|h| !(h > radius)) {
+    if box_half_width.is_some_and(|h| h.is_nan() || h <= radius) {
         eprintln!("error: expected --box HALF_WIDTH > the radius {radius}");
         return ExitCode::from(2);
     }
