@@ -295,3 +295,30 @@ fn cellmd_build_icosphere_writes_a_runnable_cell() {
     let plan = validate_file(&case.path("deck.in"), &[]).unwrap();
     assert!(plan.sim_box.periodic.iter().all(|p| !p));
 }
+
+/// The single-cell deck of `inputs/` (shortened) writes an MCAP whose
+/// Foxglove scene draws the cell's 1280 faces, and its thermo file follows
+/// the cell's volume: it shrinks towards the Laplace balance and stays within
+/// 5 % of V0.
+#[test]
+fn single_cell_deck_writes_a_foxglove_scene_of_its_surface() {
+    let out = tempfile::tempdir().unwrap();
+    let plan = validate_file(std::path::Path::new("inputs/single_cell.in"), &[("steps".into(), "1000".into())]).unwrap();
+    Simulation::execute(&plan, RunOptions { output_dir: out.path().to_path_buf(), ..Default::default() }).unwrap();
+    let bytes = std::fs::read(out.path().join("single_cell.mcap")).unwrap();
+    let scenes: Vec<serde_json::Value> = mcap::MessageStream::new(&bytes)
+        .unwrap()
+        .map(|m| m.unwrap())
+        .filter(|m| m.channel.topic == "/scene")
+        .map(|m| serde_json::from_slice(&m.data).unwrap())
+        .collect();
+    assert_eq!(scenes.len(), 2);
+    let triangles = scenes[1]["entities"][0]["triangles"].as_array().unwrap();
+    assert_eq!(triangles[0]["points"].as_array().unwrap().len(), 3 * 1280);
+    let csv = std::fs::read_to_string(out.path().join("single_cell.thermo.csv")).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let column = header.iter().position(|h| h.starts_with("volume/cell")).unwrap();
+    let volumes: Vec<f64> = csv.lines().skip(1).map(|l| l.split(',').nth(column).unwrap().parse().unwrap()).collect();
+    assert!(volumes.windows(2).all(|w| w[1] < w[0]), "{volumes:?}");
+    assert!(volumes.iter().all(|v| (v / 519.0926 - 1.0).abs() < 0.05), "{volumes:?}");
+}
