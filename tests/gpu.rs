@@ -151,7 +151,8 @@ fn gpu_matches_cpu_on_every_golden_case() {
             // Surface (body) terms: the GPU backend has no kernel and refuses them.
             assert!(doc.get("gpu_epsilon").is_none(), "{}: a surface case declares a gpu_epsilon", path.display());
             let state = initial_state(&plan);
-            let refusal = GpuBackend::new(&context, &plan.model, &state, &plan.sim_box, &settings(0.3, 1e-3, 0.0)).err().unwrap_or_default();
+            let refusal =
+                GpuBackend::new(&context, &plan.model, &state, &plan.sim_box, &settings(0.3, 1e-3, 0.0)).err().unwrap_or_default();
             assert!(refusal.contains("no kernels for surface terms"), "{}: {refusal}", deck.display());
             continue;
         }
@@ -320,7 +321,11 @@ fn every_input_deck_runs_on_the_gpu_like_on_the_cpu() {
             let dir = tempfile::tempdir().unwrap();
             let options = RunOptions { output_dir: dir.path().to_path_buf(), device: Some(DevicePreference::Gpu), ..Default::default() };
             let refusal = Simulation::execute(&plan, options).err().map(|e| e.to_string()).unwrap_or_default();
-            assert!(refusal.contains("surface terms of bodies"), "{}: expected the GPU to refuse body terms, got {refusal:?}", deck.display());
+            assert!(
+                refusal.contains("surface terms of bodies"),
+                "{}: expected the GPU to refuse body terms, got {refusal:?}",
+                deck.display()
+            );
             continue;
         }
         match run_deck_deterministic(&deck, DevicePreference::Gpu, 10_000, false) {

@@ -12,7 +12,7 @@
 //! - **Externals**: per member particle, on the unwrapped position.
 //! - **Surface terms** of closed bodies (turgor, tension, bending): each body
 //!   once, in parallel over bodies, into per-node slots that each particle
-//!   gathers in a fixed order (see [`surface`](super::surface)).
+//!   gathers in a fixed order (see `src/backend/surface.rs`).
 //!
 //! Energies and the virial are needed only on thermo steps:
 //! [`CpuBackend::compute_forces`] skips them, [`CpuBackend::compute`]
