@@ -6,7 +6,8 @@
 //! |---|---|
 //! | [`input`] | shared nom lexer for decks, topologies and force fields; `file:line:col` diagnostics |
 //! | [`deck`] | deck commands → validated [`deck::Plan`] |
-//! | [`topology`] | particles, bonds, angles, triangles, bodies |
+//! | [`topology`] | particles, bonds, angles, triangles, bodies (checked: closed, oriented, sphere topology) |
+//! | [`mesh`] | closed triangulated surfaces: edges and wings, volume, area, bending angles, the icosphere |
 //! | [`forcefield`] | particle/bond/angle/pair types checked against each interaction's schema |
 //! | [`interactions`] | the registry: one file per interaction type (its evaluator + docs) |
 //! | [`system`] | box, f64 state and the resolved [`system::Model`] |
@@ -17,9 +18,11 @@
 //! | [`output`] | MCAP, extended XYZ, LAMMPS dump, restart |
 //! | [`export`] | a deck as LAMMPS data + input (`cellmd export-lammps`) |
 //! | [`compare`] | cellmd vs LAMMPS probes, agreement table, golden reference files (`cellmd compare`) |
+//! | [`build`] | topology generators (`cellmd build icosphere`) |
 //! | [`run`] | executes a plan: run loop, thermo, blow-up diagnosis, minimise |
 
 pub mod backend;
+pub mod build;
 pub mod compare;
 pub mod deck;
 pub mod export;
@@ -29,6 +32,7 @@ pub mod input;
 pub mod integrate;
 pub mod interactions;
 pub mod kinetics;
+pub mod mesh;
 pub mod neighbor;
 pub mod output;
 pub mod run;

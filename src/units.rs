@@ -46,6 +46,12 @@ pub enum Dim {
     Rate,
     /// Length per unit time.
     Velocity,
+    /// Length² (a rest area).
+    Area,
+    /// Length³ (a rest volume).
+    Volume,
+    /// 1/length (a spontaneous curvature).
+    Curvature,
 }
 
 impl UnitSystem {
@@ -85,6 +91,9 @@ impl UnitSystem {
             (Self::Cell, Dim::Tension) => "pN/µm",
             (Self::Cell, Dim::Rate) => "1/s",
             (Self::Cell, Dim::Velocity) => "µm/s",
+            (Self::Cell, Dim::Area) => "µm²",
+            (Self::Cell, Dim::Volume) => "µm³",
+            (Self::Cell, Dim::Curvature) => "1/µm",
             (Self::Lj, Dim::Length) => "σ",
             (Self::Lj, Dim::Time) => "τ",
             (Self::Lj, Dim::Force) => "ε/σ",
@@ -99,6 +108,9 @@ impl UnitSystem {
             (Self::Lj, Dim::Tension) => "ε/σ²",
             (Self::Lj, Dim::Rate) => "1/τ",
             (Self::Lj, Dim::Velocity) => "σ/τ",
+            (Self::Lj, Dim::Area) => "σ²",
+            (Self::Lj, Dim::Volume) => "σ³",
+            (Self::Lj, Dim::Curvature) => "1/σ",
         }
     }
 }

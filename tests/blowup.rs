@@ -87,3 +87,21 @@ fn coincident_particles_on_a_slack_bond_are_not_a_blowup() {
     let error = Simulation::execute(&plan, options).err().expect("a blow-up").to_string();
     assert!(error.contains("non-finite force") && error.contains("harmonic"), "{error}");
 }
+
+#[test]
+fn a_collapsed_cell_names_its_body_term() {
+    // A tetrahedral cell under the log-law turgor, crushed through itself by
+    // a strong surface tension in one step: its volume turns negative, the log
+    // law has no pressure there, and the report names the body term.
+    let top = "[ particles ]\n1 p 0 0 0\n2 p 1 0 0\n3 p 0 1 0\n4 p 0 0 1\n[ bodies ]\n1 cell\n[ triangles ]\n1 1 3 2\n1 1 2 4\n1 2 3 4\n1 3 1 4\n";
+    let ff = "particle p drag 1\nbody cell turgor_log k 1 v0 0.1667\nbody cell surface_tension gamma 100\n";
+    let deck = "units lj\ntopology t.top\nforcefield f.ff\nbox x -10 10 f y -10 10 f z -10 10 f\ntimestep 0.1\n\
+                integrator overdamped max_displacement 1000\nrun 10\n";
+    let case = Case::new(&[("t.top", top), ("f.ff", ff), ("deck.in", deck)]);
+    let error = run_to_error(&case);
+    let RunError::Blowup { step, culprit, .. } = &error else { panic!("{error}") };
+    assert_eq!(*step, 1, "{error}");
+    let culprit = culprit.as_ref().unwrap();
+    assert_eq!((culprit.kind, culprit.label.as_str(), culprit.interaction), ("body", "cell", "turgor_log"), "{error}");
+    assert!(error.to_string().contains("non-finite force; largest force on it from body `cell` (turgor_log)"), "{error}");
+}

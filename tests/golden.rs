@@ -10,6 +10,10 @@
 //! The golden files of bond kinetics (`threshold.yaml`: LAMMPS `fix
 //! bond/break`; `bind.yaml`: `fix bond/create`) also record the bound bonds
 //! at the start and after the run, and cellmd must end with the same set.
+//!
+//! The surface (`body`) types have no LAMMPS style: their golden files come
+//! from OpenMM custom forces (`reference/openmm_surfaces.py`; the generator
+//! header says which engine produced a file).
 
 use std::path::{Path, PathBuf};
 
@@ -27,6 +31,12 @@ fn documents(path: &Path) -> Vec<golden::Document> {
 fn is_kinetics(path: &Path) -> bool {
     let name = path.file_stem().unwrap().to_str().unwrap();
     name == "bind" || cellmd::kinetics::lookup_rule(name).is_some()
+}
+
+/// Whether a golden document was produced by OpenMM (the surface types)
+/// rather than by LAMMPS through `cellmd export-lammps`.
+fn is_openmm(doc: &golden::Document) -> bool {
+    doc.get("generator").is_some_and(|g| g.starts_with("OpenMM "))
 }
 
 fn golden_files() -> Vec<PathBuf> {
@@ -147,13 +157,48 @@ fn kinetics_golden_files_tell_a_different_rule_apart() {
     assert_eq!(checked, 2, "expected the threshold and bind golden files");
 }
 
+/// The OpenMM golden files can fail: every surface case disagrees with
+/// cellmd once one parameter of each body term is off by one part in 10⁶.
+#[test]
+fn surface_golden_files_tell_a_perturbed_term_apart() {
+    let mut checked = 0;
+    for path in golden_files() {
+        for doc in documents(&path).iter().filter(|d| is_openmm(d)) {
+            let deck = Path::new("reference").join(doc.get("deck").unwrap());
+            let mut plan = validate_file(&deck, &[]).unwrap();
+            for term in &mut plan.model.body_rules {
+                let k = term.params.iter().position(|p| *p != 0.0).unwrap();
+                term.params[k] *= 1.0 + 1e-6;
+            }
+            let agreement = Agreement::new(&cellmd_probes(&plan).unwrap(), &golden::probes_of(doc).unwrap()).unwrap();
+            println!("{}: worst relative error {:.1e} with a parameter off by 1e-6", deck.display(), agreement.init.worst());
+            assert!(!agreement.agrees(golden::tolerance_of(doc).unwrap()), "{}: a perturbed term still agrees", deck.display());
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, 10);
+}
+
 /// The LAMMPS inputs committed beside each case are what `cellmd
 /// export-lammps` writes for its deck today (`reference/regenerate` copies
-/// them there): the golden data came from these decks.
+/// them there): the golden data came from these decks. OpenMM cases have
+/// none: their system is built from the deck's own files by
+/// `reference/openmm_surfaces.py`, and LAMMPS export refuses body terms.
 #[test]
 fn committed_lammps_inputs_are_current_exports() {
+    let mut openmm = 0;
     for path in golden_files() {
         for doc in documents(&path) {
+            if is_openmm(&doc) {
+                let deck = Path::new("reference").join(doc.get("deck").unwrap());
+                let plan = validate_file(&deck, &[]).unwrap();
+                assert!(plan.model.has_surface_terms(), "{}: an OpenMM case without surface terms", deck.display());
+                let refusal = cellmd::export::export(&plan, cellmd::export::ExportOptions { probes: true }).err().unwrap_or_default();
+                assert!(refusal.contains("which LAMMPS cannot express"), "{}: {refusal}", deck.display());
+                assert!(!deck.parent().unwrap().join("lammps").exists());
+                openmm += 1;
+                continue;
+            }
             let deck = Path::new("reference").join(doc.get("deck").unwrap());
             let plan = validate_file(&deck, &[]).unwrap();
             let exported = cellmd::export::export(&plan, cellmd::export::ExportOptions { probes: true }).unwrap();
@@ -169,6 +214,7 @@ fn committed_lammps_inputs_are_current_exports() {
             }
         }
     }
+    assert_eq!(openmm, 10, "expected two OpenMM cases for each of the five surface types");
 }
 
 /// Each name has `reference/NAME.yaml` or a row `| `NAME` | reason | `test` |`

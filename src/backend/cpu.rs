@@ -10,6 +10,9 @@
 //! - **Bonded terms**: bonds from each end, angles through per-term slots
 //!   (see [`bonded`](super::bonded)).
 //! - **Externals**: per member particle, on the unwrapped position.
+//! - **Surface terms** of closed bodies (turgor, tension, bending): each body
+//!   once, in parallel over bodies, into per-node slots that each particle
+//!   gathers in a fixed order (see `src/backend/surface.rs`).
 //!
 //! Energies and the virial are needed only on thermo steps:
 //! [`CpuBackend::compute_forces`] skips them, [`CpuBackend::compute`]
@@ -26,6 +29,7 @@ use rayon::prelude::*;
 use super::bonded::Bonded;
 use super::pair_table::{PairGeometry, PairTable};
 use super::sum::chunked;
+use super::surface::Surfaces;
 use super::virial::add6;
 use crate::interactions::{Law, REGISTRY};
 use crate::neighbor::{Exclusions, NeighborList};
@@ -67,6 +71,7 @@ pub struct CpuBackend {
     neighbors: NeighborList,
     exclusions: Exclusions,
     bonded: Bonded,
+    surfaces: Surfaces,
     pairs: PairTable,
     /// Registry indices of the pair interactions in use (the energy columns).
     pair_interactions: Vec<usize>,
@@ -89,6 +94,7 @@ impl CpuBackend {
             neighbors: NeighborList::new(model.max_pair_cutoff(), skin),
             exclusions: Exclusions::from_pairs(model.len(), &model.excluded_pairs(state.bonds.as_ref().map(|b| b.bound.as_slice()))),
             bonded: Bonded::new(model),
+            surfaces: Surfaces::new(model),
             pairs: PairTable::default(),
             pair_interactions,
             pair_rule_column,
@@ -168,22 +174,28 @@ impl CpuBackend {
             self.pairs.update(model, &self.pair_rule_column);
         }
         self.bonded.prepare(model, x, &images);
+        self.surfaces.prepare(model, x, &images);
         let bond_state = state.bonds.as_ref();
         if bond_state.is_some() {
             self.bonded.tensions(model, x, &images, bond_state, &mut self.bond_tension, &mut self.bond_length);
         }
-        let (pairs, bonded) = (&self.pairs, &self.bonded);
+        let (pairs, bonded, surfaces) = (&self.pairs, &self.bonded, &self.surfaces);
+        let has_surfaces = !surfaces.is_empty();
         let geometry = PairGeometry { x, types: &model.types, list: &self.neighbors, images };
         out.forces.resize(n, DVec3::ZERO);
         out.forces.par_iter_mut().enumerate().with_min_len(256).for_each(|(i, f)| {
             let pair = if has_pairs { pairs.force_on(i, &geometry) } else { DVec3::ZERO };
             *f = pair + bonded.force_on(i, model, x, &images, bond_state);
+            if has_surfaces {
+                *f += surfaces.force_on(i);
+            }
         });
         if energies {
             out.energy_by_interaction.clear();
             out.energy_by_interaction.resize(REGISTRY.len(), 0.0);
             out.virial = [0.0; 6];
             bonded.energy(model, x, &images, bond_state, &mut out.energy_by_interaction, &mut out.virial);
+            surfaces.energy(model, &mut out.energy_by_interaction, &mut out.virial);
             if has_pairs {
                 self.pair_energy(&geometry, out);
             }
@@ -227,6 +239,10 @@ impl CpuBackend {
                 ForceBreakdown { kind, label: term.label.text.clone(), interaction: term.interaction.name(), force }
             })
             .collect();
+        for (rule, force) in self.surfaces.terms_on(i) {
+            let term = &model.body_rules[rule];
+            parts.push(ForceBreakdown { kind: "body", label: term.label.text.clone(), interaction: term.interaction.name(), force });
+        }
         if !self.pair_interactions.is_empty() {
             let x = &state.positions;
             for &j in self.neighbors.neighbors(i) {

@@ -6,6 +6,7 @@ pub mod cpu;
 mod pair_table;
 pub mod stiffness;
 mod sum;
+mod surface;
 mod virial;
 
 pub use self::cpu::{CpuBackend, ForceBreakdown, Forces};

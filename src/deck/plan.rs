@@ -55,6 +55,10 @@ pub enum ThermoColumn {
     SolverResidual,
     /// Summed constraint tension of a constrained bond type (index into `Model::bond_types`).
     ConstraintTension(usize),
+    /// Summed enclosed volume of the bodies of a body type (index into `Model::body_type_names`).
+    BodyVolume(usize),
+    /// Summed surface area of the bodies of a body type.
+    BodyArea(usize),
 }
 
 /// A named trajectory output.

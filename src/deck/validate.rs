@@ -208,11 +208,22 @@ impl Validator {
 
     fn thermo_columns(&self, tokens: &[Token]) -> Result<Vec<ThermoColumn>, InputError> {
         const FIXED: &str =
-            "step, time, pe, pe/NAME, fmax, fnorm, press, pxx, pyy, pzz, pxy, pxz, pyz, nbuild, solver_iterations, solver_residual, ctension/BONDTYPE, breaks, rebinds, forms, resets, nbound/BONDTYPE, tension/BONDTYPE";
+            "step, time, pe, pe/NAME, fmax, fnorm, press, pxx, pyy, pzz, pxy, pxz, pyz, nbuild, solver_iterations, solver_residual, ctension/BONDTYPE, breaks, rebinds, forms, resets, nbound/BONDTYPE, tension/BONDTYPE, volume/BODYTYPE, area/BODYTYPE";
         let bond_type = |t: &Token, name: &str| {
             self.forcefield.bond_types.iter().position(|b| b.label.text == name).ok_or_else(|| {
                 let names: Vec<&str> = self.forcefield.bond_types.iter().map(|b| b.label.text.as_str()).collect();
                 t.error(format!("found bond type `{name}`, expected one defined in the force field ({})", names.join(", ")))
+            })
+        };
+        let body_type = |t: &Token, name: &str| {
+            let mut names: Vec<&str> = Vec::new();
+            for rule in &self.forcefield.body_rules {
+                if !names.contains(&rule.body_type.text.as_str()) {
+                    names.push(&rule.body_type.text);
+                }
+            }
+            names.iter().position(|n| *n == name).ok_or_else(|| {
+                t.error(format!("found body type `{name}`, expected one that `body` lines of the force field name ({})", names.join(", ")))
             })
         };
         tokens
@@ -247,6 +258,8 @@ impl Validator {
                         Some(("nbound", name)) => ThermoColumn::Bound(bond_type(t, name)?),
                         Some(("tension", name)) => ThermoColumn::Tension(bond_type(t, name)?),
                         Some(("ctension", name)) => ThermoColumn::ConstraintTension(bond_type(t, name)?),
+                        Some(("volume", name)) => ThermoColumn::BodyVolume(body_type(t, name)?),
+                        Some(("area", name)) => ThermoColumn::BodyArea(body_type(t, name)?),
                         _ => return Err(t.error(format!("found thermo column `{other}`, expected one of: {FIXED}"))),
                     },
                 })

@@ -681,6 +681,9 @@ impl Writer<'_> {
 /// are errors naming them.
 pub fn export(plan: &Plan, options: ExportOptions) -> Result<LammpsDeck, String> {
     let model = plan.model.clone();
+    if let Some(term) = model.body_rules.first() {
+        return Err(styles::unsupported(term));
+    }
     let kinetic = kinetic_fixes(plan)?;
     let bonds = Hybrid::new(&model.bond_types, styles::bond)?;
     let angles = Hybrid::new(&model.angle_types, styles::angle)?;

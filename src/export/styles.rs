@@ -45,7 +45,7 @@ pub struct PairStyled {
     pub shift: bool,
 }
 
-fn unsupported(term: &TermType) -> String {
+pub(super) fn unsupported(term: &TermType) -> String {
     format!(
         "{} `{}` uses `{}`, which LAMMPS cannot express",
         term.interaction.kind().with_article(),

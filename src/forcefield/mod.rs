@@ -9,13 +9,17 @@
 //! bond  actin_segment  harmonic  k 400 r0 0.1
 //! angle actin_bend     wlc_bending kappa 0.07 l0 0.1
 //! pair  actin actin    soft_repulsion k 100 sigma 0.05
+//! body  cell           turgor k 7e5 dp0 40 v0 4189
 //! ```
 //!
 //! Parameters are `name value` pairs in any order, checked against the
 //! interaction's schema (`cellmd list NAME`): unknown or repeated names,
 //! missing required values, non-finite or out-of-range values and an
 //! interaction of the wrong kind are errors at their `file:line:col`.
-//! Several `pair` lines for one type pair add up (like LAMMPS `hybrid/overlay`).
+//! Several `pair` lines for one type pair add up (like LAMMPS `hybrid/overlay`),
+//! and so do several `body` lines for one body type (the `type` of a body in
+//! the topology's `[ bodies ]`): each line is one many-body term evaluated on
+//! every body of that type.
 //!
 //! A `bond` line may end with kinetic rules (see [`crate::kinetics`]):
 //! `bond clutch harmonic k 5 r0 0.02 kinetics catch_slip kc0 10 xc 0.002 ks0 0.05 xs 0.001`.
@@ -24,4 +28,4 @@ mod params;
 mod parse;
 
 pub use self::params::{parse_kinetics, parse_params, parse_values, BondTypeKinetics, TermType};
-pub use self::parse::{check_pair_types, load_forcefield, ForceField, PairRule, ParticleType};
+pub use self::parse::{check_pair_types, load_forcefield, BodyRule, ForceField, PairRule, ParticleType};

@@ -27,6 +27,14 @@ pub struct PairRule {
     pub term: TermType,
 }
 
+/// A many-body term of every body of a type (`body TYPE INTERACTION ...`).
+#[derive(Clone, Debug)]
+pub struct BodyRule {
+    /// The body type, as named in the topology's `[ bodies ]` section.
+    pub body_type: Token,
+    pub term: TermType,
+}
+
 /// Everything the force-field files of a deck define.
 #[derive(Clone, Debug, Default)]
 pub struct ForceField {
@@ -36,6 +44,8 @@ pub struct ForceField {
     pub bond_kinetics: Vec<BondTypeKinetics>,
     pub angle_types: Vec<TermType>,
     pub pair_rules: Vec<PairRule>,
+    /// Surface terms by body type (`body` lines); several lines for one type add up.
+    pub body_rules: Vec<BodyRule>,
     /// Bond formation rules (`bind` lines).
     pub bind_lines: Vec<crate::kinetics::BindLine>,
 }
@@ -168,8 +178,17 @@ pub fn load_forcefield(
                 let term = parse_params(&t[1], &t[3], &t[4..], Kind::Pair, units)?;
                 ff.pair_rules.push(PairRule { type_a: t[1].clone(), type_b: t[2].clone(), term });
             }
+            "body" => {
+                if t.len() < 3 {
+                    return Err(kw.error("expected `body TYPE INTERACTION [param value]...`"));
+                }
+                let term = parse_params(&t[1], &t[2], &t[3..], Kind::Body, units)?;
+                ff.body_rules.push(BodyRule { body_type: t[1].clone(), term });
+            }
             "bind" => ff.bind_lines.push(crate::kinetics::parse_bind(kw, &t[1..], units)?),
-            other => return Err(kw.error(format!("found `{other}`, expected `include`, `particle`, `bond`, `angle`, `pair` or `bind`"))),
+            other => {
+                return Err(kw.error(format!("found `{other}`, expected `include`, `particle`, `bond`, `angle`, `pair`, `body` or `bind`")))
+            }
         }
     }
     stack.pop();
@@ -216,6 +235,22 @@ mod tests {
         assert_eq!(ff.particle_types[0].drag, 2.0);
         assert!((ff.particle_types[1].drag - 3.0 * std::f64::consts::PI).abs() < 1e-12);
         assert_eq!(ff.bond_types[0].params, vec![1.0, 2.0]);
+    }
+
+    #[test]
+    fn body_lines_name_a_body_type_and_a_surface_interaction() {
+        let ff = load(&[("m.ff", "particle a drag 1\nbody cell turgor k 100 v0 4\nbody cell surface_tension gamma 2\n")]).unwrap();
+        assert_eq!(ff.body_rules.len(), 2);
+        assert_eq!(ff.body_rules[0].body_type.text, "cell");
+        assert_eq!(ff.body_rules[0].term.params, vec![100.0, 0.0, 4.0]);
+        assert_eq!(
+            load(&[("m.ff", "body cell harmonic k 1 r0 1\n")]).unwrap_err(),
+            "m.ff:1:11: `harmonic` is a bond interaction, expected a body interaction here"
+        );
+        assert!(load(&[("m.ff", "bond s turgor k 1 v0 1\n")])
+            .unwrap_err()
+            .contains("`turgor` is a body interaction, expected a bond interaction"));
+        assert!(load(&[("m.ff", "body cell\n")]).unwrap_err().contains("expected `body TYPE INTERACTION"));
     }
 
     #[test]

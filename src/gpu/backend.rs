@@ -156,6 +156,11 @@ impl GpuBackend {
         if state.bonds.is_some() || !model.bind_rules.is_empty() {
             return Err("the GPU backend does not run bond kinetics yet; use `device cpu` for decks with `kinetics` or `bind`".into());
         }
+        if model.has_surface_terms() {
+            return Err(
+                "the GPU backend has no kernels for surface terms of bodies yet; use `device cpu` for decks with `body` lines".into()
+            );
+        }
         let n = model.len();
         if n == 0 {
             return Err("the GPU backend needs at least one particle".into());

@@ -12,6 +12,10 @@
 //! the run needs them; thermo quantities (energies, virial, pressure) are then
 //! evaluated by the f64 CPU backend at the read-back positions.
 //!
+//! Not on the GPU (refused by [`GpuBackend::new`], and by `device gpu`
+//! before a run; `device auto` falls back to the CPU): bond kinetics, and
+//! the surface terms of bodies (`Law::Surface`), which have no kernel yet.
+//!
 //! # Precision
 //!
 //! Forces are f32. Positions are 64-bit fixed point relative to the box's

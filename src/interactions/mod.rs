@@ -11,6 +11,11 @@
 //! Parameters reach an evaluator as a slice in schema order, already checked
 //! against the schema and by [`Interaction::validate`].
 //!
+//! Many-body terms of closed surfaces (cell shells) use [`Law::Surface`]: the
+//! evaluator sees one body's whole mesh ([`SurfaceMesh`]) with image-consistent
+//! node positions and adds a force to every node; the backend evaluates each
+//! body once per force pass into per-node slots that each particle gathers.
+//!
 //! Laws carry what later solvers need: [`Radial`] returns d²E/dr², from which
 //! the analytic pair Hessian `E''·ûûᵀ + (E'/r)(I − ûûᵀ)` follows; state that
 //! changes during a run (e.g. a rest length under kinetics) is a parameter
@@ -18,6 +23,7 @@
 
 use glam::DVec3;
 
+pub use crate::mesh::SurfaceMesh;
 use crate::units::Dim;
 
 /// Implements [`Interaction`] for a unit struct from its registration data:
@@ -55,6 +61,7 @@ macro_rules! interaction {
 
 pub mod testing;
 
+mod area_conservation;
 mod asymmetric;
 mod cable;
 mod constant_force;
@@ -62,10 +69,14 @@ mod cosine_angle;
 mod fene;
 mod harmonic;
 mod harmonic_angle;
+mod helfrich_bending;
 mod lj;
 mod soft;
 mod soft_repulsion;
 mod spring;
+mod surface_tension;
+mod turgor;
+mod turgor_log;
 mod wall;
 mod wca;
 mod wlc_bending;
@@ -87,6 +98,11 @@ pub static REGISTRY: &[&dyn Interaction] = &[
     &soft::Soft,
     &wall::Wall,
     &constant_force::ConstantForce,
+    &turgor::Turgor,
+    &turgor_log::TurgorLog,
+    &surface_tension::SurfaceTension,
+    &area_conservation::AreaConservation,
+    &helfrich_bending::HelfrichBending,
 ];
 
 /// Looks an interaction type up by its registered name.
@@ -105,6 +121,8 @@ pub enum Kind {
     Pair,
     /// One-particle external field on a group (deck `external` command).
     External,
+    /// Many-body term of a closed surface, by body type (`body` lines).
+    Body,
 }
 
 impl Kind {
@@ -115,6 +133,7 @@ impl Kind {
             Kind::Angle => "angle",
             Kind::Pair => "pair",
             Kind::External => "external",
+            Kind::Body => "body",
         }
     }
 
@@ -125,6 +144,7 @@ impl Kind {
             Kind::Angle => "an angle",
             Kind::Pair => "a pair",
             Kind::External => "an external",
+            Kind::Body => "a body",
         }
     }
 }
@@ -182,6 +202,20 @@ pub enum Law {
     ThreeBody(fn(&[f64], [DVec3; 3]) -> ThreeBody),
     /// E(r) of one particle in an external field; r is the unwrapped position.
     OneBody(fn(&[f64], DVec3) -> OneBody),
+    /// E(r_1 … r_n) of one closed surface: the evaluator gets the body's mesh
+    /// and its node positions (image-consistent, local numbering), adds the
+    /// force on each node to `forces` and returns the energy. The CPU backend
+    /// evaluates it; the GPU backend has no kernel for this family yet and
+    /// refuses decks that use it ([`Law::runs_on_gpu`]).
+    Surface(fn(params: &[f64], mesh: &SurfaceMesh, x: &[DVec3], forces: &mut [DVec3]) -> f64),
+}
+
+impl Law {
+    /// Whether the GPU backend has a kernel for this law family (and so each
+    /// interaction of the family a `shaders/interactions/NAME.wgsl` evaluator).
+    pub fn runs_on_gpu(&self) -> bool {
+        !matches!(self, Law::Surface(_))
+    }
 }
 
 /// Inclusive/exclusive numeric bound of a parameter.
@@ -376,7 +410,10 @@ mod tests {
             }
             // Kind and law agree.
             match (i.kind(), i.law()) {
-                (Kind::Bond | Kind::Pair, Law::Radial { .. }) | (Kind::Angle, Law::ThreeBody(_)) | (Kind::External, Law::OneBody(_)) => {}
+                (Kind::Bond | Kind::Pair, Law::Radial { .. })
+                | (Kind::Angle, Law::ThreeBody(_))
+                | (Kind::External, Law::OneBody(_))
+                | (Kind::Body, Law::Surface(_)) => {}
                 _ => panic!("{}: kind and law disagree", i.name()),
             }
         }

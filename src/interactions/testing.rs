@@ -7,11 +7,14 @@
 //! - translation and rotation invariance of the energy (internal laws);
 //! - zero force at the rest configuration the caller names;
 //! - for [`Law::Radial`], d²E/dr² against a central difference of dE/dr.
+//!
+//! [`Law::Surface`] laws need a mesh besides positions: their checks are the
+//! `assert_surface_*` functions, which run the same tests on a body.
 
 use glam::{DMat3, DVec3};
 
 pub use super::Interaction;
-use super::Law;
+use super::{Law, SurfaceMesh};
 
 /// Energy and per-particle forces of `law` at `positions` (1, 2 or 3 particles).
 pub fn evaluate(law: Law, params: &[f64], positions: &[DVec3]) -> (f64, Vec<DVec3>) {
@@ -31,7 +34,16 @@ pub fn evaluate(law: Law, params: &[f64], positions: &[DVec3]) -> (f64, Vec<DVec
             let out = eval(params, positions[0]);
             (out.energy, vec![out.force])
         }
+        Law::Surface(_) => panic!("a surface law needs its mesh: use evaluate_surface"),
     }
+}
+
+/// Energy and per-node forces of a surface law on `mesh` at `positions`.
+pub fn evaluate_surface(law: Law, params: &[f64], mesh: &SurfaceMesh, positions: &[DVec3]) -> (f64, Vec<DVec3>) {
+    let Law::Surface(eval) = law else { panic!("not a surface law") };
+    let mut forces = vec![DVec3::ZERO; positions.len()];
+    let energy = eval(params, mesh, positions, &mut forces);
+    (energy, forces)
 }
 
 /// Resolves a name=value list against the schema, filling defaults.
@@ -59,64 +71,137 @@ fn largest_force(forces: &[DVec3]) -> f64 {
     forces.iter().map(|f| f.length()).fold(0.0, f64::max)
 }
 
-/// F = −∇E by central differences with step `h` (length units).
-///
-/// Passes when every component agrees to `1e-6 × max(|F|max, force_floor)`.
-pub fn assert_force_is_minus_gradient(interaction: &dyn Interaction, params: &[f64], positions: &[DVec3], h: f64, force_floor: f64) {
-    let law = interaction.law();
-    let (_, forces) = evaluate(law, params, positions);
+/// Energy and forces as a function of all positions (one law, one term).
+type EnergyAndForces<'a> = dyn Fn(&[DVec3]) -> (f64, Vec<DVec3>) + 'a;
+
+fn force_is_minus_gradient(name: &str, eval: &EnergyAndForces, positions: &[DVec3], h: f64, force_floor: f64) {
+    let (_, forces) = eval(positions);
     let scale = largest_force(&forces).max(force_floor);
+    let mut plus = positions.to_vec();
+    let mut minus = positions.to_vec();
     for (p, f) in forces.iter().enumerate() {
         for axis in 0..3 {
-            let mut plus = positions.to_vec();
-            let mut minus = positions.to_vec();
             plus[p][axis] += h;
             minus[p][axis] -= h;
-            let numeric = -(evaluate(law, params, &plus).0 - evaluate(law, params, &minus).0) / (2.0 * h);
+            let numeric = -(eval(&plus).0 - eval(&minus).0) / (2.0 * h);
+            plus[p][axis] = positions[p][axis];
+            minus[p][axis] = positions[p][axis];
             let err = (numeric - f[axis]).abs() / scale;
             assert!(
                 err < 1e-6,
-                "{}: F = -grad E fails on particle {p} axis {axis}: analytic {} numeric {numeric} (rel. err {err:e}) at {positions:?}",
-                interaction.name(),
+                "{name}: F = -grad E fails on particle {p} axis {axis}: analytic {} numeric {numeric} (rel. err {err:e})",
                 f[axis]
             );
         }
     }
 }
 
-/// Σf = 0 and Σ r×f = 0 (internal forces conserve momentum and angular momentum).
-pub fn assert_momentum_conserved(interaction: &dyn Interaction, params: &[f64], positions: &[DVec3]) {
-    let (_, forces) = evaluate(interaction.law(), params, positions);
+fn momentum_conserved(name: &str, eval: &EnergyAndForces, positions: &[DVec3]) {
+    let (_, forces) = eval(positions);
     let scale = largest_force(&forces).max(f64::MIN_POSITIVE);
     let sum: DVec3 = forces.iter().sum();
-    assert!(sum.length() / scale < 1e-12, "{}: sum of forces {sum:?}", interaction.name());
+    assert!(sum.length() / scale < 1e-12, "{name}: sum of forces {sum:?}");
     let centre = positions.iter().sum::<DVec3>() / positions.len() as f64;
     let size = positions.iter().map(|p| (*p - centre).length()).fold(0.0, f64::max);
     let torque: DVec3 = positions.iter().zip(&forces).map(|(p, f)| (*p - centre).cross(*f)).sum();
-    assert!(torque.length() / (scale * size) < 1e-12, "{}: net torque {torque:?}", interaction.name());
+    assert!(torque.length() / (scale * size) < 1e-12, "{name}: net torque {torque:?}");
+}
+
+fn invariant_under_rigid_motion(name: &str, eval: &EnergyAndForces, positions: &[DVec3]) {
+    let (e0, f0) = eval(positions);
+    let shift = DVec3::new(0.37, -1.21, 2.03);
+    let rotation = DMat3::from_axis_angle(DVec3::new(1.0, 2.0, -0.5).normalize(), 0.813);
+    let moved: Vec<DVec3> = positions.iter().map(|p| rotation * *p + shift).collect();
+    let (e1, f1) = eval(&moved);
+    let tol = 1e-12 * e0.abs().max(1.0);
+    assert!((e1 - e0).abs() < tol, "{name}: energy changed under rigid motion: {e0} -> {e1}");
+    let scale = largest_force(&f0).max(f64::MIN_POSITIVE);
+    for (a, b) in f0.iter().zip(&f1) {
+        assert!((rotation * *a - *b).length() / scale < 1e-10, "{name}: forces do not rotate with the system");
+    }
+}
+
+fn zero_force_at_rest(name: &str, eval: &EnergyAndForces, rest: &[DVec3], force_scale: f64) {
+    let (_, forces) = eval(rest);
+    let worst = largest_force(&forces);
+    assert!(worst <= 1e-9 * force_scale, "{name}: force {worst} at rest");
+}
+
+/// F = −∇E by central differences with step `h` (length units).
+///
+/// Passes when every component agrees to `1e-6 × max(|F|max, force_floor)`.
+pub fn assert_force_is_minus_gradient(interaction: &dyn Interaction, params: &[f64], positions: &[DVec3], h: f64, force_floor: f64) {
+    let law = interaction.law();
+    force_is_minus_gradient(interaction.name(), &|x| evaluate(law, params, x), positions, h, force_floor);
+}
+
+/// Σf = 0 and Σ r×f = 0 (internal forces conserve momentum and angular momentum).
+pub fn assert_momentum_conserved(interaction: &dyn Interaction, params: &[f64], positions: &[DVec3]) {
+    let law = interaction.law();
+    momentum_conserved(interaction.name(), &|x| evaluate(law, params, x), positions);
 }
 
 /// E is unchanged by a translation and by a rotation of all positions.
 pub fn assert_invariant_under_rigid_motion(interaction: &dyn Interaction, params: &[f64], positions: &[DVec3]) {
     let law = interaction.law();
-    let (e0, f0) = evaluate(law, params, positions);
-    let shift = DVec3::new(0.37, -1.21, 2.03);
-    let rotation = DMat3::from_axis_angle(DVec3::new(1.0, 2.0, -0.5).normalize(), 0.813);
-    let moved: Vec<DVec3> = positions.iter().map(|p| rotation * *p + shift).collect();
-    let (e1, f1) = evaluate(law, params, &moved);
-    let tol = 1e-12 * e0.abs().max(1.0);
-    assert!((e1 - e0).abs() < tol, "{}: energy changed under rigid motion: {e0} -> {e1}", interaction.name());
-    let scale = largest_force(&f0).max(f64::MIN_POSITIVE);
-    for (a, b) in f0.iter().zip(&f1) {
-        assert!((rotation * *a - *b).length() / scale < 1e-10, "{}: forces do not rotate with the system", interaction.name());
-    }
+    invariant_under_rigid_motion(interaction.name(), &|x| evaluate(law, params, x), positions);
 }
 
 /// All forces vanish at a rest configuration.
 pub fn assert_zero_force_at_rest(interaction: &dyn Interaction, params: &[f64], rest: &[DVec3], force_scale: f64) {
-    let (_, forces) = evaluate(interaction.law(), params, rest);
-    let worst = largest_force(&forces);
-    assert!(worst <= 1e-9 * force_scale, "{}: force {worst} at rest {rest:?}", interaction.name());
+    let law = interaction.law();
+    zero_force_at_rest(interaction.name(), &|x| evaluate(law, params, x), rest, force_scale);
+}
+
+/// Every generic check of a surface law on one body: F = −∇E (central
+/// differences, step `h`), Σf = 0, Σ r×f = 0, and invariance of E under a
+/// translation and a rotation.
+pub fn assert_surface_checks(
+    interaction: &dyn Interaction,
+    params: &[f64],
+    mesh: &SurfaceMesh,
+    positions: &[DVec3],
+    h: f64,
+    force_floor: f64,
+) {
+    let law = interaction.law();
+    let eval = |x: &[DVec3]| evaluate_surface(law, params, mesh, x);
+    force_is_minus_gradient(interaction.name(), &eval, positions, h, force_floor);
+    momentum_conserved(interaction.name(), &eval, positions);
+    invariant_under_rigid_motion(interaction.name(), &eval, positions);
+}
+
+/// All forces of a surface law vanish at a rest configuration of the body.
+pub fn assert_surface_zero_force_at_rest(
+    interaction: &dyn Interaction,
+    params: &[f64],
+    mesh: &SurfaceMesh,
+    rest: &[DVec3],
+    force_scale: f64,
+) {
+    let law = interaction.law();
+    zero_force_at_rest(interaction.name(), &|x| evaluate_surface(law, params, mesh, x), rest, force_scale);
+}
+
+/// A deformed icosphere for surface-law tests: the icosphere of `level` and
+/// `radius`, stretched into an ellipsoid (1.3, 1, 0.8) and each node moved
+/// by a deterministic pseudo-random offset of up to `jitter` × radius.
+pub fn deformed_icosphere(level: u32, radius: f64, jitter: f64) -> (SurfaceMesh, Vec<DVec3>) {
+    let (x, faces) = crate::mesh::icosphere(level, radius);
+    let x = x
+        .iter()
+        .enumerate()
+        .map(|(k, p)| {
+            let k = k as f64;
+            let noise = DVec3::new((12.9898 * k).sin(), (78.233 * k + 1.0).sin(), (37.719 * k + 2.0).sin());
+            DVec3::new(1.3 * p.x, p.y, 0.8 * p.z) + jitter * radius * noise
+        })
+        .collect();
+    (SurfaceMesh::new(x_len(&faces), faces).expect("an icosphere is a closed mesh"), x)
+}
+
+fn x_len(faces: &[[u32; 3]]) -> usize {
+    faces.iter().flatten().map(|&p| p as usize + 1).max().unwrap_or(0)
 }
 
 /// For a radial law, d²E/dr² matches a central difference of dE/dr at `r`.
@@ -133,7 +218,7 @@ pub fn assert_radial_curvature(interaction: &dyn Interaction, params: &[f64], r:
 /// `internal` is false for external fields (which need not conserve momentum).
 pub fn assert_all_checks(interaction: &dyn Interaction, params: &[f64], positions: &[DVec3], h: f64, force_floor: f64) {
     assert_force_is_minus_gradient(interaction, params, positions, h, force_floor);
-    if !matches!(interaction.law(), Law::OneBody(_)) {
+    if !matches!(interaction.law(), Law::OneBody(_) | Law::Surface(_)) {
         assert_momentum_conserved(interaction, params, positions);
         assert_invariant_under_rigid_motion(interaction, params, positions);
     }

@@ -223,7 +223,15 @@ pub const SCENE_UPDATE_SCHEMA: &str = concat!(
     r#", "colors": {"type": "array", "items": "#,
     fox_color!(),
     r#"}, "indices": {"type": "array", "items": {"type": "integer", "minimum": 0}}}, "required": ["type", "pose", "thickness", "scale_invariant", "points", "color", "colors", "indices"]}}, "#,
-    r#""triangles": {"type": "array", "description": "unused (always empty)"}, "#,
+    r#""triangles": {"type": "array", "items": {"title": "foxglove.TriangleListPrimitive", "type": "object", "properties": {"pose": "#,
+    fox_pose!(),
+    r#", "points": {"type": "array", "items": "#,
+    fox_point3!(),
+    r#"}, "color": "#,
+    fox_color!(),
+    r#", "colors": {"type": "array", "items": "#,
+    fox_color!(),
+    r#"}, "indices": {"type": "array", "items": {"type": "integer", "minimum": 0}}}, "required": ["pose", "points", "color", "colors", "indices"]}}, "#,
     r#""texts": {"type": "array", "description": "unused (always empty)"}, "#,
     r#""models": {"type": "array", "description": "unused (always empty)"}"#,
     r#"}, "required": ["timestamp", "frame_id", "id", "lifetime", "frame_locked", "metadata", "arrows", "cubes", "spheres", "cylinders", "lines", "triangles", "texts", "models"]}}"#,
@@ -391,6 +399,26 @@ impl McapWriter {
             colors: [],
             indices: [],
         }];
+        // Surfaces of bodies: one triangle list, each face drawn whole at its first corner's image.
+        let triangles = if self.triangles.is_empty() {
+            Vec::new()
+        } else {
+            let mut points = Vec::with_capacity(3 * self.triangles.len());
+            for &[a, b, c] in &self.triangles {
+                let xa = frame.positions[a as usize];
+                points.push(Vector3::from(xa));
+                for p in [b, c] {
+                    points.push(Vector3::from(xa + frame.sim_box.minimum_image(frame.positions[p as usize] - xa)));
+                }
+            }
+            vec![TriangleList {
+                pose: Pose { position: Vector3 { x: 0.0, y: 0.0, z: 0.0 }, orientation: identity },
+                points,
+                color: Color { r: 0.95, g: 0.55, b: 0.35, a: 0.6 },
+                colors: [],
+                indices: [],
+            }]
+        };
         let stamp = Stamp { sec: ns / 1_000_000_000, nsec: (ns % 1_000_000_000) as u32 };
         let update = SceneUpdate {
             deletions: [],
@@ -406,7 +434,7 @@ impl McapWriter {
                 spheres,
                 cylinders: [],
                 lines,
-                triangles: [],
+                triangles,
                 texts: [],
                 models: [],
             }],
@@ -614,6 +642,16 @@ struct Stamp {
 }
 
 #[derive(Serialize)]
+struct TriangleList {
+    pose: Pose,
+    /// Three points per face (outward-wound).
+    points: Vec<Vector3>,
+    color: Color,
+    colors: [Color; 0],
+    indices: [u32; 0],
+}
+
+#[derive(Serialize)]
 struct Entity {
     timestamp: Stamp,
     frame_id: &'static str,
@@ -626,7 +664,7 @@ struct Entity {
     spheres: Vec<Sphere>,
     cylinders: [u8; 0],
     lines: Vec<Line>,
-    triangles: [u8; 0],
+    triangles: Vec<TriangleList>,
     texts: [u8; 0],
     models: [u8; 0],
 }
@@ -773,7 +811,14 @@ mod tests {
         // Bond 7–12 crosses the periodic x face: 9.95 → 9.95 + 0.1, not 0.05.
         assert_eq!(points[0]["x"], 9.95);
         assert!((points[1]["x"].as_f64().unwrap() - 10.05).abs() < 1e-12);
-        for key in ["arrows", "cubes", "cylinders", "triangles", "texts", "models", "metadata"] {
+        // The surface: one triangle list, three points per face, each face whole.
+        let triangles = entity["triangles"].as_array().unwrap();
+        assert_eq!(triangles.len(), 1);
+        let corners = triangles[0]["points"].as_array().unwrap();
+        assert_eq!(corners.len(), 3 * s.triangles.len());
+        let xs: Vec<f64> = corners.iter().map(|p| p["x"].as_f64().unwrap()).collect();
+        assert!(xs.iter().all(|x| (x - xs[0]).abs() < 5.0), "a face split across the periodic box: {xs:?}");
+        for key in ["arrows", "cubes", "cylinders", "texts", "models", "metadata"] {
             assert_eq!(entity[key], serde_json::json!([]), "{key}");
         }
     }

@@ -391,6 +391,8 @@ impl Simulation {
                 neighbor_builds: self.backend.as_ref().map_or(0, |b| b.neighbor_builds()),
                 solve: self.last_solve,
                 constraints: &self.constraints,
+                positions: &self.state.positions,
+                images: self.sim_box.images(),
             };
             let line = self.thermo.row(&inputs)?;
             match bar {
@@ -554,6 +556,16 @@ impl Simulation {
             } else {
                 "bond kinetics (`kinetics`, `bind`) run on the CPU backend only"
             };
+            return match device {
+                DevicePreference::Gpu => Err(RunError::Setup(format!("device gpu: {why}; use `device cpu` or `device auto`"))),
+                _ => {
+                    self.say(&format!("device auto: {why}; running on the CPU"));
+                    Ok(None)
+                }
+            };
+        }
+        if self.model.has_surface_terms() {
+            let why = "surface terms of bodies (`body` lines) run on the CPU backend only";
             return match device {
                 DevicePreference::Gpu => Err(RunError::Setup(format!("device gpu: {why}; use `device cpu` or `device auto`"))),
                 _ => {

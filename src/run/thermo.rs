@@ -18,6 +18,7 @@
 //! | `breaks`, `rebinds`, `forms`, `resets` | bond events so far | – |
 //! | `nbound/TYPE` | bound bonds of bond type TYPE | – |
 //! | `tension/TYPE` | summed tension of TYPE's bound bonds (clutch traction) | pN |
+//! | `volume/BODYTYPE`, `area/BODYTYPE` | summed enclosed volume and area of the bodies of a type | µm³, µm² |
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -45,6 +46,9 @@ pub struct ThermoInputs<'a> {
     pub solve: crate::integrate::implicit::SolveReport,
     /// The constrained bonds and their last tensions.
     pub constraints: &'a crate::integrate::constraints::Constraints,
+    /// Positions (wrapped) and the box's images, for body volumes and areas.
+    pub positions: &'a [glam::DVec3],
+    pub images: crate::system::Images,
 }
 
 /// A column's header name (bond-type columns name their type).
@@ -65,6 +69,8 @@ pub fn column_label(c: &ThermoColumn, model: &crate::system::Model) -> String {
         ThermoColumn::SolverIterations => "solver_iterations".into(),
         ThermoColumn::SolverResidual => "solver_residual".into(),
         ThermoColumn::ConstraintTension(t) => format!("ctension/{}", model.bond_types[*t].label.text),
+        ThermoColumn::BodyVolume(t) => format!("volume/{}", model.body_type_names[*t]),
+        ThermoColumn::BodyArea(t) => format!("area/{}", model.body_type_names[*t]),
     }
 }
 
@@ -81,7 +87,17 @@ pub fn column_unit(c: &ThermoColumn, units: UnitSystem) -> &'static str {
         ThermoColumn::Pe | ThermoColumn::PeOf(_) => units.label(Dim::Energy),
         ThermoColumn::Fmax | ThermoColumn::Fnorm => units.label(Dim::Force),
         ThermoColumn::Press | ThermoColumn::Pressure(_) => units.label(Dim::Pressure),
+        ThermoColumn::BodyVolume(_) => units.label(Dim::Volume),
+        ThermoColumn::BodyArea(_) => units.label(Dim::Area),
     }
+}
+
+/// Sum over the bodies of type `body_type` of `pick((volume, area))`.
+fn body_sum(t: &ThermoInputs, body_type: usize, pick: impl Fn((f64, f64)) -> f64) -> f64 {
+    (0..t.model.bodies.len())
+        .filter(|&b| t.model.bodies[b].body_type as usize == body_type)
+        .map(|b| pick(t.model.body_volume_and_area(b, t.positions, &t.images)))
+        .sum()
 }
 
 /// A column's value; integers are returned as exact f64.
@@ -107,6 +123,8 @@ pub fn column_value(c: &ThermoColumn, t: &ThermoInputs) -> f64 {
             let c = t.constraints;
             c.list.iter().zip(&c.tension).filter(|(k, _)| t.model.bond_type[k.bond] as usize == *ty).map(|(_, tension)| tension).sum()
         }
+        ThermoColumn::BodyVolume(k) => body_sum(t, *k, |(v, _)| v),
+        ThermoColumn::BodyArea(k) => body_sum(t, *k, |(_, a)| a),
     }
 }
 

@@ -18,6 +18,18 @@ pub struct External {
     pub members: Vec<u32>,
 }
 
+/// A closed surface of the topology (a cell, a nucleus): its nodes and mesh.
+#[derive(Clone, Debug)]
+pub struct Body {
+    /// The user's body id (`[ bodies ]`).
+    pub id: u64,
+    /// Index into [`Model::body_type_names`].
+    pub body_type: u32,
+    /// Local node k of the mesh is particle `nodes[k]` (internal indices, ascending).
+    pub nodes: Vec<u32>,
+    pub mesh: std::sync::Arc<crate::mesh::SurfaceMesh>,
+}
+
 /// Which bonded neighbours are excluded from pair interactions
 /// (LAMMPS `special_bonds lj W12 W13 W14` with weights 0 or 1).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -70,6 +82,14 @@ pub struct Model {
     pub triangles: Vec<[u32; 3]>,
     /// The body id of each triangle.
     pub triangle_body: Vec<u64>,
+    /// Body types: the names `body` lines of the force field give.
+    pub body_type_names: Vec<String>,
+    /// Surface terms (`body` lines), each acting on every body of its type.
+    pub body_rules: Vec<TermType>,
+    /// The body type of each surface term.
+    pub body_rule_type: Vec<u32>,
+    /// The bodies of the topology, in `[ bodies ]` order.
+    pub bodies: Vec<Body>,
 }
 
 fn resolve(name: &Token, table: &[TermType], what: &str) -> Result<u32, InputError> {
@@ -126,6 +146,35 @@ impl Model {
                 pair_table[b * nt + a].push(index as u32);
             }
         }
+        let mut body_type_names: Vec<String> = Vec::new();
+        let mut body_rule_type = Vec::with_capacity(ff.body_rules.len());
+        for rule in &ff.body_rules {
+            let name = &rule.body_type.text;
+            let t = body_type_names.iter().position(|n| n == name).unwrap_or_else(|| {
+                body_type_names.push(name.clone());
+                body_type_names.len() - 1
+            });
+            body_rule_type.push(t as u32);
+        }
+        let mut bodies = Vec::with_capacity(topology.bodies.len());
+        for (id, type_name) in &topology.bodies {
+            let body_type = body_type_names.iter().position(|n| *n == type_name.text).ok_or_else(|| {
+                let listed = if body_type_names.is_empty() { "none are defined".to_string() } else { body_type_names.join(", ") };
+                type_name.error(format!(
+                    "found body type `{}`, expected one that `body` lines of the force field give terms to ({listed})",
+                    type_name.text
+                ))
+            })?;
+            let faces: Vec<[u32; 3]> = topology.triangles.iter().filter(|(b, _)| b == id).map(|(_, t)| *t).collect();
+            let mut nodes: Vec<u32> = faces.iter().flatten().copied().collect();
+            nodes.sort_unstable();
+            nodes.dedup();
+            let local = |p: u32| nodes.binary_search(&p).expect("a node of the body") as u32;
+            let local_faces = faces.iter().map(|t| t.map(local)).collect();
+            let mesh = crate::mesh::SurfaceMesh::new(nodes.len(), local_faces)
+                .map_err(|e| type_name.error(format!("body {id}: {e}; expected a closed, oriented surface")))?;
+            bodies.push(Body { id: *id, body_type: body_type as u32, nodes, mesh: std::sync::Arc::new(mesh) });
+        }
         Ok(Model {
             units,
             ids: topology.ids.clone(),
@@ -149,6 +198,10 @@ impl Model {
             special_bonds,
             triangles: topology.triangles.iter().map(|t| t.1).collect(),
             triangle_body: topology.triangles.iter().map(|t| t.0).collect(),
+            body_type_names,
+            body_rules: ff.body_rules.iter().map(|r| r.term.clone()).collect(),
+            body_rule_type,
+            bodies,
         })
     }
 
@@ -187,6 +240,27 @@ impl Model {
     pub fn rest_length(&self, b: usize, bonds: &crate::kinetics::BondState) -> f64 {
         let t = self.bond_type[b] as usize;
         bonds.rest[b].or_else(|| self.bond_kinetics[t].rest_index.map(|k| self.bond_types[t].params[k])).unwrap_or(f64::NAN)
+    }
+
+    /// Whether any body has surface terms (the CPU backend evaluates them;
+    /// the GPU backend does not).
+    pub fn has_surface_terms(&self) -> bool {
+        self.bodies.iter().any(|b| self.body_rule_type.contains(&b.body_type))
+    }
+
+    /// Enclosed volume and area of body `b` at positions `x` (made
+    /// image-consistent across periodic boundaries first).
+    pub fn body_volume_and_area(&self, b: usize, x: &[glam::DVec3], images: &super::Images) -> (f64, f64) {
+        let body = &self.bodies[b];
+        let mut local = Vec::with_capacity(body.nodes.len());
+        body.mesh.unwrap_into(|k| x[body.nodes[k as usize] as usize], |d| images.minimum_image(d), &mut local);
+        (body.mesh.volume(&local), body.mesh.area(&local))
+    }
+
+    /// The surface terms (indices into `body_rules`) acting on body `b`, in force-field order.
+    pub fn rules_of_body(&self, b: usize) -> impl Iterator<Item = usize> + '_ {
+        let t = self.bodies[b].body_type;
+        (0..self.body_rules.len()).filter(move |&r| self.body_rule_type[r] == t)
     }
 
     /// Pair rules acting between particle types `a` and `b`.
@@ -263,6 +337,7 @@ impl Model {
         self.angle_types.iter().for_each(&mut mark);
         self.pair_rules.iter().for_each(&mut mark);
         self.externals.iter().for_each(|e| mark(&e.term));
+        self.body_rules.iter().for_each(&mut mark);
         (0..REGISTRY.len()).filter(|&k| used[k]).collect()
     }
 }

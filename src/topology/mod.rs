@@ -19,14 +19,21 @@
 //! [ bodies ]
 //! # id  type                     (closed surfaces: a cell, a nucleus)
 //! [ triangles ]
-//! # body  i  j  k                (outward-wound face of that body)
+//! # body  i  j  k                (outward-wound face of that body: counter-clockwise seen from outside)
 //! ```
 //!
 //! Particle ids are any distinct positive integers; types are names defined in
 //! the force field. Names of particle, bond and angle types are resolved
 //! against the force field when the deck is validated, so unknown names are
 //! reported at their position in this file.
+//!
+//! Each body must be a closed, consistently oriented 2-manifold of sphere
+//! topology (every edge in exactly two faces, once in each direction; one fan
+//! of faces around each vertex; connected; Euler characteristic 2): see
+//! `src/topology/surface.rs` for the checks and their messages, which name
+//! the offending face at its line.
 
 mod parse;
+mod surface;
 
 pub use self::parse::{parse_box_axis, parse_topology, BoxAxis, Topology, TypedTerm};

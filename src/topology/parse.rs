@@ -83,6 +83,9 @@ struct Parser {
     topology: Topology,
     index_of_id: HashMap<u64, (u32, Token)>,
     body_ids: HashMap<u64, Token>,
+    /// The id token of each body and the first token of each triangle line (for errors).
+    body_tokens: Vec<Token>,
+    face_tokens: Vec<Token>,
 }
 
 impl Parser {
@@ -154,6 +157,7 @@ impl Parser {
             return Err(s.tokens[0].error(format!("body id {id} is already used at line {}; expected unique ids", first.line)));
         }
         self.body_ids.insert(id, s.tokens[0].clone());
+        self.body_tokens.push(s.tokens[0].clone());
         self.topology.bodies.push((id, s.tokens[1].clone()));
         Ok(())
     }
@@ -172,6 +176,7 @@ impl Parser {
             return Err(s.tokens[1].error("a triangle repeats a particle; expected three distinct particles"));
         }
         self.topology.triangles.push((body, particles));
+        self.face_tokens.push(s.tokens[0].clone());
         Ok(())
     }
 }
@@ -205,6 +210,8 @@ pub fn parse_topology(file: &Arc<SourceFile>) -> Result<Topology, InputError> {
         topology: Topology { path: file.path.clone(), ..Default::default() },
         index_of_id: HashMap::new(),
         body_ids: HashMap::new(),
+        body_tokens: Vec::new(),
+        face_tokens: Vec::new(),
     };
     let mut section: Option<Section> = None;
     let mut seen_sections: Vec<Section> = Vec::new();
@@ -252,6 +259,7 @@ pub fn parse_topology(file: &Arc<SourceFile>) -> Result<Topology, InputError> {
             }
         }
     }
+    super::surface::check_bodies(&parser.topology, &parser.face_tokens, &parser.body_tokens)?;
     Ok(parser.topology)
 }
 
@@ -266,13 +274,13 @@ mod tests {
     #[test]
     fn reads_all_sections() {
         let top = parse(
-            "[ box ]\nx 0 10 p\ny 0 10 p\nz 0 5 f\n[ particles ]\n10 a 0 0 0\n20 a 1 0 0 1\n30 b 1 1 0\n[ bonds ]\ns 10 20\n[ angles ]\nbend 10 20 30\n[ bodies ]\n1 cell\n[ triangles ]\n1 10 20 30\n",
+            "[ box ]\nx 0 10 p\ny 0 10 p\nz 0 5 f\n[ particles ]\n10 a 0 0 0\n20 a 1 0 0 1\n30 b 1 1 0\n40 b 0 0 1\n[ bonds ]\ns 10 20\n[ angles ]\nbend 10 20 30\n[ bodies ]\n1 cell\n[ triangles ]\n1 10 30 20\n1 10 20 40\n1 20 30 40\n1 30 10 40\n",
         )
         .unwrap();
-        assert_eq!(top.ids, vec![10, 20, 30]);
+        assert_eq!(top.ids, vec![10, 20, 30, 40]);
         assert_eq!(top.bonds[0].particles, [0, 1]);
         assert_eq!(top.angles[0].particles, [0, 1, 2]);
-        assert_eq!(top.triangles, vec![(1, [0, 1, 2])]);
+        assert_eq!(top.triangles[0], (1, [0, 2, 1]));
         assert_eq!(top.body_of[1], Some(1));
         let axes = top.box_axes.unwrap();
         assert!(axes[0].periodic && !axes[2].periodic && axes[2].hi == 5.0);
