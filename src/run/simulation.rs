@@ -538,6 +538,22 @@ impl Simulation {
         format!("displacement {displacement:e} in one step exceeds max_displacement {:e}", self.integrator.max_displacement)
     }
 
+    /// Why the next `run` cannot use the GPU backend: the first feature in
+    /// use that only the CPU backend has (None when the GPU can run it).
+    pub fn cpu_only_feature(&self) -> Option<&'static str> {
+        if self.integrator.implicit.is_some() {
+            Some("`integrator implicit` runs on the CPU backend only")
+        } else if !self.constraints.list.is_empty() {
+            Some("constrained bonds (`constrain`) run on the CPU backend only")
+        } else if self.state.bonds.is_some() || !self.model.bind_rules.is_empty() {
+            Some("bond kinetics (`kinetics`, `bind`) run on the CPU backend only")
+        } else if self.model.has_surface_terms() {
+            Some("surface terms of bodies (`body` lines) run on the CPU backend only")
+        } else {
+            None
+        }
+    }
+
     /// The GPU to run on, per the effective `device` setting (None: the CPU).
     /// The adapter is opened once and announced.
     fn gpu_for_run(&mut self) -> Result<Option<GpuContext>, RunError> {
@@ -545,27 +561,7 @@ impl Simulation {
         if device == DevicePreference::Cpu {
             return Ok(None);
         }
-        let kinetics = self.state.bonds.is_some() || !self.model.bind_rules.is_empty();
-        let implicit = self.integrator.implicit.is_some();
-        let constrained = !self.constraints.list.is_empty();
-        if kinetics || implicit || constrained {
-            let why = if implicit {
-                "`integrator implicit` runs on the CPU backend only"
-            } else if constrained {
-                "constrained bonds (`constrain`) run on the CPU backend only"
-            } else {
-                "bond kinetics (`kinetics`, `bind`) run on the CPU backend only"
-            };
-            return match device {
-                DevicePreference::Gpu => Err(RunError::Setup(format!("device gpu: {why}; use `device cpu` or `device auto`"))),
-                _ => {
-                    self.say(&format!("device auto: {why}; running on the CPU"));
-                    Ok(None)
-                }
-            };
-        }
-        if self.model.has_surface_terms() {
-            let why = "surface terms of bodies (`body` lines) run on the CPU backend only";
+        if let Some(why) = self.cpu_only_feature() {
             return match device {
                 DevicePreference::Gpu => Err(RunError::Setup(format!("device gpu: {why}; use `device cpu` or `device auto`"))),
                 _ => {
