@@ -17,6 +17,10 @@
 //!   symmetrised, then projected onto the positive semi-definite cone
 //!   (negative eigenvalues set to 0, faer's self-adjoint eigensolver).
 //!
+//! - **Surface terms of bodies** (turgor, tension, bending) contribute no
+//!   block yet: they enter the implicit step through F only, so their own
+//!   explicit stability limit still applies to them.
+//!
 //! Blocks come in term order (bonds, angles, pairs by particle and ascending
 //! neighbour, externals), so the assembled matrix is the same on any thread
 //! count.
