@@ -49,10 +49,19 @@ PARAMS = {
 DRAG = {"a": 1.0, "b": 2.5}
 
 
+# The geometry is computed in plain Python floats (IEEE, correctly rounded
+# sqrt, math.fsum): numpy's BLAS kernels differ by CPU in the last bit, and the
+# committed topologies must come out bit-identical on every machine.
+
+def normalised(p):
+    n = math.sqrt(math.fsum(c * c for c in p))
+    return tuple(c / n for c in p)
+
+
 def icosphere(level):
     """Unit icosphere: nodes and outward-wound faces (as cellmd::mesh::icosphere)."""
     t = (1.0 + math.sqrt(5.0)) / 2.0
-    x = [np.array(p) / np.linalg.norm(p) for p in [
+    x = [normalised(p) for p in [
         (-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0), (0, -1, t), (0, 1, t),
         (0, -1, -t), (0, 1, -t), (t, 0, -1), (t, 0, 1), (-t, 0, -1), (-t, 0, 1)]]
     faces = [(0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11), (1, 5, 9), (5, 11, 4), (11, 10, 2),
@@ -64,8 +73,7 @@ def icosphere(level):
         def middle(a, b):
             key = (min(a, b), max(a, b))
             if key not in mid:
-                m = (x[a] + x[b]) / 2.0
-                x.append(m / np.linalg.norm(m))
+                x.append(normalised([(p + q) / 2.0 for p, q in zip(x[a], x[b])]))
                 mid[key] = len(x) - 1
             return mid[key]
 
@@ -74,17 +82,55 @@ def icosphere(level):
             ab, bc, ca = middle(a, b), middle(b, c), middle(c, a)
             new += [(a, ab, ca), (b, bc, ab), (c, ca, bc), (ab, bc, ca)]
         faces = new
-    return np.array(x), faces
+    return x, faces
+
+
+def rotation(rng):
+    """A random rotation: Gram-Schmidt on three Gaussian vectors."""
+    rows = []
+    for _ in range(3):
+        v = [rng.gauss(0, 1) for _ in range(3)]
+        for r in rows:
+            d = math.fsum(a * b for a, b in zip(v, r))
+            v = [a - d * b for a, b in zip(v, r)]
+        rows.append(normalised(v))
+    return rows
 
 
 def deformed(level, radius, centre, rng):
     """A random ellipsoid-like deformation of the icosphere, rotated, with node jitter."""
     x, faces = icosphere(level)
-    axes = np.array([rng.uniform(0.8, 1.25) for _ in range(3)])
-    q = np.linalg.qr(np.array([[rng.gauss(0, 1) for _ in range(3)] for _ in range(3)]))[0]
-    jitter = np.array([[rng.gauss(0, 0.06) for _ in range(3)] for _ in range(len(x))])
-    pts = radius * ((x * axes) @ q.T + jitter) + np.array(centre)
-    return pts, faces
+    axes = [rng.uniform(0.8, 1.25) for _ in range(3)]
+    q = rotation(rng)
+    pts = []
+    for p in x:
+        jitter = [rng.gauss(0, 0.06) for _ in range(3)]
+        scaled = [c * a for c, a in zip(p, axes)]
+        pts.append([radius * (math.fsum(s * r for s, r in zip(scaled, row)) + j) + c0
+                    for row, j, c0 in zip(q, jitter, centre)])
+    return np.array(pts), faces
+
+
+def volume_exact(x, faces):
+    """Enclosed volume by the divergence theorem, summed with math.fsum."""
+    o = [math.fsum(p[k] for p in x) / len(x) for k in range(3)]
+    terms = []
+    for f in faces:
+        a, b, c = ([float(p[k] - o[k]) for k in range(3)] for p in (x[f[0]], x[f[1]], x[f[2]]))
+        terms.append(a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2]) + a[2] * (b[0] * c[1] - b[1] * c[0]))
+    return math.fsum(terms) / 6.0
+
+
+def area_exact(x, faces):
+    """Total surface area, summed with math.fsum."""
+    areas = []
+    for f in faces:
+        a, b, c = ([float(v) for v in x[i]] for i in f)
+        u = [b[k] - a[k] for k in range(3)]
+        w = [c[k] - a[k] for k in range(3)]
+        n = (u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0])
+        areas.append(0.5 * math.sqrt(math.fsum(v * v for v in n)))
+    return math.fsum(areas)
 
 
 # --- the formulas of cellmd, in numpy (the self-check) -----------------------
@@ -265,9 +311,9 @@ def rename_globals(law, suffix, keys):
 def body_params(name, btype, x, faces):
     p = dict(PARAMS[name][btype])
     if "v0" in p:
-        p["v0"] = p["v0"] * volume(x, faces)
+        p["v0"] = p["v0"] * volume_exact(x, faces)
     if "a0" in p:
-        p["a0"] = p["a0"] * face_areas(x, faces).sum()
+        p["a0"] = p["a0"] * area_exact(x, faces)
     return p
 
 
