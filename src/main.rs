@@ -102,7 +102,7 @@ enum Command {
     /// Write a topology file of a generated system (deterministic).
     Build {
         #[command(subcommand)]
-        what: Build,
+        what: cellmd::build::Generator,
     },
     /// List interaction types and kinetic rules, or print one's documentation.
     List {
@@ -110,48 +110,6 @@ enum Command {
         /// Show units of the `lj` system instead of `cell`.
         #[arg(long)]
         lj: bool,
-    },
-}
-
-#[derive(Subcommand)]
-enum Build {
-    /// One cell as a closed triangulated shell: the icosphere of subdivision
-    /// LEVEL (12, 42, 162, 642, 2562 … nodes), nodes on a sphere of RADIUS,
-    /// faces as the outward-wound triangles of one body, edges as bonds.
-    Icosphere {
-        /// Subdivision level n: 10·4ⁿ + 2 nodes.
-        #[arg(long)]
-        level: u32,
-        /// Radius of the sphere the nodes lie on (length units).
-        #[arg(long)]
-        radius: f64,
-        /// Centre of the cell.
-        #[arg(long, num_args = 3, value_names = ["X", "Y", "Z"], allow_negative_numbers = true, default_values_t = [0.0, 0.0, 0.0])]
-        centre: Vec<f64>,
-        /// Particle type of the nodes.
-        #[arg(long, default_value = "node")]
-        particle_type: String,
-        /// Body type of the cell (what `body` lines of the force field name).
-        #[arg(long, default_value = "cell")]
-        body_type: String,
-        /// Bond type of the mesh edges (cortex springs).
-        #[arg(long, default_value = "edge")]
-        bond_type: String,
-        /// Write no edge bonds.
-        #[arg(long)]
-        no_bonds: bool,
-        /// Body id of the cell.
-        #[arg(long, default_value_t = 1)]
-        body_id: u64,
-        /// Id of the first node; the others follow.
-        #[arg(long, default_value_t = 1)]
-        first_id: u64,
-        /// Also write a fixed (non-periodic) cubic [ box ] of this half-width around the centre.
-        #[arg(long = "box", value_name = "HALF_WIDTH")]
-        box_half_width: Option<f64>,
-        /// The topology file to write.
-        #[arg(short, long)]
-        output: PathBuf,
     },
 }
 
@@ -303,42 +261,18 @@ fn main() -> ExitCode {
     }
 }
 
-/// `cellmd build ...`: writes the topology and prints its summary.
-fn build(what: Build) -> ExitCode {
-    let Build::Icosphere {
-        level,
-        radius,
-        centre,
-        particle_type,
-        body_type,
-        bond_type,
-        no_bonds,
-        body_id,
-        first_id,
-        box_half_width,
-        output,
-    } = what;
-    if !(radius.is_finite() && radius > 0.0) || level > 8 || centre.iter().any(|c| !c.is_finite()) {
-        eprintln!("error: expected --radius > 0, finite --centre and --level <= 8 (2 621 442 nodes); found radius {radius}, level {level}");
-        return ExitCode::from(2);
-    }
-    if box_half_width.is_some_and(|h| h.is_nan() || h <= radius) {
-        eprintln!("error: expected --box HALF_WIDTH > the radius {radius}");
-        return ExitCode::from(2);
-    }
-    let spec = cellmd::build::IcosphereCell {
-        level,
-        radius,
-        centre: glam::DVec3::new(centre[0], centre[1], centre[2]),
-        particle_type,
-        body_type,
-        bond_type: (!no_bonds).then_some(bond_type),
-        body_id,
-        first_id,
-        box_half_width,
+/// `cellmd build ...`: writes the topology and prints its summary; bad
+/// options exit with status 2 and what was expected.
+fn build(what: cellmd::build::Generator) -> ExitCode {
+    let built = match what.build() {
+        Ok(built) => built,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
     };
-    let built = cellmd::build::icosphere_cell(&spec);
-    if let Err(e) = std::fs::write(&output, &built.text) {
+    let output = what.output();
+    if let Err(e) = std::fs::write(output, &built.text) {
         eprintln!("error: cannot write {}: {e}", output.display());
         return ExitCode::from(1);
     }
