@@ -1,14 +1,4 @@
-//! `cellmd build aster`: M microtubules radiating from a centrosome node.
-//! Their directions are the Fibonacci lattice on the sphere (M points of
-//! equal area: zₖ = 1 − (2k + 1)/M, φₖ = k·π(3 − √5)), turned as a whole by
-//! a rotation uniform on SO(3) drawn from `--seed`, so the directions are
-//! evenly spread for any M and the aster's orientation is random. Each
-//! microtubule is a straight bead chain from `--core-radius` out to
-//! core + L, its first bead bonded to the centre node (`--anchor-bond-type`,
-//! rest length the core radius); `--anchor-angle-type` also writes the angle
-//! centre–first–second bead, to clamp the microtubule radially (e.g.
-//! `harmonic_angle theta0 180`). The default persistence length is 5.2 mm
-//! (microtubules).
+//! `cellmd build aster`: see [`aster`](fn@super::aster) for the construction.
 
 use std::f64::consts::PI;
 
@@ -70,7 +60,17 @@ fn fibonacci(k: u32, m: u32) -> DVec3 {
     DVec3::new(r * c, r * s, z)
 }
 
-/// The aster as a topology file.
+/// `cellmd build aster`: M microtubules radiating from a centrosome node.
+/// Their directions are the Fibonacci lattice on the sphere (M points of
+/// equal area: zₖ = 1 − (2k + 1)/M, φₖ = k·π(3 − √5)), turned as a whole by
+/// a rotation uniform on SO(3) drawn from `--seed`, so the directions are
+/// evenly spread for any M and the aster's orientation is random. Each
+/// microtubule is a straight bead chain from `--core-radius` out to
+/// core + L, its first bead bonded to the centre node (`--anchor-bond-type`,
+/// rest length the core radius); `--anchor-angle-type` also writes the angle
+/// centre–first–second bead, to clamp the microtubule radially (e.g.
+/// `harmonic_angle theta0 180`). The default persistence length is 5.2 mm
+/// (microtubules).
 pub fn aster(a: &AsterArgs) -> Result<Built, String> {
     let (n, ell) = a.chain.segmentation()?;
     let centre = vec3("--centre", &a.centre)?;

@@ -1,19 +1,4 @@
-//! `cellmd build branched`: an Arp2/3 branched network. N mother filaments
-//! (centres uniform in the cube of half-width `--extent` around `--centre`,
-//! directions uniform on the sphere) each carry B daughters at distinct
-//! beads drawn from `--seed` (never the last: the branch angle needs the
-//! next mother bead). A daughter leaves its branch bead j at the angle
-//! θ = `--branch-angle` ± `--spread` (uniform in that range; 70 ± 7° after
-//! Mullins et al. 1998) to the mother's forward direction, azimuth uniform
-//! around it, and is a straight chain of the mother's segment length.
-//! Written terms:
-//!
-//! - `--branch-bond-type` between mother bead j and the daughter's first bead (rest length ℓ);
-//! - `--branch-angle-type` on (mother bead j + 1, j, daughter's first bead), vertex j:
-//!   holds the branch angle, e.g. `angle arp23 harmonic_angle k 2 theta0 70`;
-//! - the daughter's own bending angles, starting at (j, first, second bead).
-//!
-//! One generation: daughters do not branch.
+//! `cellmd build branched`: see [`branched`](fn@super::branched) for the construction.
 
 use glam::DVec3;
 
@@ -78,7 +63,22 @@ impl Default for BranchedArgs {
     }
 }
 
-/// The branched network as a topology file.
+/// `cellmd build branched`: an Arp2/3 branched network. N mother filaments
+/// (centres uniform in the cube of half-width `--extent` around `--centre`,
+/// directions uniform on the sphere) each carry B daughters at distinct
+/// beads drawn from `--seed` (never the last: the branch angle needs the
+/// next mother bead). A daughter leaves its branch bead j at the angle
+/// θ = `--branch-angle` ± `--spread` (uniform in that range; 70 ± 7° after
+/// Mullins et al. 1998) to the mother's forward direction, azimuth uniform
+/// around it, and is a straight chain of the mother's segment length.
+/// Written terms:
+///
+/// - `--branch-bond-type` between mother bead j and the daughter's first bead (rest length ℓ);
+/// - `--branch-angle-type` on (mother bead j + 1, j, daughter's first bead), vertex j:
+///   holds the branch angle, e.g. `angle arp23 harmonic_angle k 2 theta0 70`;
+/// - the daughter's own bending angles, starting at (j, first, second bead).
+///
+/// One generation: daughters do not branch.
 pub fn branched(a: &BranchedArgs) -> Result<Built, String> {
     let (n, ell) = a.chain.segmentation()?;
     let centre = vec3("--centre", &a.centre)?;

@@ -1,20 +1,4 @@
-//! `cellmd build cells`: many icosphere cells (issue #7), each a closed body
-//! of its own (ids 1, 2, …; with `--nucleus`, cell k is body 2k − 1 and its
-//! nucleus body 2k), packed without overlap: centres at least 2R + `--gap`
-//! apart.
-//!
-//! - `--layout spheroid`: centres on a face-centred cubic lattice of
-//!   nearest-neighbour distance d = 2R + gap, turned by a rotation uniform on
-//!   SO(3) drawn from `--seed`; the N sites nearest the centre whose cells
-//!   lie inside the sphere of `--spheroid-radius` (|c| + R ≤ S).
-//! - `--layout layer`: a confluent monolayer on a hexagonal lattice in the
-//!   periodic box `--box LX LY` (z fixed, `[0, 2R + gap]`, cells at
-//!   z = R + gap/2): nx = ⌊LX/d⌋ columns and ny = ⌊LY/(d·√3/2)⌋ rows (made even
-//!   so the lattice is periodic), stretched to fill the box; with fewer than
-//!   nx·ny cells, `--seed` draws which sites are taken. Node positions are
-//!   written wrapped into the box.
-//!
-//! More cells than fit is an error that says how many do.
+//! `cellmd build cells`: see [`cells`](fn@super::cells) for the construction.
 
 use std::path::PathBuf;
 
@@ -132,7 +116,23 @@ fn fcc_sites(d: f64, reach: f64, turn: glam::DQuat) -> Vec<DVec3> {
     sites.into_iter().map(|s| s.1).collect()
 }
 
-/// The packed cells as a topology file.
+/// `cellmd build cells`: many icosphere cells (issue #7), each a closed body
+/// of its own (ids 1, 2, …; with `--nucleus`, cell k is body 2k − 1 and its
+/// nucleus body 2k), packed without overlap: centres at least 2R + `--gap`
+/// apart.
+///
+/// - `--layout spheroid`: centres on a face-centred cubic lattice of
+///   nearest-neighbour distance d = 2R + gap, turned by a rotation uniform on
+///   SO(3) drawn from `--seed`; the N sites nearest the centre whose cells
+///   lie inside the sphere of `--spheroid-radius` (|c| + R ≤ S).
+/// - `--layout layer`: a confluent monolayer on a hexagonal lattice in the
+///   periodic box `--box LX LY` (z fixed, `[0, 2R + gap]`, cells at
+///   z = R + gap/2): nx = ⌊LX/d⌋ columns and ny = ⌊LY/(d·√3/2)⌋ rows (made even
+///   so the lattice is periodic), stretched to fill the box; with fewer than
+///   nx·ny cells, `--seed` draws which sites are taken. Node positions are
+///   written wrapped into the box.
+///
+/// More cells than fit is an error that says how many do.
 pub fn cells(a: &CellsArgs) -> Result<Built, String> {
     let r = positive("--radius", a.radius)?;
     if !(a.gap.is_finite() && a.gap >= 0.0) {

@@ -1,12 +1,4 @@
-//! `cellmd build cortex`: N filaments lying on a sphere of radius R (the
-//! actin cortex under a cell's membrane). Each is a great-circle arc of
-//! contour length L (< πR) centred on a point p uniform on the sphere, along
-//! a tangent t ⊥ p at an angle uniform in [0, 2π): bead j sits at
-//! `centre + R·û(s_j)` with `u(s) = p cos(s/R) + t sin(s/R)`, s_j = −L/2 + jℓ
-//! (normalised, so every bead lies on the sphere to rounding). Consecutive
-//! beads are a chord `2R·sin(ℓ/2R)` apart: the bond rest length and `l0` to
-//! use. With `--capture D` the filaments are crosslinked as in `network`: the
-//! closest pair of beads of two filaments, if closer than D, is bonded.
+//! `cellmd build cortex`: see [`cortex`](fn@super::cortex) for the construction.
 
 use glam::DVec3;
 
@@ -54,7 +46,15 @@ impl Default for CortexArgs {
     }
 }
 
-/// The cortex as a topology file.
+/// `cellmd build cortex`: N filaments lying on a sphere of radius R (the
+/// actin cortex under a cell's membrane). Each is a great-circle arc of
+/// contour length L (< πR) centred on a point p uniform on the sphere, along
+/// a tangent t ⊥ p at an angle uniform in [0, 2π): bead j sits at
+/// `centre + R·û(s_j)` with `u(s) = p cos(s/R) + t sin(s/R)`, s_j = −L/2 + jℓ
+/// (normalised, so every bead lies on the sphere to rounding). Consecutive
+/// beads are a chord `2R·sin(ℓ/2R)` apart: the bond rest length and `l0` to
+/// use. With `--capture D` the filaments are crosslinked as in `network`: the
+/// closest pair of beads of two filaments, if closer than D, is bonded.
 pub fn cortex(a: &CortexArgs) -> Result<Built, String> {
     let (n, ell) = a.chain.segmentation()?;
     let r = positive("--radius", a.radius)?;

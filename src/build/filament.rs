@@ -1,9 +1,4 @@
-//! `cellmd build filament`: one straight bead chain of contour length L from
-//! `--start` along `--direction` (default +x; `--random-direction` draws one
-//! uniformly on the sphere from `--seed`), n segments of ℓ = L/n, bonds
-//! between neighbours and a bending angle on every consecutive triple. The
-//! summary prints κ = Lp·kT and the per-angle stiffness κ/ℓ that
-//! `wlc_bending` (`kappa κ l0 ℓ`) and `cosine_angle` (`K κ/ℓ`) need.
+//! `cellmd build filament`: see [`filament`](fn@super::filament) for the construction.
 
 use glam::DVec3;
 
@@ -43,7 +38,12 @@ impl Default for FilamentArgs {
     }
 }
 
-/// One straight filament as a topology file.
+/// `cellmd build filament`: one straight bead chain of contour length L from
+/// `--start` along `--direction` (default +x; `--random-direction` draws one
+/// uniformly on the sphere from `--seed`), n segments of ℓ = L/n, bonds
+/// between neighbours and a bending angle on every consecutive triple. The
+/// summary prints κ = Lp·kT and the per-angle stiffness κ/ℓ that
+/// `wlc_bending` (`kappa κ l0 ℓ`) and `cosine_angle` (`K κ/ℓ`) need.
 pub fn filament(a: &FilamentArgs) -> Result<Built, String> {
     let (n, ell) = a.chain.segmentation()?;
     let start = vec3("--start", &a.start)?;

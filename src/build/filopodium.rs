@@ -1,12 +1,4 @@
-//! `cellmd build filopodium`: a bundle of N parallel filaments on a
-//! hexagonal lattice of spacing a (the N lattice sites nearest the axis,
-//! in order of distance, then angle), all from the base plane through
-//! `--base` along `--direction` (default +z). Neighbouring filaments (sites
-//! a apart) are crosslinked, fascin-like, between beads of the same index
-//! every `--crosslink-every` beads, each such site taken with probability
-//! `--crosslink-probability` drawn from `--seed` (1: every site), its bond
-//! type drawn from `--crosslinker-types`. A crosslink is perpendicular to the
-//! filaments, of length a: its rest length.
+//! `cellmd build filopodium`: see [`filopodium`](fn@super::filopodium) for the construction.
 
 use std::f64::consts::TAU;
 
@@ -80,7 +72,15 @@ pub(crate) fn hexagonal_sites(count: usize) -> Vec<(f64, f64)> {
     sites.into_iter().take(count).map(|s| (s.2, s.3)).collect()
 }
 
-/// The bundle as a topology file.
+/// `cellmd build filopodium`: a bundle of N parallel filaments on a
+/// hexagonal lattice of spacing a (the N lattice sites nearest the axis,
+/// in order of distance, then angle), all from the base plane through
+/// `--base` along `--direction` (default +z). Neighbouring filaments (sites
+/// a apart) are crosslinked, fascin-like, between beads of the same index
+/// every `--crosslink-every` beads, each such site taken with probability
+/// `--crosslink-probability` drawn from `--seed` (1: every site), its bond
+/// type drawn from `--crosslinker-types`. A crosslink is perpendicular to the
+/// filaments, of length a: its rest length.
 pub fn filopodium(a: &FilopodiumArgs) -> Result<Built, String> {
     let (n, ell) = a.chain.segmentation()?;
     let spacing = positive("--spacing", a.spacing)?;

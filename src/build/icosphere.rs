@@ -1,10 +1,4 @@
-//! `cellmd build icosphere`: one cell as a closed triangulated shell, the
-//! icosphere of subdivision level n (10·4ⁿ + 2 nodes: 12, 42, 162, 642,
-//! 2562, …) of a given radius, with its nodes as particles of one body, its
-//! faces as that body's outward-wound triangles and, optionally, its edges as
-//! bonds (cortex springs). `--nucleus RADIUS` adds a second body, a
-//! concentric icosphere of the same level inside it (its own particle, body
-//! and bond types).
+//! `cellmd build icosphere`: see [`icosphere`](fn@super::icosphere) for the construction.
 
 use std::path::PathBuf;
 
@@ -109,7 +103,13 @@ pub struct IcosphereArgs {
     pub output: PathBuf,
 }
 
-/// `cellmd build icosphere`: checks the options, then [`icosphere_cell`].
+/// `cellmd build icosphere`: one cell as a closed triangulated shell, the
+/// icosphere of subdivision level n (10·4ⁿ + 2 nodes: 12, 42, 162, 642,
+/// 2562, …) of a given radius, with its nodes as particles of one body, its
+/// faces as that body's outward-wound triangles and, optionally, its edges as
+/// bonds (cortex springs). `--nucleus RADIUS` adds a second body, a
+/// concentric icosphere of the same level inside it (its own particle, body
+/// and bond types).
 pub fn icosphere(a: &IcosphereArgs) -> Result<Built, String> {
     positive("--radius", a.radius)?;
     let centre = vec3("--centre", &a.centre)?;

@@ -13,14 +13,14 @@
 //!
 //! | generator | command | what it writes |
 //! |---|---|---|
-//! | [`icosphere_cell`] | `icosphere` | one cell as a closed triangulated shell (optionally with a nucleus) |
-//! | [`filament`] | `filament` | one straight bead chain with bonds and bending angles |
-//! | [`network`] | `network` | Mikado network: random straight filaments in a periodic box, crosslinked where they cross |
-//! | [`aster`] | `aster` | microtubules radiating from a centrosome node |
-//! | [`cortex`] | `cortex` | great-circle filaments on a sphere, optionally crosslinked |
-//! | [`branched`] | `branched` | Arp2/3 network: mother filaments with daughters at 70° ± a spread |
-//! | [`filopodium`] | `filopodium` | a hexagonal bundle of parallel filaments, crosslinked between neighbours |
-//! | [`cells`] | `cells` | many icosphere cells packed in a spheroid or a confluent layer |
+//! | [`icosphere()`], [`icosphere_cell`] | `icosphere` | one cell as a closed triangulated shell (optionally with a nucleus) |
+//! | [`filament()`] | `filament` | one straight bead chain with bonds and bending angles |
+//! | [`network()`] | `network` | Mikado network: random straight filaments in a periodic box, crosslinked where they cross |
+//! | [`aster()`] | `aster` | microtubules radiating from a centrosome node |
+//! | [`cortex()`] | `cortex` | great-circle filaments on a sphere, optionally crosslinked |
+//! | [`branched()`] | `branched` | Arp2/3 network: mother filaments with daughters at 70° ± a spread |
+//! | [`filopodium()`] | `filopodium` | a hexagonal bundle of parallel filaments, crosslinked between neighbours |
+//! | [`cells()`] | `cells` | many icosphere cells packed in a spheroid or a confluent layer |
 //!
 //! **Filaments** (every generator but the cells) are chains of beads with a
 //! bond between consecutive beads and an angle on every consecutive triple

@@ -1,15 +1,4 @@
-//! `cellmd build network`: a crosslinked Mikado network (issue #6, and
-//! issue #7's random fibre network of the ECM). N straight filaments of
-//! contour length L with centres uniform in the periodic box `[0, LX) ×
-//! [0, LY) × [0, LZ)` and directions uniform on the sphere (or, with
-//! `--planar`, in the plane z = LZ/2 with directions uniform in it). Where
-//! two filaments come within `--capture` of each other, their closest pair of
-//! beads (minimum image) is crosslinked by one bond: one crosslink per pair
-//! of filaments. Each crosslink's bond type is drawn from
-//! `--crosslinker-types NAME:FRACTION,…` so each type can carry its own
-//! stiffness in the force field. Positions are written wrapped into the box;
-//! bonds across the boundary are measured by minimum image, as the engine
-//! does.
+//! `cellmd build network`: see [`network`](fn@super::network) for the construction.
 
 use glam::DVec3;
 
@@ -53,7 +42,18 @@ impl Default for NetworkArgs {
     }
 }
 
-/// The Mikado network as a topology file.
+/// `cellmd build network`: a crosslinked Mikado network (issue #6, and
+/// issue #7's random fibre network of the ECM). N straight filaments of
+/// contour length L with centres uniform in the periodic box `[0, LX) ×
+/// [0, LY) × [0, LZ)` and directions uniform on the sphere (or, with
+/// `--planar`, in the plane z = LZ/2 with directions uniform in it). Where
+/// two filaments come within `--capture` of each other, their closest pair of
+/// beads (minimum image) is crosslinked by one bond: one crosslink per pair
+/// of filaments. Each crosslink's bond type is drawn from
+/// `--crosslinker-types NAME:FRACTION,…` so each type can carry its own
+/// stiffness in the force field. Positions are written wrapped into the box;
+/// bonds across the boundary are measured by minimum image, as the engine
+/// does.
 pub fn network(a: &NetworkArgs) -> Result<Built, String> {
     let (n, ell) = a.chain.segmentation()?;
     let l = match a.box_lengths[..] {
