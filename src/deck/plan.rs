@@ -59,6 +59,10 @@ pub enum ThermoColumn {
     BodyVolume(usize),
     /// Summed surface area of the bodies of a body type.
     BodyArea(usize),
+    /// Smallest node–face distance between different bodies (`contact` lines).
+    MinDistance,
+    /// Explicit steps shortened by the contact step clamp so far.
+    ContactClamps,
 }
 
 /// A named trajectory output.

@@ -208,7 +208,7 @@ impl Validator {
 
     fn thermo_columns(&self, tokens: &[Token]) -> Result<Vec<ThermoColumn>, InputError> {
         const FIXED: &str =
-            "step, time, pe, pe/NAME, fmax, fnorm, press, pxx, pyy, pzz, pxy, pxz, pyz, nbuild, solver_iterations, solver_residual, ctension/BONDTYPE, breaks, rebinds, forms, resets, nbound/BONDTYPE, tension/BONDTYPE, volume/BODYTYPE, area/BODYTYPE";
+            "step, time, pe, pe/NAME, fmax, fnorm, press, pxx, pyy, pzz, pxy, pxz, pyz, nbuild, solver_iterations, solver_residual, ctension/BONDTYPE, breaks, rebinds, forms, resets, nbound/BONDTYPE, tension/BONDTYPE, volume/BODYTYPE, area/BODYTYPE, mindist, nclamp";
         let bond_type = |t: &Token, name: &str| {
             self.forcefield.bond_types.iter().position(|b| b.label.text == name).ok_or_else(|| {
                 let names: Vec<&str> = self.forcefield.bond_types.iter().map(|b| b.label.text.as_str()).collect();
@@ -216,14 +216,9 @@ impl Validator {
             })
         };
         let body_type = |t: &Token, name: &str| {
-            let mut names: Vec<&str> = Vec::new();
-            for rule in &self.forcefield.body_rules {
-                if !names.contains(&rule.body_type.text.as_str()) {
-                    names.push(&rule.body_type.text);
-                }
-            }
+            let names = self.forcefield.body_type_names();
             names.iter().position(|n| *n == name).ok_or_else(|| {
-                t.error(format!("found body type `{name}`, expected one that `body` lines of the force field name ({})", names.join(", ")))
+                t.error(format!("found body type `{name}`, expected one that `body` or `contact` lines of the force field name ({})", names.join(", ")))
             })
         };
         tokens
@@ -249,6 +244,11 @@ impl Validator {
                     "rebinds" => ThermoColumn::Events(EventKind::Rebind),
                     "forms" => ThermoColumn::Events(EventKind::Form),
                     "resets" => ThermoColumn::Events(EventKind::Reset),
+                    "mindist" | "nclamp" if self.forcefield.contact_rules.is_empty() => {
+                        return Err(t.error(format!("found `{}`, which needs `contact` lines in the force field; expected {FIXED}", t.text)))
+                    }
+                    "mindist" => ThermoColumn::MinDistance,
+                    "nclamp" => ThermoColumn::ContactClamps,
                     other => match other.split_once('/') {
                         Some(("pe", name)) => ThermoColumn::PeOf(REGISTRY.iter().position(|i| i.name() == name).ok_or_else(|| {
                             t.error(format!(

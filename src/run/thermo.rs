@@ -19,6 +19,8 @@
 //! | `nbound/TYPE` | bound bonds of bond type TYPE | – |
 //! | `tension/TYPE` | summed tension of TYPE's bound bonds (clutch traction) | pN |
 //! | `volume/BODYTYPE`, `area/BODYTYPE` | summed enclosed volume and area of the bodies of a type | µm³, µm² |
+//! | `mindist` | smallest node–face distance between different bodies (exact below the largest contact d̂; `inf` when no pair is within the search range) | µm |
+//! | `nclamp` | explicit steps shortened by the contact step clamp so far | – |
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -49,6 +51,10 @@ pub struct ThermoInputs<'a> {
     /// Positions (wrapped) and the box's images, for body volumes and areas.
     pub positions: &'a [glam::DVec3],
     pub images: crate::system::Images,
+    /// Smallest node–face distance between bodies at the last force pass.
+    pub min_contact_distance: f64,
+    /// Steps shortened by the contact step clamp so far.
+    pub contact_clamps: u64,
 }
 
 /// A column's header name (bond-type columns name their type).
@@ -71,6 +77,8 @@ pub fn column_label(c: &ThermoColumn, model: &crate::system::Model) -> String {
         ThermoColumn::ConstraintTension(t) => format!("ctension/{}", model.bond_types[*t].label.text),
         ThermoColumn::BodyVolume(t) => format!("volume/{}", model.body_type_names[*t]),
         ThermoColumn::BodyArea(t) => format!("area/{}", model.body_type_names[*t]),
+        ThermoColumn::MinDistance => "mindist".into(),
+        ThermoColumn::ContactClamps => "nclamp".into(),
     }
 }
 
@@ -81,7 +89,9 @@ pub fn column_unit(c: &ThermoColumn, units: UnitSystem) -> &'static str {
         | ThermoColumn::Events(_)
         | ThermoColumn::Bound(_)
         | ThermoColumn::SolverIterations
-        | ThermoColumn::SolverResidual => "-",
+        | ThermoColumn::SolverResidual
+        | ThermoColumn::ContactClamps => "-",
+        ThermoColumn::MinDistance => units.label(Dim::Length),
         ThermoColumn::Tension(_) | ThermoColumn::ConstraintTension(_) => units.label(Dim::Force),
         ThermoColumn::Time => units.label(Dim::Time),
         ThermoColumn::Pe | ThermoColumn::PeOf(_) => units.label(Dim::Energy),
@@ -125,6 +135,8 @@ pub fn column_value(c: &ThermoColumn, t: &ThermoInputs) -> f64 {
         }
         ThermoColumn::BodyVolume(k) => body_sum(t, *k, |(v, _)| v),
         ThermoColumn::BodyArea(k) => body_sum(t, *k, |(_, a)| a),
+        ThermoColumn::MinDistance => t.min_contact_distance,
+        ThermoColumn::ContactClamps => t.contact_clamps as f64,
     }
 }
 
@@ -136,7 +148,12 @@ fn bonds_of_type<'a>(t: &'a ThermoInputs, ty: usize) -> impl Iterator<Item = usi
 fn is_integer(c: &ThermoColumn) -> bool {
     matches!(
         c,
-        ThermoColumn::Step | ThermoColumn::Nbuild | ThermoColumn::Events(_) | ThermoColumn::Bound(_) | ThermoColumn::SolverIterations
+        ThermoColumn::Step
+            | ThermoColumn::Nbuild
+            | ThermoColumn::Events(_)
+            | ThermoColumn::Bound(_)
+            | ThermoColumn::SolverIterations
+            | ThermoColumn::ContactClamps
     )
 }
 
