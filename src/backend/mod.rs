@@ -2,6 +2,7 @@
 //! GPU backend must match it within each interaction's declared epsilon.
 
 mod bonded;
+mod contact;
 pub mod cpu;
 mod pair_table;
 pub mod stiffness;
@@ -9,4 +10,5 @@ mod sum;
 mod surface;
 mod virial;
 
+pub use self::contact::STEP_FRACTION as CONTACT_STEP_FRACTION;
 pub use self::cpu::{CpuBackend, ForceBreakdown, Forces};

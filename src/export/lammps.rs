@@ -681,7 +681,7 @@ impl Writer<'_> {
 /// are errors naming them.
 pub fn export(plan: &Plan, options: ExportOptions) -> Result<LammpsDeck, String> {
     let model = plan.model.clone();
-    if let Some(term) = model.body_rules.first() {
+    if let Some(term) = model.body_rules.first().or(model.contact_rules.first()) {
         return Err(styles::unsupported(term));
     }
     let kinetic = kinetic_fixes(plan)?;

@@ -161,6 +161,11 @@ impl GpuBackend {
                 "the GPU backend has no kernels for surface terms of bodies yet; use `device cpu` for decks with `body` lines".into()
             );
         }
+        if model.has_contact_terms() {
+            return Err(
+                "the GPU backend has no kernels for contact terms between bodies yet; use `device cpu` for decks with `contact` lines".into()
+            );
+        }
         let n = model.len();
         if n == 0 {
             return Err("the GPU backend needs at least one particle".into());

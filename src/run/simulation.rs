@@ -74,7 +74,11 @@ pub struct Simulation {
     event_log: Option<EventLog>,
     options: RunOptions,
     deck_stem: String,
-    scratch: Vec<DVec3>,
+    scratch: (Vec<DVec3>, Vec<DVec3>),
+    /// Per-particle displacement limits of the contact step clamp.
+    step_limits: Vec<f64>,
+    /// Explicit steps shortened by the contact step clamp.
+    pub contact_clamps: u64,
     /// The last minimisation's outcome.
     pub last_minimize: Option<FireReport>,
     /// The deck's `device` setting.
@@ -118,7 +122,9 @@ impl Simulation {
             event_log: None,
             options,
             deck_stem,
-            scratch: Vec::new(),
+            scratch: (Vec::new(), Vec::new()),
+            step_limits: Vec::new(),
+            contact_clamps: 0,
             last_minimize: None,
             device: DevicePreference::Cpu,
             last_solve: SolveReport::default(),
@@ -298,6 +304,12 @@ impl Simulation {
         Ok(())
     }
 
+    /// The smallest node–face distance between different bodies at the last
+    /// force evaluation (∞ without `contact` lines or before the first one).
+    pub fn min_contact_distance(&self) -> f64 {
+        self.backend.as_ref().map_or(f64::INFINITY, |b| b.min_contact_distance())
+    }
+
     /// Forces, energies by interaction and virial at the current state
     /// (computed now if stale).
     pub fn current_forces(&mut self) -> Result<&Forces, RunError> {
@@ -321,6 +333,7 @@ impl Simulation {
     /// Forces at the current state, with energies and virial if `energies`.
     fn compute_forces(&mut self, energies: bool) -> Result<(), RunError> {
         let backend = self.backend.as_mut().expect("backend built");
+        backend.update_contacts(&self.model, &self.state, &self.sim_box).map_err(RunError::Setup)?;
         if energies {
             backend.compute(&self.model, &self.state, &self.sim_box, &mut self.forces);
         } else {
@@ -393,6 +406,8 @@ impl Simulation {
                 constraints: &self.constraints,
                 positions: &self.state.positions,
                 images: self.sim_box.images(),
+                min_contact_distance: self.min_contact_distance(),
+                contact_clamps: self.contact_clamps,
             };
             let line = self.thermo.row(&inputs)?;
             match bar {
@@ -406,6 +421,11 @@ impl Simulation {
     /// `run N`: N overdamped steps, on the CPU backend or the GPU.
     pub fn run(&mut self, steps: u64) -> Result<(), RunError> {
         self.check_kinetics_temperature()?;
+        if self.integrator.implicit.is_some() && self.model.has_contact_terms() {
+            return Err(RunError::Setup(
+                "`integrator implicit` has no contact step clamp yet, so `contact` terms could let bodies pass through each other; use `integrator overdamped`".into(),
+            ));
+        }
         self.ensure_forces()?;
         let gpu = self.gpu_for_run()?;
         let bar = (self.options.progress && steps >= 1000).then(|| {
@@ -446,17 +466,23 @@ impl Simulation {
             }
             let moved = match self.integrator.implicit {
                 Some(implicit) => self.implicit_step(&implicit)?,
-                None => overdamped_step(
-                    &self.model,
-                    &mut self.state,
-                    &self.forces.forces,
-                    &self.sim_box,
-                    self.dt,
-                    self.kt,
-                    self.seed,
-                    &self.integrator,
-                    &mut self.scratch,
-                ),
+                None => {
+                    let n = self.model.len();
+                    let limited = self.backend.as_ref().is_some_and(|b| b.contact_step_limits(n, &mut self.step_limits));
+                    overdamped_step(
+                        &self.model,
+                        &mut self.state,
+                        &self.forces.forces,
+                        &self.sim_box,
+                        self.dt,
+                        self.kt,
+                        self.seed,
+                        &self.integrator,
+                        limited.then_some(self.step_limits.as_slice()),
+                        &mut self.scratch,
+                    )
+                    .map(|fraction| self.contact_clamps += u64::from(fraction < 1.0))
+                }
             };
             if let Err(Blowup { particle, displacement }) = moved {
                 return Err(self.blowup(particle, self.displacement_message(displacement)));
@@ -549,6 +575,8 @@ impl Simulation {
             Some("bond kinetics (`kinetics`, `bind`) run on the CPU backend only")
         } else if self.model.has_surface_terms() {
             Some("surface terms of bodies (`body` lines) run on the CPU backend only")
+        } else if self.model.has_contact_terms() {
+            Some("contact terms between bodies (`contact` lines) run on the CPU backend only")
         } else {
             None
         }
@@ -721,6 +749,11 @@ impl Simulation {
 
     /// `minimize`: FIRE to max |F| < ftol. The step counter does not advance.
     pub fn minimize(&mut self, settings: &FireSettings) -> Result<(), RunError> {
+        if self.model.has_contact_terms() {
+            return Err(RunError::Setup(
+                "`minimize` (FIRE) has no contact step clamp yet, so `contact` terms could let bodies pass through each other; relax with `run` at temperature 0 instead".into(),
+            ));
+        }
         self.ensure_forces()?;
         let mass: Vec<f64> = self.model.types.iter().map(|&t| self.model.type_drag[t as usize] * self.dt).collect();
         let mut state = self.state.clone();
