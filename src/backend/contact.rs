@@ -33,10 +33,10 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::virial::{add6, outer};
+use crate::forcefield::TermType;
 use crate::interactions::{node_face_forces, Law, Radial};
 use crate::mesh::{point_triangle, PointTriangle};
 use crate::neighbor::{Exclusions, NeighborList};
-use crate::forcefield::TermType;
 use crate::system::{registry_index, Images, Model, SimBox};
 
 /// Fraction of the distance to its closest contact a particle may move in one step.
@@ -97,7 +97,7 @@ impl Contacts {
             let t = model.bodies[b].body_type as usize;
             (0..types).any(|u| !rules[t * types + u].is_empty() || !rules[u * types + t].is_empty())
         };
-        let (mut nodes, mut node_body, mut faces) = (Vec::new(), Vec::new(), Vec::new());
+        let (mut nodes, mut node_body, mut faces): (Vec<u32>, Vec<u32>, Vec<([u32; 3], u32)>) = (Vec::new(), Vec::new(), Vec::new());
         for (b, body) in model.bodies.iter().enumerate().filter(|(b, _)| named(*b)) {
             nodes.extend(&body.nodes);
             node_body.extend(std::iter::repeat_n(b as u32, body.nodes.len()));
@@ -254,7 +254,10 @@ impl Contacts {
     /// Contact force on particle `i`: its slots in ascending pair order.
     #[inline]
     pub(super) fn force_on(&self, i: usize) -> DVec3 {
-        self.slots[self.offsets[i] as usize..self.offsets[i + 1] as usize].iter().map(|&[k, role]| self.forces[k as usize][role as usize]).fold(DVec3::ZERO, |a, b| a + b)
+        self.slots[self.offsets[i] as usize..self.offsets[i + 1] as usize]
+            .iter()
+            .map(|&[k, role]| self.forces[k as usize][role as usize])
+            .fold(DVec3::ZERO, |a, b| a + b)
     }
 
     /// The smallest node–face distance over the candidate pairs (∞ when there are none).

@@ -291,7 +291,12 @@ impl CpuBackend {
         if let Some(term) = model.contact_rules.first().filter(|_| !self.contacts.is_empty()) {
             let force = self.contacts.force_on(i);
             if force != DVec3::ZERO {
-                parts.push(ForceBreakdown { kind: "contact", label: "node–face contacts".into(), interaction: term.interaction.name(), force });
+                parts.push(ForceBreakdown {
+                    kind: "contact",
+                    label: "node–face contacts".into(),
+                    interaction: term.interaction.name(),
+                    force,
+                });
             }
         }
         if !self.pair_interactions.is_empty() {

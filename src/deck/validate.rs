@@ -218,7 +218,10 @@ impl Validator {
         let body_type = |t: &Token, name: &str| {
             let names = self.forcefield.body_type_names();
             names.iter().position(|n| *n == name).ok_or_else(|| {
-                t.error(format!("found body type `{name}`, expected one that `body` or `contact` lines of the force field name ({})", names.join(", ")))
+                t.error(format!(
+                    "found body type `{name}`, expected one that `body` or `contact` lines of the force field name ({})",
+                    names.join(", ")
+                ))
             })
         };
         tokens

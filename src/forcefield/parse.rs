@@ -217,7 +217,9 @@ pub fn load_forcefield(
             }
             "bind" => ff.bind_lines.push(crate::kinetics::parse_bind(kw, &t[1..], units)?),
             other => {
-                return Err(kw.error(format!("found `{other}`, expected `include`, `particle`, `bond`, `angle`, `pair`, `body`, `contact` or `bind`")))
+                return Err(kw.error(format!(
+                    "found `{other}`, expected `include`, `particle`, `bond`, `angle`, `pair`, `body`, `contact` or `bind`"
+                )))
             }
         }
     }
@@ -293,7 +295,9 @@ mod tests {
             load(&[("m.ff", "contact cell cell turgor k 1 v0 1\n")]).unwrap_err(),
             "m.ff:1:19: `turgor` is a body interaction, expected a contact interaction here"
         );
-        assert!(load(&[("m.ff", "body cell contact_barrier dhat 1 kappa 1\n")]).unwrap_err().contains("is a contact interaction, expected a body"));
+        assert!(load(&[("m.ff", "body cell contact_barrier dhat 1 kappa 1\n")])
+            .unwrap_err()
+            .contains("is a contact interaction, expected a body"));
         assert!(load(&[("m.ff", "contact cell cell\n")]).unwrap_err().contains("expected `contact BODYTYPE_A BODYTYPE_B INTERACTION"));
         assert!(load(&[("m.ff", "contact a b contact_barrier dhat 0 kappa 1\n")]).unwrap_err().contains("`dhat` > 0"));
     }

@@ -163,7 +163,8 @@ impl GpuBackend {
         }
         if model.has_contact_terms() {
             return Err(
-                "the GPU backend has no kernels for contact terms between bodies yet; use `device cpu` for decks with `contact` lines".into()
+                "the GPU backend has no kernels for contact terms between bodies yet; use `device cpu` for decks with `contact` lines"
+                    .into(),
             );
         }
         let n = model.len();

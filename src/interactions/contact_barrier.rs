@@ -132,7 +132,7 @@ mod tests {
         let x = [DVec3::new(0.2, 0.2, 0.05), DVec3::ZERO, DVec3::new(1.0, 0.0, 0.0), DVec3::new(0.0, 1.0, 0.0)];
         let (energy, f) = evaluate(ContactBarrier.law(), &p, &x);
         assert!(energy > 0.0);
-        assert!(f[0].z > 0.0 && f[0].x == 0.0 && f[0].y == 0.0);
+        assert!(f[0].z > 0.0 && f[0].x.abs().max(f[0].y.abs()) < 1e-12 * f[0].z, "{:?}", f[0]);
         // The reaction is split by the barycentric weights (0.6, 0.2, 0.2) of the foot.
         for (k, w) in [0.6, 0.2, 0.2].iter().enumerate() {
             assert!((f[k + 1] + *w * f[0]).length() < 1e-12 * f[0].length());

@@ -215,9 +215,7 @@ fn x_len(faces: &[[u32; 3]]) -> usize {
 
 /// For a radial or contact law, d²E/dr² matches a central difference of dE/dr at `r`.
 pub fn assert_radial_curvature(interaction: &dyn Interaction, params: &[f64], r: f64, h: f64) {
-    let (Law::Radial { eval, .. } | Law::Contact { eval, .. }) = interaction.law() else {
-        panic!("{} is not radial", interaction.name())
-    };
+    let (Law::Radial { eval, .. } | Law::Contact { eval, .. }) = interaction.law() else { panic!("{} is not radial", interaction.name()) };
     let numeric = (eval(params, r + h).de_dr - eval(params, r - h).de_dr) / (2.0 * h);
     let analytic = eval(params, r).d2e_dr2;
     let scale = analytic.abs().max(numeric.abs()).max(1e-300);
