@@ -42,14 +42,17 @@ use crate::system::{registry_index, Images, Model, SimBox};
 /// Fraction of the distance to its closest contact a particle may move in one step.
 pub const STEP_FRACTION: f64 = 0.4;
 
+/// A face of a contact body: its corners (particle indices) and its body.
+type Face = ([u32; 3], u32);
+
 /// Candidate pairs, their per-pair results and each particle's slots.
 #[derive(Default)]
 pub(super) struct Contacts {
     /// Particles that are nodes of bodies some contact rule names (ascending), and their body.
     nodes: Vec<u32>,
     node_body: Vec<u32>,
-    /// Faces of those bodies: corners (particle indices) and body.
-    faces: Vec<([u32; 3], u32)>,
+    /// Faces of those bodies.
+    faces: Vec<Face>,
     /// Faces by their first corner (compact node index), CSR.
     first_offsets: Vec<u32>,
     first_faces: Vec<u32>,
@@ -97,7 +100,7 @@ impl Contacts {
             let t = model.bodies[b].body_type as usize;
             (0..types).any(|u| !rules[t * types + u].is_empty() || !rules[u * types + t].is_empty())
         };
-        let (mut nodes, mut node_body, mut faces): (Vec<u32>, Vec<u32>, Vec<([u32; 3], u32)>) = (Vec::new(), Vec::new(), Vec::new());
+        let (mut nodes, mut node_body, mut faces): (Vec<u32>, Vec<u32>, Vec<Face>) = (Vec::new(), Vec::new(), Vec::new());
         for (b, body) in model.bodies.iter().enumerate().filter(|(b, _)| named(*b)) {
             nodes.extend(&body.nodes);
             node_body.extend(std::iter::repeat_n(b as u32, body.nodes.len()));
