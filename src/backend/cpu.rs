@@ -122,6 +122,15 @@ impl CpuBackend {
         (&self.bond_tension, &self.bond_length)
     }
 
+    /// Tension (dE/dr, positive when stretched; 0 when unbound) and length of
+    /// every bond at `state`, computed now (for outputs). Needs a force
+    /// evaluation since the model's parameters last changed.
+    pub fn bond_tensions_at(&self, model: &Model, state: &State, sim_box: &SimBox) -> (Vec<f64>, Vec<f64>) {
+        let (mut tension, mut length) = (Vec::new(), Vec::new());
+        self.bonded.tensions(model, &state.positions, &sim_box.images(), state.bonds.as_ref(), &mut tension, &mut length);
+        (tension, length)
+    }
+
     /// Rebuilds the neighbour list now.
     pub fn rebuild_neighbors(&mut self, state: &State, sim_box: &SimBox) -> Result<(), String> {
         if self.pair_interactions.is_empty() {
@@ -142,6 +151,14 @@ impl CpuBackend {
 
     pub(super) fn bonded(&self) -> &Bonded {
         &self.bonded
+    }
+
+    pub(super) fn pair_table(&self) -> &PairTable {
+        &self.pairs
+    }
+
+    pub(super) fn surfaces(&self) -> &Surfaces {
+        &self.surfaces
     }
 
     /// The neighbour list, or None when the model has no pair terms.

@@ -7,6 +7,8 @@ mod pair_table;
 pub mod stiffness;
 mod sum;
 mod surface;
+mod terms;
 mod virial;
 
 pub use self::cpu::{CpuBackend, ForceBreakdown, Forces};
+pub use self::terms::{Segment, Term, TermKind};
