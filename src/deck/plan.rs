@@ -59,6 +59,22 @@ pub enum ThermoColumn {
     BodyVolume(usize),
     /// Summed surface area of the bodies of a body type.
     BodyArea(usize),
+    /// Force transmitted across the plane x_axis = pos, tension positive
+    /// (`planetension/AXIS/POS`; see [`crate::measure::planes`]).
+    PlaneTension {
+        axis: usize,
+        pos: f64,
+    },
+    /// Method-of-planes cortical tension γ of the bodies of a body type (`gamma/BODYTYPE`).
+    CorticalTension(usize),
+    /// Mean end-to-end distance of the chains of a bond type (`e2e/BONDTYPE`;
+    /// see [`crate::measure::filaments`]).
+    EndToEnd(usize),
+    /// Tangent correlation at a lag in bonds along the chains of a bond type (`tcorr/BONDTYPE/LAG`).
+    TangentCorrelation {
+        bond_type: usize,
+        lag: usize,
+    },
 }
 
 /// A named trajectory output.
@@ -68,6 +84,8 @@ pub struct DumpSpec {
     pub every: u64,
     pub format: DumpFormat,
     pub path: PathBuf,
+    /// LAMMPS dump atom columns (`columns ...`); empty: the format's default.
+    pub columns: Vec<crate::output::AtomColumn>,
 }
 
 /// A named particle group (deck `group`).

@@ -7,9 +7,9 @@ use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 
 use super::blowup::{culprit, RunError};
-use super::thermo::{Thermo, ThermoInputs};
+use super::thermo::{column_value, Thermo, ThermoInputs};
 use crate::backend::{CpuBackend, Forces};
-use crate::deck::{Action, CoeffTarget, DumpSpec, NeighborSettings, Plan};
+use crate::deck::{Action, CoeffTarget, DumpSpec, NeighborSettings, Plan, ThermoColumn};
 use crate::gpu::backend::StepSettings;
 use crate::gpu::{DevicePreference, GpuBackend, GpuContext, GpuHalt};
 use crate::integrate::constraints::{Constraint, Constraints};
@@ -18,7 +18,7 @@ use crate::integrate::implicit::{implicit_step, ConstrainedBonds, ImplicitError,
 use crate::integrate::overdamped::{overdamped_step, Blowup, OverdampedSettings};
 use crate::kinetics::{initial_bond_state, Binding, EventLog, Formation, Kinetics};
 use crate::output::restart::{read_state, write_state, RestartData};
-use crate::output::{open_writer, FrameView, TopologyView, TrajectoryWriter};
+use crate::output::{open_writer_with_columns, FrameView, Measures, TopologyView, TrajectoryWriter};
 use crate::system::{Model, SimBox, State};
 
 /// The longest GPU segment between read-backs when no output is due.
@@ -87,6 +87,8 @@ pub struct Simulation {
     implicit_tension: Vec<f64>,
     /// The opened GPU (kept across `run` commands), or why it could not be used.
     gpu: Option<Result<GpuContext, String>>,
+    /// Bond type labels, for outputs.
+    bond_type_names: Vec<String>,
 }
 
 impl Simulation {
@@ -125,6 +127,7 @@ impl Simulation {
             constraints: Constraints::default(),
             implicit_tension: Vec::new(),
             gpu: None,
+            bond_type_names: plan.model.bond_types.iter().map(|t| t.label.text.clone()).collect(),
         }
     }
 
@@ -195,8 +198,8 @@ impl Simulation {
             }
             Action::Dump(spec) => {
                 let path = self.output_path(&spec.path);
-                let writer =
-                    open_writer(spec.format, &path, &self.topology_view()).map_err(|e| RunError::Io(format!("{}: {e}", path.display())))?;
+                let writer = open_writer_with_columns(spec.format, &path, &self.topology_view(), &spec.columns)
+                    .map_err(|e| RunError::Io(format!("{}: {e}", path.display())))?;
                 self.dumps.push(ActiveDump { spec: spec.clone(), path, writer, last_step: None });
             }
             Action::Undump(name) => {
@@ -267,6 +270,8 @@ impl Simulation {
             bonds: &self.model.bonds,
             angles: &self.model.angles,
             triangles: &self.model.triangles,
+            bond_types: &self.model.bond_type,
+            bond_type_names: &self.bond_type_names,
         }
     }
 
@@ -303,6 +308,50 @@ impl Simulation {
     pub fn current_forces(&mut self) -> Result<&Forces, RunError> {
         self.ensure_forces()?;
         Ok(&self.forces)
+    }
+
+    /// What thermo columns read, at the current state (backend built).
+    fn thermo_inputs(&self) -> ThermoInputs<'_> {
+        let (bond_tension, _) = self.backend.as_ref().expect("backend built").bond_tension_and_length();
+        ThermoInputs {
+            model: &self.model,
+            bonds: self.state.bonds.as_ref(),
+            bond_tension,
+            kinetics: &self.kinetics,
+            step: self.state.step,
+            time: self.state.time,
+            forces: &self.forces,
+            n_particles: self.model.len(),
+            kt: self.kt,
+            volume: self.sim_box.volume(),
+            neighbor_builds: self.backend.as_ref().map_or(0, |b| b.neighbor_builds()),
+            solve: self.last_solve,
+            constraints: &self.constraints,
+            positions: &self.state.positions,
+            images: self.sim_box.images(),
+            backend: self.backend.as_ref().expect("backend built"),
+            state: &self.state,
+            sim_box: &self.sim_box,
+        }
+    }
+
+    /// The value of a thermo column at the current state (forces, energies
+    /// and virial computed now if stale), as a thermo row would print it.
+    pub fn thermo_value(&mut self, column: &ThermoColumn) -> Result<f64, RunError> {
+        self.ensure_forces()?;
+        Ok(column_value(column, &self.thermo_inputs()))
+    }
+
+    /// The per-particle virial W_i at the current state (see [`crate::measure::stress`]).
+    pub fn particle_virial(&mut self) -> Result<Vec<[f64; 6]>, RunError> {
+        self.ensure_forces()?;
+        Ok(crate::measure::per_particle_virial(self.backend.as_ref().expect("backend built"), &self.model, &self.state, &self.sim_box))
+    }
+
+    /// Tension (dE/dr, positive when stretched) and length of every bond at the current state.
+    pub fn bond_tensions(&mut self) -> Result<(Vec<f64>, Vec<f64>), RunError> {
+        self.ensure_forces()?;
+        Ok(self.backend.as_ref().expect("backend built").bond_tensions_at(&self.model, &self.state, &self.sim_box))
     }
 
     /// Ensures a backend with a fresh neighbour list and forces at the current state.
@@ -355,12 +404,31 @@ impl Simulation {
     }
 
     fn write_dump(&mut self, i: usize) -> Result<(), RunError> {
+        let needs = self.dumps[i].writer.needs();
+        let (mut virial, mut tension, mut length) = (Vec::new(), Vec::new(), Vec::new());
+        if needs.any() {
+            // Measurements read the CPU backend's terms at these positions.
+            if self.backend.is_none() {
+                self.ensure_forces()?;
+            } else if !self.forces_current {
+                self.refresh_cpu_forces(false)?;
+            }
+            let backend = self.backend.as_ref().expect("backend built");
+            if needs.virial {
+                virial = crate::measure::per_particle_virial(backend, &self.model, &self.state, &self.sim_box);
+            }
+            if needs.bonds {
+                (tension, length) = backend.bond_tensions_at(&self.model, &self.state, &self.sim_box);
+            }
+        }
+        let forces: &[DVec3] = if needs.forces { &self.forces.forces } else { &[] };
         let frame = FrameView {
             step: self.state.step,
             time: self.state.time,
             sim_box: &self.sim_box,
             positions: &self.state.positions,
             images: &self.state.images,
+            measures: Measures { forces, virial: &virial, bond_tension: &tension, bond_length: &length },
         };
         self.dumps[i].writer.write_frame(&frame)?;
         self.dumps[i].last_step = Some(self.state.step);
@@ -376,25 +444,8 @@ impl Simulation {
         }
         let due = self.thermo.every > 0 && step.is_multiple_of(self.thermo.every);
         if due || force_thermo {
-            let (bond_tension, _) = self.backend.as_ref().expect("backend built").bond_tension_and_length();
-            let inputs = ThermoInputs {
-                model: &self.model,
-                bonds: self.state.bonds.as_ref(),
-                bond_tension,
-                kinetics: &self.kinetics,
-                step,
-                time: self.state.time,
-                forces: &self.forces,
-                n_particles: self.model.len(),
-                kt: self.kt,
-                volume: self.sim_box.volume(),
-                neighbor_builds: self.backend.as_ref().map_or(0, |b| b.neighbor_builds()),
-                solve: self.last_solve,
-                constraints: &self.constraints,
-                positions: &self.state.positions,
-                images: self.sim_box.images(),
-            };
-            let line = self.thermo.row(&inputs)?;
+            let values = self.thermo.values(&self.thermo_inputs());
+            let line = self.thermo.row(&values)?;
             match bar {
                 Some(bar) => bar.println(line),
                 None => self.say(&line),
