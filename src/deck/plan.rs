@@ -95,6 +95,8 @@ pub enum Action {
     ThermoFile(PathBuf),
     /// CSV log of bond kinetics events.
     EventFile(PathBuf),
+    /// CSV table of bond lifetimes per bond type, rewritten after every `run`.
+    LifetimeFile(PathBuf),
     Dump(DumpSpec),
     Undump(String),
     External(External),
@@ -129,6 +131,7 @@ impl Action {
             Action::Thermo { .. }
                 | Action::ThermoFile(_)
                 | Action::EventFile(_)
+                | Action::LifetimeFile(_)
                 | Action::Dump(_)
                 | Action::Undump(_)
                 | Action::WriteState(_)
