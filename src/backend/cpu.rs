@@ -118,6 +118,21 @@ impl CpuBackend {
 
     /// Tension (dE/dr, positive when stretched; 0 when unbound) and length of
     /// every bond at the last evaluation; empty when bonds have no kinetics.
+    /// Measures the tension and length of every bond at `state` without a
+    /// force pass (bond kinetics between GPU steps), for
+    /// [`Self::bond_tension_and_length`].
+    pub fn measure_bonds(&mut self, model: &Model, state: &State, sim_box: &SimBox) {
+        self.bonded.resolve_laws(model);
+        self.bonded.tensions(
+            model,
+            &state.positions,
+            &sim_box.images(),
+            state.bonds.as_ref(),
+            &mut self.bond_tension,
+            &mut self.bond_length,
+        );
+    }
+
     pub fn bond_tension_and_length(&self) -> (&[f64], &[f64]) {
         (&self.bond_tension, &self.bond_length)
     }

@@ -113,6 +113,8 @@ pub enum Action {
     ThermoFile(PathBuf),
     /// CSV log of bond kinetics events.
     EventFile(PathBuf),
+    /// CSV table of bond lifetimes per bond type, rewritten after every `run`.
+    LifetimeFile(PathBuf),
     Dump(DumpSpec),
     Undump(String),
     External(External),
@@ -147,6 +149,7 @@ impl Action {
             Action::Thermo { .. }
                 | Action::ThermoFile(_)
                 | Action::EventFile(_)
+                | Action::LifetimeFile(_)
                 | Action::Dump(_)
                 | Action::Undump(_)
                 | Action::WriteState(_)

@@ -22,7 +22,7 @@ use crate::topology::{parse_box_axis, parse_topology, BoxAxis, Topology};
 use crate::units::UnitSystem;
 
 /// The commands a deck understands (for "expected ..." messages).
-const COMMANDS: &str = "units, variable, topology, forcefield, box, special_bonds, temperature, timestep, seed, device, integrator, neighbor, thermo, thermo_file, events, dump, undump, group, external, unexternal, coeff, constrain, unconstrain, minimize, run, write_state, read_state, print";
+const COMMANDS: &str = "units, variable, topology, forcefield, box, special_bonds, temperature, timestep, seed, device, integrator, neighbor, thermo, thermo_file, events, lifetimes, dump, undump, group, external, unexternal, coeff, constrain, unconstrain, minimize, run, write_state, read_state, print";
 
 /// Commands that define the system and must come before it is first used.
 const SETUP: [&str; 5] = ["units", "topology", "forcefield", "box", "special_bonds"];
@@ -135,6 +135,7 @@ impl Validator {
                 [axes[0].periodic, axes[1].periodic, axes[2].periodic],
             );
             let model = Model::build(topology, &self.forcefield, self.units, self.special_bonds)?;
+            check_outward(&model, topology, &sim_box)?;
             self.positions = topology.positions.clone();
             self.sim_box = Some(sim_box);
             self.groups.insert("all".into(), Group { name: "all".into(), members: (0..model.len() as u32).collect() });
@@ -539,6 +540,10 @@ impl Validator {
                 expect_len(s, 1..=1, "events FILE.csv")?;
                 self.actions.push(Action::EventFile(PathBuf::from(&s[1].text)));
             }
+            "lifetimes" => {
+                expect_len(s, 1..=1, "lifetimes FILE.csv")?;
+                self.actions.push(Action::LifetimeFile(PathBuf::from(&s[1].text)));
+            }
             "dump" => {
                 const USAGE: &str = "dump NAME every N mcap|xyz|lammps|bonds FILE [columns COLUMN...]";
                 expect_len(s, 5..=usize::MAX, USAGE)?;
@@ -737,4 +742,22 @@ pub fn validate_file(path: &Path, overrides: &[(String, String)]) -> Result<Plan
     let file = SourceFile::read(path, None)?;
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     validate(&file, &dir, overrides)
+}
+
+/// Every body must enclose a positive volume at its initial positions (in the
+/// deck's box, across periodic boundaries): the topology check proves its faces
+/// consistently wound, and this proves them wound outward, which turgor and
+/// bending need for their signs.
+fn check_outward(model: &Model, topology: &Topology, sim_box: &SimBox) -> Result<(), InputError> {
+    let images = sim_box.images();
+    for (b, (id, type_token)) in topology.bodies.iter().enumerate() {
+        let (volume, _) = model.body_volume_and_area(b, &topology.positions, &images);
+        if volume.is_nan() || volume <= 0.0 {
+            return Err(type_token.error(format!(
+                "body {id} encloses a volume of {volume:e} at its initial positions in this box; expected a positive volume: faces wound \
+                 counter-clockwise seen from outside (swap two nodes of every face if they are wound inward)"
+            )));
+        }
+    }
+    Ok(())
 }

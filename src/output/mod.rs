@@ -37,6 +37,7 @@ use glam::DVec3;
 use crate::system::SimBox;
 use crate::units::UnitSystem;
 
+pub mod atomic;
 pub mod bond_csv;
 pub mod lammps_dump;
 pub mod mcap_writer;

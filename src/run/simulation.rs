@@ -16,7 +16,7 @@ use crate::integrate::constraints::{Constraint, Constraints};
 use crate::integrate::fire::{fire_minimize, FireReport, FireSettings};
 use crate::integrate::implicit::{implicit_step, ConstrainedBonds, ImplicitError, ImplicitSettings, SolveReport};
 use crate::integrate::overdamped::{overdamped_step, Blowup, OverdampedSettings};
-use crate::kinetics::{initial_bond_state, Binding, EventLog, Formation, Kinetics};
+use crate::kinetics::{initial_bond_state, Binding, EventLog, Formation, Kinetics, LifetimeTable};
 use crate::output::restart::{read_state, write_state, RestartData};
 use crate::output::{open_writer_with_columns, FrameView, Measures, TopologyView, TrajectoryWriter};
 use crate::system::{Model, SimBox, State};
@@ -72,6 +72,9 @@ pub struct Simulation {
     /// Bond formation (when the force field has `bind` rules).
     formation: Option<Formation>,
     event_log: Option<EventLog>,
+    /// Lifetimes of broken bonds and where the deck wants their table.
+    lifetimes: LifetimeTable,
+    lifetime_file: Option<PathBuf>,
     options: RunOptions,
     deck_stem: String,
     scratch: Vec<DVec3>,
@@ -118,6 +121,8 @@ impl Simulation {
             kinetics: Kinetics::default(),
             formation: (!plan.model.bind_rules.is_empty()).then(|| Formation::new(&plan.model, &plan.sim_box)),
             event_log: None,
+            lifetimes: LifetimeTable::default(),
+            lifetime_file: None,
             options,
             deck_stem,
             scratch: Vec::new(),
@@ -192,6 +197,7 @@ impl Simulation {
                     old.finish()?;
                 }
             }
+            Action::LifetimeFile(path) => self.lifetime_file = Some(self.output_path(path)),
             Action::ThermoFile(path) => {
                 let path = self.output_path(path);
                 self.thermo.set_file(std::fs::File::create(&path).map_err(|e| RunError::Io(format!("{}: {e}", path.display())))?)?;
@@ -480,6 +486,11 @@ impl Simulation {
             b.finish_and_clear();
         }
         self.thermo.flush()?;
+        if let Some(path) = &self.lifetime_file {
+            self.lifetimes
+                .write(path, &self.model, self.state.bonds.as_ref())
+                .map_err(|e| RunError::Io(format!("{}: {e}", path.display())))?;
+        }
         let seconds = started.elapsed().as_secs_f64();
         self.say(&format!(
             "loop time {seconds:.6} s for {steps} steps with {} particles: {:.6e} particle-steps/s",
@@ -596,8 +607,6 @@ impl Simulation {
             Some("`integrator implicit` runs on the CPU backend only")
         } else if !self.constraints.list.is_empty() {
             Some("constrained bonds (`constrain`) run on the CPU backend only")
-        } else if self.state.bonds.is_some() || !self.model.bind_rules.is_empty() {
-            Some("bond kinetics (`kinetics`, `bind`) run on the CPU backend only")
         } else if self.model.has_surface_terms() {
             Some("surface terms of bodies (`body` lines) run on the CPU backend only")
         } else {
@@ -641,7 +650,11 @@ impl Simulation {
     /// output is due (thermo, dump, the end) and at least every
     /// [`GPU_SYNC_STEPS`] steps (progress, blow-up checks), reading back the
     /// positions only where an output needs them; thermo quantities are then
-    /// computed by the CPU backend at the read-back positions.
+    /// computed by the CPU backend at the read-back positions. With bond
+    /// kinetics the host synchronises every step: it reads the positions back,
+    /// measures every bond's tension and length in f64, decides the step's
+    /// events exactly as on the CPU, and uploads the changed bond state as one
+    /// batch (a new GPU backend when bonds formed).
     fn run_gpu(&mut self, context: &GpuContext, last: u64, bar: &Option<ProgressBar>) -> Result<(), RunError> {
         let settings = StepSettings {
             dt: self.dt,
@@ -653,9 +666,11 @@ impl Simulation {
             integrator: self.integrator,
         };
         let mut gpu = GpuBackend::new(context, &self.model, &self.state, &self.sim_box, &settings).map_err(RunError::Setup)?;
+        let kinetics = self.state.bonds.is_some();
+        let evolving = self.model.bond_kinetics.iter().flat_map(|k| &k.rules).any(|r| r.rule.evolves_every_step());
         while self.state.step < last {
             let next_output = self.next_output_step(last).min(self.state.step + GPU_SYNC_STEPS);
-            let steps = next_output - self.state.step;
+            let steps = if kinetics { 1 } else { next_output - self.state.step };
             let outcome = gpu.run(self.state.step, steps);
             let done = match &outcome {
                 Ok(done) => *done,
@@ -671,7 +686,7 @@ impl Simulation {
             let dump_due = self.dumps.iter().any(|d| self.state.step.is_multiple_of(d.spec.every));
             // Positions come back only when something reads them; between
             // outputs the sync only reads the GPU's status words.
-            if final_step || thermo_due || dump_due || outcome.is_err() {
+            if final_step || thermo_due || dump_due || outcome.is_err() || kinetics {
                 gpu.download(&mut self.state);
             }
             if let Err(GpuHalt::Capacity { message, .. }) = outcome {
@@ -685,6 +700,22 @@ impl Simulation {
                     self.forces.forces[particle].length()
                 );
                 return Err(self.blowup(particle, what));
+            }
+            if kinetics {
+                // As on the CPU: decided from the tensions before the step
+                // (measured at the end of the previous one), then measured
+                // again at the new positions with the new bond state.
+                let resets = self.kinetics.resets;
+                let changed = self.kinetics_step()?;
+                if self.backend.is_none() {
+                    // Bonds formed: both backends are rebuilt for the new bond list.
+                    self.ensure_forces()?;
+                    gpu = GpuBackend::new(context, &self.model, &self.state, &self.sim_box, &settings).map_err(RunError::Setup)?;
+                } else if changed || evolving || self.kinetics.resets != resets {
+                    gpu.update_bonds(&self.model, &self.state, changed).map_err(RunError::Setup)?;
+                }
+                let backend = self.backend.as_mut().expect("backend built");
+                backend.measure_bonds(&self.model, &self.state, &self.sim_box);
             }
             if thermo_due || final_step {
                 self.refresh_cpu_forces(true)?;
@@ -719,7 +750,8 @@ impl Simulation {
 
     /// Bond kinetics of the step just integrated, decided from the tensions of
     /// its force pass; a break or rebind updates the pair exclusions.
-    fn kinetics_step(&mut self) -> Result<(), RunError> {
+    /// Returns whether a bond broke, bound or formed.
+    fn kinetics_step(&mut self) -> Result<bool, RunError> {
         let step = self.state.step - 1;
         let backend = self.backend.as_ref().expect("backend built");
         let (tension, length) = backend.bond_tension_and_length();
@@ -735,6 +767,7 @@ impl Simulation {
             report.events.extend(self.kinetics.apply_bindings(&mut self.model, &mut self.state, &self.sim_box, bindings, step, self.dt));
         }
         if !report.events.is_empty() {
+            self.lifetimes.record(&self.model, &report.events, self.dt);
             if let Some(log) = &mut self.event_log {
                 log.write(&report.events)?;
             }
@@ -750,7 +783,7 @@ impl Simulation {
             let backend = self.backend.as_mut().expect("backend built");
             backend.bonds_changed(&self.model, &self.state, &self.sim_box).map_err(RunError::Setup)?;
         }
-        Ok(())
+        Ok(report.bonds_changed)
     }
 
     /// Rules whose rates depend on kT refuse to run at T = 0.
