@@ -165,14 +165,7 @@ impl LammpsDumpWriter {
 impl TrajectoryWriter for LammpsDumpWriter {
     fn write_frame(&mut self, frame: &FrameView) -> io::Result<()> {
         check_frame(self.ids.len(), frame)?;
-        let b = frame.sim_box;
-        let out = &mut self.out;
-        writeln!(out, "ITEM: TIMESTEP\n{}", frame.step)?;
-        writeln!(out, "ITEM: NUMBER OF ATOMS\n{}", self.ids.len())?;
-        writeln!(out, "ITEM: BOX BOUNDS {0}{0} {1}{1} {2}{2}", b.boundary_letter(0), b.boundary_letter(1), b.boundary_letter(2))?;
-        for a in 0..3 {
-            writeln!(out, "{} {}", Real(b.lo[a]), Real(b.hi[a]))?;
-        }
+        // Everything is checked before the first byte, so a refused frame leaves no partial record.
         let n = self.ids.len();
         let m = &frame.measures;
         if self.needs.forces && m.forces.len() != n {
@@ -180,6 +173,14 @@ impl TrajectoryWriter for LammpsDumpWriter {
         }
         if self.needs.virial && m.virial.len() != n {
             return Err(invalid_input(format!("frame at step {} has {} virials for {n} particles", frame.step, m.virial.len())));
+        }
+        let b = frame.sim_box;
+        let out = &mut self.out;
+        writeln!(out, "ITEM: TIMESTEP\n{}", frame.step)?;
+        writeln!(out, "ITEM: NUMBER OF ATOMS\n{}", self.ids.len())?;
+        writeln!(out, "ITEM: BOX BOUNDS {0}{0} {1}{1} {2}{2}", b.boundary_letter(0), b.boundary_letter(1), b.boundary_letter(2))?;
+        for a in 0..3 {
+            writeln!(out, "{} {}", Real(b.lo[a]), Real(b.hi[a]))?;
         }
         let names: Vec<String> = self.columns.iter().map(|c| c.name()).collect();
         writeln!(out, "ITEM: ATOMS {}", names.join(" "))?;
