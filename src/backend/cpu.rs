@@ -158,8 +158,32 @@ impl CpuBackend {
 
     /// Tension (dE/dr, positive when stretched; 0 when unbound) and length of
     /// every bond at the last evaluation; empty when bonds have no kinetics.
+    /// Measures the tension and length of every bond at `state` without a
+    /// force pass (bond kinetics between GPU steps), for
+    /// [`Self::bond_tension_and_length`].
+    pub fn measure_bonds(&mut self, model: &Model, state: &State, sim_box: &SimBox) {
+        self.bonded.resolve_laws(model);
+        self.bonded.tensions(
+            model,
+            &state.positions,
+            &sim_box.images(),
+            state.bonds.as_ref(),
+            &mut self.bond_tension,
+            &mut self.bond_length,
+        );
+    }
+
     pub fn bond_tension_and_length(&self) -> (&[f64], &[f64]) {
         (&self.bond_tension, &self.bond_length)
+    }
+
+    /// Tension (dE/dr, positive when stretched; 0 when unbound) and length of
+    /// every bond at `state`, computed now (for outputs). Needs a force
+    /// evaluation since the model's parameters last changed.
+    pub fn bond_tensions_at(&self, model: &Model, state: &State, sim_box: &SimBox) -> (Vec<f64>, Vec<f64>) {
+        let (mut tension, mut length) = (Vec::new(), Vec::new());
+        self.bonded.tensions(model, &state.positions, &sim_box.images(), state.bonds.as_ref(), &mut tension, &mut length);
+        (tension, length)
     }
 
     /// Rebuilds the neighbour list now.
@@ -182,6 +206,14 @@ impl CpuBackend {
 
     pub(super) fn bonded(&self) -> &Bonded {
         &self.bonded
+    }
+
+    pub(super) fn pair_table(&self) -> &PairTable {
+        &self.pairs
+    }
+
+    pub(super) fn surfaces(&self) -> &Surfaces {
+        &self.surfaces
     }
 
     /// The neighbour list, or None when the model has no pair terms.

@@ -134,6 +134,7 @@ impl Model {
                     capture: line.capture,
                     max_bonds: line.max_bonds,
                     nearest: line.nearest,
+                    between_bodies: line.between_bodies,
                 })
             })
             .collect::<Result<_, InputError>>()?;
