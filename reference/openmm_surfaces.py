@@ -86,7 +86,9 @@ def icosphere(level):
 
 
 def rotation(rng):
-    """A random rotation: Gram-Schmidt on three Gaussian vectors."""
+    """A random rotation: Gram-Schmidt on three Gaussian vectors, the last
+    flipped if needed so that the determinant is +1 (a reflection would wind
+    the faces inward)."""
     rows = []
     for _ in range(3):
         v = [rng.gauss(0, 1) for _ in range(3)]
@@ -94,6 +96,10 @@ def rotation(rng):
             d = math.fsum(a * b for a, b in zip(v, r))
             v = [a - d * b for a, b in zip(v, r)]
         rows.append(normalised(v))
+    a, b, c = rows
+    cross = (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+    if math.fsum(x * y for x, y in zip(cross, c)) < 0.0:
+        rows[2] = tuple(-x for x in c)
     return rows
 
 

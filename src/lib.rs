@@ -15,7 +15,8 @@
 //! | [`integrate`] | Philox RNG, overdamped Euler–Maruyama, FIRE |
 //! | [`kinetics`] | stateful bonds: force-dependent unbinding, rebinding, motors, ratchets, plasticity, maturation |
 //! | [`backend`] | the CPU reference force engine (f64, rayon, deterministic) |
-//! | [`output`] | MCAP, extended XYZ, LAMMPS dump, restart |
+//! | [`measure`] | per-particle stress, plane and cortical tension, filament statistics (thermo columns, dump fields) |
+//! | [`output`] | MCAP, extended XYZ, LAMMPS dump (selectable columns), per-bond tension CSV, restart |
 //! | [`export`] | a deck as LAMMPS data + input (`cellmd export-lammps`) |
 //! | [`compare`] | cellmd vs LAMMPS probes, agreement table, golden reference files (`cellmd compare`) |
 //! | [`build`] | topology generators (`cellmd build`: icosphere, filament, network, aster, cortex, branched, filopodium, cells) |
@@ -32,6 +33,7 @@ pub mod input;
 pub mod integrate;
 pub mod interactions;
 pub mod kinetics;
+pub mod measure;
 pub mod mesh;
 pub mod neighbor;
 pub mod output;

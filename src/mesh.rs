@@ -24,6 +24,10 @@
 //!   s_w = (x_w − x_i)·e/|e|² the position of wing w's foot along the edge,
 //!   ∂θ/∂x_i = −Σ_w (1 − s_w)·∂θ/∂x_w, ∂θ/∂x_j = −Σ_w s_w·∂θ/∂x_w
 //!   (Bridson, Marino and Fedkiw 2003; the four sum to zero).
+//! - Point–triangle distance d = |p − q|, q the closest point of the face
+//!   (interior, edge or vertex region; [`point_triangle`]), with gradient
+//!   ∂d/∂p = n̂ and ∂d/∂x_k = −w_k·n̂ (w_k the barycentric weights of q,
+//!   n̂ = (p − q)/d): what node–face contact between cells needs.
 //!
 //! ```
 //! use cellmd::mesh::{icosphere, SurfaceMesh};
@@ -213,6 +217,68 @@ pub fn bending_angle(xi: DVec3, xj: DVec3, xa: DVec3, xb: DVec3) -> (f64, [DVec3
     (theta, [gi, gj, ga, gb])
 }
 
+/// The closest point of a triangle to a point `p`, as barycentric weights.
+///
+/// `distance` = |p − q| with q = Σ_k w_k x_k the closest point of the
+/// triangle [x_0, x_1, x_2] (face interior, an edge or a vertex, after
+/// Ericson, *Real-Time Collision Detection*, §5.1.5) and `normal` the unit
+/// vector (p − q)/|p − q|. Because q minimises the distance, the gradient
+/// needs no derivative of q (envelope theorem), in every region:
+/// ∂d/∂p = n̂ and ∂d/∂x_k = −w_k·n̂, which sum to zero.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointTriangle {
+    pub distance: f64,
+    pub weights: [f64; 3],
+    pub normal: DVec3,
+}
+
+/// The closest point of triangle `[a, b, c]` to `p` (see [`PointTriangle`]).
+pub fn point_triangle(p: DVec3, [a, b, c]: [DVec3; 3]) -> PointTriangle {
+    let weights = closest_weights(p, a, b, c);
+    let q = weights[0] * a + weights[1] * b + weights[2] * c;
+    let d = p - q;
+    let distance = d.length();
+    PointTriangle { distance, weights, normal: d / distance }
+}
+
+/// Barycentric weights of the point of triangle (a, b, c) closest to p,
+/// by Voronoi region: three vertices, three edges, then the interior.
+fn closest_weights(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> [f64; 3] {
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return [1.0, 0.0, 0.0];
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return [0.0, 1.0, 0.0];
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        let v = d1 / (d1 - d3);
+        return [1.0 - v, v, 0.0];
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return [0.0, 0.0, 1.0];
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        let w = d2 / (d2 - d6);
+        return [1.0 - w, 0.0, w];
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return [0.0, 1.0 - w, w];
+    }
+    let denom = 1.0 / (va + vb + vc);
+    let (v, w) = (vb * denom, vc * denom);
+    [1.0 - v - w, v, w]
+}
+
 /// The icosphere of subdivision `level` and `radius` centred at the origin:
 /// the regular icosahedron (level 0, 12 nodes), each level splitting every
 /// face into four at its edge midpoints, new nodes pushed onto the sphere.
@@ -352,6 +418,53 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn point_triangle_finds_the_face_edge_and_vertex_regions_and_its_gradient() {
+        let tri = [DVec3::ZERO, DVec3::new(2.0, 0.0, 0.0), DVec3::new(0.5, 1.5, 0.0)];
+        // Points over the interior, edges ab, bc and ca, then vertices a, b and c.
+        let cases = [
+            DVec3::new(0.7, 0.5, 0.3),
+            DVec3::new(1.0, -0.4, 0.2),
+            DVec3::new(1.6, 1.0, -0.1),
+            DVec3::new(-0.6, 0.4, 0.25),
+            DVec3::new(-0.5, -0.3, 0.1),
+            DVec3::new(2.5, -0.2, 0.3),
+            DVec3::new(0.5, 2.2, -0.4),
+        ];
+        for (k, p) in cases.iter().enumerate() {
+            let pt = point_triangle(*p, tri);
+            let q = pt.weights[0] * tri[0] + pt.weights[1] * tri[1] + pt.weights[2] * tri[2];
+            // q is in the triangle and no sampled point of it is closer.
+            assert!(pt.weights.iter().all(|w| (-1e-15..=1.0 + 1e-15).contains(w)) && (pt.weights.iter().sum::<f64>() - 1.0).abs() < 1e-14);
+            for i in 0..=40 {
+                for j in 0..=40 - i {
+                    let (u, v) = (i as f64 / 40.0, j as f64 / 40.0);
+                    let s = (1.0 - u - v) * tri[0] + u * tri[1] + v * tri[2];
+                    assert!((*p - s).length() >= pt.distance - 1e-12, "case {k}: a closer point {s}");
+                }
+            }
+            assert!(((*p - q).length() - pt.distance).abs() < 1e-14);
+            // ∂d/∂p = n̂, ∂d/∂x_k = −w_k n̂ by central differences.
+            let h = 1e-6;
+            let mut points = [*p, tri[0], tri[1], tri[2]];
+            let grads = [pt.normal, -pt.weights[0] * pt.normal, -pt.weights[1] * pt.normal, -pt.weights[2] * pt.normal];
+            for (m, g) in grads.iter().enumerate() {
+                for axis in 0..3 {
+                    let x0 = points[m][axis];
+                    points[m][axis] = x0 + h;
+                    let up = point_triangle(points[0], [points[1], points[2], points[3]]).distance;
+                    points[m][axis] = x0 - h;
+                    let down = point_triangle(points[0], [points[1], points[2], points[3]]).distance;
+                    points[m][axis] = x0;
+                    assert!(((up - down) / (2.0 * h) - g[axis]).abs() < 1e-8, "case {k}, point {m}, axis {axis}");
+                }
+            }
+        }
+        // The regions themselves.
+        let region = |p: DVec3| point_triangle(p, tri).weights.iter().filter(|w| **w > 0.0).count();
+        assert_eq!(cases.map(region), [3, 2, 2, 2, 1, 1, 1]);
     }
 
     #[test]

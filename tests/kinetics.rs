@@ -23,15 +23,16 @@ fn fixed_pairs(n: usize, lengths: &[f64]) -> String {
     top + &bonds
 }
 
-/// For each length, one pair of fixed particles that far apart joined by `per_length`
-/// parallel bonds of type `b` (bonds listed length by length): every bond of a
-/// pair carries the same tension, and a run costs per bond, not per particle.
+/// For each length `lengths[g]`, one pair of fixed particles that far apart
+/// joined by `per_length` parallel bonds of their own type `f{g}` (bonds listed
+/// length by length): every bond of a pair carries the same tension, and a run
+/// costs per bond, not per particle.
 fn parallel_bonds(per_length: usize, lengths: &[f64]) -> String {
     let mut top = String::from("[ particles ]\n");
     let mut bonds = String::from("[ bonds ]\n");
     for (g, l) in lengths.iter().enumerate() {
         top += &format!("{} a {} 0 0\n{} a {} 0 {l}\n", 2 * g + 1, 3 * g, 2 * g + 2, 3 * g);
-        bonds += &format!("b {} {}\n", 2 * g + 1, 2 * g + 2).repeat(per_length);
+        bonds += &format!("f{g} {} {}\n", 2 * g + 1, 2 * g + 2).repeat(per_length);
     }
     top + &bonds
 }
@@ -55,9 +56,6 @@ fn events(case: &Case) -> Vec<(u64, String, usize, f64)> {
         .collect()
 }
 
-/// Lifetimes at fixed force across a sweep spanning the catch-slip maximum:
-/// mean lifetime = 1/k(F) within 2 % with ≥ 10⁴ bonds per force, the
-/// lifetime distribution is exponential, and the longest-lived force is F*.
 /// Kolmogorov–Smirnov statistic D·√N of break steps against the exact law
 /// P(s ≤ m) = 1 − exp(−k·dt·(m + 1)), compared at each distinct step (the
 /// data are discrete); the critical value at α = 0.001 is 1.95.
@@ -74,6 +72,70 @@ fn ks_exponential_steps(steps: &[u64], rate_dt: f64) -> f64 {
     d * nn.sqrt()
 }
 
+/// Lifetimes at fixed force across a sweep: for each force F, 4·10⁴ parallel
+/// bonds of their own type (harmonic, k = 10, held F/k beyond rest between
+/// fixed particles) carrying the kinetic rule `rule`, run until the
+/// longest-lived force has seen 20 mean lifetimes (a bond outlives that with
+/// probability e^−20). The deck's lifetime table (`lifetimes`) must give, per
+/// force, every bond broken at tension F, τ = 1/k(F) within 2 % (four standard
+/// errors of an exponential mean), a standard error of τ/√N within 5 % (an
+/// exponential's sd is its mean) and the censored estimate equal to τ; the break
+/// steps must follow the exponential law (KS). Returns the measured τ(F).
+fn lifetime_sweep(rule: &str, kt: f64, forces: &[f64], rate: impl Fn(f64) -> f64, rate_dt_max: f64, seed: u64) -> Vec<f64> {
+    let k_bond = 10.0;
+    let lengths: Vec<f64> = forces.iter().map(|f| 1.0 + f / k_bond).collect();
+    let k_max = forces.iter().map(|&f| rate(f)).fold(0.0, f64::max);
+    let k_min = forces.iter().map(|&f| rate(f)).fold(f64::INFINITY, f64::min);
+    let dt = rate_dt_max / k_max;
+    let steps = (20.0 / (k_min * dt)).ceil() as u64;
+    let per_force = 40_000;
+    let bond_lines: Vec<String> = (0..forces.len()).map(|g| format!("bond f{g} harmonic k {k_bond} r0 1 kinetics {rule}")).collect();
+    let c = case(
+        &parallel_bonds(per_force, &lengths),
+        &bond_lines.join("\n"),
+        &format!("temperature {kt}\ntimestep {dt}\nseed {seed}\nevents events.csv\nlifetimes lifetimes.csv\nrun {steps}\n"),
+    );
+    let sim = c.run();
+    assert_eq!(sim.kinetics.breaks as usize, per_force * forces.len(), "some bonds never broke");
+    let table = std::fs::read_to_string(c.path("lifetimes.csv")).unwrap();
+    let mut rows = table.lines();
+    assert_eq!(rows.next(), Some("type,breaks,surviving,force[ε/σ],tau[τ],stderr[τ],tau_censored[τ]"));
+    let mut measured = Vec::new();
+    for (g, &f) in forces.iter().enumerate() {
+        let row: Vec<&str> = rows.next().expect("a row per bond type").split(',').collect();
+        let num = |k: usize| row[k].parse::<f64>().unwrap();
+        assert_eq!((row[0], row[1], row[2]), (format!("f{g}").as_str(), per_force.to_string().as_str(), "0"));
+        assert!((num(3) - f).abs() <= 1e-9 * f.max(1.0), "F = {f}: bonds broke at {}", num(3));
+        let (tau, exact) = (num(4), 1.0 / rate(f));
+        println!("F = {f:.4}: tau {tau:.5}, exact {exact:.5}, error {:+.3} %", 100.0 * (tau / exact - 1.0));
+        assert!((tau / exact - 1.0).abs() < 0.02, "F = {f}: mean lifetime {tau}, exact {exact}");
+        assert!((num(5) * (per_force as f64).sqrt() / tau - 1.0).abs() < 0.05, "F = {f}: stderr {} for tau {tau}", num(5));
+        assert_eq!(num(6), tau, "no survivors: the censored estimate is the plain mean");
+        measured.push(tau);
+    }
+    let mut steps_of: Vec<Vec<u64>> = vec![Vec::new(); forces.len()];
+    for (step, kind, bond, _) in events(&c) {
+        assert_eq!(kind, "break");
+        steps_of[bond / per_force].push(step);
+    }
+    for (g, &f) in forces.iter().enumerate() {
+        let ks = ks_exponential_steps(&steps_of[g], rate(f) * dt);
+        assert!(ks < 1.95, "F = {f}: lifetimes not exponential, KS D√N = {ks}");
+    }
+    measured
+}
+
+/// Bell slip bonds: τ(F) = 1/(k0·exp(F·xβ/kT)) from 0 to 2 Fβ.
+#[test]
+fn slip_lifetimes_follow_the_bell_law() {
+    let (k0, x_beta, kt): (f64, f64, f64) = (1.0, 0.5, 1.0);
+    let f_beta = kt / x_beta;
+    let forces: Vec<f64> = [0.0, 0.5, 1.0, 1.5, 2.0].iter().map(|a| a * f_beta).collect();
+    lifetime_sweep(&format!("slip k0 {k0} x_beta {x_beta}"), kt, &forces, |f| k0 * (f * x_beta / kt).exp(), 0.05, 19);
+}
+
+/// Catch-slip bonds across a sweep spanning the lifetime maximum: τ = 1/k(F)
+/// and the longest-lived force is F* = kT·ln(kc0·xc/(ks0·xs))/(xc + xs).
 #[test]
 fn catch_slip_lifetimes_follow_the_two_pathway_law() {
     let (kc0, xc, ks0, xs): (f64, f64, f64, f64) = (1.0, 1.0, 0.01, 0.5);
@@ -81,39 +143,8 @@ fn catch_slip_lifetimes_follow_the_two_pathway_law() {
     let f_star: f64 = kt * (kc0 * xc / (ks0 * xs)).ln() / (xc + xs);
     let fractions = [0.5, 0.75, 1.0, 1.25, 1.5];
     let forces: Vec<f64> = fractions.iter().map(|a| a * f_star).collect();
-    let k_bond = 10.0;
-    let lengths: Vec<f64> = forces.iter().map(|f| 1.0 + f / k_bond).collect();
     let rate = |f: f64| kc0 * (-f * xc / kt).exp() + ks0 * (f * xs / kt).exp();
-    let k_max = forces.iter().map(|&f| rate(f)).fold(0.0, f64::max);
-    let dt = 0.05 / k_max;
-    let per_force = 40_000;
-    let n = per_force * forces.len();
-    let bond = format!("bond b harmonic k {k_bond} r0 1 kinetics catch_slip kc0 {kc0} xc {xc} ks0 {ks0} xs {xs}");
-    let k_min = forces.iter().map(|&f| rate(f)).fold(f64::INFINITY, f64::min);
-    let steps = (20.0 / (k_min * dt)).ceil() as u64;
-    let c = case(&fixed_pairs(n, &lengths), &bond, &format!("temperature {kt}\ntimestep {dt}\nseed 17\nevents events.csv\nrun {steps}\n"));
-    let sim = c.run();
-    assert_eq!(sim.kinetics.breaks as usize, n, "some bonds never broke");
-    let mut lifetimes: Vec<Vec<f64>> = vec![Vec::new(); forces.len()];
-    let mut steps_of: Vec<Vec<u64>> = vec![Vec::new(); forces.len()];
-    for (step, kind, bond, force) in events(&c) {
-        assert_eq!(kind, "break");
-        let group = bond % forces.len();
-        assert!((force - forces[group]).abs() < 1e-9 * forces[group], "bond {bond} carried {force}");
-        // A bond that breaks while deciding step s was bound through s·dt and
-        // broke within the step: its lifetime is (s + ½)·dt to O(k·dt²).
-        lifetimes[group].push((step as f64 + 0.5) * dt);
-        steps_of[group].push(step);
-    }
-    let mut measured = Vec::new();
-    for (g, &f) in forces.iter().enumerate() {
-        let mean = lifetimes[g].iter().sum::<f64>() / lifetimes[g].len() as f64;
-        let expected = 1.0 / rate(f);
-        assert!((mean / expected - 1.0).abs() < 0.02, "F = {f}: mean lifetime {mean}, 1/k = {expected}");
-        measured.push(mean);
-        let ks = ks_exponential_steps(&steps_of[g], rate(f) * dt);
-        assert!(ks < 1.95, "F = {f}: lifetimes not exponential, KS D√N = {ks}");
-    }
+    let measured = lifetime_sweep(&format!("catch_slip kc0 {kc0} xc {xc} ks0 {ks0} xs {xs}"), kt, &forces, rate, 0.05, 17);
     // The longest-lived force of the sweep is F*, and lifetimes fall on both sides.
     let best = (0..forces.len()).max_by(|&a, &b| measured[a].total_cmp(&measured[b])).unwrap();
     assert_eq!(fractions[best], 1.0, "longest lifetime at {} F*, lifetimes {measured:?}", fractions[best]);
@@ -148,51 +179,9 @@ fn cadherin_lifetimes_follow_the_sliding_rebinding_chain() {
     let f_max = (0..=10_000).map(|k| k as f64 * 1e-3).max_by(|a, b| mfpt(*a).total_cmp(&mfpt(*b))).unwrap();
     let fractions = [0.0, 0.4, 0.7, 1.0, 1.6, 2.5];
     let forces: Vec<f64> = fractions.iter().map(|a| a * f_max).collect();
-    let k_bond = 10.0;
-    let lengths: Vec<f64> = forces.iter().map(|f| 1.0 + f / k_bond).collect();
-    let rate = |f: f64| 1.0 / mfpt(f);
-    let k_max = forces.iter().map(|&f| rate(f)).fold(0.0, f64::max);
-    let k_min = forces.iter().map(|&f| rate(f)).fold(f64::INFINITY, f64::min);
-    // k·dt ≤ 0.08: the lifetime estimate (s + ½)·dt is biased by (k·dt)²/12 ≤ 6e-4.
-    let dt = 0.08 / k_max;
-    let per_force = 40_000;
-    let n = per_force * forces.len();
-    let bond = format!(
-        "bond b harmonic k {k_bond} r0 1 kinetics cadherin k10 {} x1 {} ks0 {} xs {} kr0 {} xr {} k20 {} x2 {}",
-        p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7]
-    );
-    // 20 mean lifetimes of the longest-lived force: a bond outlives it with probability e^−20.
-    let steps = (20.0 / (k_min * dt)).ceil() as u64;
-    let c = case(
-        &parallel_bonds(per_force, &lengths),
-        &bond,
-        &format!("temperature {kt}\ntimestep {dt}\nseed 23\nevents events.csv\nrun {steps}\n"),
-    );
-    let sim = c.run();
-    assert_eq!(sim.kinetics.breaks as usize, n, "some bonds never broke");
-    let mut steps_of: Vec<Vec<u64>> = vec![Vec::new(); forces.len()];
-    for (step, kind, bond, force) in events(&c) {
-        assert_eq!(kind, "break");
-        let group = bond / per_force;
-        assert!((force - forces[group]).abs() <= 1e-9 * forces[group].max(1.0), "bond {bond} carried {force}");
-        steps_of[group].push(step);
-    }
-    let mut measured = Vec::new();
-    for (g, &f) in forces.iter().enumerate() {
-        // Broken while deciding step s: lifetime (s + ½)·dt (see the catch-slip test).
-        let mean = steps_of[g].iter().map(|&s| (s as f64 + 0.5) * dt).sum::<f64>() / steps_of[g].len() as f64;
-        let exact = mfpt(f);
-        println!(
-            "F = {f:.4} ({} F_max): mean lifetime {mean:.5}, exact {exact:.5}, error {:+.3} %",
-            fractions[g],
-            100.0 * (mean / exact - 1.0)
-        );
-        assert!((mean / exact - 1.0).abs() < 0.02, "F = {f}: mean lifetime {mean}, exact mean first-passage time {exact}");
-        measured.push(mean);
-        // The runtime's single rate: exponential break steps.
-        let ks = ks_exponential_steps(&steps_of[g], rate(f) * dt);
-        assert!(ks < 1.95, "F = {f}: lifetimes not exponential, KS D√N = {ks}");
-    }
+    let rule = format!("cadherin k10 {} x1 {} ks0 {} xs {} kr0 {} xr {} k20 {} x2 {}", p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7]);
+    // k·dt ≤ 0.08: the lifetime estimate is biased by (k·dt)²/12 ≤ 6e-4.
+    let measured = lifetime_sweep(&rule, kt, &forces, |f| 1.0 / mfpt(f), 0.08, 23);
     // Catch below the maximum (each force lives longer than the one before),
     // slip beyond it: the longest-lived force of the sweep is F_max.
     for g in 1..forces.len() {
@@ -429,7 +418,9 @@ fn kinetics_runs_are_bit_identical_across_thread_counts() {
         top += &format!("{} a {x} {y} 0\n{} bead {x} {y} 0.5\n", 2 * m + 1, 2 * m + 2);
         bonds += &format!("b {} {}\n", 2 * m + 1, 2 * m + 2);
     }
-    let ff = "particle a fixed\nparticle bead drag 1\nbond b harmonic k 20 r0 0.5 kinetics slip k0 0.5 x_beta 0.2 kinetics rebind k_on 2 capture 1 kinetics motor v0 0.1 fs 3\npair bead bead wca epsilon 1 sigma 0.3\n";
+    // Beads also form (and lose) bonds to the neighbouring sites within reach.
+    let ff = "particle a fixed\nparticle bead drag 1\nbond b harmonic k 20 r0 0.5 kinetics slip k0 0.5 x_beta 0.2 kinetics rebind k_on 2 capture 1 kinetics motor v0 0.1 fs 3\n\
+              bond x harmonic k 5 r0 1.5 kinetics slip k0 1 x_beta 0.1\nbind a bead x k_on 0.5 capture 2.2 max_bonds 2\npair bead bead wca epsilon 1 sigma 0.3\n";
     let deck = "units lj\ntopology t.top\nforcefield f.ff\nbox x -5 45 f y -5 35 f z -5 5 f\nneighbor skin 0.2\ntemperature 1\ntimestep 2e-4\nseed 3\nevents events.csv\nrun 3000\n";
     let run = |threads: usize| {
         let c = Case::new(&[("t.top", &(top.clone() + &bonds)), ("f.ff", ff), ("deck.in", deck)]);
@@ -448,10 +439,12 @@ fn kinetics_runs_are_bit_identical_across_thread_counts() {
             sim.state.bonds.clone().unwrap(),
             log,
             sim.kinetics.breaks,
+            sim.kinetics.forms,
         )
     };
     let (one, two) = (run(1), run(2));
     assert!(one.3 > 100, "too few events to test: {}", one.3);
+    assert!(one.4 > 100, "too few bonds formed to test: {}", one.4);
     assert_eq!(one.0, two.0);
     assert_eq!(one.1, two.1);
     assert_eq!(one.2, two.2);
@@ -585,4 +578,120 @@ fn bond_formation_partner_modes() {
             assert_eq!([a as u32 - base, b as u32 - base], expected, "{mode}: bond {a}-{b}");
         }
     }
+}
+
+/// The MCAP trajectory's `/cellmd/events` channel carries exactly the events
+/// of the CSV log (same steps, kinds, bonds, particles, forces and ages, bit
+/// for bit), and each event message is followed by the bond state it left.
+#[test]
+fn mcap_event_channel_carries_the_event_log() {
+    let bond = "bond f0 harmonic k 10 r0 1 kinetics slip k0 2 x_beta 0.2 kinetics rebind k_on 3 capture 2";
+    let c = case(
+        &parallel_bonds(300, &[1.2]),
+        bond,
+        "temperature 1\ntimestep 0.01\nseed 8\nevents events.csv\ndump t every 100 mcap t.mcap\nrun 400\n",
+    );
+    c.run();
+    let csv = std::fs::read_to_string(c.path("events.csv")).unwrap();
+    let rows: Vec<Vec<String>> = csv.lines().skip(1).map(|l| l.split(',').map(String::from).collect()).collect();
+    assert!(rows.len() > 200, "too few events to test: {}", rows.len());
+    let bytes = std::fs::read(c.path("t.mcap")).unwrap();
+    let (mut from_mcap, mut states_after_events) = (Vec::new(), 0);
+    let mut last_topic = String::new();
+    for message in mcap::MessageStream::new(&bytes).unwrap() {
+        let message = message.unwrap();
+        let topic = message.channel.topic.clone();
+        if topic == "/cellmd/bond_state" && last_topic == "/cellmd/events" {
+            states_after_events += 1;
+        }
+        if topic == "/cellmd/events" {
+            let doc: serde_json::Value = serde_json::from_slice(&message.data).unwrap();
+            for e in doc["events"].as_array().unwrap() {
+                assert_eq!(e["step"], doc["step"]);
+                from_mcap.push(e.clone());
+            }
+        }
+        last_topic = topic;
+    }
+    assert_eq!(from_mcap.len(), rows.len());
+    for (e, row) in from_mcap.iter().zip(&rows) {
+        let number = |k: usize| row[k].parse::<f64>().unwrap();
+        assert_eq!(e["step"].as_u64().unwrap(), row[0].parse::<u64>().unwrap());
+        assert_eq!(e["kind"].as_str().unwrap(), row[2]);
+        assert_eq!(e["bond"].as_u64().unwrap(), row[3].parse::<u64>().unwrap());
+        assert_eq!(e["particles"], serde_json::json!([row[5].parse::<u64>().unwrap(), row[6].parse::<u64>().unwrap()]));
+        assert_eq!(e["force"].as_f64().unwrap().to_bits(), number(7).to_bits());
+        assert_eq!(e["age"].as_f64().unwrap().to_bits(), number(9).to_bits());
+    }
+    let event_steps = rows.iter().map(|r| &r[0]).collect::<std::collections::BTreeSet<_>>().len();
+    assert_eq!(states_after_events, event_steps, "one bond-state message after each step's events");
+}
+
+/// Clutch traction: a filament held on the substrate by clutch bonds and
+/// pulled along them with force f per bead settles where the clutches carry the
+/// whole load, so `tension/clutch` = N·f (the bonds lie along the pull, so
+/// their summed tension is the traction on the substrate). The clutches bind to
+/// fixed sites, or to movable ligands (drag 1) each tethered to a fixed pin,
+/// whose tethers then carry the same traction.
+#[test]
+fn clutch_traction_balances_the_pulling_force() {
+    let n = 8;
+    let f = 0.7;
+    for movable in [false, true] {
+        let mut top = String::from("[ particles ]\n");
+        let mut bonds = String::from("[ bonds ]\n");
+        for k in 0..n {
+            let (bead, site, pin) = (3 * k + 1, 3 * k + 2, 3 * k + 3);
+            let x = 0.5 * k as f64;
+            top += &format!("{bead} actin {x} 0 0\n{site} site {} 0 0\n{pin} pin {} 0 0\n", x - 0.05, x - 0.1);
+            bonds += &format!("clutch {bead} {site}\n");
+            if movable {
+                bonds += &format!("tether {site} {pin}\n");
+            }
+            if k > 0 {
+                bonds += &format!("segment {} {bead}\n", bead - 3);
+            }
+        }
+        // A clutch that breaks only beyond 1000 % strain (it settles at 280 %): deterministic at T = 0.
+        let site = if movable { "particle site drag 1" } else { "particle site fixed" };
+        let ff = format!(
+            "particle actin drag 1\n{site}\nparticle pin fixed\nbond segment harmonic k 50 r0 0.5\nbond tether harmonic k 20 r0 0.05\n\
+             bond clutch harmonic k 5 r0 0.05 kinetics threshold strain 10\n"
+        );
+        let deck = format!(
+            "units cell\ntopology t.top\nforcefield f.ff\nbox x -5 10 f y -5 5 f z -5 5 f\ngroup actin type actin\n\
+             external pull actin constant_force fx {f}\ntimestep 1e-3\nthermo 30000 step tension/clutch nbound/clutch tension/tether\n\
+             thermo_file t.csv\nrun 30000\n"
+        );
+        let c = Case::new(&[("t.top", &(top + &bonds)), ("f.ff", &ff), ("deck.in", &deck)]);
+        c.run();
+        let thermo = std::fs::read_to_string(c.path("t.csv")).unwrap();
+        let last: Vec<f64> = thermo.lines().last().unwrap().split(',').map(|v| v.parse().unwrap()).collect();
+        assert_eq!(last[2], n as f64, "every clutch still bound");
+        let load = n as f64 * f;
+        assert!((last[1] - load).abs() < 1e-9 * load, "movable {movable}: traction {} pN against a pull of {load} pN", last[1]);
+        let tether = if movable { load } else { 0.0 };
+        assert!((last[3] - tether).abs() < 1e-9 * load, "movable {movable}: tethers carry {} pN", last[3]);
+    }
+}
+
+/// A step too coarse to resolve a bond's lifetime (k·dt > 0.1) is run with
+/// the exact survival probability but warned about, once per bond type, naming
+/// the type and its k·dt.
+#[test]
+fn coarse_steps_are_warned_about_once_per_bond_type() {
+    let bond = "bond f0 harmonic k 10 r0 1 kinetics slip k0 50 x_beta 0.1";
+    let c = case(&parallel_bonds(50, &[1.0]), bond, "temperature 1\ntimestep 0.01\nseed 2\nrun 5\n");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_cellmd"))
+        .arg("run")
+        .arg(c.path("deck.in"))
+        .arg("-o")
+        .arg(c.output_dir())
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let warnings: Vec<&str> = stderr.lines().filter(|l| l.contains("warning")).collect();
+    assert_eq!(warnings.len(), 1, "{stderr}");
+    assert!(warnings[0].contains("bond type `f0` has k_off·dt = 0.500"), "{}", warnings[0]);
 }

@@ -322,3 +322,74 @@ fn single_cell_deck_writes_a_foxglove_scene_of_its_surface() {
     assert!(volumes.windows(2).all(|w| w[1] < w[0]), "{volumes:?}");
     assert!(volumes.iter().all(|v| (v / 519.0926 - 1.0).abs() < 0.05), "{volumes:?}");
 }
+
+/// One topology holding the sections of several (each section once, their lines in order).
+fn merged_topology(texts: &[&str]) -> String {
+    let mut sections: Vec<(String, String)> = Vec::new();
+    for text in texts {
+        let mut current = None;
+        for line in text.lines().filter(|l| !l.trim_start().starts_with('#') && !l.trim().is_empty()) {
+            if line.starts_with('[') {
+                let k = sections.iter().position(|(h, _)| h == line).unwrap_or_else(|| {
+                    sections.push((line.to_string(), String::new()));
+                    sections.len() - 1
+                });
+                current = Some(k);
+            } else {
+                let body = &mut sections[current.expect("a section header first")].1;
+                body.push_str(line);
+                body.push('\n');
+            }
+        }
+    }
+    sections.into_iter().map(|(h, b)| format!("{h}\n{b}")).collect()
+}
+
+/// Cell–cell junctions: two touching cells whose nodes may bind (`bind node
+/// node junction … between bodies`) form junction bonds only across the two
+/// bodies, although neighbouring nodes of one cell are closer than the capture
+/// radius; pulled apart, the slip junctions break and the cells separate.
+#[test]
+fn junctions_bind_only_across_cells_and_break_when_pulled_apart() {
+    let (radius, gap, capture) = (1.0, 0.1, 0.4);
+    let cell = |body_id: u64, first_id: u64, x: f64| {
+        icosphere_cell(&IcosphereCell {
+            level: 2,
+            radius,
+            centre: DVec3::new(x, 0.0, 0.0),
+            bond_type: Some("edge".into()),
+            body_id,
+            first_id,
+            ..Default::default()
+        })
+    };
+    let (a, b) = (cell(1, 1, -(radius + 0.5 * gap)), cell(2, 163, radius + 0.5 * gap));
+    assert!(a.edge_lengths[0] < capture, "nodes of one cell lie within capture of each other");
+    let ff = format!(
+        "particle node drag 1\nbody cell turgor k 100 v0 {v}\nbody cell surface_tension gamma 1\nbond edge harmonic k 100 r0 {edge}\n\
+         bond junction harmonic k 10 r0 0.25 kinetics slip k0 0.01 x_beta 0.005\n\
+         bind node node junction k_on 200 capture {capture} between bodies\n",
+        v = a.volume,
+        edge = a.edge_lengths[1]
+    );
+    let deck = "units cell\ntopology cells.top\nforcefield cells.ff\nbox x -10 10 f y -10 10 f z -10 10 f\ntemperature 298\n\
+                timestep 1e-3\nseed 4\nevents events.csv\ngroup left id 1:162\ngroup right id 163:324\nrun 100\n\
+                external apart_l left constant_force fx -1\nexternal apart_r right constant_force fx 1\nrun 3000\n";
+    let c = Case::new(&[("cells.top", &merged_topology(&[&a.text, &b.text])), ("cells.ff", &ff), ("deck.in", deck)]);
+    let sim = c.run();
+    let log = std::fs::read_to_string(c.path("events.csv")).unwrap();
+    let mut formed = 0;
+    for row in log.lines().skip(1) {
+        let f: Vec<&str> = row.split(',').collect();
+        let (i, j): (u64, u64) = (f[5].parse().unwrap(), f[6].parse().unwrap());
+        assert!((i <= 162) != (j <= 162), "{} between particles {i} and {j} of one cell", f[2]);
+        formed += (f[2] == "form") as u32;
+    }
+    assert!(formed >= 3, "only {formed} junctions formed");
+    assert!(sim.kinetics.breaks >= formed as u64, "{} of {formed} junctions broke", sim.kinetics.breaks);
+    let bound = sim.state.bonds.as_ref().unwrap().bound[sim.model.topology_bonds..].iter().filter(|&&b| b).count();
+    assert_eq!(bound, 0, "junctions still bound after the pull");
+    let centre = |lo: usize, hi: usize| sim.state.positions[lo..hi].iter().fold(DVec3::ZERO, |s, x| s + *x) / (hi - lo) as f64;
+    let separation = (centre(162, 324) - centre(0, 162)).x;
+    assert!(separation > 2.0 * radius + gap + capture, "cells {separation} µm apart");
+}

@@ -48,8 +48,10 @@ fn forces(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index)
         let d = separation(i, other);
         let r = length(d);
         let radial = radial_law(topo[P.off_term_kind + term], term_params(term), r);
-        f += force_along(radial, d, r);
-        e += 0.5 * radial.energy;
+        // A kinetic bond's maturation scale (1 for every other bond).
+        let scale = fparams[P.off_term_scale + term];
+        f += scale * force_along(radial, d, r);
+        e += 0.5 * scale * radial.energy;
     }
 
     // Angles: evaluated around the vertex j with i and k at their minimum images.

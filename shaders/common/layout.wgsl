@@ -27,10 +27,10 @@ struct Params {
     seed_lo: u32, seed_hi: u32, step_lo: u32, step_hi: u32,
     // neighbour `check`, scan blocks over cells, dispatch width (workgroups along x), 1 for `noise gaussian`
     neighbor_check: u32, scan_blocks: u32, groups_x: u32, gaussian: u32,
-    // offsets of the sections of `topo`
+    // offsets of the sections of `topo`, then of the term force scales in `fparams`
     off_term_kind: u32, off_pair_start: u32, off_pair_terms: u32, off_bond_offsets: u32,
     off_bond_ends: u32, off_angle_offsets: u32, off_angle_slots: u32, off_ext_offsets: u32,
-    off_ext_terms: u32, off_excl_offsets: u32, off_excl: u32, pad1: u32,
+    off_ext_terms: u32, off_excl_offsets: u32, off_excl: u32, off_term_scale: u32,
     // offsets of the sections of `fparams`
     off_params: u32, off_skip2: u32, off_mobility: u32, off_amplitude: u32,
 }

@@ -74,13 +74,18 @@ impl Bonded {
         }
     }
 
-    /// Pass 1: resolves bond evaluators and fills the angle slots.
-    pub(super) fn prepare(&mut self, model: &Model, x: &[DVec3], images: &Images) {
+    /// The evaluator of each bond type's law.
+    pub(super) fn resolve_laws(&mut self, model: &Model) {
         self.bond_eval.clear();
         self.bond_eval.extend(model.bond_types.iter().map(|t| match t.interaction.law() {
             Law::Radial { eval, .. } => eval,
             _ => unreachable!("bond law is radial"),
         }));
+    }
+
+    /// Pass 1: resolves bond evaluators and fills the angle slots.
+    pub(super) fn prepare(&mut self, model: &Model, x: &[DVec3], images: &Images) {
+        self.resolve_laws(model);
         self.angle_slots.par_chunks_mut(3).enumerate().with_min_len(1024).for_each(|(a, slots)| {
             slots.copy_from_slice(&eval_angle(model, a, x, images).1.forces);
         });

@@ -13,6 +13,11 @@
 //! - **Surface terms** of closed bodies (turgor, tension, bending): each body
 //!   once, in parallel over bodies, into per-node slots that each particle
 //!   gathers in a fixed order (see `src/backend/surface.rs`).
+//! - **Contact terms** between bodies (`contact` lines): node–face candidate
+//!   pairs, each evaluated into its own slot, gathered per particle in pair
+//!   order (see `src/backend/contact.rs`); [`CpuBackend::update_contacts`]
+//!   keeps the candidate list current and [`CpuBackend::contact_step_limits`]
+//!   gives the explicit step its clamp.
 //!
 //! Energies and the virial are needed only on thermo steps:
 //! [`CpuBackend::compute_forces`] skips them, [`CpuBackend::compute`]
@@ -27,6 +32,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::bonded::Bonded;
+use super::contact::Contacts;
 use super::pair_table::{PairGeometry, PairTable};
 use super::sum::chunked;
 use super::surface::Surfaces;
@@ -72,6 +78,7 @@ pub struct CpuBackend {
     exclusions: Exclusions,
     bonded: Bonded,
     surfaces: Surfaces,
+    contacts: Contacts,
     pairs: PairTable,
     /// Registry indices of the pair interactions in use (the energy columns).
     pair_interactions: Vec<usize>,
@@ -95,6 +102,7 @@ impl CpuBackend {
             exclusions: Exclusions::from_pairs(model.len(), &model.excluded_pairs(state.bonds.as_ref().map(|b| b.bound.as_slice()))),
             bonded: Bonded::new(model),
             surfaces: Surfaces::new(model),
+            contacts: Contacts::new(model),
             pairs: PairTable::default(),
             pair_interactions,
             pair_rule_column,
@@ -102,7 +110,39 @@ impl CpuBackend {
             bond_length: Vec::new(),
         };
         backend.rebuild_neighbors(state, sim_box)?;
+        backend.update_contacts(model, state, sim_box)?;
         Ok(backend)
+    }
+
+    /// Rebuilds the contact candidate list if a contact node moved more than
+    /// d̂/2 since it was built. Call before every force evaluation at moved
+    /// positions: a stale list could miss a pair (nothing to do without
+    /// `contact` lines).
+    pub fn update_contacts(&mut self, model: &Model, state: &State, sim_box: &SimBox) -> Result<(), String> {
+        self.contacts.update(model, &state.positions, sim_box)
+    }
+
+    /// The smallest node–face distance between different bodies at the last
+    /// evaluation: exact below the largest contact d̂, ∞ when no pair is
+    /// within the search range 2·d̂ (and when there are no `contact` lines).
+    pub fn min_contact_distance(&self) -> f64 {
+        self.contacts.min_distance()
+    }
+
+    /// Contact candidate-list builds so far.
+    pub fn contact_builds(&self) -> u64 {
+        self.contacts.builds()
+    }
+
+    /// Fills `limits` with each particle's largest safe displacement for the
+    /// next explicit step (see `src/backend/contact.rs`); false (and `limits`
+    /// untouched) when the model has no contact terms.
+    pub fn contact_step_limits(&self, n: usize, limits: &mut Vec<f64>) -> bool {
+        if self.contacts.is_empty() {
+            return false;
+        }
+        self.contacts.fill_step_limits(n, limits);
+        true
     }
 
     /// Bonds broke or bound: pair exclusions follow the bound bonds, so they
@@ -118,8 +158,32 @@ impl CpuBackend {
 
     /// Tension (dE/dr, positive when stretched; 0 when unbound) and length of
     /// every bond at the last evaluation; empty when bonds have no kinetics.
+    /// Measures the tension and length of every bond at `state` without a
+    /// force pass (bond kinetics between GPU steps), for
+    /// [`Self::bond_tension_and_length`].
+    pub fn measure_bonds(&mut self, model: &Model, state: &State, sim_box: &SimBox) {
+        self.bonded.resolve_laws(model);
+        self.bonded.tensions(
+            model,
+            &state.positions,
+            &sim_box.images(),
+            state.bonds.as_ref(),
+            &mut self.bond_tension,
+            &mut self.bond_length,
+        );
+    }
+
     pub fn bond_tension_and_length(&self) -> (&[f64], &[f64]) {
         (&self.bond_tension, &self.bond_length)
+    }
+
+    /// Tension (dE/dr, positive when stretched; 0 when unbound) and length of
+    /// every bond at `state`, computed now (for outputs). Needs a force
+    /// evaluation since the model's parameters last changed.
+    pub fn bond_tensions_at(&self, model: &Model, state: &State, sim_box: &SimBox) -> (Vec<f64>, Vec<f64>) {
+        let (mut tension, mut length) = (Vec::new(), Vec::new());
+        self.bonded.tensions(model, &state.positions, &sim_box.images(), state.bonds.as_ref(), &mut tension, &mut length);
+        (tension, length)
     }
 
     /// Rebuilds the neighbour list now.
@@ -142,6 +206,14 @@ impl CpuBackend {
 
     pub(super) fn bonded(&self) -> &Bonded {
         &self.bonded
+    }
+
+    pub(super) fn pair_table(&self) -> &PairTable {
+        &self.pairs
+    }
+
+    pub(super) fn surfaces(&self) -> &Surfaces {
+        &self.surfaces
     }
 
     /// The neighbour list, or None when the model has no pair terms.
@@ -175,12 +247,13 @@ impl CpuBackend {
         }
         self.bonded.prepare(model, x, &images);
         self.surfaces.prepare(model, x, &images);
+        self.contacts.prepare(model, x, &images);
         let bond_state = state.bonds.as_ref();
         if bond_state.is_some() {
             self.bonded.tensions(model, x, &images, bond_state, &mut self.bond_tension, &mut self.bond_length);
         }
-        let (pairs, bonded, surfaces) = (&self.pairs, &self.bonded, &self.surfaces);
-        let has_surfaces = !surfaces.is_empty();
+        let (pairs, bonded, surfaces, contacts) = (&self.pairs, &self.bonded, &self.surfaces, &self.contacts);
+        let (has_surfaces, has_contacts) = (!surfaces.is_empty(), !contacts.is_empty());
         let geometry = PairGeometry { x, types: &model.types, list: &self.neighbors, images };
         out.forces.resize(n, DVec3::ZERO);
         out.forces.par_iter_mut().enumerate().with_min_len(256).for_each(|(i, f)| {
@@ -189,6 +262,9 @@ impl CpuBackend {
             if has_surfaces {
                 *f += surfaces.force_on(i);
             }
+            if has_contacts {
+                *f += contacts.force_on(i);
+            }
         });
         if energies {
             out.energy_by_interaction.clear();
@@ -196,6 +272,7 @@ impl CpuBackend {
             out.virial = [0.0; 6];
             bonded.energy(model, x, &images, bond_state, &mut out.energy_by_interaction, &mut out.virial);
             surfaces.energy(model, &mut out.energy_by_interaction, &mut out.virial);
+            contacts.energy(model, x, &images, &mut out.energy_by_interaction, &mut out.virial);
             if has_pairs {
                 self.pair_energy(&geometry, out);
             }
@@ -242,6 +319,17 @@ impl CpuBackend {
         for (rule, force) in self.surfaces.terms_on(i) {
             let term = &model.body_rules[rule];
             parts.push(ForceBreakdown { kind: "body", label: term.label.text.clone(), interaction: term.interaction.name(), force });
+        }
+        if let Some(term) = model.contact_rules.first().filter(|_| !self.contacts.is_empty()) {
+            let force = self.contacts.force_on(i);
+            if force != DVec3::ZERO {
+                parts.push(ForceBreakdown {
+                    kind: "contact",
+                    label: "node–face contacts".into(),
+                    interaction: term.interaction.name(),
+                    force,
+                });
+            }
         }
         if !self.pair_interactions.is_empty() {
             let x = &state.positions;

@@ -2,11 +2,15 @@
 //! GPU backend must match it within each interaction's declared epsilon.
 
 mod bonded;
+mod contact;
 pub mod cpu;
 mod pair_table;
 pub mod stiffness;
 mod sum;
 mod surface;
+mod terms;
 mod virial;
 
+pub use self::contact::STEP_FRACTION as CONTACT_STEP_FRACTION;
 pub use self::cpu::{CpuBackend, ForceBreakdown, Forces};
+pub use self::terms::{Segment, Term, TermKind};

@@ -87,11 +87,11 @@ impl PairTable {
         }
     }
 
-    /// Calls `visit(column, d, r, radial)` for every pair term acting on
+    /// Calls `visit(column, d, r, radial, j)` for every pair term acting on
     /// particle `i` (d = x_j − x_i, minimum image), neighbours in list order
     /// and rules in force-field order.
     #[inline(always)]
-    fn for_each_term(&self, i: usize, g: &PairGeometry, mut visit: impl FnMut(usize, DVec3, f64, Radial)) {
+    pub(super) fn for_each_term(&self, i: usize, g: &PairGeometry, mut visit: impl FnMut(usize, DVec3, f64, Radial, u32)) {
         let PairGeometry { x, types, list, images } = g;
         let xi = x[i];
         let row = types[i] as usize * self.n_types;
@@ -105,7 +105,7 @@ impl PairTable {
             let r = r2.sqrt();
             for k in &self.kernels[self.start[pair] as usize..self.start[pair + 1] as usize] {
                 if r < k.cutoff {
-                    visit(k.column as usize, d, r, (k.eval)(&self.params[k.params.0 as usize..k.params.1 as usize], r));
+                    visit(k.column as usize, d, r, (k.eval)(&self.params[k.params.0 as usize..k.params.1 as usize], r), j);
                 }
             }
         }
@@ -115,14 +115,14 @@ impl PairTable {
     #[inline]
     pub(super) fn force_on(&self, i: usize, g: &PairGeometry) -> DVec3 {
         let mut f = DVec3::ZERO;
-        self.for_each_term(i, g, |_, d, r, radial| f += radial.force_along(d, r));
+        self.for_each_term(i, g, |_, d, r, radial, _| f += radial.force_along(d, r));
         f
     }
 
     /// Adds half the pair energy of particle `i` per column to `energy` and
     /// half its pair virial to `virial` (thermo steps only).
     pub(super) fn energy_of(&self, i: usize, g: &PairGeometry, energy: &mut [f64], virial: &mut [f64; 6]) {
-        self.for_each_term(i, g, |column, d, r, radial| {
+        self.for_each_term(i, g, |column, d, r, radial, _| {
             energy[column] += 0.5 * radial.energy;
             // r_ij ⊗ f_ij with r_ij = −d, counted half from each side.
             add6(virial, outer(-0.5 * d, radial.force_along(d, r)));

@@ -20,6 +20,8 @@
 //! - **Surface terms of bodies** (turgor, tension, bending) contribute no
 //!   block yet: they enter the implicit step through F only, so their own
 //!   explicit stability limit still applies to them.
+//! - **Contact terms between bodies** have no block either: the run refuses
+//!   `integrator implicit` with `contact` lines (no step clamp there yet).
 //!
 //! Blocks come in term order (bonds, angles, pairs by particle and ascending
 //! neighbour, externals), so the assembled matrix is the same on any thread

@@ -131,6 +131,17 @@ impl Surfaces {
         }
     }
 
+    /// Calls `visit(nodes, x, forces)` for every term of every body at the
+    /// last evaluation: the body's nodes (internal indices), their
+    /// image-consistent positions and the term's force on each.
+    pub(super) fn for_each_term(&self, model: &Model, mut visit: impl FnMut(&[u32], &[DVec3], &[DVec3])) {
+        for (b, scratch) in self.bodies.iter().enumerate() {
+            for forces in &scratch.forces {
+                visit(&model.bodies[b].nodes, &scratch.x, forces);
+            }
+        }
+    }
+
     /// The surface terms on particle `i` with their forces (diagnostics):
     /// (index into `Model::body_rules`, force).
     pub(super) fn terms_on(&self, i: usize) -> Vec<(usize, DVec3)> {

@@ -59,6 +59,26 @@ pub enum ThermoColumn {
     BodyVolume(usize),
     /// Summed surface area of the bodies of a body type.
     BodyArea(usize),
+    /// Smallest node–face distance between different bodies (`contact` lines).
+    MinDistance,
+    /// Explicit steps shortened by the contact step clamp so far.
+    ContactClamps,
+    /// Force transmitted across the plane x_axis = pos, tension positive
+    /// (`planetension/AXIS/POS`; see [`crate::measure::planes`]).
+    PlaneTension {
+        axis: usize,
+        pos: f64,
+    },
+    /// Method-of-planes cortical tension γ of the bodies of a body type (`gamma/BODYTYPE`).
+    CorticalTension(usize),
+    /// Mean end-to-end distance of the chains of a bond type (`e2e/BONDTYPE`;
+    /// see [`crate::measure::filaments`]).
+    EndToEnd(usize),
+    /// Tangent correlation at a lag in bonds along the chains of a bond type (`tcorr/BONDTYPE/LAG`).
+    TangentCorrelation {
+        bond_type: usize,
+        lag: usize,
+    },
 }
 
 /// A named trajectory output.
@@ -68,6 +88,8 @@ pub struct DumpSpec {
     pub every: u64,
     pub format: DumpFormat,
     pub path: PathBuf,
+    /// LAMMPS dump atom columns (`columns ...`); empty: the format's default.
+    pub columns: Vec<crate::output::AtomColumn>,
 }
 
 /// A named particle group (deck `group`).
@@ -95,6 +117,8 @@ pub enum Action {
     ThermoFile(PathBuf),
     /// CSV log of bond kinetics events.
     EventFile(PathBuf),
+    /// CSV table of bond lifetimes per bond type, rewritten after every `run`.
+    LifetimeFile(PathBuf),
     Dump(DumpSpec),
     Undump(String),
     External(External),
@@ -129,6 +153,7 @@ impl Action {
             Action::Thermo { .. }
                 | Action::ThermoFile(_)
                 | Action::EventFile(_)
+                | Action::LifetimeFile(_)
                 | Action::Dump(_)
                 | Action::Undump(_)
                 | Action::WriteState(_)

@@ -16,13 +16,13 @@ use crate::integrate::overdamped::OverdampedSettings;
 use crate::integrate::rng::Noise;
 use crate::interactions::{param_index, Kind, REGISTRY};
 use crate::kinetics::EventKind;
-use crate::output::DumpFormat;
+use crate::output::{AtomColumn, DumpFormat};
 use crate::system::{External, Model, SimBox, SpecialBonds};
 use crate::topology::{parse_box_axis, parse_topology, BoxAxis, Topology};
 use crate::units::UnitSystem;
 
 /// The commands a deck understands (for "expected ..." messages).
-const COMMANDS: &str = "units, variable, topology, forcefield, box, special_bonds, temperature, timestep, seed, device, integrator, neighbor, thermo, thermo_file, events, dump, undump, group, external, unexternal, coeff, constrain, unconstrain, minimize, run, write_state, read_state, print";
+const COMMANDS: &str = "units, variable, topology, forcefield, box, special_bonds, temperature, timestep, seed, device, integrator, neighbor, thermo, thermo_file, events, lifetimes, dump, undump, group, external, unexternal, coeff, constrain, unconstrain, minimize, run, write_state, read_state, print";
 
 /// Commands that define the system and must come before it is first used.
 const SETUP: [&str; 5] = ["units", "topology", "forcefield", "box", "special_bonds"];
@@ -135,6 +135,7 @@ impl Validator {
                 [axes[0].periodic, axes[1].periodic, axes[2].periodic],
             );
             let model = Model::build(topology, &self.forcefield, self.units, self.special_bonds)?;
+            check_outward(&model, topology, &sim_box)?;
             self.positions = topology.positions.clone();
             self.sim_box = Some(sim_box);
             self.groups.insert("all".into(), Group { name: "all".into(), members: (0..model.len() as u32).collect() });
@@ -208,7 +209,7 @@ impl Validator {
 
     fn thermo_columns(&self, tokens: &[Token]) -> Result<Vec<ThermoColumn>, InputError> {
         const FIXED: &str =
-            "step, time, pe, pe/NAME, fmax, fnorm, press, pxx, pyy, pzz, pxy, pxz, pyz, nbuild, solver_iterations, solver_residual, ctension/BONDTYPE, breaks, rebinds, forms, resets, nbound/BONDTYPE, tension/BONDTYPE, volume/BODYTYPE, area/BODYTYPE";
+            "step, time, pe, pe/NAME, fmax, fnorm, press, pxx, pyy, pzz, pxy, pxz, pyz, nbuild, solver_iterations, solver_residual, ctension/BONDTYPE, breaks, rebinds, forms, resets, nbound/BONDTYPE, tension/BONDTYPE, volume/BODYTYPE, area/BODYTYPE, planetension/AXIS/POS, gamma/BODYTYPE, e2e/BONDTYPE, tcorr/BONDTYPE/LAG, mindist, nclamp";
         let bond_type = |t: &Token, name: &str| {
             self.forcefield.bond_types.iter().position(|b| b.label.text == name).ok_or_else(|| {
                 let names: Vec<&str> = self.forcefield.bond_types.iter().map(|b| b.label.text.as_str()).collect();
@@ -216,14 +217,12 @@ impl Validator {
             })
         };
         let body_type = |t: &Token, name: &str| {
-            let mut names: Vec<&str> = Vec::new();
-            for rule in &self.forcefield.body_rules {
-                if !names.contains(&rule.body_type.text.as_str()) {
-                    names.push(&rule.body_type.text);
-                }
-            }
+            let names = self.forcefield.body_type_names();
             names.iter().position(|n| *n == name).ok_or_else(|| {
-                t.error(format!("found body type `{name}`, expected one that `body` lines of the force field name ({})", names.join(", ")))
+                t.error(format!(
+                    "found body type `{name}`, expected one that `body` or `contact` lines of the force field name ({})",
+                    names.join(", ")
+                ))
             })
         };
         tokens
@@ -249,6 +248,11 @@ impl Validator {
                     "rebinds" => ThermoColumn::Events(EventKind::Rebind),
                     "forms" => ThermoColumn::Events(EventKind::Form),
                     "resets" => ThermoColumn::Events(EventKind::Reset),
+                    "mindist" | "nclamp" if self.forcefield.contact_rules.is_empty() => {
+                        return Err(t.error(format!("found `{}`, which needs `contact` lines in the force field; expected {FIXED}", t.text)))
+                    }
+                    "mindist" => ThermoColumn::MinDistance,
+                    "nclamp" => ThermoColumn::ContactClamps,
                     other => match other.split_once('/') {
                         Some(("pe", name)) => ThermoColumn::PeOf(REGISTRY.iter().position(|i| i.name() == name).ok_or_else(|| {
                             t.error(format!(
@@ -260,8 +264,46 @@ impl Validator {
                         Some(("ctension", name)) => ThermoColumn::ConstraintTension(bond_type(t, name)?),
                         Some(("volume", name)) => ThermoColumn::BodyVolume(body_type(t, name)?),
                         Some(("area", name)) => ThermoColumn::BodyArea(body_type(t, name)?),
+                        Some(("gamma", name)) => ThermoColumn::CorticalTension(body_type(t, name)?),
+                        Some(("e2e", name)) => ThermoColumn::EndToEnd(bond_type(t, name)?),
+                        Some(("planetension", rest)) => {
+                            let usage = format!("found `{other}`, expected planetension/AXIS/POS with AXIS x, y or z and POS a number");
+                            let (axis, pos) = rest.split_once('/').ok_or_else(|| t.error(usage.clone()))?;
+                            let axis = ["x", "y", "z"].iter().position(|a| *a == axis).ok_or_else(|| t.error(usage.clone()))?;
+                            let pos = pos.parse::<f64>().ok().filter(|p| p.is_finite()).ok_or_else(|| t.error(usage))?;
+                            ThermoColumn::PlaneTension { axis, pos }
+                        }
+                        Some(("tcorr", rest)) => {
+                            let usage = format!("found `{other}`, expected tcorr/BONDTYPE/LAG with LAG a whole number of bonds");
+                            let (name, lag) = rest.rsplit_once('/').ok_or_else(|| t.error(usage.clone()))?;
+                            let lag = lag.parse::<usize>().map_err(|_| t.error(usage))?;
+                            ThermoColumn::TangentCorrelation { bond_type: bond_type(t, name)?, lag }
+                        }
                         _ => return Err(t.error(format!("found thermo column `{other}`, expected one of: {FIXED}"))),
                     },
+                })
+            })
+            .collect()
+    }
+
+    /// The optional `columns C...` of a `dump` (LAMMPS dumps only).
+    fn dump_columns(&self, format: DumpFormat, rest: &[Token], usage: &str) -> Result<Vec<AtomColumn>, InputError> {
+        let Some(first) = rest.first() else { return Ok(Vec::new()) };
+        if first.text != "columns" {
+            return Err(first.error(format!("found `{}`, expected `columns` or the end of the line (`{usage}`)", first.text)));
+        }
+        if format != DumpFormat::Lammps {
+            return Err(first.error(format!("`{}` dumps have fixed fields; expected `columns` only after `lammps`", format.keyword())));
+        }
+        if rest.len() < 2 {
+            return Err(first.error("expected at least one column name after `columns`"));
+        }
+        rest[1..]
+            .iter()
+            .map(|t| {
+                AtomColumn::from_name(&t.text).ok_or_else(|| {
+                    let names: Vec<String> = AtomColumn::all().iter().map(|c| c.name()).collect();
+                    t.error(format!("found dump column `{}`, expected one of: {}", t.text, names.join(" ")))
                 })
             })
             .collect()
@@ -501,8 +543,13 @@ impl Validator {
                 expect_len(s, 1..=1, "events FILE.csv")?;
                 self.actions.push(Action::EventFile(PathBuf::from(&s[1].text)));
             }
+            "lifetimes" => {
+                expect_len(s, 1..=1, "lifetimes FILE.csv")?;
+                self.actions.push(Action::LifetimeFile(PathBuf::from(&s[1].text)));
+            }
             "dump" => {
-                expect_len(s, 5..=5, "dump NAME every N mcap|xyz|lammps FILE")?;
+                const USAGE: &str = "dump NAME every N mcap|xyz|lammps|bonds FILE [columns COLUMN...]";
+                expect_len(s, 5..=usize::MAX, USAGE)?;
                 if s[2].text != "every" {
                     return Err(s[2].error(format!("found `{}`, expected `every`", s[2].text)));
                 }
@@ -511,8 +558,9 @@ impl Validator {
                     return Err(s[3].error("found 0, expected a dump interval >= 1"));
                 }
                 let format = DumpFormat::from_keyword(&s[4].text)
-                    .ok_or_else(|| s[4].error(format!("found format `{}`, expected `mcap`, `xyz` or `lammps`", s[4].text)))?;
+                    .ok_or_else(|| s[4].error(format!("found format `{}`, expected `mcap`, `xyz`, `lammps` or `bonds`", s[4].text)))?;
                 let path = PathBuf::from(&s[5].text);
+                let columns = self.dump_columns(format, &s[6..], USAGE)?;
                 if self.dumps.contains_key(&s[1].text) {
                     return Err(
                         s[1].error(format!("dump `{}` is already active; expected a new name or `undump {}` first", s[1].text, s[1].text))
@@ -522,7 +570,7 @@ impl Validator {
                     return Err(s[5].error(format!("`{}` is already written by another dump; expected a different file", s[5].text)));
                 }
                 self.dumps.insert(s[1].text.clone(), path.clone());
-                self.actions.push(Action::Dump(DumpSpec { name: s[1].text.clone(), every, format, path }));
+                self.actions.push(Action::Dump(DumpSpec { name: s[1].text.clone(), every, format, path, columns }));
             }
             "undump" => {
                 expect_len(s, 1..=1, "undump NAME")?;
@@ -697,4 +745,22 @@ pub fn validate_file(path: &Path, overrides: &[(String, String)]) -> Result<Plan
     let file = SourceFile::read(path, None)?;
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     validate(&file, &dir, overrides)
+}
+
+/// Every body must enclose a positive volume at its initial positions (in the
+/// deck's box, across periodic boundaries): the topology check proves its faces
+/// consistently wound, and this proves them wound outward, which turgor and
+/// bending need for their signs.
+fn check_outward(model: &Model, topology: &Topology, sim_box: &SimBox) -> Result<(), InputError> {
+    let images = sim_box.images();
+    for (b, (id, type_token)) in topology.bodies.iter().enumerate() {
+        let (volume, _) = model.body_volume_and_area(b, &topology.positions, &images);
+        if volume.is_nan() || volume <= 0.0 {
+            return Err(type_token.error(format!(
+                "body {id} encloses a volume of {volume:e} at its initial positions in this box; expected a positive volume: faces wound \
+                 counter-clockwise seen from outside (swap two nodes of every face if they are wound inward)"
+            )));
+        }
+    }
+    Ok(())
 }

@@ -297,6 +297,11 @@ fn kinetic_fixes(plan: &Plan) -> Result<KineticFixes, String> {
                 "{name} has `partner random`: LAMMPS `fix bond/create` binds mutual-nearest partners only (`partner nearest`)"
             ));
         }
+        if r.between_bodies {
+            return Err(format!(
+                "{name} has `between bodies`: LAMMPS `fix bond/create` cannot restrict binding to particles of different bodies"
+            ));
+        }
         if let Some(dt) = steps.iter().find(|&&dt| -(-r.k_on * dt).exp_m1() < 1.0) {
             return Err(format!(
                 "{name}: binding is not certain within a step (k_on·dt = {:e}); LAMMPS `fix bond/create` binds every eligible pair at once: export it with k_on·dt ≥ 40",
@@ -634,6 +639,7 @@ impl Writer<'_> {
                 Action::Thermo { every, .. } => self.line(format!("thermo {every}")),
                 Action::ThermoFile(path) => self.line(format!("# thermo_file {}: the LAMMPS log holds the thermo table", path.display())),
                 Action::EventFile(path) => self.line(format!("# events {}: bond kinetics are not exported", path.display())),
+                Action::LifetimeFile(path) => self.line(format!("# lifetimes {}: bond kinetics are not exported", path.display())),
                 Action::Dump(spec) => self.line(format!(
                     "dump {} all custom {} {} id type xu yu zu",
                     ident("d_", &spec.name),
@@ -681,7 +687,7 @@ impl Writer<'_> {
 /// are errors naming them.
 pub fn export(plan: &Plan, options: ExportOptions) -> Result<LammpsDeck, String> {
     let model = plan.model.clone();
-    if let Some(term) = model.body_rules.first() {
+    if let Some(term) = model.body_rules.first().or(model.contact_rules.first()) {
         return Err(styles::unsupported(term));
     }
     let kinetic = kinetic_fixes(plan)?;

@@ -10,6 +10,7 @@
 //! angle actin_bend     wlc_bending kappa 0.07 l0 0.1
 //! pair  actin actin    soft_repulsion k 100 sigma 0.05
 //! body  cell           turgor k 7e5 dp0 40 v0 4189
+//! contact cell cell    contact_barrier dhat 0.1 kappa 100
 //! ```
 //!
 //! Parameters are `name value` pairs in any order, checked against the
@@ -19,7 +20,9 @@
 //! Several `pair` lines for one type pair add up (like LAMMPS `hybrid/overlay`),
 //! and so do several `body` lines for one body type (the `type` of a body in
 //! the topology's `[ bodies ]`): each line is one many-body term evaluated on
-//! every body of that type.
+//! every body of that type. A `contact` line names two body types (possibly
+//! the same) and a node–face term that acts between every node of a body of
+//! one type and every face of a different body of the other.
 //!
 //! A `bond` line may end with kinetic rules (see [`crate::kinetics`]):
 //! `bond clutch harmonic k 5 r0 0.02 kinetics catch_slip kc0 10 xc 0.002 ks0 0.05 xs 0.001`.
@@ -28,4 +31,4 @@ mod params;
 mod parse;
 
 pub use self::params::{parse_kinetics, parse_params, parse_values, BondTypeKinetics, TermType};
-pub use self::parse::{check_pair_types, load_forcefield, BodyRule, ForceField, PairRule, ParticleType};
+pub use self::parse::{check_pair_types, load_forcefield, BodyRule, ContactRule, ForceField, PairRule, ParticleType};

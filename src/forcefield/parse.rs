@@ -35,6 +35,14 @@ pub struct BodyRule {
     pub term: TermType,
 }
 
+/// A node–face term between bodies of two types (`contact TYPE_A TYPE_B INTERACTION ...`).
+#[derive(Clone, Debug)]
+pub struct ContactRule {
+    pub type_a: Token,
+    pub type_b: Token,
+    pub term: TermType,
+}
+
 /// Everything the force-field files of a deck define.
 #[derive(Clone, Debug, Default)]
 pub struct ForceField {
@@ -46,6 +54,8 @@ pub struct ForceField {
     pub pair_rules: Vec<PairRule>,
     /// Surface terms by body type (`body` lines); several lines for one type add up.
     pub body_rules: Vec<BodyRule>,
+    /// Contact terms between bodies by body-type pair (`contact` lines).
+    pub contact_rules: Vec<ContactRule>,
     /// Bond formation rules (`bind` lines).
     pub bind_lines: Vec<crate::kinetics::BindLine>,
 }
@@ -53,6 +63,19 @@ pub struct ForceField {
 impl ForceField {
     pub fn particle_type(&self, name: &str) -> Option<usize> {
         self.particle_types.iter().position(|t| t.name.text == name)
+    }
+
+    /// The body types the force field names, in order of first appearance:
+    /// those of `body` lines, then those only `contact` lines name.
+    pub fn body_type_names(&self) -> Vec<&str> {
+        let mut names: Vec<&str> = Vec::new();
+        let named = self.body_rules.iter().map(|r| &r.body_type).chain(self.contact_rules.iter().flat_map(|r| [&r.type_a, &r.type_b]));
+        for t in named {
+            if !names.contains(&t.text.as_str()) {
+                names.push(&t.text);
+            }
+        }
+        names
     }
 }
 
@@ -185,9 +208,18 @@ pub fn load_forcefield(
                 let term = parse_params(&t[1], &t[2], &t[3..], Kind::Body, units)?;
                 ff.body_rules.push(BodyRule { body_type: t[1].clone(), term });
             }
+            "contact" => {
+                if t.len() < 4 {
+                    return Err(kw.error("expected `contact BODYTYPE_A BODYTYPE_B INTERACTION [param value]...`"));
+                }
+                let term = parse_params(&t[1], &t[3], &t[4..], Kind::Contact, units)?;
+                ff.contact_rules.push(ContactRule { type_a: t[1].clone(), type_b: t[2].clone(), term });
+            }
             "bind" => ff.bind_lines.push(crate::kinetics::parse_bind(kw, &t[1..], units)?),
             other => {
-                return Err(kw.error(format!("found `{other}`, expected `include`, `particle`, `bond`, `angle`, `pair`, `body` or `bind`")))
+                return Err(kw.error(format!(
+                    "found `{other}`, expected `include`, `particle`, `bond`, `angle`, `pair`, `body`, `contact` or `bind`"
+                )))
             }
         }
     }
@@ -251,6 +283,23 @@ mod tests {
             .unwrap_err()
             .contains("`turgor` is a body interaction, expected a bond interaction"));
         assert!(load(&[("m.ff", "body cell\n")]).unwrap_err().contains("expected `body TYPE INTERACTION"));
+    }
+
+    #[test]
+    fn contact_lines_name_two_body_types_and_a_contact_interaction() {
+        let ff = load(&[("m.ff", "body cell turgor k 1 v0 1\ncontact cell nucleus contact_barrier dhat 0.1 kappa 10\n")]).unwrap();
+        assert_eq!((ff.contact_rules[0].type_a.text.as_str(), ff.contact_rules[0].type_b.text.as_str()), ("cell", "nucleus"));
+        assert_eq!(ff.contact_rules[0].term.params, vec![0.1, 10.0]);
+        assert_eq!(ff.body_type_names(), ["cell", "nucleus"]);
+        assert_eq!(
+            load(&[("m.ff", "contact cell cell turgor k 1 v0 1\n")]).unwrap_err(),
+            "m.ff:1:19: `turgor` is a body interaction, expected a contact interaction here"
+        );
+        assert!(load(&[("m.ff", "body cell contact_barrier dhat 1 kappa 1\n")])
+            .unwrap_err()
+            .contains("is a contact interaction, expected a body"));
+        assert!(load(&[("m.ff", "contact cell cell\n")]).unwrap_err().contains("expected `contact BODYTYPE_A BODYTYPE_B INTERACTION"));
+        assert!(load(&[("m.ff", "contact a b contact_barrier dhat 0 kappa 1\n")]).unwrap_err().contains("`dhat` > 0"));
     }
 
     #[test]

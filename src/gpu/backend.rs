@@ -7,6 +7,11 @@
 //! resumes from the last completed step, so the result is the same as with a
 //! large enough list. A refused step (blow-up) halts too, leaving the state
 //! of the last completed step in place.
+//!
+//! Bond kinetics are decided on the host from the read-back positions;
+//! [`GpuBackend::update_bonds`] then uploads the new bond state (bound bonds,
+//! their rest lengths and scales, the exclusions of the bound bonds) as one
+//! batch and has the neighbour list rebuilt.
 
 use glam::DVec3;
 use wgpu::util::DeviceExt;
@@ -112,6 +117,9 @@ pub struct GpuBackend {
     kernels: Kernels,
     builds: u64,
     grown: u32,
+    settings: StepSettings,
+    /// The next `run` or `evaluate` rebuilds the neighbour list first.
+    pending_rebuild: bool,
 }
 
 /// Refuses a storage buffer the adapter cannot bind (wgpu would abort).
@@ -153,20 +161,22 @@ fn words<T: bytemuck::Pod>(data: &[T]) -> &[u8] {
 impl GpuBackend {
     /// Uploads the model and state and compiles the kernels.
     pub fn new(ctx: &GpuContext, model: &Model, state: &State, sim_box: &SimBox, settings: &StepSettings) -> Result<Self, String> {
-        if state.bonds.is_some() || !model.bind_rules.is_empty() {
-            return Err("the GPU backend does not run bond kinetics yet; use `device cpu` for decks with `kinetics` or `bind`".into());
-        }
         if model.has_surface_terms() {
             return Err(
                 "the GPU backend has no kernels for surface terms of bodies yet; use `device cpu` for decks with `body` lines".into()
+            );
+        }
+        if model.has_contact_terms() {
+            return Err(
+                "the GPU backend has no kernels for contact terms between bodies yet; use `device cpu` for decks with `contact` lines"
+                    .into(),
             );
         }
         let n = model.len();
         if n == 0 {
             return Err("the GPU backend needs at least one particle".into());
         }
-        let exclusions = Exclusions::from_pairs(n, &model.excluded_pairs(None));
-        let packed = pack(model, &exclusions, settings.dt, settings.kt)?;
+        let packed = pack_state(model, state, settings)?;
         let cutoff = model.max_pair_cutoff();
         let has_pairs = !model.pair_rules.is_empty() && cutoff > 0.0;
         let range = cutoff + settings.skin;
@@ -221,8 +231,9 @@ impl GpuBackend {
         let state_buffer = zeros("state", particle_bytes, rw);
         let next = zeros("next", particle_bytes, rw);
         let reference = zeros("reference", particle_bytes, rw);
-        let topo = init("topo", words(&pad16(packed.topo)), wgpu::BufferUsages::STORAGE);
-        let fparams = init("fparams", words(&pad16(packed.fparams)), wgpu::BufferUsages::STORAGE);
+        let uploads = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
+        let topo = init("topo", words(&pad16(packed.topo)), uploads);
+        let fparams = init("fparams", words(&pad16(packed.fparams)), uploads);
         let cell_count = zeros("cell_count", 4 * cells as u64, rw);
         let cell_data = zeros("cell_data", 4 * (cells as u64 + 1 + scan_blocks as u64 + n as u64), rw);
         let nlist = zeros("nlist", nlist_bytes(n as u32, params.nlist_cap), rw);
@@ -312,6 +323,8 @@ impl GpuBackend {
             kernels,
             builds: 0,
             grown: 0,
+            settings: *settings,
+            pending_rebuild: true,
             ctx: ctx.clone(),
         };
         backend.upload(state);
@@ -364,7 +377,35 @@ impl GpuBackend {
             }
         }
         self.ctx.queue.write_buffer(&self.state, 0, words(&data));
-        self.reset_status(true);
+        self.pending_rebuild = true;
+    }
+
+    /// Uploads the bond state of `state` (after bond kinetics changed it) as
+    /// one batch: the bound bonds with their own rest lengths and scales, and
+    /// the exclusions of the bound bonds; `rebuild` asks for a neighbour-list
+    /// rebuild before the next step (when bonds broke or bound, so that the
+    /// pair exclusions changed).
+    pub fn update_bonds(&mut self, model: &Model, state: &State, rebuild: bool) -> Result<(), String> {
+        let packed = pack_state(model, state, &self.settings)?;
+        let (topo, fparams) = (pad16(packed.topo), pad16(packed.fparams));
+        let fits = |buffer: &wgpu::Buffer, bytes: usize| bytes as u64 <= buffer.size();
+        if fits(&self.topo, 4 * topo.len()) && fits(&self.fparams, 4 * fparams.len()) {
+            self.ctx.queue.write_buffer(&self.topo, 0, words(&topo));
+            self.ctx.queue.write_buffer(&self.fparams, 0, words(&fparams));
+        } else {
+            check_binding(&self.ctx, "the topology", 4 * topo.len() as u64)?;
+            let uploads = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
+            let init = |label: &str, contents: &[u8]| {
+                self.ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage: uploads })
+            };
+            self.topo = init("topo", words(&topo));
+            self.fparams = init("fparams", words(&fparams));
+            self.main_group = self.bind_main();
+        }
+        self.params.topo_offsets = packed.topo_offsets;
+        self.params.fparam_offsets = packed.fparam_offsets;
+        self.pending_rebuild |= rebuild;
+        Ok(())
     }
 
     fn reset_status(&self, force_rebuild: bool) {
@@ -488,7 +529,7 @@ impl GpuBackend {
         }
         let readback = started.elapsed().as_secs_f64() / repetitions as f64;
         self.ctx.queue.write_buffer(&self.state, 0, &saved);
-        self.reset_status(true);
+        self.pending_rebuild = true;
         Ok(PhaseTimes { check, neighbor_build, forces, integrate, readback })
     }
 
@@ -558,6 +599,7 @@ impl GpuBackend {
     /// if the neighbour list cannot grow to hold every neighbour.
     pub fn evaluate(&mut self) -> Result<(), String> {
         loop {
+            self.pending_rebuild = false;
             self.reset_status(true);
             self.write_params();
             let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
@@ -578,7 +620,7 @@ impl GpuBackend {
     /// Returns the number of steps done (all of them unless halted).
     pub fn run(&mut self, first_step: u64, steps: u64) -> Result<u64, GpuHalt> {
         let mut done = 0u64;
-        let mut force_rebuild = false;
+        let mut force_rebuild = std::mem::take(&mut self.pending_rebuild);
         while done < steps {
             let step = first_step + done;
             let chunk = (steps - done).min(u32::MAX as u64 / 2);
@@ -634,4 +676,12 @@ fn initial_capacity(n: usize, sim_box: &SimBox, range: f64, has_pairs: bool) -> 
     let volume = sim_box.volume();
     let mean = if volume > 0.0 { n as f64 / volume * 4.0 / 3.0 * std::f64::consts::PI * range.powi(3) } else { n as f64 };
     ((1.25 * mean + 8.0).ceil() as u32).clamp(32, n.max(32) as u32).next_multiple_of(8)
+}
+
+/// [`pack`] for the model at `state`: with bond kinetics, only the bound bonds
+/// (with their own rest lengths and scales) and the exclusions they make.
+fn pack_state(model: &Model, state: &State, settings: &StepSettings) -> Result<super::pack::Packed, String> {
+    let bound = state.bonds.as_ref().map(|b| b.bound.as_slice());
+    let exclusions = Exclusions::from_pairs(model.len(), &model.excluded_pairs(bound));
+    pack(model, &exclusions, settings.dt, settings.kt, state.bonds.as_ref())
 }

@@ -13,8 +13,9 @@
 //! evaluated by the f64 CPU backend at the read-back positions.
 //!
 //! Not on the GPU (refused by [`GpuBackend::new`], and by `device gpu`
-//! before a run; `device auto` falls back to the CPU): bond kinetics, and
-//! the surface terms of bodies (`Law::Surface`), which have no kernel yet.
+//! before a run; `device auto` falls back to the CPU): bond kinetics, the
+//! surface terms of bodies (`Law::Surface`) and contact terms between bodies
+//! (`Law::Contact`), which have no kernel yet.
 //!
 //! # Precision
 //!

@@ -10,10 +10,17 @@
 //!   amplitude √(2kT·dt/γ) (computed in f64; both 0 for a `fixed` type).
 //!
 //! Terms are numbered bond types, then angle types, then pair rules, then
-//! externals.
+//! externals, then — with bond kinetics — one term per bound bond of a type
+//! with kinetic rules, holding that bond's own rest length. Each term also has
+//! a force scale (`fparams`, at `topo_offsets[11]`): a kinetic bond's
+//! maturation scale, 1 for every other term. Unbound bonds are left out of the
+//! bond ends, and `exclusions` must be those of the bound bonds. Bond kinetics
+//! are decided on the host; [`pack`] is rerun after every step that changes
+//! bond state and the result uploaded as one batch.
 
 use bytemuck::{Pod, Zeroable};
 
+use crate::kinetics::BondState;
 use crate::neighbor::Exclusions;
 use crate::system::{registry_index, Model, SimBox};
 
@@ -48,7 +55,8 @@ pub struct Params {
     pub groups_x: u32,
     /// 1 for `noise gaussian`.
     pub gaussian: u32,
-    /// Offsets of the `topo` sections, in layout.wgsl's order.
+    /// Offsets of the `topo` sections, in layout.wgsl's order (the last: of
+    /// the term scales in `fparams`).
     pub topo_offsets: [u32; 12],
     /// Offsets of the `fparams` sections: params, skip2, mobility, amplitude.
     pub fparam_offsets: [u32; 4],
@@ -97,8 +105,9 @@ fn push_csr<T: Copy>(rows: &[Vec<T>], offsets: &mut Vec<u32>, flat: &mut Vec<T>)
     }
 }
 
-/// Packs the model for `dt` and `kt` (mobilities and noise amplitudes depend on them).
-pub fn pack(model: &Model, exclusions: &Exclusions, dt: f64, kt: f64) -> Result<Packed, String> {
+/// Packs the model for `dt` and `kt` (mobilities and noise amplitudes depend
+/// on them) and the bond state `bonds`, if the model has bond kinetics.
+pub fn pack(model: &Model, exclusions: &Exclusions, dt: f64, kt: f64, bonds: Option<&BondState>) -> Result<Packed, String> {
     let n = model.len();
     let nt = model.type_names.len();
     let terms: Vec<_> =
@@ -106,16 +115,45 @@ pub fn pack(model: &Model, exclusions: &Exclusions, dt: f64, kt: f64) -> Result<
     let angle_base = model.bond_types.len();
     let pair_base = angle_base + model.angle_types.len();
     let external_base = pair_base + model.pair_rules.len();
+    // Kinetic bonds (bound, of a type with kinetic rules): (bond, own term).
+    let kinetic: Vec<usize> = match bonds {
+        Some(state) => (0..model.bonds.len())
+            .filter(|&b| state.bound[b] && !model.bond_kinetics[model.bond_type[b] as usize].rules.is_empty())
+            .collect(),
+        None => Vec::new(),
+    };
+    let mut own_term = vec![u32::MAX; model.bonds.len()];
+    for (k, &b) in kinetic.iter().enumerate() {
+        own_term[b] = (terms.len() + k) as u32;
+    }
 
-    let mut fparams = Vec::with_capacity(terms.len() * PARAM_SLOTS);
-    for term in &terms {
-        if term.params.len() > PARAM_SLOTS {
-            return Err(format!("`{}` has {} parameters; the GPU backend holds {PARAM_SLOTS}", term.label.text, term.params.len()));
+    let mut fparams = Vec::with_capacity((terms.len() + kinetic.len()) * PARAM_SLOTS);
+    let mut push_params = |label: &str, params: &[f64]| {
+        if params.len() > PARAM_SLOTS {
+            return Err(format!("`{label}` has {} parameters; the GPU backend holds {PARAM_SLOTS}", params.len()));
         }
         let start = fparams.len();
-        fparams.extend(term.params.iter().map(|&p| p as f32));
+        fparams.extend(params.iter().map(|&p| p as f32));
         fparams.resize(start + PARAM_SLOTS, 0.0);
+        Ok(())
+    };
+    for term in &terms {
+        push_params(&term.label.text, &term.params)?;
     }
+    let mut scales = vec![1.0f32; terms.len()];
+    if let Some(state) = bonds {
+        for &b in &kinetic {
+            let t = model.bond_type[b] as usize;
+            let mut params = model.bond_types[t].params.clone();
+            if let Some(k) = model.bond_kinetics[t].rest_index {
+                params[k] = model.rest_length(b, state);
+            }
+            push_params(&model.bond_types[t].label.text, &params)?;
+            scales.push(state.scale[b] as f32);
+        }
+    }
+    let scale_offset = fparams.len();
+    fparams.extend(&scales);
     let skip2_offset = fparams.len();
     for a in 0..nt as u32 {
         for b in 0..nt as u32 {
@@ -134,6 +172,7 @@ pub fn pack(model: &Model, exclusions: &Exclusions, dt: f64, kt: f64) -> Result<
     let mut offsets = [0u32; 12];
     offsets[0] = topo.len() as u32;
     topo.extend(terms.iter().map(|t| registry_index(t) as u32));
+    topo.extend(kinetic.iter().map(|&b| registry_index(&model.bond_types[model.bond_type[b] as usize]) as u32));
     // Pair rules per type pair.
     offsets[1] = topo.len() as u32;
     let pair_rows: Vec<Vec<u32>> =
@@ -146,7 +185,10 @@ pub fn pack(model: &Model, exclusions: &Exclusions, dt: f64, kt: f64) -> Result<
     // Bond ends, angle slots and externals by particle, in term order.
     let mut bond_rows = vec![Vec::new(); n];
     for (b, &[i, j]) in model.bonds.iter().enumerate() {
-        let term = model.bond_type[b];
+        if bonds.is_some_and(|state| !state.bound[b]) {
+            continue;
+        }
+        let term = if own_term[b] != u32::MAX { own_term[b] } else { model.bond_type[b] };
         bond_rows[i as usize].push([j, term]);
         bond_rows[j as usize].push([i, term]);
     }
@@ -176,6 +218,7 @@ pub fn pack(model: &Model, exclusions: &Exclusions, dt: f64, kt: f64) -> Result<
         offsets[slot + 1] = topo.len() as u32;
         topo.extend(&flat);
     }
+    offsets[11] = scale_offset as u32;
     if topo.len() > u32::MAX as usize / 2 {
         return Err(format!("the model needs {} words of GPU topology, more than the u32 index range", topo.len()));
     }

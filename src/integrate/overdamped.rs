@@ -13,6 +13,20 @@
 //! A step is computed into a scratch buffer and committed only if every
 //! displacement is finite and no longer than `max_displacement`, so a blow-up
 //! leaves the last good configuration in place.
+//!
+//! # Step clamp (contact between bodies)
+//!
+//! With per-particle limits L_i (the contact step clamp: no node or face
+//! corner may move more than 0.4 × the distance of its closest contact), the
+//! step is shortened to s·dt with the largest s ∈ (0, 1] such that every
+//! limited particle's displacement s·a_i + √s·b_i (drift a_i = dt·F_i/γ,
+//! noise b_i = √(2kT·dt/γ)·ξ_i) satisfies s|a_i| + √s|b_i| ≤ L_i: the
+//! Euler–Maruyama step of length s·dt with the same draw ξ (drift scales with
+//! the time, noise with its square root), and time advances by s·dt. All
+//! particles take the shortened step, so the dynamics stay consistent; since
+//! s is chosen after ξ is drawn, clamped steps slightly bias the noise
+//! (large draws near a contact are shortened), so with kT > 0 clamping should
+//! be rare — frequent clamps mean dt is too large for the contact stiffness.
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -45,9 +59,21 @@ pub struct Blowup {
     pub displacement: f64,
 }
 
-/// Advances `state` by one step of length `dt` at temperature `kt`.
+/// The largest s ∈ (0, 1] with s·|a| + √s·|b| ≤ `limit` (1 when the full step fits).
+fn step_fraction(a: f64, b: f64, limit: f64) -> f64 {
+    if a + b <= limit {
+        return 1.0;
+    }
+    // u = √s solves |a|u² + |b|u − L = 0 (the stable root).
+    let u = 2.0 * limit / (b + (b * b + 4.0 * a * limit).sqrt());
+    u * u
+}
+
+/// Advances `state` by one step of length `dt` at temperature `kt`, shortened
+/// to s·dt when a particle would move farther than its entry of `limits`
+/// (see the module docs). Returns s (1 for a full step).
 ///
-/// `scratch` is reused between calls. On a blow-up `state` is unchanged.
+/// `scratch` (drift, noise) is reused between calls. On a blow-up `state` is unchanged.
 #[allow(clippy::too_many_arguments)]
 pub fn overdamped_step(
     model: &Model,
@@ -58,31 +84,50 @@ pub fn overdamped_step(
     kt: f64,
     seed: u64,
     settings: &OverdampedSettings,
-    scratch: &mut Vec<DVec3>,
-) -> Result<(), Blowup> {
+    limits: Option<&[f64]>,
+    scratch: &mut (Vec<DVec3>, Vec<DVec3>),
+) -> Result<f64, Blowup> {
     let step = state.step;
     let refused = |d: &DVec3| !d.is_finite() || d.length() > settings.max_displacement;
-    scratch.resize(state.len(), DVec3::ZERO);
-    let any_refused = scratch.par_iter_mut().enumerate().with_min_len(1024).fold(
-        || false,
-        |bad, (i, dx)| {
-            let gamma = model.type_drag[model.types[i] as usize];
-            if gamma.is_infinite() {
-                // A `fixed` particle never moves (and draws no noise).
-                *dx = DVec3::ZERO;
-                return bad;
-            }
-            let mut d = forces[i] * (dt / gamma);
-            if kt > 0.0 {
-                let amplitude = (2.0 * kt * dt / gamma).sqrt();
-                let xi = noise3(seed, step, i as u32, settings.noise);
-                d += amplitude * DVec3::from_array(xi);
-            }
-            *dx = d;
-            bad | refused(&d)
-        },
-    );
-    if any_refused.reduce(|| false, |a, b| a | b) {
+    let (drift, noise) = scratch;
+    drift.resize(state.len(), DVec3::ZERO);
+    noise.resize(state.len(), DVec3::ZERO);
+    drift.par_iter_mut().zip(noise.par_iter_mut()).enumerate().with_min_len(1024).for_each(|(i, (a, b))| {
+        let gamma = model.type_drag[model.types[i] as usize];
+        (*a, *b) = (DVec3::ZERO, DVec3::ZERO);
+        if gamma.is_infinite() {
+            // A `fixed` particle never moves (and draws no noise).
+            return;
+        }
+        *a = forces[i] * (dt / gamma);
+        if kt > 0.0 {
+            let amplitude = (2.0 * kt * dt / gamma).sqrt();
+            *b = amplitude * DVec3::from_array(noise3(seed, step, i as u32, settings.noise));
+        }
+    });
+    // The minimum is exact, so s does not depend on the thread count.
+    let fraction = limits.map_or(1.0, |limits| {
+        (0..state.len())
+            .into_par_iter()
+            .with_min_len(1024)
+            .map(|i| step_fraction(drift[i].length(), noise[i].length(), limits[i]))
+            .reduce(|| 1.0, f64::min)
+    });
+    let root = fraction.sqrt();
+    let any_refused = drift
+        .par_iter_mut()
+        .zip(noise.par_iter())
+        .with_min_len(1024)
+        .fold(
+            || false,
+            |bad, (a, b)| {
+                *a = if fraction == 1.0 { *a + *b } else { fraction * *a + root * *b };
+                bad | refused(a)
+            },
+        )
+        .reduce(|| false, |a, b| a | b);
+    let scratch = &*drift;
+    if any_refused {
         let particle = scratch.iter().position(refused).expect("a refused displacement");
         return Err(Blowup { particle, displacement: scratch[particle].length() });
     }
@@ -93,6 +138,23 @@ pub fn overdamped_step(
         },
     );
     state.step += 1;
-    state.time += dt;
-    Ok(())
+    state.time += fraction * dt;
+    Ok(fraction)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::step_fraction;
+
+    #[test]
+    fn the_step_fraction_keeps_drift_plus_noise_within_the_limit() {
+        assert_eq!(step_fraction(0.1, 0.2, 0.5), 1.0);
+        for (a, b, limit) in [(1.0, 0.0, 0.25), (0.0, 1.0, 0.25), (2.0, 0.5, 0.3), (1e-3, 4.0, 1e-2)] {
+            let s = step_fraction(a, b, limit);
+            assert!(s > 0.0 && s < 1.0);
+            assert!((s * a + s.sqrt() * b - limit).abs() < 1e-12 * limit, "({a}, {b}, {limit}): s = {s}");
+        }
+        assert_eq!(step_fraction(1.0, 0.0, 0.25), 0.25);
+        assert_eq!(step_fraction(0.0, 1.0, 0.25), 0.0625);
+    }
 }

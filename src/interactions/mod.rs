@@ -16,6 +16,11 @@
 //! node positions and adds a force to every node; the backend evaluates each
 //! body once per force pass into per-node slots that each particle gathers.
 //!
+//! Contact between different bodies uses [`Law::Contact`]: an energy b(d) of
+//! the distance d from a node of one body to a face of another
+//! ([`crate::mesh::point_triangle`]), spread onto the node and the face's
+//! corners by [`node_face_forces`].
+//!
 //! Laws carry what later solvers need: [`Radial`] returns d²E/dr², from which
 //! the analytic pair Hessian `E''·ûûᵀ + (E'/r)(I − ûûᵀ)` follows; state that
 //! changes during a run (e.g. a rest length under kinetics) is a parameter
@@ -65,6 +70,7 @@ mod area_conservation;
 mod asymmetric;
 mod cable;
 mod constant_force;
+mod contact_barrier;
 mod cosine_angle;
 mod fene;
 mod harmonic;
@@ -103,6 +109,7 @@ pub static REGISTRY: &[&dyn Interaction] = &[
     &surface_tension::SurfaceTension,
     &area_conservation::AreaConservation,
     &helfrich_bending::HelfrichBending,
+    &contact_barrier::ContactBarrier,
 ];
 
 /// Looks an interaction type up by its registered name.
@@ -123,6 +130,8 @@ pub enum Kind {
     External,
     /// Many-body term of a closed surface, by body type (`body` lines).
     Body,
+    /// Node–face term between different bodies, by body-type pair (`contact` lines).
+    Contact,
 }
 
 impl Kind {
@@ -134,6 +143,7 @@ impl Kind {
             Kind::Pair => "pair",
             Kind::External => "external",
             Kind::Body => "body",
+            Kind::Contact => "contact",
         }
     }
 
@@ -145,6 +155,7 @@ impl Kind {
             Kind::Pair => "a pair",
             Kind::External => "an external",
             Kind::Body => "a body",
+            Kind::Contact => "a contact",
         }
     }
 }
@@ -208,14 +219,28 @@ pub enum Law {
     /// evaluates it; the GPU backend has no kernel for this family yet and
     /// refuses decks that use it ([`Law::runs_on_gpu`]).
     Surface(fn(params: &[f64], mesh: &SurfaceMesh, x: &[DVec3], forces: &mut [DVec3]) -> f64),
+    /// b(d) of the distance d from a node of one body to a face of another
+    /// (E ≡ 0 for d ≥ `range`); the CPU backend finds the node–face pairs
+    /// and spreads the force with [`node_face_forces`]. No GPU kernel yet.
+    Contact { eval: fn(&[f64], f64) -> Radial, range: fn(&[f64]) -> f64 },
 }
 
 impl Law {
     /// Whether the GPU backend has a kernel for this law family (and so each
     /// interaction of the family a `shaders/interactions/NAME.wgsl` evaluator).
     pub fn runs_on_gpu(&self) -> bool {
-        !matches!(self, Law::Surface(_))
+        !matches!(self, Law::Surface(_) | Law::Contact { .. })
     }
+}
+
+/// Forces [node, corner 0, corner 1, corner 2] of a node–face energy b(d) with
+/// db/dd = `radial.de_dr` at the closest point `pt`: −b′·∂d/∂x, i.e.
+/// −b′·n̂ on the node and +b′·w_k·n̂ on corner k (they sum to zero, and exert
+/// no torque since all act along n̂ through the line p–q).
+#[inline]
+pub fn node_face_forces(radial: &Radial, pt: &crate::mesh::PointTriangle) -> [DVec3; 4] {
+    let g = radial.de_dr * pt.normal;
+    [-g, pt.weights[0] * g, pt.weights[1] * g, pt.weights[2] * g]
 }
 
 /// Inclusive/exclusive numeric bound of a parameter.
@@ -413,7 +438,8 @@ mod tests {
                 (Kind::Bond | Kind::Pair, Law::Radial { .. })
                 | (Kind::Angle, Law::ThreeBody(_))
                 | (Kind::External, Law::OneBody(_))
-                | (Kind::Body, Law::Surface(_)) => {}
+                | (Kind::Body, Law::Surface(_))
+                | (Kind::Contact, Law::Contact { .. }) => {}
                 _ => panic!("{}: kind and law disagree", i.name()),
             }
         }

@@ -8,6 +8,9 @@
 //! - zero force at the rest configuration the caller names;
 //! - for [`Law::Radial`], d²E/dr² against a central difference of dE/dr.
 //!
+//! A [`Law::Contact`] law is viewed as a function of four positions: the
+//! node, then the three corners of the face.
+//!
 //! [`Law::Surface`] laws need a mesh besides positions: their checks are the
 //! `assert_surface_*` functions, which run the same tests on a body.
 
@@ -16,7 +19,8 @@ use glam::{DMat3, DVec3};
 pub use super::Interaction;
 use super::{Law, SurfaceMesh};
 
-/// Energy and per-particle forces of `law` at `positions` (1, 2 or 3 particles).
+/// Energy and per-particle forces of `law` at `positions` (1, 2 or 3
+/// particles; 4 for a contact law: node, then the face's corners).
 pub fn evaluate(law: Law, params: &[f64], positions: &[DVec3]) -> (f64, Vec<DVec3>) {
     match law {
         Law::Radial { eval, .. } => {
@@ -33,6 +37,11 @@ pub fn evaluate(law: Law, params: &[f64], positions: &[DVec3]) -> (f64, Vec<DVec
         Law::OneBody(eval) => {
             let out = eval(params, positions[0]);
             (out.energy, vec![out.force])
+        }
+        Law::Contact { eval, range } => {
+            let pt = crate::mesh::point_triangle(positions[0], [positions[1], positions[2], positions[3]]);
+            let out = if pt.distance < range(params) { eval(params, pt.distance) } else { super::Radial::ZERO };
+            (out.energy, super::node_face_forces(&out, &pt).to_vec())
         }
         Law::Surface(_) => panic!("a surface law needs its mesh: use evaluate_surface"),
     }
@@ -204,9 +213,9 @@ fn x_len(faces: &[[u32; 3]]) -> usize {
     faces.iter().flatten().map(|&p| p as usize + 1).max().unwrap_or(0)
 }
 
-/// For a radial law, d²E/dr² matches a central difference of dE/dr at `r`.
+/// For a radial or contact law, d²E/dr² matches a central difference of dE/dr at `r`.
 pub fn assert_radial_curvature(interaction: &dyn Interaction, params: &[f64], r: f64, h: f64) {
-    let Law::Radial { eval, .. } = interaction.law() else { panic!("{} is not radial", interaction.name()) };
+    let (Law::Radial { eval, .. } | Law::Contact { eval, .. }) = interaction.law() else { panic!("{} is not radial", interaction.name()) };
     let numeric = (eval(params, r + h).de_dr - eval(params, r - h).de_dr) / (2.0 * h);
     let analytic = eval(params, r).d2e_dr2;
     let scale = analytic.abs().max(numeric.abs()).max(1e-300);

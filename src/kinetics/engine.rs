@@ -152,6 +152,7 @@ impl Kinetics {
                 particles: [model.ids[i as usize], model.ids[j as usize]],
                 force: tension[b],
                 length: length[b],
+                age: o.age,
             });
         }
         self.outcomes = outcomes;
@@ -202,6 +203,7 @@ impl Kinetics {
                 particles: [model.ids[i as usize], model.ids[j as usize]],
                 force: 0.0,
                 length: sim_box.minimum_image(state.positions[j as usize] - state.positions[i as usize]).length(),
+                age: 0.0,
             });
         }
         events

@@ -1,11 +1,13 @@
 //! Bond events and the plain-text event log.
 //!
 //! The CSV event file (`events FILE` in a deck) has one row per event:
-//! `step,time[s],event,bond,type,i,j,force[pN],length[µm]` — `event` is
+//! `step,time[s],event,bond,type,i,j,force[pN],length[µm],age[s]` — `event` is
 //! `break`, `rebind`, `form` or `reset`, `bond` the bond's index (0-based, in
 //! topology order, new bonds appended), `i j` the particle ids, `force` the
 //! tension the bond carried (dE/dr, positive when stretched) and `length` its
-//! length when the event was decided.
+//! length when the event was decided, `age` the time the bond had been bound
+//! through the end of that step (a break's age is the bond's lifetime, to
+//! within the step in which it broke; rebinds and formations have age 0).
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -44,6 +46,8 @@ pub struct Event {
     pub particles: [u64; 2],
     pub force: f64,
     pub length: f64,
+    /// Time bound through the end of the event's step (0 for rebind and form).
+    pub age: f64,
 }
 
 /// The CSV event file.
@@ -56,10 +60,11 @@ impl EventLog {
         let mut out = BufWriter::new(file);
         writeln!(
             out,
-            "step,time[{}],event,bond,type,i,j,force[{}],length[{}]",
+            "step,time[{}],event,bond,type,i,j,force[{}],length[{}],age[{}]",
             units.label(Dim::Time),
             units.label(Dim::Force),
-            units.label(Dim::Length)
+            units.label(Dim::Length),
+            units.label(Dim::Time)
         )?;
         Ok(Self { out })
     }
@@ -68,7 +73,7 @@ impl EventLog {
         for e in events {
             writeln!(
                 self.out,
-                "{},{:e},{},{},{},{},{},{:e},{:e}",
+                "{},{:e},{},{},{},{},{},{:e},{:e},{:e}",
                 e.step,
                 e.time,
                 e.kind.name(),
@@ -77,7 +82,8 @@ impl EventLog {
                 e.particles[0],
                 e.particles[1],
                 e.force,
-                e.length
+                e.length,
+                e.age
             )?;
         }
         Ok(())

@@ -3,7 +3,7 @@
 //! A force-field line
 //!
 //! ```text
-//! bind TYPE_A TYPE_B BONDTYPE k_on K capture R [max_bonds N] [partner random|nearest]
+//! bind TYPE_A TYPE_B BONDTYPE k_on K capture R [max_bonds N] [partner random|nearest] [between any|bodies]
 //! ```
 //!
 //! lets every pair of a TYPE_A and a TYPE_B particle closer than R (minimum
@@ -13,6 +13,9 @@
 //! With `partner nearest`, a pair is a candidate only if each is the other's
 //! nearest eligible partner with free capacity (mutual-nearest, as LAMMPS
 //! `fix bond/create` pairs closest candidates); ties go to the lower index.
+//! With `between bodies`, only particles of two different bodies bind (cell–
+//! cell junctions such as cadherin trans-dimers: the nodes of one cell's shell
+//! never bind each other, however close).
 //! Candidate pairs are decided in parallel with Philox numbers keyed by
 //! (seed, step, i, j) and accepted in ascending (i, j) order, so a particle
 //! never exceeds its capacity and the outcome does not depend on threads.
@@ -59,6 +62,8 @@ pub struct BindRule {
     pub max_bonds: u32,
     /// Only mutual-nearest pairs are candidates.
     pub nearest: bool,
+    /// Only particles of two different bodies bind.
+    pub between_bodies: bool,
 }
 
 /// A `bind` line as parsed (names resolved later against the model).
@@ -71,16 +76,17 @@ pub struct BindLine {
     pub capture: f64,
     pub max_bonds: u32,
     pub nearest: bool,
+    pub between_bodies: bool,
 }
 
 /// Parses `bind A B BONDTYPE k_on K capture R [max_bonds N] [partner random|nearest]`
 /// (tokens after `bind`).
 pub fn parse_bind(keyword: &Token, t: &[Token], units: UnitSystem) -> Result<BindLine, InputError> {
-    const USAGE: &str = "bind TYPE_A TYPE_B BONDTYPE k_on K capture R [max_bonds N] [partner random|nearest]";
+    const USAGE: &str = "bind TYPE_A TYPE_B BONDTYPE k_on K capture R [max_bonds N] [partner random|nearest] [between any|bodies]";
     if t.len() < 3 {
         return Err(keyword.error(format!("expected `{USAGE}`")));
     }
-    let (mut max_bonds, mut nearest) = (1, false);
+    let (mut max_bonds, mut nearest, mut between_bodies) = (1, false, false);
     let mut values = Vec::new();
     for pair in t[3..].chunks(2) {
         let Some(value) = pair.get(1) else {
@@ -100,6 +106,15 @@ pub fn parse_bind(keyword: &Token, t: &[Token], units: UnitSystem) -> Result<Bin
                     other => return Err(value.error(format!("found `{other}`, expected `random` or `nearest`"))),
                 }
             }
+            "between" => {
+                between_bodies = match value.text.as_str() {
+                    "any" => false,
+                    "bodies" => true,
+                    other => {
+                        return Err(value.error(format!("found `{other}`, expected `any` or `bodies` (particles of different bodies)")))
+                    }
+                }
+            }
             _ => values.extend_from_slice(pair),
         }
     }
@@ -112,6 +127,7 @@ pub fn parse_bind(keyword: &Token, t: &[Token], units: UnitSystem) -> Result<Bin
         capture: values[1],
         max_bonds,
         nearest,
+        between_bodies,
     })
 }
 
@@ -133,7 +149,11 @@ pub enum Binding {
 pub struct Formation {
     neighbors: NeighborList,
     none: Exclusions,
+    /// The body of each particle (`NO_BODY` outside bodies).
+    body: Vec<u32>,
 }
+
+const NO_BODY: u32 = u32::MAX;
 
 impl Formation {
     /// The candidate list has a skin of 0.3 × capture (capped so the box
@@ -145,7 +165,13 @@ impl Formation {
         let lengths = sim_box.lengths();
         let room = (0..3).filter(|&a| sim_box.periodic[a]).map(|a| 0.5 * lengths[a] - capture).fold(f64::INFINITY, f64::min);
         let skin = (0.3 * capture).min(room.max(0.0));
-        Self { neighbors: NeighborList::new(capture, skin), none: Exclusions::none() }
+        let mut body = vec![NO_BODY; model.len()];
+        for (b, nodes) in model.bodies.iter().enumerate() {
+            for &i in &nodes.nodes {
+                body[i as usize] = b as u32;
+            }
+        }
+        Self { neighbors: NeighborList::new(capture, skin), none: Exclusions::none(), body }
     }
 
     /// The bindings decided at `step` from the positions of `state`.
@@ -186,7 +212,7 @@ impl Formation {
             }
         }
         // Eligible partners of particle i within capture: (j, rule, distance).
-        let (neighbors, count_now, bound_now) = (&self.neighbors, &count, &bound_pairs);
+        let (neighbors, count_now, bound_now, body) = (&self.neighbors, &count, &bound_pairs, &self.body);
         let eligible = move |i: usize| {
             neighbors.neighbors(i).iter().filter_map(move |&j| {
                 let (ti, tj) = (model.types[i], model.types[j as usize]);
@@ -194,8 +220,9 @@ impl Formation {
                 let r = &model.bind_rules[k];
                 let key = ((i as u32).min(j), (i as u32).max(j), r.bond_type);
                 let free = count_now[i * rules + k] < r.max_bonds && count_now[j as usize * rules + k] < r.max_bonds;
+                let across = !r.between_bodies || (body[i] != NO_BODY && body[j as usize] != NO_BODY && body[i] != body[j as usize]);
                 let d = sim_box.minimum_image(x[j as usize] - x[i]).length();
-                (d < r.capture && free && !bound_now.contains(&key)).then_some((j, k, d))
+                (d < r.capture && free && across && !bound_now.contains(&key)).then_some((j, k, d))
             })
         };
         // For `partner nearest`: each particle's nearest eligible partner per rule.

@@ -27,6 +27,7 @@ use crate::interactions::ParamSpec;
 mod engine;
 mod events;
 mod formation;
+mod lifetimes;
 mod state;
 
 mod cadherin;
@@ -42,6 +43,7 @@ mod threshold;
 pub use self::engine::{initial_bond_state, Kinetics, KineticsReport};
 pub use self::events::{Event, EventKind, EventLog};
 pub use self::formation::{parse_bind, BindLine, BindRule, Binding, Formation};
+pub use self::lifetimes::LifetimeTable;
 pub use self::state::{BondState, FormedBond};
 pub(crate) use self::threshold::deterministic_strain;
 
@@ -101,6 +103,11 @@ pub trait KineticRule: Sync + Send {
     /// Whether the rule changes the rest length (the bond law must have `r0`).
     fn needs_rest_length(&self) -> bool {
         matches!(self.effect(), Effect::RestLengthRate(_) | Effect::PlasticReset(_))
+    }
+    /// Whether the rule changes a bound bond's law every step (rest length or
+    /// stiffness scale), not only at events.
+    fn evolves_every_step(&self) -> bool {
+        matches!(self.effect(), Effect::RestLengthRate(_) | Effect::Maturation(_))
     }
 }
 

@@ -24,6 +24,11 @@
 //!   (type index + 1, the order of the force field's type names); positions
 //!   are the stored (wrapped) ones with image flags `ix iy iz`, so the
 //!   unwrapped position is `x + ix·Lx`. Reals use shortest round-trip form.
+//! * `dump … lammps FILE columns C...` selects the atom columns instead
+//!   (LAMMPS `dump custom` style; the header line names them). Without
+//!   `columns` the output is the default above, unchanged. See [`AtomColumn`]
+//!   for the names and units; the per-particle stress columns follow LAMMPS
+//!   `compute stress/atom` (see [`crate::measure::stress`]).
 //! * The simulated time is not written (`ITEM: TIME` is not understood by
 //!   every reader); it is `step · dt` for a constant time step, and the MCAP
 //!   and XYZ outputs carry it.
@@ -32,7 +37,90 @@ use std::fs::File;
 use std::io::{self, BufWriter, Write};
 use std::path::Path;
 
-use super::{check_frame, check_topology, FrameView, Real, TopologyView, TrajectoryWriter};
+use super::{check_frame, check_topology, invalid_input, FrameView, Needs, Real, TopologyView, TrajectoryWriter};
+
+/// A per-atom column of a LAMMPS dump (`dump … lammps FILE columns ...`).
+///
+/// | name | meaning | unit (`cell`) |
+/// |---|---|---|
+/// | `id`, `type` | user id, 1-based type number | – |
+/// | `x y z` | stored (wrapped) position | µm |
+/// | `ix iy iz` | image flags | – |
+/// | `xu yu zu` | unwrapped position x + ix·Lx | µm |
+/// | `fx fy fz` | total force | pN |
+/// | `wxx wyy wzz wxy wxz wyz` | per-particle virial W_i (Σ_i W_i = the thermo virial; positive in compression) | pN·µm |
+/// | `sxx syy szz sxy sxz syz` | LAMMPS `compute stress/atom`: S_i = −W_i (stress × volume; positive in tension) | pN·µm |
+/// | `vonmises` | von Mises equivalent of S_i | pN·µm |
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AtomColumn {
+    Id,
+    Type,
+    /// Wrapped position component.
+    X(usize),
+    Image(usize),
+    /// Unwrapped position component.
+    Unwrapped(usize),
+    Force(usize),
+    /// Per-particle virial component (xx yy zz xy xz yz).
+    Virial(usize),
+    /// Per-particle stress × volume, −virial (xx yy zz xy xz yz).
+    Stress(usize),
+    VonMises,
+}
+
+const TENSOR: [&str; 6] = ["xx", "yy", "zz", "xy", "xz", "yz"];
+const AXES: [&str; 3] = ["x", "y", "z"];
+
+impl AtomColumn {
+    /// Every column, in the order `cellmd` lists them.
+    pub fn all() -> Vec<AtomColumn> {
+        let mut v = vec![AtomColumn::Id, AtomColumn::Type];
+        v.extend((0..3).map(AtomColumn::X));
+        v.extend((0..3).map(AtomColumn::Image));
+        v.extend((0..3).map(AtomColumn::Unwrapped));
+        v.extend((0..3).map(AtomColumn::Force));
+        v.extend((0..6).map(AtomColumn::Virial));
+        v.extend((0..6).map(AtomColumn::Stress));
+        v.push(AtomColumn::VonMises);
+        v
+    }
+
+    /// The default columns: `id type x y z ix iy iz`.
+    pub fn defaults() -> Vec<AtomColumn> {
+        let mut v = vec![AtomColumn::Id, AtomColumn::Type];
+        v.extend((0..3).map(AtomColumn::X));
+        v.extend((0..3).map(AtomColumn::Image));
+        v
+    }
+
+    /// The deck and header name.
+    pub fn name(self) -> String {
+        match self {
+            AtomColumn::Id => "id".into(),
+            AtomColumn::Type => "type".into(),
+            AtomColumn::X(a) => AXES[a].into(),
+            AtomColumn::Image(a) => format!("i{}", AXES[a]),
+            AtomColumn::Unwrapped(a) => format!("{}u", AXES[a]),
+            AtomColumn::Force(a) => format!("f{}", AXES[a]),
+            AtomColumn::Virial(k) => format!("w{}", TENSOR[k]),
+            AtomColumn::Stress(k) => format!("s{}", TENSOR[k]),
+            AtomColumn::VonMises => "vonmises".into(),
+        }
+    }
+
+    /// The column named `name`.
+    pub fn from_name(name: &str) -> Option<AtomColumn> {
+        AtomColumn::all().into_iter().find(|c| c.name() == name)
+    }
+
+    fn needs(self) -> Needs {
+        match self {
+            AtomColumn::Force(_) => Needs { forces: true, ..Needs::default() },
+            AtomColumn::Virial(_) | AtomColumn::Stress(_) | AtomColumn::VonMises => Needs { virial: true, ..Needs::default() },
+            _ => Needs::default(),
+        }
+    }
+}
 
 /// Writes LAMMPS text dump frames to a file.
 pub struct LammpsDumpWriter {
@@ -41,21 +129,51 @@ pub struct LammpsDumpWriter {
     types: Vec<u32>,
     /// Internal indices sorted by user id.
     order: Vec<usize>,
+    columns: Vec<AtomColumn>,
+    needs: Needs,
+    line: String,
 }
 
 impl LammpsDumpWriter {
-    /// Creates (or truncates) `path`.
+    /// Creates (or truncates) `path`, with the default columns.
     pub fn create(path: &Path, topology: &TopologyView) -> io::Result<Self> {
+        Self::with_columns(path, topology, &[])
+    }
+
+    /// Creates (or truncates) `path` writing `columns` (empty: the defaults).
+    pub fn with_columns(path: &Path, topology: &TopologyView, columns: &[AtomColumn]) -> io::Result<Self> {
         check_topology(topology)?;
         let mut order: Vec<usize> = (0..topology.ids.len()).collect();
         order.sort_by_key(|&i| topology.ids[i]);
-        Ok(Self { out: BufWriter::new(File::create(path)?), ids: topology.ids.to_vec(), types: topology.types.to_vec(), order })
+        let columns = if columns.is_empty() { AtomColumn::defaults() } else { columns.to_vec() };
+        let needs = columns.iter().fold(Needs::default(), |a, c| {
+            let n = c.needs();
+            Needs { forces: a.forces || n.forces, virial: a.virial || n.virial, bonds: a.bonds || n.bonds }
+        });
+        Ok(Self {
+            out: BufWriter::new(File::create(path)?),
+            ids: topology.ids.to_vec(),
+            types: topology.types.to_vec(),
+            order,
+            columns,
+            needs,
+            line: String::new(),
+        })
     }
 }
 
 impl TrajectoryWriter for LammpsDumpWriter {
     fn write_frame(&mut self, frame: &FrameView) -> io::Result<()> {
         check_frame(self.ids.len(), frame)?;
+        // Everything is checked before the first byte, so a refused frame leaves no partial record.
+        let n = self.ids.len();
+        let m = &frame.measures;
+        if self.needs.forces && m.forces.len() != n {
+            return Err(invalid_input(format!("frame at step {} has {} forces for {n} particles", frame.step, m.forces.len())));
+        }
+        if self.needs.virial && m.virial.len() != n {
+            return Err(invalid_input(format!("frame at step {} has {} virials for {n} particles", frame.step, m.virial.len())));
+        }
         let b = frame.sim_box;
         let out = &mut self.out;
         writeln!(out, "ITEM: TIMESTEP\n{}", frame.step)?;
@@ -64,13 +182,35 @@ impl TrajectoryWriter for LammpsDumpWriter {
         for a in 0..3 {
             writeln!(out, "{} {}", Real(b.lo[a]), Real(b.hi[a]))?;
         }
-        writeln!(out, "ITEM: ATOMS id type x y z ix iy iz")?;
+        let names: Vec<String> = self.columns.iter().map(|c| c.name()).collect();
+        writeln!(out, "ITEM: ATOMS {}", names.join(" "))?;
+        let line = &mut self.line;
         for &i in &self.order {
-            let x = frame.positions[i];
-            let im = frame.image(i);
-            writeln!(out, "{} {} {} {} {} {} {} {}", self.ids[i], self.types[i] + 1, Real(x.x), Real(x.y), Real(x.z), im[0], im[1], im[2])?;
+            line.clear();
+            for (k, c) in self.columns.iter().enumerate() {
+                if k > 0 {
+                    line.push(' ');
+                }
+                use std::fmt::Write as _;
+                let _ = match *c {
+                    AtomColumn::Id => write!(line, "{}", self.ids[i]),
+                    AtomColumn::Type => write!(line, "{}", self.types[i] + 1),
+                    AtomColumn::X(a) => write!(line, "{}", Real(frame.positions[i][a])),
+                    AtomColumn::Image(a) => write!(line, "{}", frame.image(i)[a]),
+                    AtomColumn::Unwrapped(a) => write!(line, "{}", Real(b.unwrap(frame.positions[i], frame.image(i))[a])),
+                    AtomColumn::Force(a) => write!(line, "{}", Real(m.forces[i][a])),
+                    AtomColumn::Virial(t) => write!(line, "{}", Real(m.virial[i][t])),
+                    AtomColumn::Stress(t) => write!(line, "{}", Real(-m.virial[i][t])),
+                    AtomColumn::VonMises => write!(line, "{}", Real(crate::measure::von_mises(&m.virial[i]))),
+                };
+            }
+            writeln!(out, "{line}")?;
         }
         Ok(())
+    }
+
+    fn needs(&self) -> Needs {
+        self.needs
     }
 
     fn finish(mut self: Box<Self>) -> io::Result<()> {
@@ -125,5 +265,47 @@ mod tests {
         }
         assert_eq!(lines[9], "3 1 3 7.25 -1.5 0 0 0");
         assert_eq!(lines[10], "7 2 9.95 5 2.5 -1 2 0");
+    }
+
+    #[test]
+    fn selected_columns_write_forces_stress_and_von_mises() {
+        let s = Sample::new(1);
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("s.lammpstrj");
+        let names = "id xu fx wxy sxx syy szz sxy vonmises";
+        let columns: Vec<AtomColumn> = names.split(' ').map(|n| AtomColumn::from_name(n).unwrap()).collect();
+        let mut w = LammpsDumpWriter::with_columns(&path, &s.topology(), &columns).unwrap();
+        assert_eq!(w.needs(), Needs { forces: true, virial: true, bonds: false });
+        // Without the measures the frame is refused, not written with zeros.
+        assert!(w.write_frame(&s.frame(0)).is_err());
+        let forces: Vec<glam::DVec3> = (0..4).map(|i| glam::DVec3::new(i as f64 + 0.5, 0.0, 0.0)).collect();
+        // Particle k: a hydrostatic virial −k·I plus a shear k in xy.
+        let virial: Vec<[f64; 6]> = (0..4).map(|k| [-(k as f64), -(k as f64), -(k as f64), k as f64, 0.0, 0.0]).collect();
+        let mut frame = s.frame(0);
+        frame.measures = super::super::Measures { forces: &forces, virial: &virial, ..Default::default() };
+        w.write_frame(&frame).unwrap();
+        Box::new(w).finish().unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines[8], format!("ITEM: ATOMS {names}"));
+        for line in &lines[9..] {
+            let cols: Vec<f64> = line.split(' ').map(|c| c.parse().unwrap()).collect();
+            let i = s.ids.iter().position(|&x| x as f64 == cols[0]).unwrap();
+            let k = i as f64;
+            let xu = s.sim_box.unwrap(s.frames[0][i], s.images[i]).x;
+            assert_eq!(cols[1..5], [xu, k + 0.5, k, k]);
+            assert_eq!(cols[5..8], [k, k, -k], "stress is −virial");
+            assert!((cols[8] - 3f64.sqrt() * k).abs() < 1e-12, "von Mises of the shear alone: {line}");
+        }
+    }
+
+    #[test]
+    fn column_names_round_trip_and_defaults_are_the_classic_header() {
+        for c in AtomColumn::all() {
+            assert_eq!(AtomColumn::from_name(&c.name()), Some(c));
+        }
+        let names: Vec<String> = AtomColumn::defaults().iter().map(|c| c.name()).collect();
+        assert_eq!(names.join(" "), "id type x y z ix iy iz");
+        assert_eq!(AtomColumn::from_name("c_stress[1]"), None);
     }
 }

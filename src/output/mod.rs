@@ -9,7 +9,8 @@
 //! |---|---|---|---|
 //! | MCAP (Foxglove) | `mcap` | [`mcap_writer`] | topology, frames, bond state, a 3D scene |
 //! | extended XYZ (OVITO, ASE) | `xyz` | [`xyz`] | species, position, id; box and pbc per frame |
-//! | LAMMPS text dump | `lammps` | [`lammps_dump`] | id, type, position, image flags, sorted by id |
+//! | LAMMPS text dump | `lammps` | [`lammps_dump`] | id, type, position, image flags, sorted by id; or the columns the deck names (forces, per-particle stress, von Mises) |
+//! | per-bond tension (CSV) | `bonds` | [`bond_csv`] | per frame and bond: ids, type, length, tension dE/dr, midpoint |
 //! | restart (JSON) | — | [`restart`] | step, time, box, ids, positions, images, bond state |
 //!
 //! Conventions shared by all writers:
@@ -36,12 +37,15 @@ use glam::DVec3;
 use crate::system::SimBox;
 use crate::units::UnitSystem;
 
+pub mod atomic;
+pub mod bond_csv;
 pub mod lammps_dump;
 pub mod mcap_writer;
 pub mod restart;
 pub mod xyz;
 
-pub use self::lammps_dump::LammpsDumpWriter;
+pub use self::bond_csv::BondCsvWriter;
+pub use self::lammps_dump::{AtomColumn, LammpsDumpWriter};
 pub use self::mcap_writer::McapWriter;
 pub use self::restart::{read_state, write_state, RestartData};
 pub use self::xyz::XyzWriter;
@@ -63,6 +67,9 @@ pub struct TopologyView<'a> {
     pub angles: &'a [[u32; 3]],
     /// Surface triangles, internal indices.
     pub triangles: &'a [[u32; 3]],
+    /// Type index of each bond (into `bond_type_names`); may be empty.
+    pub bond_types: &'a [u32],
+    pub bond_type_names: &'a [String],
 }
 
 /// One frame of the trajectory, borrowed from the run.
@@ -75,6 +82,35 @@ pub struct FrameView<'a> {
     pub positions: &'a [DVec3],
     /// Image counters by internal index, or empty for all zeros.
     pub images: &'a [[i32; 3]],
+    /// What the writer asked for in [`TrajectoryWriter::needs`]; empty otherwise.
+    pub measures: Measures<'a>,
+}
+
+/// Per-frame quantities beyond positions, filled when a writer needs them.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Measures<'a> {
+    /// Total force on each particle (force units).
+    pub forces: &'a [DVec3],
+    /// Per-particle virial W_i (xx, yy, zz, xy, xz, yz; energy units), see
+    /// [`crate::measure::stress`].
+    pub virial: &'a [[f64; 6]],
+    /// Per bond: tension dE/dr (positive when stretched, 0 when unbound) and length.
+    pub bond_tension: &'a [f64],
+    pub bond_length: &'a [f64],
+}
+
+/// The per-frame quantities a writer reads beyond positions.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Needs {
+    pub forces: bool,
+    pub virial: bool,
+    pub bonds: bool,
+}
+
+impl Needs {
+    pub fn any(self) -> bool {
+        self.forces || self.virial || self.bonds
+    }
 }
 
 impl FrameView<'_> {
@@ -96,6 +132,10 @@ pub trait TrajectoryWriter: Send {
     fn write_bond_events(&mut self, _events: &[crate::kinetics::Event], _bound: &[bool]) -> io::Result<()> {
         Ok(())
     }
+    /// The quantities the writer reads from [`FrameView::measures`].
+    fn needs(&self) -> Needs {
+        Needs::default()
+    }
 }
 
 /// The trajectory formats a deck can ask for.
@@ -104,6 +144,8 @@ pub enum DumpFormat {
     Mcap,
     Xyz,
     Lammps,
+    /// Per-bond tension and length, CSV.
+    Bonds,
 }
 
 impl DumpFormat {
@@ -113,6 +155,7 @@ impl DumpFormat {
             "mcap" => Some(Self::Mcap),
             "xyz" => Some(Self::Xyz),
             "lammps" => Some(Self::Lammps),
+            "bonds" => Some(Self::Bonds),
             _ => None,
         }
     }
@@ -123,6 +166,7 @@ impl DumpFormat {
             Self::Mcap => "mcap",
             Self::Xyz => "xyz",
             Self::Lammps => "lammps",
+            Self::Bonds => "bonds",
         }
     }
 
@@ -132,16 +176,32 @@ impl DumpFormat {
             Self::Mcap => "mcap",
             Self::Xyz => "xyz",
             Self::Lammps => "lammpstrj",
+            Self::Bonds => "csv",
         }
     }
 }
 
 /// Opens a writer of `format` at `path` (created or truncated).
 pub fn open_writer(format: DumpFormat, path: &Path, topology: &TopologyView) -> io::Result<Box<dyn TrajectoryWriter>> {
+    open_writer_with_columns(format, path, topology, &[])
+}
+
+/// [`open_writer`] with the LAMMPS dump's atom columns (empty: the default
+/// `id type x y z ix iy iz`; other formats take none).
+pub fn open_writer_with_columns(
+    format: DumpFormat,
+    path: &Path,
+    topology: &TopologyView,
+    columns: &[AtomColumn],
+) -> io::Result<Box<dyn TrajectoryWriter>> {
+    if !columns.is_empty() && format != DumpFormat::Lammps {
+        return Err(invalid_input(format!("only `lammps` dumps take columns, not `{}`", format.keyword())));
+    }
     Ok(match format {
         DumpFormat::Mcap => Box::new(McapWriter::create(path, topology)?),
         DumpFormat::Xyz => Box::new(XyzWriter::create(path, topology)?),
-        DumpFormat::Lammps => Box::new(LammpsDumpWriter::create(path, topology)?),
+        DumpFormat::Lammps => Box::new(LammpsDumpWriter::with_columns(path, topology, columns)?),
+        DumpFormat::Bonds => Box::new(BondCsvWriter::create(path, topology)?),
     })
 }
 
@@ -278,6 +338,8 @@ pub(crate) mod test_support {
                 bonds: &self.bonds,
                 angles: &self.angles,
                 triangles: &self.triangles,
+                bond_types: &[],
+                bond_type_names: &[],
             }
         }
 
@@ -288,6 +350,7 @@ pub(crate) mod test_support {
                 sim_box: &self.sim_box,
                 positions: &self.frames[f],
                 images: &self.images,
+                measures: Measures::default(),
             }
         }
     }
@@ -300,7 +363,7 @@ mod tests {
 
     #[test]
     fn keywords_round_trip() {
-        for f in [DumpFormat::Mcap, DumpFormat::Xyz, DumpFormat::Lammps] {
+        for f in [DumpFormat::Mcap, DumpFormat::Xyz, DumpFormat::Lammps, DumpFormat::Bonds] {
             assert_eq!(DumpFormat::from_keyword(f.keyword()), Some(f));
         }
         assert_eq!(DumpFormat::from_keyword("dcd"), None);

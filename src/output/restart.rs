@@ -37,13 +37,14 @@
 //! `<path>`, so an interrupted write leaves either the old file or the new
 //! one, never a truncated mix.
 
-use std::fs::{self, File};
-use std::io::{self, BufReader, BufWriter, Write};
-use std::path::{Path, PathBuf};
+use std::fs::File;
+use std::io::{self, BufReader, Write};
+use std::path::Path;
 
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
+use super::atomic::write_atomically;
 use crate::system::{SimBox, State};
 use crate::units::UnitSystem;
 
@@ -143,28 +144,11 @@ pub fn write_state(path: &Path, data: &RestartData) -> Result<(), String> {
         #[serde(flatten)]
         data: &'a RestartData,
     }
-    let tmp = tmp_path(path);
-    let result = (|| -> io::Result<()> {
-        let file = File::create(&tmp)?;
-        let mut out = BufWriter::new(file);
-        serde_json::to_writer(&mut out, &Document { format: RESTART_FORMAT, version: RESTART_VERSION, data }).map_err(io::Error::other)?;
-        out.write_all(b"\n")?;
-        let file = out.into_inner().map_err(|e| e.into_error())?;
-        file.sync_all()?;
-        drop(file);
-        fs::rename(&tmp, path)?;
-        // Persist the rename itself where the platform allows opening a directory.
-        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            if let Ok(dir) = File::open(dir) {
-                let _ = dir.sync_all();
-            }
-        }
-        Ok(())
-    })();
-    result.map_err(|e| {
-        let _ = fs::remove_file(&tmp);
-        format!("cannot write restart file '{}': {e}", path.display())
+    write_atomically(path, |out| {
+        serde_json::to_writer(&mut *out, &Document { format: RESTART_FORMAT, version: RESTART_VERSION, data }).map_err(io::Error::other)?;
+        out.write_all(b"\n")
     })
+    .map_err(|e| format!("cannot write restart file '{}': {e}", path.display()))
 }
 
 /// Reads a restart file, checking its format tag, version and array lengths.
@@ -193,12 +177,6 @@ pub fn read_state(path: &Path) -> Result<RestartData, String> {
     Ok(data)
 }
 
-fn tmp_path(path: &Path) -> PathBuf {
-    let mut name = path.as_os_str().to_owned();
-    name.push(".tmp");
-    PathBuf::from(name)
-}
-
 /// Serializes a [`UnitSystem`] as its deck keyword (`cell`, `lj`).
 mod units_keyword {
     use serde::{de::Error, Deserialize, Deserializer, Serializer};
@@ -217,7 +195,10 @@ mod units_keyword {
 
 #[cfg(test)]
 mod tests {
+    use std::fs;
+
     use super::*;
+    use crate::output::atomic::tmp_path;
 
     fn sample() -> RestartData {
         RestartData {

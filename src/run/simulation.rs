@@ -7,18 +7,18 @@ use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 
 use super::blowup::{culprit, RunError};
-use super::thermo::{Thermo, ThermoInputs};
+use super::thermo::{column_value, Thermo, ThermoInputs};
 use crate::backend::{CpuBackend, Forces};
-use crate::deck::{Action, CoeffTarget, DumpSpec, NeighborSettings, Plan};
+use crate::deck::{Action, CoeffTarget, DumpSpec, NeighborSettings, Plan, ThermoColumn};
 use crate::gpu::backend::StepSettings;
 use crate::gpu::{DevicePreference, GpuBackend, GpuContext, GpuHalt};
 use crate::integrate::constraints::{Constraint, Constraints};
 use crate::integrate::fire::{fire_minimize, FireReport, FireSettings};
 use crate::integrate::implicit::{implicit_step, ConstrainedBonds, ImplicitError, ImplicitSettings, SolveReport};
 use crate::integrate::overdamped::{overdamped_step, Blowup, OverdampedSettings};
-use crate::kinetics::{initial_bond_state, Binding, EventLog, Formation, Kinetics};
+use crate::kinetics::{initial_bond_state, Binding, EventLog, Formation, Kinetics, LifetimeTable};
 use crate::output::restart::{read_state, write_state, RestartData};
-use crate::output::{open_writer, FrameView, TopologyView, TrajectoryWriter};
+use crate::output::{open_writer_with_columns, FrameView, Measures, TopologyView, TrajectoryWriter};
 use crate::system::{Model, SimBox, State};
 
 /// The longest GPU segment between read-backs when no output is due.
@@ -72,9 +72,16 @@ pub struct Simulation {
     /// Bond formation (when the force field has `bind` rules).
     formation: Option<Formation>,
     event_log: Option<EventLog>,
+    /// Lifetimes of broken bonds and where the deck wants their table.
+    lifetimes: LifetimeTable,
+    lifetime_file: Option<PathBuf>,
     options: RunOptions,
     deck_stem: String,
-    scratch: Vec<DVec3>,
+    scratch: (Vec<DVec3>, Vec<DVec3>),
+    /// Per-particle displacement limits of the contact step clamp.
+    step_limits: Vec<f64>,
+    /// Explicit steps shortened by the contact step clamp.
+    pub contact_clamps: u64,
     /// The last minimisation's outcome.
     pub last_minimize: Option<FireReport>,
     /// The deck's `device` setting.
@@ -87,6 +94,8 @@ pub struct Simulation {
     implicit_tension: Vec<f64>,
     /// The opened GPU (kept across `run` commands), or why it could not be used.
     gpu: Option<Result<GpuContext, String>>,
+    /// Bond type labels, for outputs.
+    bond_type_names: Vec<String>,
 }
 
 impl Simulation {
@@ -116,15 +125,20 @@ impl Simulation {
             kinetics: Kinetics::default(),
             formation: (!plan.model.bind_rules.is_empty()).then(|| Formation::new(&plan.model, &plan.sim_box)),
             event_log: None,
+            lifetimes: LifetimeTable::default(),
+            lifetime_file: None,
             options,
             deck_stem,
-            scratch: Vec::new(),
+            scratch: (Vec::new(), Vec::new()),
+            step_limits: Vec::new(),
+            contact_clamps: 0,
             last_minimize: None,
             device: DevicePreference::Cpu,
             last_solve: SolveReport::default(),
             constraints: Constraints::default(),
             implicit_tension: Vec::new(),
             gpu: None,
+            bond_type_names: plan.model.bond_types.iter().map(|t| t.label.text.clone()).collect(),
         }
     }
 
@@ -189,14 +203,15 @@ impl Simulation {
                     old.finish()?;
                 }
             }
+            Action::LifetimeFile(path) => self.lifetime_file = Some(self.output_path(path)),
             Action::ThermoFile(path) => {
                 let path = self.output_path(path);
                 self.thermo.set_file(std::fs::File::create(&path).map_err(|e| RunError::Io(format!("{}: {e}", path.display())))?)?;
             }
             Action::Dump(spec) => {
                 let path = self.output_path(&spec.path);
-                let writer =
-                    open_writer(spec.format, &path, &self.topology_view()).map_err(|e| RunError::Io(format!("{}: {e}", path.display())))?;
+                let writer = open_writer_with_columns(spec.format, &path, &self.topology_view(), &spec.columns)
+                    .map_err(|e| RunError::Io(format!("{}: {e}", path.display())))?;
                 self.dumps.push(ActiveDump { spec: spec.clone(), path, writer, last_step: None });
             }
             Action::Undump(name) => {
@@ -267,6 +282,8 @@ impl Simulation {
             bonds: &self.model.bonds,
             angles: &self.model.angles,
             triangles: &self.model.triangles,
+            bond_types: &self.model.bond_type,
+            bond_type_names: &self.bond_type_names,
         }
     }
 
@@ -298,11 +315,63 @@ impl Simulation {
         Ok(())
     }
 
+    /// The smallest node–face distance between different bodies at the last
+    /// force evaluation (∞ without `contact` lines or before the first one).
+    pub fn min_contact_distance(&self) -> f64 {
+        self.backend.as_ref().map_or(f64::INFINITY, |b| b.min_contact_distance())
+    }
+
     /// Forces, energies by interaction and virial at the current state
     /// (computed now if stale).
     pub fn current_forces(&mut self) -> Result<&Forces, RunError> {
         self.ensure_forces()?;
         Ok(&self.forces)
+    }
+
+    /// What thermo columns read, at the current state (backend built).
+    fn thermo_inputs(&self) -> ThermoInputs<'_> {
+        let (bond_tension, _) = self.backend.as_ref().expect("backend built").bond_tension_and_length();
+        ThermoInputs {
+            model: &self.model,
+            bonds: self.state.bonds.as_ref(),
+            bond_tension,
+            kinetics: &self.kinetics,
+            step: self.state.step,
+            time: self.state.time,
+            forces: &self.forces,
+            n_particles: self.model.len(),
+            kt: self.kt,
+            volume: self.sim_box.volume(),
+            neighbor_builds: self.backend.as_ref().map_or(0, |b| b.neighbor_builds()),
+            solve: self.last_solve,
+            constraints: &self.constraints,
+            positions: &self.state.positions,
+            images: self.sim_box.images(),
+            backend: self.backend.as_ref().expect("backend built"),
+            state: &self.state,
+            sim_box: &self.sim_box,
+            min_contact_distance: self.min_contact_distance(),
+            contact_clamps: self.contact_clamps,
+        }
+    }
+
+    /// The value of a thermo column at the current state (forces, energies
+    /// and virial computed now if stale), as a thermo row would print it.
+    pub fn thermo_value(&mut self, column: &ThermoColumn) -> Result<f64, RunError> {
+        self.ensure_forces()?;
+        Ok(column_value(column, &self.thermo_inputs()))
+    }
+
+    /// The per-particle virial W_i at the current state (see [`crate::measure::stress`]).
+    pub fn particle_virial(&mut self) -> Result<Vec<[f64; 6]>, RunError> {
+        self.ensure_forces()?;
+        Ok(crate::measure::per_particle_virial(self.backend.as_ref().expect("backend built"), &self.model, &self.state, &self.sim_box))
+    }
+
+    /// Tension (dE/dr, positive when stretched) and length of every bond at the current state.
+    pub fn bond_tensions(&mut self) -> Result<(Vec<f64>, Vec<f64>), RunError> {
+        self.ensure_forces()?;
+        Ok(self.backend.as_ref().expect("backend built").bond_tensions_at(&self.model, &self.state, &self.sim_box))
     }
 
     /// Ensures a backend with a fresh neighbour list and forces at the current state.
@@ -321,6 +390,7 @@ impl Simulation {
     /// Forces at the current state, with energies and virial if `energies`.
     fn compute_forces(&mut self, energies: bool) -> Result<(), RunError> {
         let backend = self.backend.as_mut().expect("backend built");
+        backend.update_contacts(&self.model, &self.state, &self.sim_box).map_err(RunError::Setup)?;
         if energies {
             backend.compute(&self.model, &self.state, &self.sim_box, &mut self.forces);
         } else {
@@ -355,12 +425,31 @@ impl Simulation {
     }
 
     fn write_dump(&mut self, i: usize) -> Result<(), RunError> {
+        let needs = self.dumps[i].writer.needs();
+        let (mut virial, mut tension, mut length) = (Vec::new(), Vec::new(), Vec::new());
+        if needs.any() {
+            // Measurements read the CPU backend's terms at these positions.
+            if self.backend.is_none() {
+                self.ensure_forces()?;
+            } else if !self.forces_current {
+                self.refresh_cpu_forces(false)?;
+            }
+            let backend = self.backend.as_ref().expect("backend built");
+            if needs.virial {
+                virial = crate::measure::per_particle_virial(backend, &self.model, &self.state, &self.sim_box);
+            }
+            if needs.bonds {
+                (tension, length) = backend.bond_tensions_at(&self.model, &self.state, &self.sim_box);
+            }
+        }
+        let forces: &[DVec3] = if needs.forces { &self.forces.forces } else { &[] };
         let frame = FrameView {
             step: self.state.step,
             time: self.state.time,
             sim_box: &self.sim_box,
             positions: &self.state.positions,
             images: &self.state.images,
+            measures: Measures { forces, virial: &virial, bond_tension: &tension, bond_length: &length },
         };
         self.dumps[i].writer.write_frame(&frame)?;
         self.dumps[i].last_step = Some(self.state.step);
@@ -376,25 +465,8 @@ impl Simulation {
         }
         let due = self.thermo.every > 0 && step.is_multiple_of(self.thermo.every);
         if due || force_thermo {
-            let (bond_tension, _) = self.backend.as_ref().expect("backend built").bond_tension_and_length();
-            let inputs = ThermoInputs {
-                model: &self.model,
-                bonds: self.state.bonds.as_ref(),
-                bond_tension,
-                kinetics: &self.kinetics,
-                step,
-                time: self.state.time,
-                forces: &self.forces,
-                n_particles: self.model.len(),
-                kt: self.kt,
-                volume: self.sim_box.volume(),
-                neighbor_builds: self.backend.as_ref().map_or(0, |b| b.neighbor_builds()),
-                solve: self.last_solve,
-                constraints: &self.constraints,
-                positions: &self.state.positions,
-                images: self.sim_box.images(),
-            };
-            let line = self.thermo.row(&inputs)?;
+            let values = self.thermo.values(&self.thermo_inputs());
+            let line = self.thermo.row(&values)?;
             match bar {
                 Some(bar) => bar.println(line),
                 None => self.say(&line),
@@ -406,6 +478,11 @@ impl Simulation {
     /// `run N`: N overdamped steps, on the CPU backend or the GPU.
     pub fn run(&mut self, steps: u64) -> Result<(), RunError> {
         self.check_kinetics_temperature()?;
+        if self.integrator.implicit.is_some() && self.model.has_contact_terms() {
+            return Err(RunError::Setup(
+                "`integrator implicit` has no contact step clamp yet, so `contact` terms could let bodies pass through each other; use `integrator overdamped`".into(),
+            ));
+        }
         self.ensure_forces()?;
         let gpu = self.gpu_for_run()?;
         let bar = (self.options.progress && steps >= 1000).then(|| {
@@ -429,6 +506,11 @@ impl Simulation {
             b.finish_and_clear();
         }
         self.thermo.flush()?;
+        if let Some(path) = &self.lifetime_file {
+            self.lifetimes
+                .write(path, &self.model, self.state.bonds.as_ref())
+                .map_err(|e| RunError::Io(format!("{}: {e}", path.display())))?;
+        }
         let seconds = started.elapsed().as_secs_f64();
         self.say(&format!(
             "loop time {seconds:.6} s for {steps} steps with {} particles: {:.6e} particle-steps/s",
@@ -446,17 +528,23 @@ impl Simulation {
             }
             let moved = match self.integrator.implicit {
                 Some(implicit) => self.implicit_step(&implicit)?,
-                None => overdamped_step(
-                    &self.model,
-                    &mut self.state,
-                    &self.forces.forces,
-                    &self.sim_box,
-                    self.dt,
-                    self.kt,
-                    self.seed,
-                    &self.integrator,
-                    &mut self.scratch,
-                ),
+                None => {
+                    let n = self.model.len();
+                    let limited = self.backend.as_ref().is_some_and(|b| b.contact_step_limits(n, &mut self.step_limits));
+                    overdamped_step(
+                        &self.model,
+                        &mut self.state,
+                        &self.forces.forces,
+                        &self.sim_box,
+                        self.dt,
+                        self.kt,
+                        self.seed,
+                        &self.integrator,
+                        limited.then_some(self.step_limits.as_slice()),
+                        &mut self.scratch,
+                    )
+                    .map(|fraction| self.contact_clamps += u64::from(fraction < 1.0))
+                }
             };
             if let Err(Blowup { particle, displacement }) = moved {
                 return Err(self.blowup(particle, self.displacement_message(displacement)));
@@ -545,10 +633,10 @@ impl Simulation {
             Some("`integrator implicit` runs on the CPU backend only")
         } else if !self.constraints.list.is_empty() {
             Some("constrained bonds (`constrain`) run on the CPU backend only")
-        } else if self.state.bonds.is_some() || !self.model.bind_rules.is_empty() {
-            Some("bond kinetics (`kinetics`, `bind`) run on the CPU backend only")
         } else if self.model.has_surface_terms() {
             Some("surface terms of bodies (`body` lines) run on the CPU backend only")
+        } else if self.model.has_contact_terms() {
+            Some("contact terms between bodies (`contact` lines) run on the CPU backend only")
         } else {
             None
         }
@@ -590,7 +678,11 @@ impl Simulation {
     /// output is due (thermo, dump, the end) and at least every
     /// [`GPU_SYNC_STEPS`] steps (progress, blow-up checks), reading back the
     /// positions only where an output needs them; thermo quantities are then
-    /// computed by the CPU backend at the read-back positions.
+    /// computed by the CPU backend at the read-back positions. With bond
+    /// kinetics the host synchronises every step: it reads the positions back,
+    /// measures every bond's tension and length in f64, decides the step's
+    /// events exactly as on the CPU, and uploads the changed bond state as one
+    /// batch (a new GPU backend when bonds formed).
     fn run_gpu(&mut self, context: &GpuContext, last: u64, bar: &Option<ProgressBar>) -> Result<(), RunError> {
         let settings = StepSettings {
             dt: self.dt,
@@ -602,9 +694,11 @@ impl Simulation {
             integrator: self.integrator,
         };
         let mut gpu = GpuBackend::new(context, &self.model, &self.state, &self.sim_box, &settings).map_err(RunError::Setup)?;
+        let kinetics = self.state.bonds.is_some();
+        let evolving = self.model.bond_kinetics.iter().flat_map(|k| &k.rules).any(|r| r.rule.evolves_every_step());
         while self.state.step < last {
             let next_output = self.next_output_step(last).min(self.state.step + GPU_SYNC_STEPS);
-            let steps = next_output - self.state.step;
+            let steps = if kinetics { 1 } else { next_output - self.state.step };
             let outcome = gpu.run(self.state.step, steps);
             let done = match &outcome {
                 Ok(done) => *done,
@@ -620,7 +714,7 @@ impl Simulation {
             let dump_due = self.dumps.iter().any(|d| self.state.step.is_multiple_of(d.spec.every));
             // Positions come back only when something reads them; between
             // outputs the sync only reads the GPU's status words.
-            if final_step || thermo_due || dump_due || outcome.is_err() {
+            if final_step || thermo_due || dump_due || outcome.is_err() || kinetics {
                 gpu.download(&mut self.state);
             }
             if let Err(GpuHalt::Capacity { message, .. }) = outcome {
@@ -634,6 +728,22 @@ impl Simulation {
                     self.forces.forces[particle].length()
                 );
                 return Err(self.blowup(particle, what));
+            }
+            if kinetics {
+                // As on the CPU: decided from the tensions before the step
+                // (measured at the end of the previous one), then measured
+                // again at the new positions with the new bond state.
+                let resets = self.kinetics.resets;
+                let changed = self.kinetics_step()?;
+                if self.backend.is_none() {
+                    // Bonds formed: both backends are rebuilt for the new bond list.
+                    self.ensure_forces()?;
+                    gpu = GpuBackend::new(context, &self.model, &self.state, &self.sim_box, &settings).map_err(RunError::Setup)?;
+                } else if changed || evolving || self.kinetics.resets != resets {
+                    gpu.update_bonds(&self.model, &self.state, changed).map_err(RunError::Setup)?;
+                }
+                let backend = self.backend.as_mut().expect("backend built");
+                backend.measure_bonds(&self.model, &self.state, &self.sim_box);
             }
             if thermo_due || final_step {
                 self.refresh_cpu_forces(true)?;
@@ -668,7 +778,8 @@ impl Simulation {
 
     /// Bond kinetics of the step just integrated, decided from the tensions of
     /// its force pass; a break or rebind updates the pair exclusions.
-    fn kinetics_step(&mut self) -> Result<(), RunError> {
+    /// Returns whether a bond broke, bound or formed.
+    fn kinetics_step(&mut self) -> Result<bool, RunError> {
         let step = self.state.step - 1;
         let backend = self.backend.as_ref().expect("backend built");
         let (tension, length) = backend.bond_tension_and_length();
@@ -684,6 +795,7 @@ impl Simulation {
             report.events.extend(self.kinetics.apply_bindings(&mut self.model, &mut self.state, &self.sim_box, bindings, step, self.dt));
         }
         if !report.events.is_empty() {
+            self.lifetimes.record(&self.model, &report.events, self.dt);
             if let Some(log) = &mut self.event_log {
                 log.write(&report.events)?;
             }
@@ -699,7 +811,7 @@ impl Simulation {
             let backend = self.backend.as_mut().expect("backend built");
             backend.bonds_changed(&self.model, &self.state, &self.sim_box).map_err(RunError::Setup)?;
         }
-        Ok(())
+        Ok(report.bonds_changed)
     }
 
     /// Rules whose rates depend on kT refuse to run at T = 0.
@@ -721,6 +833,11 @@ impl Simulation {
 
     /// `minimize`: FIRE to max |F| < ftol. The step counter does not advance.
     pub fn minimize(&mut self, settings: &FireSettings) -> Result<(), RunError> {
+        if self.model.has_contact_terms() {
+            return Err(RunError::Setup(
+                "`minimize` (FIRE) has no contact step clamp yet, so `contact` terms could let bodies pass through each other; relax with `run` at temperature 0 instead".into(),
+            ));
+        }
         self.ensure_forces()?;
         let mass: Vec<f64> = self.model.types.iter().map(|&t| self.model.type_drag[t as usize] * self.dt).collect();
         let mut state = self.state.clone();

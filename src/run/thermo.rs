@@ -19,6 +19,12 @@
 //! | `nbound/TYPE` | bound bonds of bond type TYPE | – |
 //! | `tension/TYPE` | summed tension of TYPE's bound bonds (clutch traction) | pN |
 //! | `volume/BODYTYPE`, `area/BODYTYPE` | summed enclosed volume and area of the bodies of a type | µm³, µm² |
+//! | `mindist` | smallest node–face distance between different bodies (exact below the largest contact d̂; `inf` when no pair is within the search range) | µm |
+//! | `nclamp` | explicit steps shortened by the contact step clamp so far | – |
+//! | `planetension/AXIS/POS` | normal force transmitted across the plane x_AXIS = POS by every bond, pair, angle and body term crossing it; positive = tension ([`planes`](crate::measure::planes)) | pN |
+//! | `gamma/BODYTYPE` | cortical tension γ = ⟨Σ_cut T·\|û·n̂\|⟩/(2πR) over diametral planes of each body, mean over the type's bodies ([`planes`](crate::measure::planes)) | pN/µm |
+//! | `e2e/BONDTYPE` | mean end-to-end distance of the chains of bonds of the type ([`filaments`](crate::measure::filaments)) | µm |
+//! | `tcorr/BONDTYPE/LAG` | tangent correlation ⟨t_s·t_{s+LAG}⟩ along those chains, LAG in bonds | – |
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -26,6 +32,7 @@ use std::io::{BufWriter, Write};
 use crate::backend::Forces;
 use crate::deck::ThermoColumn;
 use crate::interactions::REGISTRY;
+use crate::measure::{filaments, planes};
 use crate::units::{Dim, UnitSystem};
 
 /// Values a thermo row is made from.
@@ -49,6 +56,15 @@ pub struct ThermoInputs<'a> {
     /// Positions (wrapped) and the box's images, for body volumes and areas.
     pub positions: &'a [glam::DVec3],
     pub images: crate::system::Images,
+    /// Smallest node–face distance between bodies at the last force pass.
+    pub min_contact_distance: f64,
+    /// Steps shortened by the contact step clamp so far.
+    pub contact_clamps: u64,
+    /// The backend after a force evaluation at `state` (for measurements
+    /// that read the force terms).
+    pub backend: &'a crate::backend::CpuBackend,
+    pub state: &'a crate::system::State,
+    pub sim_box: &'a crate::system::SimBox,
 }
 
 /// A column's header name (bond-type columns name their type).
@@ -71,6 +87,12 @@ pub fn column_label(c: &ThermoColumn, model: &crate::system::Model) -> String {
         ThermoColumn::ConstraintTension(t) => format!("ctension/{}", model.bond_types[*t].label.text),
         ThermoColumn::BodyVolume(t) => format!("volume/{}", model.body_type_names[*t]),
         ThermoColumn::BodyArea(t) => format!("area/{}", model.body_type_names[*t]),
+        ThermoColumn::MinDistance => "mindist".into(),
+        ThermoColumn::ContactClamps => "nclamp".into(),
+        ThermoColumn::PlaneTension { axis, pos } => format!("planetension/{}/{pos}", ["x", "y", "z"][*axis]),
+        ThermoColumn::CorticalTension(t) => format!("gamma/{}", model.body_type_names[*t]),
+        ThermoColumn::EndToEnd(t) => format!("e2e/{}", model.bond_types[*t].label.text),
+        ThermoColumn::TangentCorrelation { bond_type, lag } => format!("tcorr/{}/{lag}", model.bond_types[*bond_type].label.text),
     }
 }
 
@@ -81,8 +103,13 @@ pub fn column_unit(c: &ThermoColumn, units: UnitSystem) -> &'static str {
         | ThermoColumn::Events(_)
         | ThermoColumn::Bound(_)
         | ThermoColumn::SolverIterations
-        | ThermoColumn::SolverResidual => "-",
-        ThermoColumn::Tension(_) | ThermoColumn::ConstraintTension(_) => units.label(Dim::Force),
+        | ThermoColumn::SolverResidual
+        | ThermoColumn::ContactClamps
+        | ThermoColumn::TangentCorrelation { .. } => "-",
+        ThermoColumn::MinDistance => units.label(Dim::Length),
+        ThermoColumn::Tension(_) | ThermoColumn::ConstraintTension(_) | ThermoColumn::PlaneTension { .. } => units.label(Dim::Force),
+        ThermoColumn::CorticalTension(_) => units.label(Dim::Tension),
+        ThermoColumn::EndToEnd(_) => units.label(Dim::Length),
         ThermoColumn::Time => units.label(Dim::Time),
         ThermoColumn::Pe | ThermoColumn::PeOf(_) => units.label(Dim::Energy),
         ThermoColumn::Fmax | ThermoColumn::Fnorm => units.label(Dim::Force),
@@ -116,7 +143,15 @@ pub fn column_value(c: &ThermoColumn, t: &ThermoInputs) -> f64 {
         ThermoColumn::Nbuild => t.neighbor_builds as f64,
         ThermoColumn::Events(kind) => t.kinetics.count(*kind) as f64,
         ThermoColumn::Bound(ty) => bonds_of_type(t, *ty).count() as f64,
-        ThermoColumn::Tension(ty) => bonds_of_type(t, *ty).map(|b| t.bond_tension[b]).sum(),
+        ThermoColumn::Tension(ty) => {
+            // The backend keeps per-bond tensions only for kinetic bonds; compute them otherwise.
+            if t.bond_tension.len() == t.model.bonds.len() {
+                bonds_of_type(t, *ty).map(|b| t.bond_tension[b]).sum()
+            } else {
+                let (tension, _) = t.backend.bond_tensions_at(t.model, t.state, t.sim_box);
+                bonds_of_type(t, *ty).map(|b| tension[b]).sum()
+            }
+        }
         ThermoColumn::SolverIterations => t.solve.iterations as f64,
         ThermoColumn::SolverResidual => t.solve.relative_residual,
         ThermoColumn::ConstraintTension(ty) => {
@@ -125,6 +160,14 @@ pub fn column_value(c: &ThermoColumn, t: &ThermoInputs) -> f64 {
         }
         ThermoColumn::BodyVolume(k) => body_sum(t, *k, |(v, _)| v),
         ThermoColumn::BodyArea(k) => body_sum(t, *k, |(_, a)| a),
+        ThermoColumn::MinDistance => t.min_contact_distance,
+        ThermoColumn::ContactClamps => t.contact_clamps as f64,
+        ThermoColumn::PlaneTension { axis, pos } => planes::plane_tension(t.backend, t.model, t.state, t.sim_box, *axis, *pos),
+        ThermoColumn::CorticalTension(k) => planes::cortical_tension(t.backend, t.model, t.state, t.sim_box, *k),
+        ThermoColumn::EndToEnd(ty) => filaments::end_to_end(&filaments::chains(t.model, *ty), t.positions, t.sim_box),
+        ThermoColumn::TangentCorrelation { bond_type, lag } => {
+            filaments::tangent_correlation(&filaments::chains(t.model, *bond_type), t.positions, t.sim_box, *lag)
+        }
     }
 }
 
@@ -136,7 +179,12 @@ fn bonds_of_type<'a>(t: &'a ThermoInputs, ty: usize) -> impl Iterator<Item = usi
 fn is_integer(c: &ThermoColumn) -> bool {
     matches!(
         c,
-        ThermoColumn::Step | ThermoColumn::Nbuild | ThermoColumn::Events(_) | ThermoColumn::Bound(_) | ThermoColumn::SolverIterations
+        ThermoColumn::Step
+            | ThermoColumn::Nbuild
+            | ThermoColumn::Events(_)
+            | ThermoColumn::Bound(_)
+            | ThermoColumn::SolverIterations
+            | ThermoColumn::ContactClamps
     )
 }
 
@@ -191,9 +239,14 @@ impl Thermo {
         format!("{names}\n{units}")
     }
 
-    /// A row for stdout; also appended to the CSV file when one is set.
-    pub fn row(&mut self, inputs: &ThermoInputs) -> std::io::Result<String> {
-        let values: Vec<f64> = self.columns.iter().map(|c| column_value(c, inputs)).collect();
+    /// The values of a row, in column order.
+    pub fn values(&self, inputs: &ThermoInputs) -> Vec<f64> {
+        self.columns.iter().map(|c| column_value(c, inputs)).collect()
+    }
+
+    /// A row of [`values`](Self::values) for stdout; also appended to the
+    /// CSV file when one is set.
+    pub fn row(&mut self, values: &[f64]) -> std::io::Result<String> {
         let line: String = (0..self.columns.len())
             .map(|k| {
                 let w = self.width(k);
@@ -214,7 +267,7 @@ impl Thermo {
             let fields: Vec<String> = self
                 .columns
                 .iter()
-                .zip(&values)
+                .zip(values)
                 .map(|(c, v)| if is_integer(c) { format!("{}", *v as u64) } else { format!("{v:e}") })
                 .collect();
             writeln!(file, "{}", fields.join(","))?;

@@ -88,6 +88,10 @@ pub struct Model {
     pub body_rules: Vec<TermType>,
     /// The body type of each surface term.
     pub body_rule_type: Vec<u32>,
+    /// Node–face contact terms between bodies (`contact` lines).
+    pub contact_rules: Vec<TermType>,
+    /// The body types (a, b) each contact term acts between (symmetric).
+    pub contact_rule_types: Vec<(u32, u32)>,
     /// The bodies of the topology, in `[ bodies ]` order.
     pub bodies: Vec<Body>,
 }
@@ -130,6 +134,7 @@ impl Model {
                     capture: line.capture,
                     max_bonds: line.max_bonds,
                     nearest: line.nearest,
+                    between_bodies: line.between_bodies,
                 })
             })
             .collect::<Result<_, InputError>>()?;
@@ -146,22 +151,28 @@ impl Model {
                 pair_table[b * nt + a].push(index as u32);
             }
         }
-        let mut body_type_names: Vec<String> = Vec::new();
-        let mut body_rule_type = Vec::with_capacity(ff.body_rules.len());
-        for rule in &ff.body_rules {
-            let name = &rule.body_type.text;
-            let t = body_type_names.iter().position(|n| n == name).unwrap_or_else(|| {
-                body_type_names.push(name.clone());
-                body_type_names.len() - 1
-            });
-            body_rule_type.push(t as u32);
+        let body_type_names: Vec<String> = ff.body_type_names().into_iter().map(String::from).collect();
+        let body_type_index = |t: &Token| body_type_names.iter().position(|n| *n == t.text).expect("named by the force field") as u32;
+        let body_rule_type = ff.body_rules.iter().map(|r| body_type_index(&r.body_type)).collect();
+        for t in ff.contact_rules.iter().flat_map(|r| [&r.type_a, &r.type_b]) {
+            if !topology.bodies.iter().any(|(_, name)| name.text == t.text) {
+                let mut listed: Vec<&str> = Vec::new();
+                for (_, name) in &topology.bodies {
+                    if !listed.contains(&name.text.as_str()) {
+                        listed.push(&name.text);
+                    }
+                }
+                let listed = if listed.is_empty() { "it has none".to_string() } else { listed.join(", ") };
+                return Err(t.error(format!("found body type `{}`, expected a body type of the topology's [ bodies ] ({listed})", t.text)));
+            }
         }
+        let contact_rule_types = ff.contact_rules.iter().map(|r| (body_type_index(&r.type_a), body_type_index(&r.type_b))).collect();
         let mut bodies = Vec::with_capacity(topology.bodies.len());
         for (id, type_name) in &topology.bodies {
             let body_type = body_type_names.iter().position(|n| *n == type_name.text).ok_or_else(|| {
                 let listed = if body_type_names.is_empty() { "none are defined".to_string() } else { body_type_names.join(", ") };
                 type_name.error(format!(
-                    "found body type `{}`, expected one that `body` lines of the force field give terms to ({listed})",
+                    "found body type `{}`, expected one that `body` or `contact` lines of the force field give terms to ({listed})",
                     type_name.text
                 ))
             })?;
@@ -201,6 +212,8 @@ impl Model {
             body_type_names,
             body_rules: ff.body_rules.iter().map(|r| r.term.clone()).collect(),
             body_rule_type,
+            contact_rules: ff.contact_rules.iter().map(|r| r.term.clone()).collect(),
+            contact_rule_types,
             bodies,
         })
     }
@@ -246,6 +259,20 @@ impl Model {
     /// the GPU backend does not).
     pub fn has_surface_terms(&self) -> bool {
         self.bodies.iter().any(|b| self.body_rule_type.contains(&b.body_type))
+    }
+
+    /// Whether any contact term acts between bodies (CPU only, explicit steps only).
+    pub fn has_contact_terms(&self) -> bool {
+        !self.contact_rules.is_empty()
+    }
+
+    /// The contact terms (indices into `contact_rules`) between a node of a
+    /// body of type `node_type` and a face of a body of type `face_type`.
+    pub fn contact_rules_between(&self, node_type: u32, face_type: u32) -> impl Iterator<Item = usize> + '_ {
+        (0..self.contact_rules.len()).filter(move |&r| {
+            let (a, b) = self.contact_rule_types[r];
+            (a, b) == (node_type, face_type) || (b, a) == (node_type, face_type)
+        })
     }
 
     /// Enclosed volume and area of body `b` at positions `x` (made
@@ -338,6 +365,7 @@ impl Model {
         self.pair_rules.iter().for_each(&mut mark);
         self.externals.iter().for_each(|e| mark(&e.term));
         self.body_rules.iter().for_each(&mut mark);
+        self.contact_rules.iter().for_each(&mut mark);
         (0..REGISTRY.len()).filter(|&k| used[k]).collect()
     }
 }

@@ -1,0 +1,317 @@
+//! Node–face contact between bodies on the CPU (`contact` lines), gathered
+//! per particle.
+//!
+//! A contact term b(d) acts between a node p of one body and a face
+//! (x_0, x_1, x_2) of another, d = |p − q| the distance to the face's closest
+//! point q = Σ w_k x_k ([`point_triangle`]); the forces are −b′·n̂ on the node
+//! and b′·w_k·n̂ on corner k ([`node_face_forces`]).
+//!
+//! 1. **Candidates** (Verlet style): every (node, face) pair of different
+//!    bodies, with a contact rule between their types, closer than
+//!    r_s = 2·d̂ (d̂ the largest contact range: a skin of d̂). They are found
+//!    through the cell list of [`NeighborList`] over the contact nodes with
+//!    cutoff r_s + ℓ_max (ℓ_max the longest face edge): every point of a face
+//!    lies within ℓ_max of each of its corners, so a node within r_s of a
+//!    face is within r_s + ℓ_max of the face's first corner. Pairs are sorted
+//!    by (node, face). The list is rebuilt as soon as a contact node has
+//!    moved more than d̂/2 since the last build (checked before every force
+//!    pass), so a pair outside it is always farther apart than d̂.
+//! 2. **Pass** (parallel over pairs): each pair writes its four forces and
+//!    its distance into its own slot; positions are made image-consistent
+//!    around the face's first corner.
+//! 3. **Gather**: each particle sums its slots in ascending pair order, as
+//!    surface terms are gathered: bit-identical on any thread count.
+//!
+//! [`Contacts::fill_step_limits`] gives the explicit integrator each
+//! particle's largest safe displacement: 0.4 × the distance of its closest
+//! candidate pair and at most 0.4·d̂ (pairs outside the list are beyond d̂).
+//! With every node and corner moving at most 0.4·d along a straight step,
+//! a pair closes by at most 0.8·d (additive CCD bound: the distance is
+//! 1-Lipschitz in each point), so no node passes through a face.
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use super::virial::{add6, outer};
+use crate::forcefield::TermType;
+use crate::interactions::{node_face_forces, Law, Radial};
+use crate::mesh::{point_triangle, PointTriangle};
+use crate::neighbor::{Exclusions, NeighborList};
+use crate::system::{registry_index, Images, Model, SimBox};
+
+/// Fraction of the distance to its closest contact a particle may move in one step.
+pub const STEP_FRACTION: f64 = 0.4;
+
+/// A face of a contact body: its corners (particle indices) and its body.
+type Face = ([u32; 3], u32);
+
+/// Candidate pairs, their per-pair results and each particle's slots.
+#[derive(Default)]
+pub(super) struct Contacts {
+    /// Particles that are nodes of bodies some contact rule names (ascending), and their body.
+    nodes: Vec<u32>,
+    node_body: Vec<u32>,
+    /// Faces of those bodies.
+    faces: Vec<Face>,
+    /// Faces by their first corner (compact node index), CSR.
+    first_offsets: Vec<u32>,
+    first_faces: Vec<u32>,
+    /// Contact rules between a node of body type a and a face of body type b, at `a·types + b`.
+    rules: Vec<Vec<u32>>,
+    body_types: usize,
+    /// The largest contact range d̂ (also the skin).
+    dhat: f64,
+    /// Contact-node positions at the last build (`None`: never built).
+    reference: Option<Vec<DVec3>>,
+    builds: u64,
+    /// Candidate pairs (compact node, face), sorted; per pair its distance and forces.
+    pairs: Vec<[u32; 2]>,
+    distance: Vec<f64>,
+    forces: Vec<[DVec3; 4]>,
+    /// Particle i's slots are `slots[offsets[i]..offsets[i + 1]]`: (pair, role 0–3).
+    offsets: Vec<u32>,
+    slots: Vec<[u32; 2]>,
+}
+
+/// b(d) of one contact term (zero beyond its range).
+#[inline]
+fn radial(term: &TermType, d: f64) -> Radial {
+    let Law::Contact { eval, range } = term.interaction.law() else { unreachable!("contact law") };
+    if d < range(&term.params) {
+        eval(&term.params, d)
+    } else {
+        Radial::ZERO
+    }
+}
+
+impl Contacts {
+    pub(super) fn new(model: &Model) -> Self {
+        if !model.has_contact_terms() {
+            return Self::default();
+        }
+        let types = model.body_type_names.len();
+        let mut rules = vec![Vec::new(); types * types];
+        for a in 0..types {
+            for b in 0..types {
+                rules[a * types + b] = model.contact_rules_between(a as u32, b as u32).map(|r| r as u32).collect();
+            }
+        }
+        let named = |b: usize| {
+            let t = model.bodies[b].body_type as usize;
+            (0..types).any(|u| !rules[t * types + u].is_empty() || !rules[u * types + t].is_empty())
+        };
+        let (mut nodes, mut node_body, mut faces): (Vec<u32>, Vec<u32>, Vec<Face>) = (Vec::new(), Vec::new(), Vec::new());
+        for (b, body) in model.bodies.iter().enumerate().filter(|(b, _)| named(*b)) {
+            nodes.extend(&body.nodes);
+            node_body.extend(std::iter::repeat_n(b as u32, body.nodes.len()));
+            faces.extend(body.mesh.triangles().iter().map(|t| (t.map(|k| body.nodes[k as usize]), b as u32)));
+        }
+        // Bodies are disjoint but not in particle order: sort nodes by particle.
+        let mut order: Vec<usize> = (0..nodes.len()).collect();
+        order.sort_unstable_by_key(|&k| nodes[k]);
+        let (nodes, node_body): (Vec<u32>, Vec<u32>) = order.iter().map(|&k| (nodes[k], node_body[k])).unzip();
+        let compact = |p: u32| nodes.binary_search(&p).expect("a contact node");
+        let mut rows = vec![Vec::new(); nodes.len()];
+        for (f, (corners, _)) in faces.iter().enumerate() {
+            rows[compact(corners[0])].push(f as u32);
+        }
+        let (first_offsets, first_faces) = csr(rows);
+        let dhat = model
+            .contact_rules
+            .iter()
+            .map(|t| match t.interaction.law() {
+                Law::Contact { range, .. } => range(&t.params),
+                _ => unreachable!("contact law"),
+            })
+            .fold(0.0, f64::max);
+        Self {
+            nodes,
+            node_body,
+            faces,
+            first_offsets,
+            first_faces,
+            rules,
+            body_types: types,
+            dhat,
+            offsets: vec![0; model.len() + 1],
+            ..Self::default()
+        }
+    }
+
+    /// Whether there is anything to evaluate.
+    pub(super) fn is_empty(&self) -> bool {
+        self.nodes.is_empty()
+    }
+
+    /// Candidate-list builds so far.
+    pub(super) fn builds(&self) -> u64 {
+        self.builds
+    }
+
+    fn rules_between(&self, node_body: u32, face_body: u32, model: &Model) -> &[u32] {
+        let t = |b: u32| model.bodies[b as usize].body_type as usize;
+        &self.rules[t(node_body) * self.body_types + t(face_body)]
+    }
+
+    /// Image-consistent closest point of pair `k`'s face to its node.
+    #[inline]
+    fn geometry(&self, k: usize, x: &[DVec3], images: &Images) -> PointTriangle {
+        let [node, face] = self.pairs[k];
+        closest(x, images, self.nodes[node as usize], self.faces[face as usize].0)
+    }
+
+    /// Rebuilds the candidate list if never built or a contact node moved more than d̂/2.
+    pub(super) fn update(&mut self, model: &Model, x: &[DVec3], sim_box: &SimBox) -> Result<(), String> {
+        if self.is_empty() {
+            return Ok(());
+        }
+        let images = sim_box.images();
+        let half = 0.5 * self.dhat;
+        let stale = self.reference.as_ref().is_none_or(|reference| {
+            self.nodes.par_iter().zip(reference.par_iter()).any(|(&p, x0)| {
+                let d = images.minimum_image(x[p as usize] - *x0).length();
+                d.is_nan() || d > half
+            })
+        });
+        if stale {
+            self.rebuild(model, x, sim_box)?;
+        }
+        Ok(())
+    }
+
+    fn rebuild(&mut self, model: &Model, x: &[DVec3], sim_box: &SimBox) -> Result<(), String> {
+        let images = sim_box.images();
+        let compact_x: Vec<DVec3> = self.nodes.iter().map(|&p| x[p as usize]).collect();
+        let longest = self
+            .faces
+            .par_iter()
+            .map(|(c, _)| {
+                let [a, b, c] = c.map(|p| x[p as usize]);
+                images.minimum_image(b - a).length().max(images.minimum_image(c - a).length()).max(images.minimum_image(c - b).length())
+            })
+            .reduce(|| 0.0, f64::max);
+        let search = 2.0 * self.dhat;
+        let mut list = NeighborList::new(search + longest, 0.0);
+        list.build(&compact_x, sim_box, &Exclusions::none()).map_err(|e| format!("contact search: {e}"))?;
+        let this = &*self;
+        let rows: Vec<Vec<u32>> = (0..this.nodes.len())
+            .into_par_iter()
+            .map(|k| {
+                let body = this.node_body[k];
+                let mut mine = Vec::new();
+                for &j in list.neighbors(k) {
+                    let j = j as usize;
+                    for &f in &this.first_faces[this.first_offsets[j] as usize..this.first_offsets[j + 1] as usize] {
+                        let (corners, face_body) = this.faces[f as usize];
+                        if face_body != body
+                            && !this.rules_between(body, face_body, model).is_empty()
+                            && closest(x, &images, this.nodes[k], corners).distance < search
+                        {
+                            mine.push(f);
+                        }
+                    }
+                }
+                mine.sort_unstable();
+                mine
+            })
+            .collect();
+        self.pairs = rows.iter().enumerate().flat_map(|(k, faces)| faces.iter().map(move |&f| [k as u32, f])).collect();
+        let mut slots = vec![Vec::new(); model.len()];
+        for (k, &[node, face]) in self.pairs.iter().enumerate() {
+            let (corners, _) = self.faces[face as usize];
+            for (role, p) in [self.nodes[node as usize], corners[0], corners[1], corners[2]].into_iter().enumerate() {
+                slots[p as usize].push([k as u32, role as u32]);
+            }
+        }
+        (self.offsets, self.slots) = csr(slots);
+        self.distance.resize(self.pairs.len(), 0.0);
+        self.forces.resize(self.pairs.len(), [DVec3::ZERO; 4]);
+        self.reference = Some(compact_x);
+        self.builds += 1;
+        Ok(())
+    }
+
+    /// Evaluates every candidate pair into its slot (the list must be current: [`Self::update`]).
+    pub(super) fn prepare(&mut self, model: &Model, x: &[DVec3], images: &Images) {
+        let this = &*self;
+        let results: Vec<(f64, [DVec3; 4])> = (0..this.pairs.len())
+            .into_par_iter()
+            .with_min_len(256)
+            .map(|k| {
+                let pt = this.geometry(k, x, images);
+                let [node, face] = this.pairs[k];
+                let mut forces = [DVec3::ZERO; 4];
+                for &r in this.rules_between(this.node_body[node as usize], this.faces[face as usize].1, model) {
+                    let f = node_face_forces(&radial(&model.contact_rules[r as usize], pt.distance), &pt);
+                    forces.iter_mut().zip(f).for_each(|(a, b)| *a += b);
+                }
+                (pt.distance, forces)
+            })
+            .collect();
+        for (k, (d, f)) in results.into_iter().enumerate() {
+            self.distance[k] = d;
+            self.forces[k] = f;
+        }
+    }
+
+    /// Contact force on particle `i`: its slots in ascending pair order.
+    #[inline]
+    pub(super) fn force_on(&self, i: usize) -> DVec3 {
+        self.slots[self.offsets[i] as usize..self.offsets[i + 1] as usize]
+            .iter()
+            .map(|&[k, role]| self.forces[k as usize][role as usize])
+            .fold(DVec3::ZERO, |a, b| a + b)
+    }
+
+    /// The smallest node–face distance over the candidate pairs (∞ when there are none).
+    pub(super) fn min_distance(&self) -> f64 {
+        self.distance.iter().copied().fold(f64::INFINITY, f64::min)
+    }
+
+    /// Each particle's largest safe displacement in the next step (∞ for
+    /// particles of no contact body); see the module docs.
+    pub(super) fn fill_step_limits(&self, n: usize, limits: &mut Vec<f64>) {
+        limits.clear();
+        limits.resize(n, f64::INFINITY);
+        let cap = STEP_FRACTION * self.dhat;
+        self.nodes.iter().for_each(|&p| limits[p as usize] = cap);
+        limits.par_iter_mut().enumerate().with_min_len(1024).for_each(|(i, limit)| {
+            for &[k, _] in &self.slots[self.offsets[i] as usize..self.offsets[i + 1] as usize] {
+                *limit = limit.min(STEP_FRACTION * self.distance[k as usize]);
+            }
+        });
+    }
+
+    /// Energies per registry entry and the virial (d·n̂ ⊗ f_node per pair), pair by pair.
+    pub(super) fn energy(&self, model: &Model, x: &[DVec3], images: &Images, energy: &mut [f64], virial: &mut [f64; 6]) {
+        for k in 0..self.pairs.len() {
+            let pt = self.geometry(k, x, images);
+            let [node, face] = self.pairs[k];
+            for &r in self.rules_between(self.node_body[node as usize], self.faces[face as usize].1, model) {
+                let term = &model.contact_rules[r as usize];
+                energy[registry_index(term)] += radial(term, pt.distance).energy;
+            }
+            add6(virial, outer(pt.distance * pt.normal, self.forces[k][0]));
+        }
+    }
+}
+
+/// Closest point of face `corners` to particle `p`, image-consistent around corner 0.
+#[inline]
+fn closest(x: &[DVec3], images: &Images, p: u32, corners: [u32; 3]) -> PointTriangle {
+    let a = x[corners[0] as usize];
+    let around = |q: u32| a + images.minimum_image(x[q as usize] - a);
+    point_triangle(around(p), [a, around(corners[1]), around(corners[2])])
+}
+
+/// Rows to CSR (offsets, flat).
+fn csr<T>(rows: Vec<Vec<T>>) -> (Vec<u32>, Vec<T>) {
+    let mut offsets = Vec::with_capacity(rows.len() + 1);
+    let mut flat = Vec::new();
+    offsets.push(0);
+    for row in rows {
+        flat.extend(row);
+        offsets.push(flat.len() as u32);
+    }
+    (offsets, flat)
+}

@@ -1,0 +1,22 @@
+//! Measurements read from a configuration and its force terms: per-particle
+//! stress, plane and cortical tension, filament statistics.
+//!
+//! They are computed by the CPU reference backend at output steps only (on
+//! GPU runs after the positions come back), from the decomposition of every
+//! force term into segments ([`Term`](crate::backend::Term)), so that each
+//! quantity is consistent with the virial and the forces of the same step.
+//!
+//! | quantity | where | module |
+//! |---|---|---|
+//! | per-particle virial W_i, stress S_i = −W_i, von Mises | LAMMPS dump columns `wxx`…`wyz`, `sxx`…`syz`, `vonmises` | [`stress`] |
+//! | per-bond tension and length | `dump NAME every N bonds FILE.csv` | [`crate::output::bond_csv`] |
+//! | force across a plane | thermo `planetension/AXIS/POS` | [`planes`] |
+//! | cortical tension γ (method of planes) | thermo `gamma/BODYTYPE` | [`planes`] |
+//! | end-to-end distance, tangent correlation | thermo `e2e/BONDTYPE`, `tcorr/BONDTYPE/LAG` | [`filaments`] |
+
+pub mod filaments;
+pub mod planes;
+pub mod stress;
+
+pub use self::planes::{cortical_tension, plane_tension};
+pub use self::stress::{per_particle_virial, von_mises};

@@ -1,0 +1,206 @@
+//! Contact between cells (`contact_barrier`, issue #7): two pressurised
+//! icosphere cells pressed together never interpenetrate.
+//!
+//! - At every step the smallest node–face distance between the cells,
+//!   computed here by brute force over all node × face pairs, stays > 0,
+//!   and the engine's `mindist` equals it whenever it is below d̂.
+//! - The cells flatten against each other (a contact patch of many nodes).
+//! - The step clamp acts (and keeps the distance positive) when the time step
+//!   is too large for the barrier, with noise too.
+//! - Runs are bit-identical on 1 and 2 threads; the implicit integrator,
+//!   FIRE and the GPU backend refuse `contact` lines.
+//! - `topologies/cell_contact.top` is two `cellmd build icosphere` cells merged.
+
+mod common;
+
+use cellmd::build::{icosphere_cell, IcosphereCell};
+use cellmd::deck::validate_file;
+use cellmd::mesh::point_triangle;
+use cellmd::run::{RunOptions, Simulation};
+use common::Case;
+use glam::DVec3;
+
+/// Two level-`level` cells of radius `radius`, centres on the x axis a `gap` apart at their surfaces.
+fn two_cells(level: u32, radius: f64, gap: f64) -> String {
+    let half = radius + gap / 2.0;
+    let left = IcosphereCell { level, radius, centre: DVec3::new(-half, 0.0, 0.0), bond_type: None, ..Default::default() };
+    let nodes = icosphere_cell(&left).nodes as u64;
+    let right = IcosphereCell { centre: DVec3::new(half, 0.0, 0.0), body_id: 2, first_id: nodes + 1, ..left.clone() };
+    merge_topologies(&[icosphere_cell(&left).text, icosphere_cell(&right).text])
+}
+
+const SHELLS: &str = "body cell turgor k 1000 dp0 100 v0 32.4\nbody cell surface_tension gamma 100\n";
+const BARRIER: &str = "contact cell cell contact_barrier dhat 0.1 kappa 200\n";
+
+/// Two 162-node cells (R = 2 µm, 0.1 µm apart) with force-field lines `ff`
+/// (after `particle node drag 1`), pushed together by `push` pN per node.
+fn case_with(ff: &str, push: f64, settings: &str) -> Case {
+    let deck = format!(
+        "units cell\ntopology cells.top\nforcefield cells.ff\nbox x -10 10 f y -10 10 f z -10 10 f\n\
+         group left id 1:162\ngroup right id 163:324\n\
+         external push_left left constant_force fx {push}\nexternal push_right right constant_force fx -{push}\n{settings}"
+    );
+    Case::new(&[("cells.top", &two_cells(2, 2.0, 0.1)), ("cells.ff", &format!("particle node drag 1\n{ff}")), ("deck.in", &deck)])
+}
+
+/// Pressurised, tense cells with the barrier between them.
+fn pressed_case(push: f64, settings: &str) -> Case {
+    case_with(&format!("{SHELLS}{BARRIER}"), push, settings)
+}
+
+/// The smallest distance from a node of one body to a face of the other, over all pairs.
+fn brute_force_min_distance(sim: &Simulation) -> f64 {
+    let x = &sim.state.positions;
+    let mut min = f64::INFINITY;
+    for (a, b) in [(0, 1), (1, 0)] {
+        let (nodes, faces) = (&sim.model.bodies[a], &sim.model.bodies[b]);
+        for &p in &nodes.nodes {
+            for t in faces.mesh.triangles() {
+                let corners = t.map(|k| x[faces.nodes[k as usize] as usize]);
+                min = min.min(point_triangle(x[p as usize], corners).distance);
+            }
+        }
+    }
+    min
+}
+
+/// Runs `steps` single steps, checking the distance after each; returns the
+/// smallest distance seen.
+fn run_checking_every_step(sim: &mut Simulation, steps: u64, dhat: f64) -> f64 {
+    let mut smallest = f64::INFINITY;
+    for _ in 0..steps {
+        sim.run(1).unwrap();
+        let exact = brute_force_min_distance(sim);
+        assert!(exact > 0.0, "step {}: the cells interpenetrate (min distance {exact:e})", sim.state.step);
+        if exact < dhat {
+            // Equal up to rounding (the engine measures around each face's first corner).
+            let reported = sim.min_contact_distance();
+            assert!((reported - exact).abs() <= 1e-12 * exact, "step {}: mindist {reported:e}, brute force {exact:e}", sim.state.step);
+        }
+        smallest = smallest.min(exact);
+    }
+    smallest
+}
+
+fn width_along_x(sim: &Simulation, body: usize) -> f64 {
+    let xs = sim.model.bodies[body].nodes.iter().map(|&p| sim.state.positions[p as usize].x);
+    let (lo, hi) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| (lo.min(x), hi.max(x)));
+    hi - lo
+}
+
+#[test]
+fn pressed_cells_flatten_against_each_other_without_touching() {
+    let case = pressed_case(2.0, "temperature 0\ntimestep 1e-3\nrun 0\n");
+    let plan = case.plan();
+    let mut sim =
+        Simulation::before_first_run(&plan, RunOptions { output_dir: case.output_dir().to_path_buf(), ..Default::default() }).unwrap();
+    let width0 = width_along_x(&sim, 0);
+    let smallest = run_checking_every_step(&mut sim, 1500, 0.1);
+    // A flat patch: many nodes of each cell within d̂ of the other cell.
+    let x = &sim.state.positions;
+    let near = |a: usize, b: usize| {
+        let faces = &sim.model.bodies[b];
+        sim.model.bodies[a]
+            .nodes
+            .iter()
+            .filter(|&&p| {
+                faces
+                    .mesh
+                    .triangles()
+                    .iter()
+                    .any(|t| point_triangle(x[p as usize], t.map(|k| x[faces.nodes[k as usize] as usize])).distance < 0.1)
+            })
+            .count()
+    };
+    let (patch, width) = (near(0, 1).min(near(1, 0)), width_along_x(&sim, 0));
+    println!("smallest distance {smallest:.4e} µm, final {:.4e} µm, contact patch {patch} nodes, width {width0:.4} → {width:.4} µm, {} clamped steps", sim.min_contact_distance(), sim.contact_clamps);
+    assert!(patch >= 7, "no flat contact patch: {patch} nodes within d̂");
+    assert!(width < width0 - 0.05, "the cell did not flatten: width {width0} → {width}");
+    assert!(sim.forces.energy_by_interaction.iter().sum::<f64>().is_finite());
+}
+
+#[test]
+fn the_step_clamp_keeps_a_too_large_step_from_jumping_through() {
+    // Without the clamp a node would move 0.5 µm a step: five times d̂.
+    let case = pressed_case(50.0, "temperature 0.0041\nseed 7\ntimestep 1e-2\nrun 0\n");
+    let plan = case.plan();
+    let mut sim =
+        Simulation::before_first_run(&plan, RunOptions { output_dir: case.output_dir().to_path_buf(), ..Default::default() }).unwrap();
+    let smallest = run_checking_every_step(&mut sim, 200, 0.1);
+    println!("smallest distance {smallest:.4e} µm, {} of 200 steps clamped, time {:.4e} s", sim.contact_clamps, sim.state.time);
+    assert!(sim.contact_clamps > 0, "the clamp never acted");
+    assert!(sim.state.time < 200.0 * 1e-2, "clamped steps advance time by less than dt");
+}
+
+#[test]
+fn contact_runs_are_bit_identical_on_one_and_two_threads() {
+    let case = pressed_case(5.0, "temperature 0.0041\nseed 3\ntimestep 1e-3\nthermo 100 step pe mindist nclamp\nrun 300\n");
+    let plan = case.plan();
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| {
+            Simulation::execute(&plan, RunOptions { output_dir: case.output_dir().to_path_buf(), ..Default::default() }).unwrap()
+        })
+    };
+    let (one, two) = (run(1), run(2));
+    let bits = |s: &Simulation| s.state.positions.iter().flat_map(|x| x.to_array().map(f64::to_bits)).collect::<Vec<_>>();
+    assert_eq!(bits(&one), bits(&two));
+    assert_eq!(one.forces.total_energy().to_bits(), two.forces.total_energy().to_bits());
+    assert_eq!(one.forces.virial.map(f64::to_bits), two.forces.virial.map(f64::to_bits));
+    assert!(one.min_contact_distance() < 0.1, "the cells never came into contact");
+}
+
+#[test]
+fn solvers_without_a_step_clamp_and_the_gpu_refuse_contact_terms() {
+    for (settings, expected) in [
+        ("integrator implicit\ntemperature 0\ntimestep 1e-3\nrun 10\n", "`integrator implicit` has no contact step clamp"),
+        ("temperature 0\ntimestep 1e-3\nminimize ftol 1e-3\n", "`minimize` (FIRE) has no contact step clamp"),
+    ] {
+        let case = pressed_case(1.0, settings);
+        let plan = case.plan();
+        let error =
+            Simulation::execute(&plan, RunOptions { output_dir: case.output_dir().to_path_buf(), ..Default::default() }).err().unwrap();
+        assert!(error.to_string().contains(expected), "{error}");
+    }
+    // Bodies with contact terms only (no `body` lines), so contact is the CPU-only feature named.
+    let case = case_with(BARRIER, 1.0, "temperature 0\ntimestep 1e-3\nrun 0\n");
+    let sim = Simulation::before_first_run(&case.plan(), RunOptions::default()).unwrap();
+    assert_eq!(sim.cpu_only_feature(), Some("contact terms between bodies (`contact` lines) run on the CPU backend only"));
+}
+
+/// Topology texts merged section by section (each section once, in the
+/// order first seen; comment lines above the first section kept).
+fn merge_topologies(texts: &[String]) -> String {
+    let mut sections: Vec<(String, String)> = vec![(String::new(), String::new())];
+    for text in texts {
+        let mut current = 0;
+        for line in text.lines() {
+            if line.starts_with('[') {
+                current = sections.iter().position(|(name, _)| name == line).unwrap_or_else(|| {
+                    sections.push((line.to_string(), String::new()));
+                    sections.len() - 1
+                });
+            } else if !(current > 0 && line.starts_with('#')) {
+                sections[current].1 += &format!("{line}\n");
+            }
+        }
+    }
+    sections.iter().map(|(name, body)| if name.is_empty() { body.clone() } else { format!("{name}\n{body}") }).collect()
+}
+
+/// `topologies/cell_contact.top` is two `cellmd build icosphere` cells merged
+/// (regenerate with `CELLMD_WRITE_TOPOLOGY=1 cargo test --test contact the_cell_contact_topology`).
+#[test]
+fn the_cell_contact_topology_is_two_icosphere_builds() {
+    let left = IcosphereCell { level: 3, radius: 3.0, centre: DVec3::new(-3.06, 0.0, 0.0), ..Default::default() };
+    let right = IcosphereCell { centre: DVec3::new(3.06, 0.0, 0.0), body_id: 2, first_id: 643, ..left.clone() };
+    let text = merge_topologies(&[icosphere_cell(&left).text, icosphere_cell(&right).text]);
+    let path = "topologies/cell_contact.top";
+    if std::env::var_os("CELLMD_WRITE_TOPOLOGY").is_some() {
+        std::fs::write(path, &text).unwrap();
+    }
+    assert!(std::fs::read_to_string(path).unwrap() == text, "{path} is not the two builds; regenerate with CELLMD_WRITE_TOPOLOGY=1");
+    let plan = validate_file(std::path::Path::new("inputs/cell_contact.in"), &[]).unwrap();
+    assert_eq!(plan.model.bodies.len(), 2);
+    assert_eq!(plan.model.bodies[1].nodes.len(), 642);
+}
