@@ -17,16 +17,16 @@ use cellmd::build::{icosphere_cell, IcosphereCell};
 use cellmd::deck::validate_file;
 use cellmd::mesh::point_triangle;
 use cellmd::run::{RunOptions, Simulation};
-use common::Case;
+use common::{merge_topologies, Case};
 use glam::DVec3;
 
 /// Two level-`level` cells of radius `radius`, centres on the x axis a `gap` apart at their surfaces.
 fn two_cells(level: u32, radius: f64, gap: f64) -> String {
     let half = radius + gap / 2.0;
     let left = IcosphereCell { level, radius, centre: DVec3::new(-half, 0.0, 0.0), bond_type: None, ..Default::default() };
-    let nodes = icosphere_cell(&left).nodes as u64;
+    let nodes = icosphere_cell(&left).shells[0].nodes as u64;
     let right = IcosphereCell { centre: DVec3::new(half, 0.0, 0.0), body_id: 2, first_id: nodes + 1, ..left.clone() };
-    merge_topologies(&[icosphere_cell(&left).text, icosphere_cell(&right).text])
+    merge_topologies(&[&icosphere_cell(&left).text, &icosphere_cell(&right).text])
 }
 
 const SHELLS: &str = "body cell turgor k 1000 dp0 100 v0 32.4\nbody cell surface_tension gamma 100\n";
@@ -168,33 +168,13 @@ fn solvers_without_a_step_clamp_and_the_gpu_refuse_contact_terms() {
     assert_eq!(sim.cpu_only_feature(), Some("contact terms between bodies (`contact` lines) run on the CPU backend only"));
 }
 
-/// Topology texts merged section by section (each section once, in the
-/// order first seen; comment lines above the first section kept).
-fn merge_topologies(texts: &[String]) -> String {
-    let mut sections: Vec<(String, String)> = vec![(String::new(), String::new())];
-    for text in texts {
-        let mut current = 0;
-        for line in text.lines() {
-            if line.starts_with('[') {
-                current = sections.iter().position(|(name, _)| name == line).unwrap_or_else(|| {
-                    sections.push((line.to_string(), String::new()));
-                    sections.len() - 1
-                });
-            } else if !(current > 0 && line.starts_with('#')) {
-                sections[current].1 += &format!("{line}\n");
-            }
-        }
-    }
-    sections.iter().map(|(name, body)| if name.is_empty() { body.clone() } else { format!("{name}\n{body}") }).collect()
-}
-
 /// `topologies/cell_contact.top` is two `cellmd build icosphere` cells merged
 /// (regenerate with `CELLMD_WRITE_TOPOLOGY=1 cargo test --test contact the_cell_contact_topology`).
 #[test]
 fn the_cell_contact_topology_is_two_icosphere_builds() {
     let left = IcosphereCell { level: 3, radius: 3.0, centre: DVec3::new(-3.06, 0.0, 0.0), ..Default::default() };
     let right = IcosphereCell { centre: DVec3::new(3.06, 0.0, 0.0), body_id: 2, first_id: 643, ..left.clone() };
-    let text = merge_topologies(&[icosphere_cell(&left).text, icosphere_cell(&right).text]);
+    let text = merge_topologies(&[&icosphere_cell(&left).text, &icosphere_cell(&right).text]);
     let path = "topologies/cell_contact.top";
     if std::env::var_os("CELLMD_WRITE_TOPOLOGY").is_some() {
         std::fs::write(path, &text).unwrap();

@@ -248,11 +248,11 @@ fn plane_tension_integrates_to_the_virial() {
 /// Young–Laplace ΔP·R/2.
 fn shell_gamma(level: u32) -> (f64, f64, usize) {
     let cell = icosphere_cell(&IcosphereCell { level, radius: 5.0, ..Default::default() });
-    let [_, mean_edge, _] = cell.edge_lengths;
+    let [_, mean_edge, _] = cell.shells[0].edge_lengths;
     let ff = format!(
         "particle node drag 1\nbond edge harmonic k 1000 r0 {:?}\nbody cell turgor k 200 dp0 100 v0 {:?}\n",
         0.8 * mean_edge,
-        cell.volume
+        cell.shells[0].volume
     );
     let deck = "units cell\ntopology cell.top\nforcefield cell.ff\nbox x -40 40 f y -40 40 f z -40 40 f\ntimestep 1e-4\n\
                 minimize ftol 1e-7 maxiter 200000\n";
@@ -260,11 +260,11 @@ fn shell_gamma(level: u32) -> (f64, f64, usize) {
     let mut sim = case.run();
     assert!(sim.last_minimize.as_ref().unwrap().converged, "FIRE did not converge");
     let v = sim.thermo_value(&ThermoColumn::BodyVolume(0)).unwrap();
-    let dp = 100.0 + 200.0 * (cell.volume - v) / cell.volume;
+    let dp = 100.0 + 200.0 * (cell.shells[0].volume - v) / cell.shells[0].volume;
     let (_, r) = cellmd::measure::planes::body_centre_and_radius(&sim.model, 0, &sim.state.positions, &sim.sim_box);
     let gamma = sim.thermo_value(&ThermoColumn::CorticalTension(0)).unwrap();
     assert_virial_sums(&mut sim);
-    (gamma, dp * r / 2.0, cell.nodes)
+    (gamma, dp * r / 2.0, cell.shells[0].nodes)
 }
 
 /// Young–Laplace through the method of planes: at level 3 (642 nodes) the

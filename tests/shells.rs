@@ -20,7 +20,7 @@ use cellmd::build::{icosphere_cell, IcosphereCell};
 use cellmd::deck::validate_file;
 use cellmd::gpu::DevicePreference;
 use cellmd::run::{RunOptions, Simulation};
-use common::Case;
+use common::{merge_topologies, Case};
 use glam::DVec3;
 
 /// Enclosed volume and area of body 0 of a simulation.
@@ -323,28 +323,6 @@ fn single_cell_deck_writes_a_foxglove_scene_of_its_surface() {
     assert!(volumes.iter().all(|v| (v / 519.0926 - 1.0).abs() < 0.05), "{volumes:?}");
 }
 
-/// One topology holding the sections of several (each section once, their lines in order).
-fn merged_topology(texts: &[&str]) -> String {
-    let mut sections: Vec<(String, String)> = Vec::new();
-    for text in texts {
-        let mut current = None;
-        for line in text.lines().filter(|l| !l.trim_start().starts_with('#') && !l.trim().is_empty()) {
-            if line.starts_with('[') {
-                let k = sections.iter().position(|(h, _)| h == line).unwrap_or_else(|| {
-                    sections.push((line.to_string(), String::new()));
-                    sections.len() - 1
-                });
-                current = Some(k);
-            } else {
-                let body = &mut sections[current.expect("a section header first")].1;
-                body.push_str(line);
-                body.push('\n');
-            }
-        }
-    }
-    sections.into_iter().map(|(h, b)| format!("{h}\n{b}")).collect()
-}
-
 /// Cell–cell junctions: two touching cells whose nodes may bind (`bind node
 /// node junction … between bodies`) form junction bonds only across the two
 /// bodies, although neighbouring nodes of one cell are closer than the capture
@@ -364,18 +342,18 @@ fn junctions_bind_only_across_cells_and_break_when_pulled_apart() {
         })
     };
     let (a, b) = (cell(1, 1, -(radius + 0.5 * gap)), cell(2, 163, radius + 0.5 * gap));
-    assert!(a.edge_lengths[0] < capture, "nodes of one cell lie within capture of each other");
+    assert!(a.shells[0].edge_lengths[0] < capture, "nodes of one cell lie within capture of each other");
     let ff = format!(
         "particle node drag 1\nbody cell turgor k 100 v0 {v}\nbody cell surface_tension gamma 1\nbond edge harmonic k 100 r0 {edge}\n\
          bond junction harmonic k 10 r0 0.25 kinetics slip k0 0.01 x_beta 0.005\n\
          bind node node junction k_on 200 capture {capture} between bodies\n",
-        v = a.volume,
-        edge = a.edge_lengths[1]
+        v = a.shells[0].volume,
+        edge = a.shells[0].edge_lengths[1]
     );
     let deck = "units cell\ntopology cells.top\nforcefield cells.ff\nbox x -10 10 f y -10 10 f z -10 10 f\ntemperature 298\n\
                 timestep 1e-3\nseed 4\nevents events.csv\ngroup left id 1:162\ngroup right id 163:324\nrun 100\n\
                 external apart_l left constant_force fx -1\nexternal apart_r right constant_force fx 1\nrun 3000\n";
-    let c = Case::new(&[("cells.top", &merged_topology(&[&a.text, &b.text])), ("cells.ff", &ff), ("deck.in", deck)]);
+    let c = Case::new(&[("cells.top", &merge_topologies(&[&a.text, &b.text])), ("cells.ff", &ff), ("deck.in", deck)]);
     let sim = c.run();
     let log = std::fs::read_to_string(c.path("events.csv")).unwrap();
     let mut formed = 0;

@@ -101,3 +101,23 @@ pub fn grid_positions(n_side: usize, a: f64) -> Vec<glam::DVec3> {
     }
     out
 }
+
+/// Topology texts merged section by section (each section once, in the
+/// order first seen; comment lines above the first section kept).
+pub fn merge_topologies(texts: &[&str]) -> String {
+    let mut sections: Vec<(String, String)> = vec![(String::new(), String::new())];
+    for text in texts {
+        let mut current = 0;
+        for line in text.lines() {
+            if line.starts_with('[') {
+                current = sections.iter().position(|(name, _)| name == line).unwrap_or_else(|| {
+                    sections.push((line.to_string(), String::new()));
+                    sections.len() - 1
+                });
+            } else if !(current > 0 && line.starts_with('#')) {
+                sections[current].1 += &format!("{line}\n");
+            }
+        }
+    }
+    sections.iter().map(|(name, body)| if name.is_empty() { body.clone() } else { format!("{name}\n{body}") }).collect()
+}
