@@ -314,10 +314,6 @@ fn every_input_deck_runs_on_the_gpu_like_on_the_cpu() {
     for deck in decks {
         let plan = cellmd::deck::validate_file(&deck, &[("steps".into(), "10".into()), ("fire_iterations".into(), "10".into())]).unwrap();
         let setup = Simulation::before_first_run(&plan, RunOptions::default()).unwrap();
-        if setup.state.bonds.is_some() {
-            // Bond kinetics need kT > 0: see `kinetics_decks_give_the_same_events_on_the_gpu`.
-            continue;
-        }
         if let Some(why) = setup.cpu_only_feature() {
             // A CPU-only feature: the GPU must refuse the deck with the reason.
             let dir = tempfile::tempdir().unwrap();
@@ -325,6 +321,10 @@ fn every_input_deck_runs_on_the_gpu_like_on_the_cpu() {
             let refusal = Simulation::execute(&plan, options).err().map(|e| e.to_string()).unwrap_or_default();
             assert!(refusal.contains(why), "{}: expected the GPU to refuse with {why:?}, got {refusal:?}", deck.display());
             refused += 1;
+            continue;
+        }
+        if setup.state.bonds.is_some() {
+            // Bond kinetics need kT > 0: see `kinetics_decks_give_the_same_events_on_the_gpu`.
             continue;
         }
         match run_deck_deterministic(&deck, DevicePreference::Gpu, 10_000, false) {
@@ -516,7 +516,9 @@ fn kinetics_decks_give_the_same_events_on_the_gpu() {
     for deck in decks {
         let vars = [("steps".into(), "400".into()), ("fire_iterations".into(), "10".into())];
         let plan = cellmd::deck::validate_file(&deck, &vars).unwrap();
-        if Simulation::before_first_run(&plan, RunOptions::default()).unwrap().state.bonds.is_none() {
+        let setup = Simulation::before_first_run(&plan, RunOptions::default()).unwrap();
+        if setup.state.bonds.is_none() || setup.cpu_only_feature().is_some() {
+            // No kinetics, or refused by the GPU (checked in `every_input_deck_runs_on_the_gpu_like_on_the_cpu`).
             continue;
         }
         let run = |device: DevicePreference| {
