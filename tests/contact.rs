@@ -17,7 +17,7 @@ use cellmd::build::{icosphere_cell, IcosphereCell};
 use cellmd::deck::validate_file;
 use cellmd::mesh::point_triangle;
 use cellmd::run::{RunOptions, Simulation};
-use common::{merge_topologies, Case};
+use common::{merge_topologies, position_bits, Case};
 use glam::DVec3;
 
 /// Two level-`level` cells of radius `radius`, centres on the x axis a `gap` apart at their surfaces.
@@ -135,16 +135,8 @@ fn the_step_clamp_keeps_a_too_large_step_from_jumping_through() {
 #[test]
 fn contact_runs_are_bit_identical_on_one_and_two_threads() {
     let case = pressed_case(5.0, "temperature 0.0041\nseed 3\ntimestep 1e-3\nthermo 100 step pe mindist nclamp\nrun 300\n");
-    let plan = case.plan();
-    let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-        pool.install(|| {
-            Simulation::execute(&plan, RunOptions { output_dir: case.output_dir().to_path_buf(), ..Default::default() }).unwrap()
-        })
-    };
-    let (one, two) = (run(1), run(2));
-    let bits = |s: &Simulation| s.state.positions.iter().flat_map(|x| x.to_array().map(f64::to_bits)).collect::<Vec<_>>();
-    assert_eq!(bits(&one), bits(&two));
+    let (one, two) = (case.run_with_threads(1), case.run_with_threads(2));
+    assert_eq!(position_bits(&one), position_bits(&two));
     assert_eq!(one.forces.total_energy().to_bits(), two.forces.total_energy().to_bits());
     assert_eq!(one.forces.virial.map(f64::to_bits), two.forces.virial.map(f64::to_bits));
     assert!(one.min_contact_distance() < 0.1, "the cells never came into contact");

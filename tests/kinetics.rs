@@ -424,23 +424,9 @@ fn kinetics_runs_are_bit_identical_across_thread_counts() {
     let deck = "units lj\ntopology t.top\nforcefield f.ff\nbox x -5 45 f y -5 35 f z -5 5 f\nneighbor skin 0.2\ntemperature 1\ntimestep 2e-4\nseed 3\nevents events.csv\nrun 3000\n";
     let run = |threads: usize| {
         let c = Case::new(&[("t.top", &(top.clone() + &bonds)), ("f.ff", ff), ("deck.in", deck)]);
-        let plan = c.plan();
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-        let sim = pool.install(|| {
-            cellmd::run::Simulation::execute(
-                &plan,
-                cellmd::run::RunOptions { output_dir: c.output_dir().to_path_buf(), ..Default::default() },
-            )
-            .unwrap()
-        });
+        let sim = c.run_with_threads(threads);
         let log = std::fs::read(c.path("events.csv")).unwrap();
-        (
-            sim.state.positions.iter().map(|x| x.to_array().map(f64::to_bits)).collect::<Vec<_>>(),
-            sim.state.bonds.clone().unwrap(),
-            log,
-            sim.kinetics.breaks,
-            sim.kinetics.forms,
-        )
+        (common::position_bits(&sim), sim.state.bonds.clone().unwrap(), log, sim.kinetics.breaks, sim.kinetics.forms)
     };
     let (one, two) = (run(1), run(2));
     assert!(one.3 > 100, "too few events to test: {}", one.3);

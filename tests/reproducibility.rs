@@ -2,9 +2,7 @@
 
 mod common;
 
-use cellmd::deck::validate_file;
-use cellmd::run::{RunOptions, Simulation};
-use common::Case;
+use common::{position_bits, Case};
 
 /// A periodic bead-spring system with pairs, bonds, angles and noise.
 fn chains_case(extra: &str) -> Case {
@@ -33,22 +31,12 @@ fn chains_case(extra: &str) -> Case {
     Case::new(&[("t.top", &(top + &bonds + &angles)), ("f.ff", ff), ("deck.in", &deck)])
 }
 
-fn run_with_threads(case: &Case, threads: usize) -> Simulation {
-    let plan = validate_file(&case.path("deck.in"), &[]).unwrap();
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-    pool.install(|| Simulation::execute(&plan, RunOptions { output_dir: case.output_dir().to_path_buf(), ..Default::default() }).unwrap())
-}
-
-fn bits(sim: &Simulation) -> Vec<[u64; 3]> {
-    sim.state.positions.iter().map(|x| [x.x.to_bits(), x.y.to_bits(), x.z.to_bits()]).collect()
-}
-
 #[test]
 fn one_and_two_threads_give_identical_bits() {
     let case = chains_case("run 500\n");
-    let one = run_with_threads(&case, 1);
-    let two = run_with_threads(&case, 2);
-    assert_eq!(bits(&one), bits(&two));
+    let one = case.run_with_threads(1);
+    let two = case.run_with_threads(2);
+    assert_eq!(position_bits(&one), position_bits(&two));
     assert_eq!(one.state.images, two.state.images);
     assert_eq!(one.forces.total_energy().to_bits(), two.forces.total_energy().to_bits());
     assert_eq!(one.forces.virial.map(f64::to_bits), two.forces.virial.map(f64::to_bits));
@@ -58,20 +46,20 @@ fn one_and_two_threads_give_identical_bits() {
 
 #[test]
 fn a_run_split_by_a_restart_is_bit_identical() {
-    let whole = run_with_threads(&chains_case("run 300\nrun 300\n"), 2);
+    let whole = chains_case("run 300\nrun 300\n").run_with_threads(2);
     let first = chains_case("run 300\nwrite_state half.state\n");
-    run_with_threads(&first, 2);
+    first.run_with_threads(2);
     let second = chains_case("read_state half.state\nrun 300\n");
     std::fs::copy(first.path("half.state"), second.path("half.state")).unwrap();
-    let resumed = run_with_threads(&second, 1);
+    let resumed = second.run_with_threads(1);
     assert_eq!(resumed.state.step, 600);
-    assert_eq!(bits(&whole), bits(&resumed));
+    assert_eq!(position_bits(&whole), position_bits(&resumed));
     assert_eq!(whole.state.images, resumed.state.images);
 }
 
 #[test]
 fn different_seeds_give_different_trajectories() {
-    let a = run_with_threads(&chains_case("run 20\n"), 2);
-    let b = run_with_threads(&chains_case("seed 100\nrun 20\n"), 2);
-    assert_ne!(bits(&a), bits(&b));
+    let a = chains_case("run 20\n").run_with_threads(2);
+    let b = chains_case("seed 100\nrun 20\n").run_with_threads(2);
+    assert_ne!(position_bits(&a), position_bits(&b));
 }

@@ -20,7 +20,7 @@ use cellmd::build::{icosphere_cell, IcosphereCell};
 use cellmd::deck::validate_file;
 use cellmd::gpu::DevicePreference;
 use cellmd::run::{RunOptions, Simulation};
-use common::{merge_topologies, Case};
+use common::{merge_topologies, position_bits, Case};
 use glam::DVec3;
 
 /// Enclosed volume and area of body 0 of a simulation.
@@ -225,15 +225,8 @@ fn body_terms_are_deterministic_and_refused_on_the_gpu() {
     let ff = "body cell turgor k 500 dp0 50 v0 400\nbody cell surface_tension gamma 100\nbody cell helfrich_bending kappa 0.5\nbody cell area_conservation kl 200 a0 300\n";
     let case = cell_case(3, 5.0, ff, "temperature 300\ntimestep 1e-4\nseed 5\nrun 200\n");
     let plan = case.plan();
-    let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-        pool.install(|| {
-            Simulation::execute(&plan, RunOptions { output_dir: case.output_dir().to_path_buf(), ..Default::default() }).unwrap()
-        })
-    };
-    let (one, two) = (run(1), run(2));
-    let bits = |s: &Simulation| s.state.positions.iter().map(|p| p.to_array().map(f64::to_bits)).collect::<Vec<_>>();
-    assert_eq!(bits(&one), bits(&two));
+    let (one, two) = (case.run_with_threads(1), case.run_with_threads(2));
+    assert_eq!(position_bits(&one), position_bits(&two));
     assert!(one.state.positions.iter().zip(&plan.positions).any(|(a, b)| (*a - *b).length() > 1e-3));
     let gpu = Simulation::execute(
         &plan,

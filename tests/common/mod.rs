@@ -13,6 +13,13 @@ pub struct Case {
 }
 
 impl Case {
+    /// Runs the deck on a pool of `threads` worker threads.
+    pub fn run_with_threads(&self, threads: usize) -> Simulation {
+        let plan = self.plan();
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| Simulation::execute(&plan, RunOptions { output_dir: self.dir.path().to_path_buf(), ..Default::default() }).unwrap())
+    }
+
     /// Files as (name, contents); the deck is `deck.in`.
     pub fn new(files: &[(&str, &str)]) -> Self {
         let dir = tempfile::tempdir().unwrap();
@@ -120,4 +127,9 @@ pub fn merge_topologies(texts: &[&str]) -> String {
         }
     }
     sections.iter().map(|(name, body)| if name.is_empty() { body.clone() } else { format!("{name}\n{body}") }).collect()
+}
+
+/// The bits of every position (for bit-identity checks).
+pub fn position_bits(sim: &Simulation) -> Vec<[u64; 3]> {
+    sim.state.positions.iter().map(|x| x.to_array().map(f64::to_bits)).collect()
 }
