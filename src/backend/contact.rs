@@ -29,9 +29,10 @@
 //! a pair closes by at most 0.8·d (additive CCD bound: the distance is
 //! 1-Lipschitz in each point), so no node passes through a face.
 
-use glam::DVec3;
+use glam::{DMat3, DVec3};
 use rayon::prelude::*;
 
+use super::stiffness::StiffnessBlock;
 use super::virial::{add6, outer};
 use crate::forcefield::TermType;
 use crate::interactions::{node_face_forces, Law, Radial};
@@ -280,6 +281,33 @@ impl Contacts {
                 *limit = limit.min(STEP_FRACTION * self.distance[k as usize]);
             }
         });
+    }
+
+    /// Appends each candidate pair's Gauss–Newton stiffness blocks
+    /// max(b″, 0)·g_a g_bᵀ, g = (n̂, −w_0 n̂, −w_1 n̂, −w_2 n̂) over (node, corners),
+    /// in pair order (see `src/backend/stiffness.rs`).
+    pub(super) fn stiffness(&self, model: &Model, x: &[DVec3], images: &Images, blocks: &mut Vec<StiffnessBlock>) {
+        for k in 0..self.pairs.len() {
+            let pt = self.geometry(k, x, images);
+            let [node, face] = self.pairs[k];
+            let (corners, face_body) = self.faces[face as usize];
+            let curvature: f64 = self
+                .rules_between(self.node_body[node as usize], face_body, model)
+                .iter()
+                .map(|&r| radial(&model.contact_rules[r as usize], pt.distance).d2e_dr2)
+                .sum();
+            if curvature <= 0.0 {
+                continue;
+            }
+            let nn = DMat3::from_cols(pt.normal * pt.normal.x, pt.normal * pt.normal.y, pt.normal * pt.normal.z) * curvature;
+            let particles = [self.nodes[node as usize], corners[0], corners[1], corners[2]];
+            let g = [1.0, -pt.weights[0], -pt.weights[1], -pt.weights[2]];
+            for a in 0..4 {
+                for b in 0..4 {
+                    blocks.push(StiffnessBlock { i: particles[a], j: particles[b], block: nn * (g[a] * g[b]) });
+                }
+            }
+        }
     }
 
     /// Energies per registry entry and the virial (d·n̂ ⊗ f_node per pair), pair by pair.

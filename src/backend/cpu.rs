@@ -216,6 +216,10 @@ impl CpuBackend {
         &self.surfaces
     }
 
+    pub(super) fn contacts(&self) -> &Contacts {
+        &self.contacts
+    }
+
     /// The neighbour list, or None when the model has no pair terms.
     pub(super) fn neighbor_list(&self) -> Option<&NeighborList> {
         (!self.pair_interactions.is_empty()).then_some(&self.neighbors)

@@ -20,8 +20,13 @@
 //! - **Surface terms of bodies** (turgor, tension, bending) contribute no
 //!   block yet: they enter the implicit step through F only, so their own
 //!   explicit stability limit still applies to them.
-//! - **Contact terms between bodies** have no block either: the run refuses
-//!   `integrator implicit` with `contact` lines (no step clamp there yet).
+//! - **Contact pairs between bodies** (node p, face corners x_k, distance d
+//!   to the closest point q = Σ w_k x_k): the Gauss–Newton block
+//!   max(b″, 0)·g gᵀ with g = ∂d/∂(p, x_0, x_1, x_2) = (n̂, −w_0 n̂, −w_1 n̂,
+//!   −w_2 n̂) (the weights' own derivatives drop out at a closest point).
+//!   The dropped part b′·∂²d is negative semi-definite for a repulsive
+//!   barrier (b′ < 0): the projection would remove it anyway. The implicit
+//!   step also applies the contact step clamp.
 //!
 //! Blocks come in term order (bonds, angles, pairs by particle and ascending
 //! neighbour, externals), so the assembled matrix is the same on any thread
@@ -135,6 +140,7 @@ impl CpuBackend {
                 }
             }
         }
+        self.contacts().stiffness(model, x, &images, &mut blocks);
         for external in &model.externals {
             let Law::OneBody(eval) = external.term.interaction.law() else { unreachable!("external law is one-body") };
             for &m in &external.members {

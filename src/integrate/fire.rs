@@ -8,6 +8,13 @@
 //!
 //! then v ← v + Δt·F/m and x ← x + Δt·v, each particle's move capped at `dmax`
 //! (as LAMMPS `min_modify dmax`). Converged when max |Fᵢ| < `ftol`.
+//!
+//! **Step clamp** (contact between bodies): when the evaluation also gives
+//! per-particle limits Lᵢ (the contact clamp of `src/backend/contact.rs`:
+//! no node or face corner may move more than 0.4 × the distance of its
+//! closest contact), the whole move is scaled by s = min(1, minᵢ Lᵢ/|Δxᵢ|),
+//! a line search that keeps every body outside every other; the velocities
+//! are kept, so FIRE's own Δt adaptation is unchanged.
 
 use glam::DVec3;
 
@@ -36,16 +43,25 @@ pub struct FireReport {
     pub iterations: u64,
     pub energy: f64,
     pub max_force: f64,
+    /// Iterations whose move the contact step clamp shortened.
+    pub clamped: u64,
 }
 
-/// Minimises with FIRE. `evaluate` fills the forces at a state and returns the energy.
+/// The largest s ∈ (0, 1] with s·|Δxᵢ| ≤ Lᵢ for every particle (1 when `limits` is empty).
+pub fn clamp_fraction(moves: &[DVec3], limits: &[f64]) -> f64 {
+    limits.iter().zip(moves).map(|(limit, dx)| if dx.length() > *limit { limit / dx.length() } else { 1.0 }).fold(1.0, f64::min)
+}
+
+/// Minimises with FIRE. `evaluate` fills the forces at a state, and the
+/// per-particle step limits if the model has any (else leaves them empty),
+/// and returns the energy.
 pub fn fire_minimize<E>(
     state: &mut State,
     sim_box: &SimBox,
     mass: &[f64],
     dt0: f64,
     settings: &FireSettings,
-    mut evaluate: impl FnMut(&State, &mut Vec<DVec3>) -> Result<f64, E>,
+    mut evaluate: impl FnMut(&State, &mut Vec<DVec3>, &mut Vec<f64>) -> Result<f64, E>,
 ) -> Result<FireReport, E> {
     const N_MIN: u32 = 5;
     const F_INC: f64 = 1.1;
@@ -55,13 +71,15 @@ pub fn fire_minimize<E>(
     let n = state.len();
     let mut v = vec![DVec3::ZERO; n];
     let mut f = Vec::with_capacity(n);
+    let (mut limits, mut moves) = (Vec::new(), vec![DVec3::ZERO; n]);
     let (mut dt, dt_max, mut alpha, mut positive_steps) = (dt0, 10.0 * dt0, ALPHA0, 0u32);
-    let mut iterations = 0;
+    let (mut iterations, mut clamped) = (0, 0);
     loop {
-        let energy = evaluate(state, &mut f)?;
+        limits.clear();
+        let energy = evaluate(state, &mut f, &mut limits)?;
         let max_force = f.iter().map(|x| x.length()).fold(0.0, f64::max);
         if max_force < settings.ftol || iterations >= settings.max_iterations {
-            return Ok(FireReport { converged: max_force < settings.ftol, iterations, energy, max_force });
+            return Ok(FireReport { converged: max_force < settings.ftol, iterations, energy, max_force, clamped });
         }
         iterations += 1;
         let power: f64 = f.iter().zip(&v).map(|(f, v)| f.dot(*v)).sum();
@@ -84,13 +102,15 @@ pub fn fire_minimize<E>(
         }
         for i in 0..n {
             v[i] += dt * f[i] / mass[i];
-            let mut dx = dt * v[i];
+            let dx = dt * v[i];
             let len = dx.length();
-            if len > settings.dmax {
-                dx *= settings.dmax / len;
-            }
-            state.positions[i] += dx;
-            sim_box.wrap(&mut state.positions[i], &mut state.images[i]);
+            moves[i] = if len > settings.dmax { dx * (settings.dmax / len) } else { dx };
+        }
+        let s = clamp_fraction(&moves, &limits);
+        clamped += u64::from(s < 1.0);
+        for ((x, image), dx) in state.positions.iter_mut().zip(state.images.iter_mut()).zip(&moves) {
+            *x += s * *dx;
+            sim_box.wrap(x, image);
         }
     }
 }
@@ -104,14 +124,49 @@ mod tests {
         let sim_box = SimBox::new(DVec3::splat(-10.0), DVec3::splat(10.0), [false; 3]);
         let mut state = State::new(vec![DVec3::new(1.0, -2.0, 0.5), DVec3::new(-0.3, 0.2, 0.9)]);
         let k = DVec3::new(1.0, 50.0, 400.0);
-        let report =
-            fire_minimize::<()>(&mut state, &sim_box, &[1e-3, 1e-3], 1e-3, &FireSettings { ftol: 1e-8, ..Default::default() }, |s, f| {
+        let report = fire_minimize::<()>(
+            &mut state,
+            &sim_box,
+            &[1e-3, 1e-3],
+            1e-3,
+            &FireSettings { ftol: 1e-8, ..Default::default() },
+            |s, f, _| {
                 f.clear();
                 f.extend(s.positions.iter().map(|x| -k * *x));
                 Ok(s.positions.iter().map(|x| 0.5 * (k * *x).dot(*x)).sum())
-            })
-            .unwrap();
+            },
+        )
+        .unwrap();
         assert!(report.converged, "{report:?}");
         assert!(state.positions.iter().all(|x| x.length() < 1e-8 / 1.0));
+    }
+
+    /// With limits L = 0.4·(x − 1) (a contact at x = 1), FIRE sliding down
+    /// a slope towards x = 0 approaches x = 1 but never reaches it.
+    #[test]
+    fn the_step_clamp_keeps_particles_short_of_their_contact() {
+        let sim_box = SimBox::new(DVec3::splat(-10.0), DVec3::splat(10.0), [false; 3]);
+        let mut state = State::new(vec![DVec3::new(3.0, 0.0, 0.0)]);
+        let mut lowest = f64::INFINITY;
+        let settings = FireSettings { ftol: 1e-12, max_iterations: 60, dmax: 0.5 };
+        let report = fire_minimize::<()>(&mut state, &sim_box, &[1.0], 0.1, &settings, |s, f, limits| {
+            lowest = lowest.min(s.positions[0].x);
+            f.clear();
+            f.push(DVec3::new(-1.0, 0.0, 0.0));
+            limits.push(0.4 * (s.positions[0].x - 1.0));
+            Ok(s.positions[0].x)
+        })
+        .unwrap();
+        assert!(report.clamped > 10, "{report:?}");
+        assert!(lowest > 1.0 && lowest < 1.0 + 1e-3, "closest approach {lowest}");
+    }
+
+    #[test]
+    fn clamp_fraction_is_the_largest_safe_scale() {
+        let moves = [DVec3::new(1.0, 0.0, 0.0), DVec3::new(0.0, 0.5, 0.0)];
+        assert_eq!(clamp_fraction(&moves, &[]), 1.0);
+        assert_eq!(clamp_fraction(&moves, &[2.0, f64::INFINITY]), 1.0);
+        assert_eq!(clamp_fraction(&moves, &[0.25, 0.5]), 0.25);
+        assert_eq!(clamp_fraction(&moves, &[1.0, 0.1]), 0.2);
     }
 }

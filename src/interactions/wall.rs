@@ -14,7 +14,7 @@ const K: usize = 4;
 static PARAMS: [ParamSpec; 5] = [
     ParamSpec::new("nx", Dim::Dimensionless, "x component of the wall normal (normalised internally)").default(0.0),
     ParamSpec::new("ny", Dim::Dimensionless, "y component of the wall normal (normalised internally)").default(0.0),
-    ParamSpec::new("nz", Dim::Dimensionless, "z component of the wall normal (normalised internally)").default(1.0),
+    ParamSpec::new("nz", Dim::Dimensionless, "z component of the wall normal (normalised internally)").default(0.0),
     ParamSpec::new("d", Dim::Length, "offset of the plane n̂·x = d from the origin, along n̂").default(0.0),
     ParamSpec::new("k", Dim::Stiffness, "stiffness of the wall").non_negative(),
 ];

@@ -478,11 +478,6 @@ impl Simulation {
     /// `run N`: N overdamped steps, on the CPU backend or the GPU.
     pub fn run(&mut self, steps: u64) -> Result<(), RunError> {
         self.check_kinetics_temperature()?;
-        if self.integrator.implicit.is_some() && self.model.has_contact_terms() {
-            return Err(RunError::Setup(
-                "`integrator implicit` has no contact step clamp yet, so `contact` terms could let bodies pass through each other; use `integrator overdamped`".into(),
-            ));
-        }
         self.ensure_forces()?;
         let gpu = self.gpu_for_run()?;
         let bar = (self.options.progress && steps >= 1000).then(|| {
@@ -595,6 +590,7 @@ impl Simulation {
     fn implicit_step(&mut self, implicit: &ImplicitSettings) -> Result<Result<(), Blowup>, RunError> {
         let backend = self.backend.as_ref().expect("backend built");
         let stiffness = backend.stiffness(&self.model, &self.state, &self.sim_box);
+        let limited = backend.contact_step_limits(self.model.len(), &mut self.step_limits);
         let (model, forces, sim_box) = (&self.model, &self.forces.forces, &self.sim_box);
         let mut constrained =
             ConstrainedBonds { pairs: self.constraints.list.iter().map(|c| model.bonds[c.bond]).collect(), tension: Vec::new() };
@@ -610,10 +606,12 @@ impl Simulation {
             &self.integrator,
             implicit,
             &mut constrained,
+            limited.then_some(self.step_limits.as_slice()),
         );
         self.implicit_tension = constrained.tension;
         match outcome {
             Ok(report) => {
+                self.contact_clamps += u64::from(report.step_fraction < 1.0);
                 self.last_solve = report;
                 Ok(Ok(()))
             }
@@ -833,19 +831,16 @@ impl Simulation {
 
     /// `minimize`: FIRE to max |F| < ftol. The step counter does not advance.
     pub fn minimize(&mut self, settings: &FireSettings) -> Result<(), RunError> {
-        if self.model.has_contact_terms() {
-            return Err(RunError::Setup(
-                "`minimize` (FIRE) has no contact step clamp yet, so `contact` terms could let bodies pass through each other; relax with `run` at temperature 0 instead".into(),
-            ));
-        }
         self.ensure_forces()?;
         let mass: Vec<f64> = self.model.types.iter().map(|&t| self.model.type_drag[t as usize] * self.dt).collect();
         let mut state = self.state.clone();
         let backend = self.backend.as_mut().expect("backend built");
         let (model, sim_box, forces) = (&self.model, &self.sim_box, &mut self.forces);
-        let report = fire_minimize(&mut state, sim_box, &mass, self.dt, settings, |s, f| {
+        let report = fire_minimize(&mut state, sim_box, &mass, self.dt, settings, |s, f, limits| {
             backend.update_neighbors(s, sim_box, true).map_err(RunError::Setup)?;
+            backend.update_contacts(model, s, sim_box).map_err(RunError::Setup)?;
             backend.compute(model, s, sim_box, forces);
+            backend.contact_step_limits(s.len(), limits);
             f.clone_from(&forces.forces);
             Ok::<f64, RunError>(forces.total_energy())
         })?;
@@ -857,9 +852,14 @@ impl Simulation {
         }
         let verdict = if report.converged { "converged" } else { "stopped at maxiter without converging" };
         self.say(&format!(
-            "minimize (FIRE): {verdict} after {} iterations: max |F| = {:e} (ftol {:e}), pe = {:e}",
-            report.iterations, report.max_force, settings.ftol, report.energy
+            "minimize (FIRE): {verdict} after {} iterations: max |F| = {:e} (ftol {:e}), pe = {:e}{}",
+            report.iterations,
+            report.max_force,
+            settings.ftol,
+            report.energy,
+            if report.clamped > 0 { format!(", {} moves shortened by the contact step clamp", report.clamped) } else { String::new() }
         ));
+        self.contact_clamps += report.clamped;
         self.last_minimize = Some(report);
         Ok(())
     }

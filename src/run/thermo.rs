@@ -20,7 +20,7 @@
 //! | `tension/TYPE` | summed tension of TYPE's bound bonds (clutch traction) | pN |
 //! | `volume/BODYTYPE`, `area/BODYTYPE` | summed enclosed volume and area of the bodies of a type | µm³, µm² |
 //! | `mindist` | smallest node–face distance between different bodies (exact below the largest contact d̂; `inf` when no pair is within the search range) | µm |
-//! | `nclamp` | explicit steps shortened by the contact step clamp so far | – |
+//! | `nclamp` | steps (explicit or implicit) and FIRE moves shortened by the contact step clamp so far | – |
 //! | `planetension/AXIS/POS` | normal force transmitted across the plane x_AXIS = POS by every bond, pair, angle and body term crossing it; positive = tension ([`planes`](crate::measure::planes)) | pN |
 //! | `gamma/BODYTYPE` | cortical tension γ = ⟨Σ_cut T·\|û·n̂\|⟩/(2πR) over diametral planes of each body, mean over the type's bodies ([`planes`](crate::measure::planes)) | pN/µm |
 //! | `e2e/BONDTYPE` | mean end-to-end distance of the chains of bonds of the type ([`filaments`](crate::measure::filaments)) | µm |
