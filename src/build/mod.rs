@@ -77,7 +77,7 @@ pub use self::cells::{cells, CellsArgs, Layout};
 pub use self::cortex::{cortex, CortexArgs};
 pub use self::filament::{filament, FilamentArgs};
 pub use self::filopodium::{filopodium, FilopodiumArgs};
-pub use self::icosphere::{icosphere, icosphere_cell, IcosphereArgs, IcosphereCell, Nucleus};
+pub use self::icosphere::{icosphere, icosphere_cell, IcosphereArgs, IcosphereCell, Nucleus, ShellOptions};
 pub use self::network::{network, NetworkArgs};
 
 /// The `cellmd build` subcommands: one per generator.
@@ -150,7 +150,8 @@ pub struct Common {
 /// Statistics of one closed shell (a cell or a nucleus) as written.
 #[derive(Clone, Debug)]
 pub struct Shell {
-    pub body_id: u64,
+    /// Its body, if it was written as one.
+    pub body_id: Option<u64>,
     pub nodes: usize,
     pub edges: usize,
     pub faces: usize,
@@ -432,6 +433,16 @@ impl Draws {
     }
 }
 
+/// The smallest, mean and largest of `values` (all 0 when there are none).
+pub(crate) fn min_mean_max(values: &[f64]) -> [f64; 3] {
+    if values.is_empty() {
+        return [0.0; 3];
+    }
+    let lo = values.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    [lo, values.iter().sum::<f64>() / values.len() as f64, hi]
+}
+
 /// Expects a finite positive value of option `name`.
 pub(crate) fn positive(name: &str, v: f64) -> Result<f64, String> {
     if v.is_finite() && v > 0.0 {
@@ -620,9 +631,7 @@ impl Crosslinks {
             types.0.iter().enumerate().map(|(t, (name, _))| format!("{name} {}", self.links.iter().filter(|l| l.0 == t).count())).collect();
         let mut s = format!("{} crosslinks ({})", self.links.len(), counts.join(", "));
         if !self.links.is_empty() {
-            let d = self.links.iter().map(|l| l.3);
-            let (lo, hi) = (d.clone().fold(f64::INFINITY, f64::min), d.clone().fold(0.0, f64::max));
-            let mean = d.sum::<f64>() / self.links.len() as f64;
+            let [lo, mean, hi] = min_mean_max(&self.links.iter().map(|l| l.3).collect::<Vec<_>>());
             write!(s, "; crosslink length min {lo:.6e} mean {mean:.6e} max {hi:.6e} (for r0)").unwrap();
         }
         s
