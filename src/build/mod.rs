@@ -21,8 +21,10 @@
 //! | [`branched()`] | `branched` | Arp2/3 network: mother filaments with daughters at 70° ± a spread |
 //! | [`filopodium()`] | `filopodium` | a hexagonal bundle of parallel filaments, crosslinked between neighbours |
 //! | [`cells()`] | `cells` | many icosphere cells packed in a spheroid or a confluent layer |
+//! | [`sheet()`] | `sheet` | a 2D epithelial sheet (seed 001): hexagonal cells as rings of nodes (or single particles) joined by junction bonds |
 //!
-//! **Filaments** (every generator but the cells) are chains of beads with a
+//! **Filaments** (of `filament`, `network`, `aster`, `cortex`, `branched`
+//! and `filopodium`) are chains of beads with a
 //! bond between consecutive beads and an angle on every consecutive triple
 //! (vertex in the middle), the form of [`wlc_bending`](crate::interactions)
 //! and `cosine_angle`. A chain of contour length L has `--segments n` bonds
@@ -61,6 +63,7 @@ mod filament;
 mod filopodium;
 mod icosphere;
 mod network;
+mod sheet;
 
 use std::f64::consts::TAU;
 use std::fmt::Write;
@@ -79,6 +82,7 @@ pub use self::filament::{filament, FilamentArgs};
 pub use self::filopodium::{filopodium, FilopodiumArgs};
 pub use self::icosphere::{icosphere, icosphere_cell, IcosphereArgs, IcosphereCell, Nucleus, ShellOptions};
 pub use self::network::{network, NetworkArgs};
+pub use self::sheet::{sheet, SheetArgs};
 
 /// The `cellmd build` subcommands: one per generator.
 #[derive(clap::Subcommand, Clone, Debug)]
@@ -104,6 +108,10 @@ pub enum Generator {
     Filopodium(FilopodiumArgs),
     /// Many icosphere cells packed without overlap in a spheroid or a confluent layer.
     Cells(CellsArgs),
+    /// A 2D epithelial sheet (seed 001): hexagonal cells, each a ring of
+    /// nodes with edge bonds and a centre node with spokes (or one particle),
+    /// neighbours joined by junction bonds.
+    Sheet(SheetArgs),
 }
 
 impl Generator {
@@ -118,6 +126,7 @@ impl Generator {
             Self::Branched(a) => branched(a),
             Self::Filopodium(a) => filopodium(a),
             Self::Cells(a) => cells(a),
+            Self::Sheet(a) => sheet(a),
         }
     }
 
@@ -132,6 +141,7 @@ impl Generator {
             Self::Branched(a) => a.common.output.as_path(),
             Self::Filopodium(a) => a.common.output.as_path(),
             Self::Cells(a) => a.common.output.as_path(),
+            Self::Sheet(a) => a.common.output.as_path(),
         }
     }
 }
@@ -383,6 +393,7 @@ pub(crate) mod stream {
     pub const BRANCHED: u32 = 0x6275_0005;
     pub const FILOPODIUM: u32 = 0x6275_0006;
     pub const CELLS: u32 = 0x6275_0007;
+    pub const SHEET: u32 = 0x6275_0008;
 }
 
 impl Draws {
