@@ -196,6 +196,8 @@ fn bad_options_exit_with_status_2_and_say_what_was_expected() {
         (&["icosphere", "--level", "1", "--radius", "1", "--nucleus", "2"][..], "expected 0 < --nucleus RADIUS < --radius 1, found 2"),
         (&["sheet", "--rows", "2", "--columns", "2", "--cell-size", "-1"][..], "expected --cell-size > 0, found -1"),
         (&["sheet", "--rows", "2", "--columns", "2", "--cell-size", "3", "--jitter", "0.49", "--gap", "1"][..], "convex hexagon"),
+        (&["tensegrity", "--radius", "5", "--level", "1", "--microtubules", "50"][..], "expected --microtubules <= 42"),
+        (&["tensegrity", "--radius", "5", "--nucleus", "6"][..], "expected 0 < --nucleus RADIUS < --radius 5, found 6"),
     ] {
         let mut all = vec!["build"];
         all.extend_from_slice(args);
@@ -208,10 +210,15 @@ fn bad_options_exit_with_status_2_and_say_what_was_expected() {
     }
 }
 
+/// The number that the summary `said` prints after `key` after `what` ("… WHAT … KEY 1.5 …").
+fn printed(said: &str, what: &str, key: &str) -> f64 {
+    let rest = said.split(what).nth(1).unwrap_or_else(|| panic!("no `{what}` in {said}"));
+    rest.split(key).nth(1).unwrap().split([' ', ',']).next().unwrap().parse().unwrap()
+}
+
 /// The mean that the summary `said` prints after `what` ("… WHAT … mean b …").
 fn printed_mean(said: &str, what: &str) -> f64 {
-    let rest = said.split(what).nth(1).unwrap_or_else(|| panic!("no `{what}` in {said}"));
-    rest.split(" mean ").nth(1).unwrap().split(' ').next().unwrap().parse().unwrap()
+    printed(said, what, " mean ")
 }
 
 /// Runs `deck` with the force field `ff` on `out.top` in `dir`; returns what it printed.
@@ -322,4 +329,152 @@ fn sheet() {
     println!("regular sheet pulled by factor × n_S·F_c (n_S = {n_s}): (factor, breaks, bound of {total}) {outcomes:?}");
     assert_eq!((outcomes[0].1, outcomes[0].2), (0, total), "{outcomes:?}");
     assert!(outcomes[4].1 > 0 && outcomes[4].2 < total, "{outcomes:?}");
+}
+
+/// Relaxes the structure by FIRE and returns each bond's (type, length, tension) at the minimum.
+fn relaxed_bonds(dir: &Path, ff: &str) -> Vec<(String, f64, f64)> {
+    let deck = "box x -20 20 f y -20 20 f z -20 20 f\ntimestep 1e-4\nminimize ftol 1e-9 maxiter 200000\ndump b every 1000 bonds bonds.csv\nrun 1\n";
+    run_in(dir, ff, deck);
+    let rows = csv_columns(&dir.join("bonds.csv"), &["step", "type", "length", "tension"]);
+    rows.into_iter().filter(|r| r[0] == "0").map(|r| (r[1].clone(), r[2].parse().unwrap(), r[3].parse().unwrap())).collect()
+}
+
+/// The symmetric equilibrium of the icosahedral tensegrity cell of
+/// `src/build/tensegrity.rs` (cortex R, nucleus RN, a strut on every ray):
+/// tensions (strut, cortex edge, nucleus edge, actin cable) in pN, by
+/// Newton's method on the radii (R′, RN′) of the two cortex and nucleus node balances.
+fn icosahedral_equilibrium(r: f64, rn: f64, [kc, tau_c, kn, ks, ka, tau_a]: [f64; 6]) -> [f64; 4] {
+    let (c, q) = (1.0 / 5f64.sqrt(), 2.5 / (0.4 * std::f64::consts::PI).sin());
+    let l = r - rn;
+    let d0 = (r * r + rn * rn - 2.0 * r * rn * c).sqrt();
+    let tensions = |x: [f64; 2]| {
+        let d = (x[0] * x[0] + x[1] * x[1] - 2.0 * x[0] * x[1] * c).sqrt();
+        let strut = ks * ((x[0] - x[1]) - l) / l;
+        let cortex = kc * (x[0] / r - 1.0 + tau_c);
+        let nucleus = kn * (x[1] / rn - 1.0);
+        let actin = ka * (d / d0 - 1.0 + tau_a);
+        ([strut, cortex, nucleus, actin], d)
+    };
+    // Outward force on a cortex node and on a nucleus node.
+    let residual = |x: [f64; 2]| {
+        let ([strut, cortex, nucleus, actin], d) = tensions(x);
+        [-strut - q * cortex - 5.0 * actin * (x[0] - x[1] * c) / d, strut - q * nucleus + 5.0 * actin * (x[0] * c - x[1]) / d]
+    };
+    let mut x = [r, rn];
+    for _ in 0..50 {
+        let f = residual(x);
+        let h = 1e-7;
+        let j: Vec<[f64; 2]> = (0..2)
+            .map(|k| {
+                let mut y = x;
+                y[k] += h;
+                let g = residual(y);
+                [(g[0] - f[0]) / h, (g[1] - f[1]) / h]
+            })
+            .collect();
+        let det = j[0][0] * j[1][1] - j[1][0] * j[0][1];
+        x[0] -= (f[0] * j[1][1] - f[1] * j[1][0]) / det;
+        x[1] -= (j[0][0] * f[1] - j[0][1] * f[0]) / det;
+    }
+    let f = residual(x);
+    assert!(f[0].abs() + f[1].abs() < 1e-12, "Newton did not converge: {f:?}");
+    tensions(x).0
+}
+
+#[test]
+fn tensegrity() {
+    // Level 0: an icosahedral cortex (R = 5) around an icosahedral nucleus
+    // (RN = 2), a strut on every ray and crossing actin cables. Pre-strained
+    // cables put the struts in compression; by symmetry the engine's relaxed
+    // structure must match the two-equation equilibrium.
+    let dir = tempfile::tempdir().unwrap();
+    let said = build_in(dir.path(), &["tensegrity", "--radius", "5", "--level", "0", "--nucleus", "2", "--microtubules", "12"]);
+    assert!(said.contains("radial elements of length L = 3.0 (r0): 12 microtubule struts") && said.contains("60 actin cables"), "{said}");
+    let sin72 = (0.4 * std::f64::consts::PI).sin();
+    let (r, rn) = (5.0, 2.0);
+    let d0 = (r * r + rn * rn - 2.0 * r * rn / 5f64.sqrt()).sqrt();
+    let ff = |[kc, tau_c, kn, ks, ka, tau_a]: [f64; 6]| {
+        format!(
+            "particle node drag 1\nparticle nucleus_node drag 1\nbond edge cable k {kc} r0 {:?} tau {tau_c}\nbond nucleus_edge spring k {kn} r0 {:?}\n\
+             bond microtubule spring k {ks} r0 3\nbond actin cable k {ka} r0 {d0:?} tau {tau_a}\n",
+            r / sin72,
+            rn / sin72
+        )
+    };
+    let params = [100.0, 0.1, 200.0, 300.0, 20.0, 0.05];
+    let expected = icosahedral_equilibrium(r, rn, params);
+    let bonds = relaxed_bonds(dir.path(), &ff(params));
+    let mut errors = Vec::new();
+    for (name, count, t) in
+        [("microtubule", 12, expected[0]), ("edge", 30, expected[1]), ("nucleus_edge", 30, expected[2]), ("actin", 60, expected[3])]
+    {
+        let of: Vec<f64> = bonds.iter().filter(|b| b.0 == name).map(|b| b.2).collect();
+        assert_eq!(of.len(), count);
+        errors.push(of.iter().map(|x| (x / t - 1.0).abs()).fold(0.0, f64::max));
+    }
+    println!(
+        "icosahedral tensegrity: exact tensions (strut, cortex, nucleus edge, actin) {expected:?} pN; worst relative errors {errors:?}"
+    );
+    assert!(expected[0] < 0.0 && expected[1] > 0.0 && expected[3] > 0.0, "{expected:?}");
+    assert!(errors.iter().all(|e| *e < 1e-6), "{errors:?}");
+    // Without pre-strain the structure is at rest as built: no force anywhere.
+    let slack = relaxed_bonds(dir.path(), &ff([100.0, 0.0, 200.0, 300.0, 20.0, 0.0]));
+    assert!(slack.iter().all(|b| b.2.abs() < 1e-9), "{slack:?}");
+
+    // Level 2 with everything: a strut on every ray, 12 focal adhesions held
+    // fixed, stress fibres of 3 cables, actin cables, and the shells as
+    // bodies whose turgor stands for seed 003's cytosol and nucleoskeleton
+    // (without them the cable cortex folds up and the spring nucleus buckles
+    // in). Relaxed, the cell holds its shape with every cable in tension and
+    // every strut in compression.
+    let said = build_in(
+        dir.path(),
+        &[
+            "tensegrity",
+            "--radius",
+            "5",
+            "--level",
+            "2",
+            "--nucleus",
+            "2.5",
+            "--microtubules",
+            "162",
+            "--focal-adhesions",
+            "12",
+            "--fibre-segments",
+            "3",
+            "--seed",
+            "4",
+            "--bodies",
+        ],
+    );
+    assert!(said.contains("radial elements of length L = 2.5 (r0): 162 microtubule struts"), "{said}");
+    let (edge, nucleus_edge, actin) =
+        (printed_mean(&said, "cortex ("), printed_mean(&said, "nucleus ("), printed_mean(&said, "actin cables"));
+    let ff = format!(
+        "particle node drag 1\nparticle nucleus_node drag 1\nparticle fibre_bead drag 1\nparticle focal_adhesion fixed\n\
+         bond edge cable k 100 r0 {edge} tau 0.2\nbond nucleus_edge spring k 200 r0 {nucleus_edge}\nbond microtubule spring k 300 r0 2.5\n\
+         bond actin cable k 20 r0 {actin} tau 0.2\nbond stress_fibre cable k 50 r0 {} tau 0.1\n\
+         body cell turgor k 100 v0 {}\nbody nucleus turgor k 5000 v0 {}\n",
+        2.5 / 3.0,
+        printed(&said, "cortex (", "enclosed volume "),
+        printed(&said, "nucleus (", "enclosed volume ")
+    );
+    let bonds = relaxed_bonds(dir.path(), &ff);
+    let of = |name: &str| bonds.iter().filter(|b| b.0 == name).collect::<Vec<_>>();
+    let range = |name: &str| {
+        let t: Vec<f64> = of(name).iter().map(|b| b.2).collect();
+        (t.len(), t.iter().copied().fold(f64::INFINITY, f64::min), t.iter().copied().fold(f64::NEG_INFINITY, f64::max))
+    };
+    let report: Vec<_> = ["edge", "actin", "stress_fibre", "microtubule", "nucleus_edge"].iter().map(|n| (n, range(n))).collect();
+    println!("relaxed tensegrity cell, tension (count, min, max) per type in pN: {report:?}");
+    for name in ["edge", "actin", "stress_fibre"] {
+        assert!(range(name).1 > 0.0, "{name} goes slack: {report:?}");
+    }
+    assert!(range("microtubule").2 < 0.0, "a strut is not compressed: {report:?}");
+    // It holds its shape: the struts shorten by little, the cortex stays near its size.
+    let mean_length = |name: &str| of(name).iter().map(|b| b.1).sum::<f64>() / of(name).len() as f64;
+    let (strut, cortex) = (mean_length("microtubule") / 2.5, mean_length("edge") / edge);
+    println!("mean strut length / L = {strut:.4}, mean cortex edge / built = {cortex:.4}");
+    assert!(strut > 0.9 && strut < 1.0 && cortex > 0.8 && cortex < 1.0, "{strut} {cortex}");
 }

@@ -22,6 +22,7 @@
 //! | [`filopodium()`] | `filopodium` | a hexagonal bundle of parallel filaments, crosslinked between neighbours |
 //! | [`cells()`] | `cells` | many icosphere cells packed in a spheroid or a confluent layer |
 //! | [`sheet()`] | `sheet` | a 2D epithelial sheet (seed 001): hexagonal cells as rings of nodes (or single particles) joined by junction bonds |
+//! | [`tensegrity()`] | `tensegrity` | a tensegrity cell (seed 003): cortex and nucleus shells, radial microtubule struts, actin cables and stress fibres from focal adhesions |
 //!
 //! **Filaments** (of `filament`, `network`, `aster`, `cortex`, `branched`
 //! and `filopodium`) are chains of beads with a
@@ -64,6 +65,7 @@ mod filopodium;
 mod icosphere;
 mod network;
 mod sheet;
+mod tensegrity;
 
 use std::f64::consts::TAU;
 use std::fmt::Write;
@@ -83,6 +85,7 @@ pub use self::filopodium::{filopodium, FilopodiumArgs};
 pub use self::icosphere::{icosphere, icosphere_cell, IcosphereArgs, IcosphereCell, Nucleus, ShellOptions};
 pub use self::network::{network, NetworkArgs};
 pub use self::sheet::{sheet, SheetArgs};
+pub use self::tensegrity::{tensegrity, TensegrityArgs};
 
 /// The `cellmd build` subcommands: one per generator.
 #[derive(clap::Subcommand, Clone, Debug)]
@@ -112,6 +115,10 @@ pub enum Generator {
     /// nodes with edge bonds and a centre node with spokes (or one particle),
     /// neighbours joined by junction bonds.
     Sheet(SheetArgs),
+    /// A tensegrity cell (seed 003): a cortex shell, a nucleus shell (or a
+    /// centrosome node), radial microtubule struts, actin cables from the
+    /// cortex to the nucleus and stress fibres from focal adhesions.
+    Tensegrity(TensegrityArgs),
 }
 
 impl Generator {
@@ -127,6 +134,7 @@ impl Generator {
             Self::Filopodium(a) => filopodium(a),
             Self::Cells(a) => cells(a),
             Self::Sheet(a) => sheet(a),
+            Self::Tensegrity(a) => tensegrity(a),
         }
     }
 
@@ -142,6 +150,7 @@ impl Generator {
             Self::Filopodium(a) => a.common.output.as_path(),
             Self::Cells(a) => a.common.output.as_path(),
             Self::Sheet(a) => a.common.output.as_path(),
+            Self::Tensegrity(a) => a.common.output.as_path(),
         }
     }
 }
@@ -241,6 +250,16 @@ impl Writer {
     pub fn particle(&mut self, type_name: &str, x: DVec3, body: Option<u64>) -> u64 {
         self.particles.push((type_name.to_string(), x, body));
         self.first_id + self.particles.len() as u64 - 1
+    }
+
+    /// The id the next particle will get.
+    pub fn next_id(&self) -> u64 {
+        self.first_id + self.particles.len() as u64
+    }
+
+    /// Gives particle `id` another type.
+    pub fn set_type(&mut self, id: u64, type_name: &str) {
+        self.particles[(id - self.first_id) as usize].0 = type_name.to_string();
     }
 
     /// The position of particle `id`.
@@ -394,6 +413,7 @@ pub(crate) mod stream {
     pub const FILOPODIUM: u32 = 0x6275_0006;
     pub const CELLS: u32 = 0x6275_0007;
     pub const SHEET: u32 = 0x6275_0008;
+    pub const TENSEGRITY: u32 = 0x6275_0009;
 }
 
 impl Draws {
