@@ -422,6 +422,13 @@ mod tests {
     }
 
     #[test]
+    fn the_committed_sheet_is_what_the_builder_writes() {
+        let a = SheetArgs { rows: 8, columns: 12, ..SheetArgs::default() };
+        let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/topologies/sheet.top")).unwrap();
+        assert_eq!(sheet(&a).unwrap().text, text);
+    }
+
+    #[test]
     fn bad_options_say_what_was_expected() {
         let a = SheetArgs::default();
         assert_eq!(sheet(&SheetArgs { cell_size: 0.0, ..a.clone() }).unwrap_err(), "expected --cell-size > 0, found 0");

@@ -215,6 +215,11 @@ fn draw_struts(unit: &[DVec3], struts: usize, towards: DVec3, sigma: f64, draws:
     chosen
 }
 
+/// `x` rounded to 4 decimals, a rounding error around 0 printed as 0 (not −0).
+fn four_places(x: f64) -> f64 {
+    (x * 1e4).round() / 1e4 + 0.0
+}
+
 /// `cellmd build tensegrity`: a cortex shell, a nucleus shell (or a
 /// centrosome node), radial microtubule struts and, from each focal
 /// adhesion, a stress fibre, and actin cables from each cortex node to the
@@ -336,8 +341,8 @@ pub fn tensegrity(a: &TensegrityArgs) -> Result<Built, String> {
         towards.y,
         towards.z,
         a.common.seed,
-        struts_cos.iter().sum::<f64>() / struts_cos.len().max(1) as f64,
-        unit.iter().map(|u| u.dot(towards)).sum::<f64>() / rays as f64
+        four_places(struts_cos.iter().sum::<f64>() / struts_cos.len().max(1) as f64),
+        four_places(unit.iter().map(|u| u.dot(towards)).sum::<f64>() / rays as f64)
     ));
     lines.push(format!(
         "self-stress: cables (`{}`, `{}`, `{}`) with pre-strain tau > 0 put the struts `{}` (spring law) in compression",
@@ -448,6 +453,21 @@ mod tests {
         assert!(struts.iter().all(|b| b.particles[0] == 12));
         assert_eq!(top.bonds.len(), 12 + 30);
         assert!(bonds_of(&top, "microtubule").all(|[x, y]| ((x - y).length() - 10.0).abs() < 1e-12));
+    }
+
+    #[test]
+    fn the_committed_tensegrity_cell_is_what_the_builder_writes() {
+        let a = TensegrityArgs {
+            centre: vec![0.0, 0.0, 10.0],
+            microtubules: Some(162),
+            focal_adhesions: 30,
+            fibre_segments: 3,
+            bodies: true,
+            common: Common { seed: 3, output: "t.top".into() },
+            ..TensegrityArgs::default()
+        };
+        let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/topologies/tensegrity_cell.top")).unwrap();
+        assert_eq!(tensegrity(&a).unwrap().text, text);
     }
 
     #[test]
