@@ -70,7 +70,7 @@ pub struct ShellOptions {
     /// Write no edge bonds (neither the cell's nor the nucleus').
     #[arg(long)]
     pub no_bonds: bool,
-    /// Add a nucleus: a concentric icosphere of this radius (< --radius), a body of its own.
+    /// Add a nucleus: a concentric icosphere of this radius (< --radius).
     #[arg(allow_negative_numbers = true, long, value_name = "RADIUS")]
     pub nucleus: Option<f64>,
     /// Particle type of the nucleus' nodes.
