@@ -19,7 +19,7 @@
 //! | [`output`] | MCAP, extended XYZ, LAMMPS dump (selectable columns), per-bond tension CSV, restart |
 //! | [`export`] | a deck as LAMMPS data + input (`cellmd export-lammps`) |
 //! | [`compare`] | cellmd vs LAMMPS probes, agreement table, golden reference files (`cellmd compare`) |
-//! | [`build`] | topology generators (`cellmd build`: icosphere, filament, network, aster, cortex, branched, filopodium, cells) |
+//! | [`build`] | topology generators (`cellmd build`: icosphere, filament, network, aster, cortex, branched, filopodium, cells, sheet, tensegrity) |
 //! | [`run`] | executes a plan: run loop, thermo, blow-up diagnosis, minimise |
 
 pub mod backend;

@@ -101,8 +101,9 @@ enum Command {
     },
     /// Write a topology file of a generated system (deterministic).
     Build {
+        // Boxed: the generators' options dwarf every other command's.
         #[command(subcommand)]
-        what: cellmd::build::Generator,
+        what: Box<cellmd::build::Generator>,
     },
     /// List interaction types and kinetic rules, or print one's documentation.
     List {
@@ -263,7 +264,7 @@ fn main() -> ExitCode {
 
 /// `cellmd build ...`: writes the topology and prints its summary; bad
 /// options exit with status 2 and what was expected.
-fn build(what: cellmd::build::Generator) -> ExitCode {
+fn build(what: Box<cellmd::build::Generator>) -> ExitCode {
     let built = match what.build() {
         Ok(built) => built,
         Err(e) => {

@@ -9,25 +9,31 @@ fn cellmd(dir: &Path, args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_cellmd")).current_dir(dir).args(args).output().unwrap()
 }
 
+/// Builds `out.top` with `args` in `dir` and returns what the builder printed.
+fn build_in(dir: &Path, args: &[&str]) -> String {
+    let mut all = vec!["build"];
+    all.extend_from_slice(args);
+    all.extend_from_slice(&["-o", "out.top"]);
+    let built = cellmd(dir, &all);
+    let said = String::from_utf8_lossy(&built.stdout).to_string();
+    assert!(built.status.success(), "cellmd {all:?}: {}", String::from_utf8_lossy(&built.stderr));
+    assert!(said.starts_with("wrote out.top: "), "{said}");
+    said
+}
+
 /// Builds `out.top` with `args`, then checks a deck of it with the force
 /// field `ff` (and the deck line `extra`, e.g. a box). Returns what the
 /// builder printed.
 fn build_and_check(args: &[&str], ff: &str, extra: &str) -> String {
     let dir = tempfile::tempdir().unwrap();
-    let mut all = vec!["build"];
-    all.extend_from_slice(args);
-    all.extend_from_slice(&["-o", "out.top"]);
-    let built = cellmd(dir.path(), &all);
-    let said = String::from_utf8_lossy(&built.stdout).to_string();
-    assert!(built.status.success(), "cellmd {all:?}: {}", String::from_utf8_lossy(&built.stderr));
-    assert!(said.starts_with("wrote out.top: "), "{said}");
+    let said = build_in(dir.path(), args);
     std::fs::write(dir.path().join("ff.ff"), ff).unwrap();
     std::fs::write(dir.path().join("deck.in"), format!("units cell\ntopology out.top\nforcefield ff.ff\n{extra}timestep 1e-6\nrun 1\n"))
         .unwrap();
     let checked = cellmd(dir.path(), &["check", "deck.in"]);
     assert!(
         checked.status.success(),
-        "cellmd check after {all:?}:\n{}{}",
+        "cellmd check after {args:?}:\n{}{}",
         String::from_utf8_lossy(&checked.stdout),
         String::from_utf8_lossy(&checked.stderr)
     );
@@ -188,6 +194,10 @@ fn bad_options_exit_with_status_2_and_say_what_was_expected() {
         ),
         (&["cells", "--layout", "spheroid", "--count", "100", "--radius", "1", "--spheroid-radius", "2"][..], "too many cells: at most"),
         (&["icosphere", "--level", "1", "--radius", "1", "--nucleus", "2"][..], "expected 0 < --nucleus RADIUS < --radius 1, found 2"),
+        (&["sheet", "--rows", "2", "--columns", "2", "--cell-size", "-1"][..], "expected --cell-size > 0, found -1"),
+        (&["sheet", "--rows", "2", "--columns", "2", "--cell-size", "3", "--jitter", "0.49", "--gap", "1"][..], "convex hexagon"),
+        (&["tensegrity", "--radius", "5", "--level", "1", "--microtubules", "50"][..], "expected --microtubules <= 42"),
+        (&["tensegrity", "--radius", "5", "--nucleus", "6"][..], "expected 0 < --nucleus RADIUS < --radius 5, found 6"),
     ] {
         let mut all = vec!["build"];
         all.extend_from_slice(args);
@@ -198,4 +208,273 @@ fn bad_options_exit_with_status_2_and_say_what_was_expected() {
         assert!(err.contains(expected), "{all:?}: {err}");
         assert!(!dir.path().join("x.top").exists());
     }
+}
+
+/// The number that the summary `said` prints after `key` after `what` ("… WHAT … KEY 1.5 …").
+fn printed(said: &str, what: &str, key: &str) -> f64 {
+    let rest = said.split(what).nth(1).unwrap_or_else(|| panic!("no `{what}` in {said}"));
+    rest.split(key).nth(1).unwrap().split([' ', ',']).next().unwrap().parse().unwrap()
+}
+
+/// The mean that the summary `said` prints after `what` ("… WHAT … mean b …").
+fn printed_mean(said: &str, what: &str) -> f64 {
+    printed(said, what, " mean ")
+}
+
+/// Runs `deck` with the force field `ff` on `out.top` in `dir`; returns what it printed.
+fn run_in(dir: &Path, ff: &str, deck: &str) -> String {
+    std::fs::write(dir.join("ff.ff"), ff).unwrap();
+    std::fs::write(dir.join("deck.in"), format!("units cell\ntopology out.top\nforcefield ff.ff\n{deck}")).unwrap();
+    let out = cellmd(dir, &["run", "deck.in", "-o", ".", "--quiet"]);
+    let said = String::from_utf8_lossy(&out.stdout).to_string();
+    assert!(out.status.success(), "cellmd run:\n{deck}\n{said}{}", String::from_utf8_lossy(&out.stderr));
+    said
+}
+
+/// The columns `names` (header `name[unit]`) of every row of a CSV file.
+fn csv_columns(path: &Path, names: &[&str]) -> Vec<Vec<String>> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').map(|h| h.split('[').next().unwrap()).collect();
+    let at: Vec<usize> =
+        names.iter().map(|n| header.iter().position(|h| h == n).unwrap_or_else(|| panic!("no column {n} in {header:?}"))).collect();
+    lines.map(|l| l.split(',').collect::<Vec<_>>()).map(|f| at.iter().map(|&k| f[k].to_string()).collect()).collect()
+}
+
+/// The junction bonds (ids) of the topology `out.top` in `dir`.
+fn junctions_in(dir: &Path) -> Vec<(u64, u64)> {
+    let top = std::fs::read_to_string(dir.join("out.top")).unwrap();
+    let bonds = top.split("[ bonds ]").nth(1).unwrap().split("\n[").next().unwrap();
+    let fields = bonds.lines().map(|l| l.split_whitespace().collect::<Vec<_>>());
+    fields.filter(|f| f.first() == Some(&"junction")).map(|f| (f[1].parse().unwrap(), f[2].parse().unwrap())).collect()
+}
+
+const SHEET_FF: &str = "particle node drag 1\nparticle cell_centre drag 1\nbond edge harmonic k 50 r0 EDGE\nbond spoke harmonic k 10 r0 SPOKE\nbond junction harmonic k 20 r0 JUNCTION\n";
+
+/// The sheet force field with the rest lengths `said` prints and the junction `kinetics`.
+fn sheet_ff(said: &str, kinetics: &str) -> String {
+    SHEET_FF
+        .replace("EDGE", &printed_mean(said, "edge length").to_string())
+        .replace("SPOKE", &printed_mean(said, "spoke length").to_string())
+        .replace("JUNCTION", &format!("{}{kinetics}", printed_mean(said, "junctions `junction`: length")))
+}
+
+#[test]
+fn sheet() {
+    let said = build_and_check(
+        &["sheet", "--rows", "3", "--columns", "4", "--cell-size", "2", "--nodes-per-edge", "0"],
+        "particle cell_centre drag 1\nbond junction harmonic k 10 r0 2\n",
+        "box x -9 9 f y -9 9 f z -1 1 f\n",
+    );
+    assert!(said.contains("12 cells (3 rows × 4 columns)") && said.contains("23 junctions `junction`"), "{said}");
+    let setup =
+        "box x -30 30 f y -30 30 f z -5 5 f\ntimestep 1e-3\nthermo_file thermo.csv\nthermo 100 step pe fmax breaks nbound/junction\n";
+
+    // A jittered sheet of rings is pre-stressed as built (one rest length per
+    // bond type); at kT = 0 it relaxes by gradient flow — the energy never
+    // rises — towards a minimum that FIRE then reaches.
+    let dir = tempfile::tempdir().unwrap();
+    let said = build_in(
+        dir.path(),
+        &["sheet", "--rows", "4", "--columns", "6", "--cell-size", "3", "--nodes-per-edge", "2", "--jitter", "0.05", "--seed", "2"],
+    );
+    let printed = run_in(dir.path(), &sheet_ff(&said, ""), &format!("{setup}run 3000\nminimize ftol 1e-6 maxiter 100000\n"));
+    let relax = csv_columns(&dir.path().join("thermo.csv"), &["pe", "fmax"]);
+    let pe: Vec<f64> = relax.iter().map(|r| r[0].parse().unwrap()).collect();
+    let fmax: Vec<f64> = relax.iter().map(|r| r[1].parse().unwrap()).collect();
+    println!(
+        "jittered sheet relaxing: pe {:.4e} → {:.4e} pN·µm, fmax {:.4e} → {:.4e} pN",
+        pe[0],
+        pe[pe.len() - 1],
+        fmax[0],
+        fmax[fmax.len() - 1]
+    );
+    assert!(pe.windows(2).all(|w| w[1] <= w[0]) && pe[pe.len() - 1] < 0.5 * pe[0], "{pe:?}");
+    let fire = printed.lines().find(|l| l.starts_with("minimize (FIRE)")).unwrap_or_else(|| panic!("{printed}"));
+    println!("then {fire}");
+    assert!(fire.contains(": converged after"), "{fire}");
+
+    // A regular sheet of hexagons (7 particles a cell, ids cell by cell, rows
+    // from −y, each from −x) is at rest as built. Junctions break beyond a
+    // force threshold F_c (seed 001). Pull the first column of cells S to
+    // −x and the last to +x: only junctions join S to the rest, so at
+    // equilibrium their tensions' x-components sum to the pull, and a pull
+    // above n_S·F_c must break one; well below it the sheet holds.
+    let (rows, columns, per_cell) = (4u64, 6u64, 7u64);
+    let said = build_in(dir.path(), &["sheet", "--rows", "4", "--columns", "6", "--cell-size", "3", "--nodes-per-edge", "1"]);
+    let fc = 1.0;
+    let ff = sheet_ff(&said, &format!(" kinetics threshold force {fc}"));
+    let junctions = junctions_in(dir.path());
+    let total = junctions.len();
+    assert_eq!(total, 2 * (5 * 4 + 3 * (2 * 6 - 1)));
+    let column = |i: u64| (0..rows).map(move |j| (j * columns + i) * per_cell + 1).map(|first| (first, first + per_cell - 1));
+    let in_first = |id: u64| column(0).any(|(a, b)| (a..=b).contains(&id));
+    let n_s = junctions.iter().filter(|(i, j)| in_first(*i) != in_first(*j)).count() as f64;
+    let group =
+        |name: &str, i: u64| format!("group {name} id {}\n", column(i).map(|(a, b)| format!("{a}:{b}")).collect::<Vec<_>>().join(" "));
+    let pulled = (rows * per_cell) as f64;
+    let mut outcomes = Vec::new();
+    for factor in [0.25, 0.5, 0.75, 1.0, 1.5] {
+        let f = factor * n_s * fc / pulled;
+        let deck = format!(
+            "{setup}{}{}external pl left constant_force fx {}\nexternal pr right constant_force fx {f}\nrun 5000\n",
+            group("left", 0),
+            group("right", columns - 1),
+            -f
+        );
+        run_in(dir.path(), &ff, &deck);
+        let last = csv_columns(&dir.path().join("thermo.csv"), &["breaks", "nbound/junction"]).pop().unwrap();
+        outcomes.push((factor, last[0].parse::<u64>().unwrap(), last[1].parse::<usize>().unwrap()));
+    }
+    println!("regular sheet pulled by factor × n_S·F_c (n_S = {n_s}): (factor, breaks, bound of {total}) {outcomes:?}");
+    assert_eq!((outcomes[0].1, outcomes[0].2), (0, total), "{outcomes:?}");
+    assert!(outcomes[4].1 > 0 && outcomes[4].2 < total, "{outcomes:?}");
+}
+
+/// Relaxes the structure by FIRE and returns each bond's (type, length, tension) at the minimum.
+fn relaxed_bonds(dir: &Path, ff: &str) -> Vec<(String, f64, f64)> {
+    let deck = "box x -20 20 f y -20 20 f z -20 20 f\ntimestep 1e-4\nminimize ftol 1e-9 maxiter 200000\ndump b every 1000 bonds bonds.csv\nrun 1\n";
+    run_in(dir, ff, deck);
+    let rows = csv_columns(&dir.join("bonds.csv"), &["step", "type", "length", "tension"]);
+    rows.into_iter().filter(|r| r[0] == "0").map(|r| (r[1].clone(), r[2].parse().unwrap(), r[3].parse().unwrap())).collect()
+}
+
+/// The symmetric equilibrium of the icosahedral tensegrity cell of
+/// `src/build/tensegrity.rs` (cortex R, nucleus RN, a strut on every ray):
+/// tensions (strut, cortex edge, nucleus edge, actin cable) in pN, by
+/// Newton's method on the radii (R′, RN′) of the two cortex and nucleus node balances.
+fn icosahedral_equilibrium(r: f64, rn: f64, [kc, tau_c, kn, ks, ka, tau_a]: [f64; 6]) -> [f64; 4] {
+    let (c, q) = (1.0 / 5f64.sqrt(), 2.5 / (0.4 * std::f64::consts::PI).sin());
+    let l = r - rn;
+    let d0 = (r * r + rn * rn - 2.0 * r * rn * c).sqrt();
+    let tensions = |x: [f64; 2]| {
+        let d = (x[0] * x[0] + x[1] * x[1] - 2.0 * x[0] * x[1] * c).sqrt();
+        let strut = ks * ((x[0] - x[1]) - l) / l;
+        let cortex = kc * (x[0] / r - 1.0 + tau_c);
+        let nucleus = kn * (x[1] / rn - 1.0);
+        let actin = ka * (d / d0 - 1.0 + tau_a);
+        ([strut, cortex, nucleus, actin], d)
+    };
+    // Outward force on a cortex node and on a nucleus node.
+    let residual = |x: [f64; 2]| {
+        let ([strut, cortex, nucleus, actin], d) = tensions(x);
+        [-strut - q * cortex - 5.0 * actin * (x[0] - x[1] * c) / d, strut - q * nucleus + 5.0 * actin * (x[0] * c - x[1]) / d]
+    };
+    let mut x = [r, rn];
+    for _ in 0..50 {
+        let f = residual(x);
+        let h = 1e-7;
+        let j: Vec<[f64; 2]> = (0..2)
+            .map(|k| {
+                let mut y = x;
+                y[k] += h;
+                let g = residual(y);
+                [(g[0] - f[0]) / h, (g[1] - f[1]) / h]
+            })
+            .collect();
+        let det = j[0][0] * j[1][1] - j[1][0] * j[0][1];
+        x[0] -= (f[0] * j[1][1] - f[1] * j[1][0]) / det;
+        x[1] -= (j[0][0] * f[1] - j[0][1] * f[0]) / det;
+    }
+    let f = residual(x);
+    assert!(f[0].abs() + f[1].abs() < 1e-12, "Newton did not converge: {f:?}");
+    tensions(x).0
+}
+
+#[test]
+fn tensegrity() {
+    // Level 0: an icosahedral cortex (R = 5) around an icosahedral nucleus
+    // (RN = 2), a strut on every ray and crossing actin cables. Pre-strained
+    // cables put the struts in compression; by symmetry the engine's relaxed
+    // structure must match the two-equation equilibrium.
+    let dir = tempfile::tempdir().unwrap();
+    let said = build_in(dir.path(), &["tensegrity", "--radius", "5", "--level", "0", "--nucleus", "2", "--microtubules", "12"]);
+    assert!(said.contains("radial elements of length L = 3.0 (r0): 12 microtubule struts") && said.contains("60 actin cables"), "{said}");
+    let sin72 = (0.4 * std::f64::consts::PI).sin();
+    let (r, rn) = (5.0, 2.0);
+    let d0 = (r * r + rn * rn - 2.0 * r * rn / 5f64.sqrt()).sqrt();
+    let ff = |[kc, tau_c, kn, ks, ka, tau_a]: [f64; 6]| {
+        format!(
+            "particle node drag 1\nparticle nucleus_node drag 1\nbond edge cable k {kc} r0 {:?} tau {tau_c}\nbond nucleus_edge spring k {kn} r0 {:?}\n\
+             bond microtubule spring k {ks} r0 3\nbond actin cable k {ka} r0 {d0:?} tau {tau_a}\n",
+            r / sin72,
+            rn / sin72
+        )
+    };
+    let params = [100.0, 0.1, 200.0, 300.0, 20.0, 0.05];
+    let expected = icosahedral_equilibrium(r, rn, params);
+    let bonds = relaxed_bonds(dir.path(), &ff(params));
+    let mut errors = Vec::new();
+    for (name, count, t) in
+        [("microtubule", 12, expected[0]), ("edge", 30, expected[1]), ("nucleus_edge", 30, expected[2]), ("actin", 60, expected[3])]
+    {
+        let of: Vec<f64> = bonds.iter().filter(|b| b.0 == name).map(|b| b.2).collect();
+        assert_eq!(of.len(), count);
+        errors.push(of.iter().map(|x| (x / t - 1.0).abs()).fold(0.0, f64::max));
+    }
+    println!(
+        "icosahedral tensegrity: exact tensions (strut, cortex, nucleus edge, actin) {expected:?} pN; worst relative errors {errors:?}"
+    );
+    assert!(expected[0] < 0.0 && expected[1] > 0.0 && expected[3] > 0.0, "{expected:?}");
+    assert!(errors.iter().all(|e| *e < 1e-6), "{errors:?}");
+    // Without pre-strain the structure is at rest as built: no force anywhere.
+    let slack = relaxed_bonds(dir.path(), &ff([100.0, 0.0, 200.0, 300.0, 20.0, 0.0]));
+    assert!(slack.iter().all(|b| b.2.abs() < 1e-9), "{slack:?}");
+
+    // Level 2 with everything: a strut on every ray, 12 focal adhesions held
+    // fixed, stress fibres of 3 cables, actin cables, and the shells as
+    // bodies whose turgor stands for seed 003's cytosol and nucleoskeleton
+    // (without them the cable cortex folds up and the spring nucleus buckles
+    // in). Relaxed, the cell holds its shape with every cable in tension and
+    // every strut in compression.
+    let said = build_in(
+        dir.path(),
+        &[
+            "tensegrity",
+            "--radius",
+            "5",
+            "--level",
+            "2",
+            "--nucleus",
+            "2.5",
+            "--microtubules",
+            "162",
+            "--focal-adhesions",
+            "12",
+            "--fibre-segments",
+            "3",
+            "--seed",
+            "4",
+            "--bodies",
+        ],
+    );
+    assert!(said.contains("radial elements of length L = 2.5 (r0): 162 microtubule struts"), "{said}");
+    let (edge, nucleus_edge, actin) =
+        (printed_mean(&said, "cortex ("), printed_mean(&said, "nucleus ("), printed_mean(&said, "actin cables"));
+    let ff = format!(
+        "particle node drag 1\nparticle nucleus_node drag 1\nparticle fibre_bead drag 1\nparticle focal_adhesion fixed\n\
+         bond edge cable k 100 r0 {edge} tau 0.2\nbond nucleus_edge spring k 200 r0 {nucleus_edge}\nbond microtubule spring k 300 r0 2.5\n\
+         bond actin cable k 20 r0 {actin} tau 0.2\nbond stress_fibre cable k 50 r0 {} tau 0.1\n\
+         body cell turgor k 100 v0 {}\nbody nucleus turgor k 5000 v0 {}\n",
+        2.5 / 3.0,
+        printed(&said, "cortex (", "enclosed volume "),
+        printed(&said, "nucleus (", "enclosed volume ")
+    );
+    let bonds = relaxed_bonds(dir.path(), &ff);
+    let of = |name: &str| bonds.iter().filter(|b| b.0 == name).collect::<Vec<_>>();
+    let range = |name: &str| {
+        let t: Vec<f64> = of(name).iter().map(|b| b.2).collect();
+        (t.len(), t.iter().copied().fold(f64::INFINITY, f64::min), t.iter().copied().fold(f64::NEG_INFINITY, f64::max))
+    };
+    let report: Vec<_> = ["edge", "actin", "stress_fibre", "microtubule", "nucleus_edge"].iter().map(|n| (n, range(n))).collect();
+    println!("relaxed tensegrity cell, tension (count, min, max) per type in pN: {report:?}");
+    for name in ["edge", "actin", "stress_fibre"] {
+        assert!(range(name).1 > 0.0, "{name} goes slack: {report:?}");
+    }
+    assert!(range("microtubule").2 < 0.0, "a strut is not compressed: {report:?}");
+    // It holds its shape: the struts shorten by little, the cortex stays near its size.
+    let mean_length = |name: &str| of(name).iter().map(|b| b.1).sum::<f64>() / of(name).len() as f64;
+    let (strut, cortex) = (mean_length("microtubule") / 2.5, mean_length("edge") / edge);
+    println!("mean strut length / L = {strut:.4}, mean cortex edge / built = {cortex:.4}");
+    assert!(strut > 0.9 && strut < 1.0 && cortex > 0.8 && cortex < 1.0, "{strut} {cortex}");
 }

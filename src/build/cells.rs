@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use glam::DVec3;
 
-use super::icosphere::{unit_icosphere, ShellSpec};
+use super::icosphere::{unit_icosphere, ShellOptions, ShellSpec};
 use super::{positive, stream, vec3, Built, Common, Draws, Writer};
 
 /// How `cells` arranges the cells.
@@ -42,30 +42,9 @@ pub struct CellsArgs {
     /// `layer`: edge lengths of the periodic box [0, LX) × [0, LY); `spheroid`: the half-width of a fixed cubic box around the centre (one number).
     #[arg(allow_negative_numbers = true, long = "box", num_args = 1..=2, value_names = ["LX", "LY"])]
     pub box_size: Vec<f64>,
-    /// A nucleus of this radius (< --radius) inside each cell.
-    #[arg(allow_negative_numbers = true, long, value_name = "RADIUS")]
-    pub nucleus: Option<f64>,
-    /// Particle type of the cells' nodes.
-    #[arg(long, default_value = "node")]
-    pub particle_type: String,
-    /// Body type of the cells.
-    #[arg(long, default_value = "cell")]
-    pub body_type: String,
-    /// Bond type of the cells' mesh edges.
-    #[arg(long, default_value = "edge")]
-    pub bond_type: String,
-    /// Write no edge bonds.
-    #[arg(long)]
-    pub no_bonds: bool,
-    /// Particle type of the nuclei's nodes.
-    #[arg(long, default_value = "nucleus_node")]
-    pub nucleus_particle_type: String,
-    /// Body type of the nuclei.
-    #[arg(long, default_value = "nucleus")]
-    pub nucleus_body_type: String,
-    /// Bond type of the nuclei's mesh edges.
-    #[arg(long, default_value = "nucleus_edge")]
-    pub nucleus_bond_type: String,
+    // The cells' (and nuclei's) types; `--nucleus RADIUS` puts a nucleus in every cell.
+    #[command(flatten)]
+    pub shell: ShellOptions,
     #[command(flatten)]
     pub common: Common,
 }
@@ -81,14 +60,7 @@ impl Default for CellsArgs {
             spheroid_radius: Some(4.0),
             centre: vec![0.0; 3],
             box_size: Vec::new(),
-            nucleus: None,
-            particle_type: "node".into(),
-            body_type: "cell".into(),
-            bond_type: "edge".into(),
-            no_bonds: false,
-            nucleus_particle_type: "nucleus_node".into(),
-            nucleus_body_type: "nucleus".into(),
-            nucleus_bond_type: "nucleus_edge".into(),
+            shell: ShellOptions::default(),
             common: Common { seed: 1, output: PathBuf::from("cells.top") },
         }
     }
@@ -141,11 +113,7 @@ pub fn cells(a: &CellsArgs) -> Result<Built, String> {
     if a.level > 6 {
         return Err(format!("expected --level <= 6, found {}", a.level));
     }
-    if let Some(rn) = a.nucleus {
-        if !(rn.is_finite() && rn > 0.0 && rn < r) {
-            return Err(format!("expected 0 < --nucleus RADIUS < --radius {r}, found {rn}"));
-        }
-    }
+    let nucleus = a.shell.nucleus(r)?;
     if a.count == Some(0) {
         return Err("expected --count >= 1, found 0".into());
     }
@@ -206,33 +174,31 @@ pub fn cells(a: &CellsArgs) -> Result<Built, String> {
     };
     let (unit, mesh) = unit_icosphere(a.level);
     let mut w = Writer::new(1);
-    let per_cell = if a.nucleus.is_some() { 2 } else { 1 };
+    let per_cell = if nucleus.is_some() { 2 } else { 1 };
+    let cell_bond = a.shell.bond_types().0;
     for (k, c) in centres.iter().enumerate() {
         let body = per_cell * k as u64 + 1;
-        let bond = |t: &str| (!a.no_bonds).then(|| t.to_string());
-        let cell_bond = bond(&a.bond_type);
         ShellSpec {
             mesh: &mesh,
             unit: &unit,
             radius: r,
             centre: *c,
-            particle_type: &a.particle_type,
-            body_type: &a.body_type,
+            particle_type: &a.shell.particle_type,
+            body_type: &a.shell.body_type,
             bond_type: cell_bond.as_deref(),
-            body_id: body,
+            body_id: Some(body),
         }
         .write(&mut w);
-        if let Some(rn) = a.nucleus {
-            let nucleus_bond = bond(&a.nucleus_bond_type);
+        if let Some(n) = &nucleus {
             ShellSpec {
                 mesh: &mesh,
                 unit: &unit,
-                radius: rn,
+                radius: n.radius,
                 centre: *c,
-                particle_type: &a.nucleus_particle_type,
-                body_type: &a.nucleus_body_type,
-                bond_type: nucleus_bond.as_deref(),
-                body_id: body + 1,
+                particle_type: &n.particle_type,
+                body_type: &n.body_type,
+                bond_type: n.bond_type.as_deref(),
+                body_id: Some(body + 1),
             }
             .write(&mut w);
         }
@@ -248,10 +214,10 @@ pub fn cells(a: &CellsArgs) -> Result<Built, String> {
         "{} cells of radius {r:?} {where_}, centres >= {d:?} apart (gap {:?}){}",
         centres.len(),
         a.gap,
-        a.nucleus.map_or(String::new(), |rn| format!(", each with a nucleus of radius {rn:?}"))
+        nucleus.as_ref().map_or(String::new(), |n| format!(", each with a nucleus of radius {:?}", n.radius))
     )];
     lines.push(format!("each cell: {}", w.shells[0].summary()));
-    if a.nucleus.is_some() {
+    if nucleus.is_some() {
         lines.push(format!("each nucleus: {}", w.shells[1].summary()));
     }
     let title = format!("{} icosphere cells (level {}), {:?} layout, seed {}", centres.len(), a.level, a.layout, a.common.seed)
@@ -283,7 +249,7 @@ mod tests {
 
     #[test]
     fn a_spheroid_packs_cells_without_overlap_inside_its_sphere() {
-        let a = CellsArgs { nucleus: Some(0.5), ..CellsArgs::default() };
+        let a = CellsArgs { shell: ShellOptions { nucleus: Some(0.5), ..ShellOptions::default() }, ..CellsArgs::default() };
         let built = cells(&a).unwrap();
         assert_eq!((built.bodies, built.particles), (26, 13 * 2 * 42));
         let c = centres(&built, 42, 2, |d| d);

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use glam::DVec3;
 
-use super::{positive, vec3, Built, Shell, Writer};
+use super::{min_mean_max, positive, vec3, Built, Shell, Writer};
 use crate::mesh::{icosphere as icosphere_mesh, SurfaceMesh};
 
 /// Options of an icosphere cell.
@@ -53,6 +53,74 @@ impl Default for IcosphereCell {
     }
 }
 
+/// The shell options of every generator that writes icosphere cells
+/// (`icosphere`, `cells`, `tensegrity`): the types of the cell's nodes, body
+/// and mesh edges, and an optional nucleus with types of its own.
+#[derive(clap::Args, Clone, Debug)]
+pub struct ShellOptions {
+    /// Particle type of the cell's nodes.
+    #[arg(long, default_value = "node")]
+    pub particle_type: String,
+    /// Body type of the cell (what `body` lines of the force field name).
+    #[arg(long, default_value = "cell")]
+    pub body_type: String,
+    /// Bond type of the cell's mesh edges (cortex springs).
+    #[arg(long, default_value = "edge")]
+    pub bond_type: String,
+    /// Write no edge bonds (neither the cell's nor the nucleus').
+    #[arg(long)]
+    pub no_bonds: bool,
+    /// Add a nucleus: a concentric icosphere of this radius (< --radius).
+    #[arg(allow_negative_numbers = true, long, value_name = "RADIUS")]
+    pub nucleus: Option<f64>,
+    /// Particle type of the nucleus' nodes.
+    #[arg(long, default_value = "nucleus_node")]
+    pub nucleus_particle_type: String,
+    /// Body type of the nucleus.
+    #[arg(long, default_value = "nucleus")]
+    pub nucleus_body_type: String,
+    /// Bond type of the nucleus' mesh edges.
+    #[arg(long, default_value = "nucleus_edge")]
+    pub nucleus_bond_type: String,
+}
+
+impl Default for ShellOptions {
+    fn default() -> Self {
+        Self {
+            particle_type: "node".into(),
+            body_type: "cell".into(),
+            bond_type: "edge".into(),
+            no_bonds: false,
+            nucleus: None,
+            nucleus_particle_type: "nucleus_node".into(),
+            nucleus_body_type: "nucleus".into(),
+            nucleus_bond_type: "nucleus_edge".into(),
+        }
+    }
+}
+
+impl ShellOptions {
+    /// The edge bond types of the cell and of the nucleus: `None` with `--no-bonds`.
+    pub fn bond_types(&self) -> (Option<String>, Option<String>) {
+        let bond = |t: &str| (!self.no_bonds).then(|| t.to_string());
+        (bond(&self.bond_type), bond(&self.nucleus_bond_type))
+    }
+
+    /// The nucleus for a cell of radius `radius`, checked: 0 < RN < `radius`.
+    pub fn nucleus(&self, radius: f64) -> Result<Option<Nucleus>, String> {
+        let Some(r) = self.nucleus else { return Ok(None) };
+        if !(r.is_finite() && r > 0.0 && r < radius) {
+            return Err(format!("expected 0 < --nucleus RADIUS < --radius {radius}, found {r}"));
+        }
+        Ok(Some(Nucleus {
+            radius: r,
+            particle_type: self.nucleus_particle_type.clone(),
+            body_type: self.nucleus_body_type.clone(),
+            bond_type: self.bond_types().1,
+        }))
+    }
+}
+
 /// Command-line options of `cellmd build icosphere`.
 #[derive(clap::Args, Clone, Debug)]
 pub struct IcosphereArgs {
@@ -65,18 +133,8 @@ pub struct IcosphereArgs {
     /// Centre of the cell.
     #[arg(long, num_args = 3, value_names = ["X", "Y", "Z"], allow_negative_numbers = true, default_values_t = [0.0, 0.0, 0.0])]
     pub centre: Vec<f64>,
-    /// Particle type of the nodes.
-    #[arg(long, default_value = "node")]
-    pub particle_type: String,
-    /// Body type of the cell (what `body` lines of the force field name).
-    #[arg(long, default_value = "cell")]
-    pub body_type: String,
-    /// Bond type of the mesh edges (cortex springs).
-    #[arg(long, default_value = "edge")]
-    pub bond_type: String,
-    /// Write no edge bonds (neither the cell's nor the nucleus').
-    #[arg(long)]
-    pub no_bonds: bool,
+    #[command(flatten)]
+    pub shell: ShellOptions,
     /// Body id of the cell (the nucleus, if any, is the next).
     #[arg(long, default_value_t = 1)]
     pub body_id: u64,
@@ -86,18 +144,6 @@ pub struct IcosphereArgs {
     /// Also write a fixed (non-periodic) cubic [ box ] of this half-width around the centre.
     #[arg(allow_negative_numbers = true, long = "box", value_name = "HALF_WIDTH")]
     pub box_half_width: Option<f64>,
-    /// Add a nucleus: a concentric icosphere of this radius (< --radius), a second body.
-    #[arg(allow_negative_numbers = true, long, value_name = "RADIUS")]
-    pub nucleus: Option<f64>,
-    /// Particle type of the nucleus' nodes.
-    #[arg(long, default_value = "nucleus_node")]
-    pub nucleus_particle_type: String,
-    /// Body type of the nucleus.
-    #[arg(long, default_value = "nucleus")]
-    pub nucleus_body_type: String,
-    /// Bond type of the nucleus' mesh edges.
-    #[arg(long, default_value = "nucleus_edge")]
-    pub nucleus_bond_type: String,
     /// The topology file to write.
     #[arg(short, long)]
     pub output: PathBuf,
@@ -119,31 +165,21 @@ pub fn icosphere(a: &IcosphereArgs) -> Result<Built, String> {
     if a.box_half_width.is_some_and(|h| h.is_nan() || h <= a.radius) {
         return Err(format!("expected --box HALF_WIDTH > the radius {}", a.radius));
     }
-    if let Some(r) = a.nucleus {
-        if !(r.is_finite() && r > 0.0 && r < a.radius) {
-            return Err(format!("expected 0 < --nucleus RADIUS < --radius {}, found {r}", a.radius));
-        }
-    }
+    let nucleus = a.shell.nucleus(a.radius)?;
     if a.body_id == 0 || a.first_id == 0 {
         return Err("expected --body-id and --first-id >= 1".into());
     }
-    let bond = |t: &str| (!a.no_bonds).then(|| t.to_string());
     Ok(icosphere_cell(&IcosphereCell {
         level: a.level,
         radius: a.radius,
         centre,
-        particle_type: a.particle_type.clone(),
-        body_type: a.body_type.clone(),
-        bond_type: bond(&a.bond_type),
+        particle_type: a.shell.particle_type.clone(),
+        body_type: a.shell.body_type.clone(),
+        bond_type: a.shell.bond_types().0,
         body_id: a.body_id,
         first_id: a.first_id,
         box_half_width: a.box_half_width,
-        nucleus: a.nucleus.map(|radius| Nucleus {
-            radius,
-            particle_type: a.nucleus_particle_type.clone(),
-            body_type: a.nucleus_body_type.clone(),
-            bond_type: bond(&a.nucleus_bond_type),
-        }),
+        nucleus,
     }))
 }
 
@@ -157,23 +193,27 @@ pub(crate) struct ShellSpec<'a> {
     pub particle_type: &'a str,
     pub body_type: &'a str,
     pub bond_type: Option<&'a str>,
-    pub body_id: u64,
+    /// The body the shell is: its nodes' body and its faces'; `None` writes
+    /// the nodes and edges alone (no body, no faces).
+    pub body_id: Option<u64>,
 }
 
 impl ShellSpec<'_> {
     /// Adds the shell's nodes, edge bonds, body and faces to `w`.
     pub fn write(&self, w: &mut Writer) -> Shell {
         let x: Vec<DVec3> = self.unit.iter().map(|p| *p * self.radius + self.centre).collect();
-        let ids: Vec<u64> = x.iter().map(|p| w.particle(self.particle_type, *p, Some(self.body_id))).collect();
+        let ids: Vec<u64> = x.iter().map(|p| w.particle(self.particle_type, *p, self.body_id)).collect();
         let lengths: Vec<f64> = self.mesh.edges().iter().map(|e| (x[e.ends[1] as usize] - x[e.ends[0] as usize]).length()).collect();
         if let Some(bond) = self.bond_type {
             for e in self.mesh.edges() {
                 w.bond(bond, ids[e.ends[0] as usize], ids[e.ends[1] as usize]);
             }
         }
-        w.body(self.body_id, self.body_type);
-        for f in self.mesh.triangles() {
-            w.triangle(self.body_id, f.map(|k| ids[k as usize]));
+        if let Some(body) = self.body_id {
+            w.body(body, self.body_type);
+            for f in self.mesh.triangles() {
+                w.triangle(body, f.map(|k| ids[k as usize]));
+            }
         }
         let shell = Shell {
             body_id: self.body_id,
@@ -182,11 +222,7 @@ impl ShellSpec<'_> {
             faces: self.mesh.triangles().len(),
             volume: self.mesh.volume(&x),
             area: self.mesh.area(&x),
-            edge_lengths: [
-                lengths.iter().copied().fold(f64::INFINITY, f64::min),
-                lengths.iter().sum::<f64>() / lengths.len() as f64,
-                lengths.iter().copied().fold(0.0, f64::max),
-            ],
+            edge_lengths: min_mean_max(&lengths),
         };
         w.shells.push(shell.clone());
         shell
@@ -216,7 +252,7 @@ pub fn icosphere_cell(spec: &IcosphereCell) -> Built {
         particle_type: &spec.particle_type,
         body_type: &spec.body_type,
         bond_type: spec.bond_type.as_deref(),
-        body_id: spec.body_id,
+        body_id: Some(spec.body_id),
     }
     .write(&mut w);
     let mut lines = vec![cell.summary()];
@@ -230,7 +266,7 @@ pub fn icosphere_cell(spec: &IcosphereCell) -> Built {
             particle_type: &n.particle_type,
             body_type: &n.body_type,
             bond_type: n.bond_type.as_deref(),
-            body_id: spec.body_id + 1,
+            body_id: Some(spec.body_id + 1),
         }
         .write(&mut w);
         lines.push(format!("nucleus (body {}, radius {:?}): {}", spec.body_id + 1, n.radius, nucleus.summary()));
@@ -322,21 +358,17 @@ mod tests {
             level: 1,
             radius: 3.0,
             centre: vec![0.0; 3],
-            particle_type: "node".into(),
-            body_type: "cell".into(),
-            bond_type: "edge".into(),
-            no_bonds: false,
+            shell: ShellOptions { nucleus: Some(nucleus), ..ShellOptions::default() },
             body_id: 1,
             first_id: 1,
             box_half_width: None,
-            nucleus: Some(nucleus),
-            nucleus_particle_type: "n".into(),
-            nucleus_body_type: "nucleus".into(),
-            nucleus_bond_type: "ne".into(),
             output: "x.top".into(),
         };
         assert_eq!(icosphere(&args(3.0)).unwrap_err(), "expected 0 < --nucleus RADIUS < --radius 3, found 3");
         assert!(icosphere(&args(-1.0)).is_err());
         assert_eq!(icosphere(&args(1.0)).unwrap().bodies, 2);
+        let bare = IcosphereArgs { shell: ShellOptions { no_bonds: true, ..args(1.0).shell }, ..args(1.0) };
+        assert_eq!(bare.shell.bond_types(), (None, None));
+        assert_eq!(icosphere(&bare).unwrap().bonds, 0);
     }
 }

@@ -21,8 +21,11 @@
 //! | [`branched()`] | `branched` | Arp2/3 network: mother filaments with daughters at 70° ± a spread |
 //! | [`filopodium()`] | `filopodium` | a hexagonal bundle of parallel filaments, crosslinked between neighbours |
 //! | [`cells()`] | `cells` | many icosphere cells packed in a spheroid or a confluent layer |
+//! | [`sheet()`] | `sheet` | a 2D epithelial sheet (seed 001): hexagonal cells as rings of nodes (or single particles) joined by junction bonds |
+//! | [`tensegrity()`] | `tensegrity` | a tensegrity cell (seed 003): cortex and nucleus shells, radial microtubule struts, actin cables and stress fibres from focal adhesions |
 //!
-//! **Filaments** (every generator but the cells) are chains of beads with a
+//! **Filaments** (of `filament`, `network`, `aster`, `cortex`, `branched`
+//! and `filopodium`) are chains of beads with a
 //! bond between consecutive beads and an angle on every consecutive triple
 //! (vertex in the middle), the form of [`wlc_bending`](crate::interactions)
 //! and `cosine_angle`. A chain of contour length L has `--segments n` bonds
@@ -61,6 +64,8 @@ mod filament;
 mod filopodium;
 mod icosphere;
 mod network;
+mod sheet;
+mod tensegrity;
 
 use std::f64::consts::TAU;
 use std::fmt::Write;
@@ -77,8 +82,10 @@ pub use self::cells::{cells, CellsArgs, Layout};
 pub use self::cortex::{cortex, CortexArgs};
 pub use self::filament::{filament, FilamentArgs};
 pub use self::filopodium::{filopodium, FilopodiumArgs};
-pub use self::icosphere::{icosphere, icosphere_cell, IcosphereArgs, IcosphereCell, Nucleus};
+pub use self::icosphere::{icosphere, icosphere_cell, IcosphereArgs, IcosphereCell, Nucleus, ShellOptions};
 pub use self::network::{network, NetworkArgs};
+pub use self::sheet::{sheet, SheetArgs};
+pub use self::tensegrity::{tensegrity, TensegrityArgs};
 
 /// The `cellmd build` subcommands: one per generator.
 #[derive(clap::Subcommand, Clone, Debug)]
@@ -104,6 +111,14 @@ pub enum Generator {
     Filopodium(FilopodiumArgs),
     /// Many icosphere cells packed without overlap in a spheroid or a confluent layer.
     Cells(CellsArgs),
+    /// A 2D epithelial sheet (seed 001): hexagonal cells, each a ring of
+    /// nodes with edge bonds and a centre node with spokes (or one particle),
+    /// neighbours joined by junction bonds.
+    Sheet(SheetArgs),
+    /// A tensegrity cell (seed 003): a cortex shell, a nucleus shell (or a
+    /// centrosome node), radial microtubule struts, actin cables from the
+    /// cortex to the nucleus and stress fibres from focal adhesions.
+    Tensegrity(TensegrityArgs),
 }
 
 impl Generator {
@@ -118,6 +133,8 @@ impl Generator {
             Self::Branched(a) => branched(a),
             Self::Filopodium(a) => filopodium(a),
             Self::Cells(a) => cells(a),
+            Self::Sheet(a) => sheet(a),
+            Self::Tensegrity(a) => tensegrity(a),
         }
     }
 
@@ -132,6 +149,8 @@ impl Generator {
             Self::Branched(a) => a.common.output.as_path(),
             Self::Filopodium(a) => a.common.output.as_path(),
             Self::Cells(a) => a.common.output.as_path(),
+            Self::Sheet(a) => a.common.output.as_path(),
+            Self::Tensegrity(a) => a.common.output.as_path(),
         }
     }
 }
@@ -150,7 +169,8 @@ pub struct Common {
 /// Statistics of one closed shell (a cell or a nucleus) as written.
 #[derive(Clone, Debug)]
 pub struct Shell {
-    pub body_id: u64,
+    /// Its body, if it was written as one.
+    pub body_id: Option<u64>,
     pub nodes: usize,
     pub edges: usize,
     pub faces: usize,
@@ -230,6 +250,16 @@ impl Writer {
     pub fn particle(&mut self, type_name: &str, x: DVec3, body: Option<u64>) -> u64 {
         self.particles.push((type_name.to_string(), x, body));
         self.first_id + self.particles.len() as u64 - 1
+    }
+
+    /// The id the next particle will get.
+    pub fn next_id(&self) -> u64 {
+        self.first_id + self.particles.len() as u64
+    }
+
+    /// Gives particle `id` another type.
+    pub fn set_type(&mut self, id: u64, type_name: &str) {
+        self.particles[(id - self.first_id) as usize].0 = type_name.to_string();
     }
 
     /// The position of particle `id`.
@@ -382,6 +412,8 @@ pub(crate) mod stream {
     pub const BRANCHED: u32 = 0x6275_0005;
     pub const FILOPODIUM: u32 = 0x6275_0006;
     pub const CELLS: u32 = 0x6275_0007;
+    pub const SHEET: u32 = 0x6275_0008;
+    pub const TENSEGRITY: u32 = 0x6275_0009;
 }
 
 impl Draws {
@@ -430,6 +462,16 @@ impl Draws {
         all.sort_unstable();
         all
     }
+}
+
+/// The smallest, mean and largest of `values` (all 0 when there are none).
+pub(crate) fn min_mean_max(values: &[f64]) -> [f64; 3] {
+    if values.is_empty() {
+        return [0.0; 3];
+    }
+    let lo = values.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    [lo, values.iter().sum::<f64>() / values.len() as f64, hi]
 }
 
 /// Expects a finite positive value of option `name`.
@@ -620,9 +662,7 @@ impl Crosslinks {
             types.0.iter().enumerate().map(|(t, (name, _))| format!("{name} {}", self.links.iter().filter(|l| l.0 == t).count())).collect();
         let mut s = format!("{} crosslinks ({})", self.links.len(), counts.join(", "));
         if !self.links.is_empty() {
-            let d = self.links.iter().map(|l| l.3);
-            let (lo, hi) = (d.clone().fold(f64::INFINITY, f64::min), d.clone().fold(0.0, f64::max));
-            let mean = d.sum::<f64>() / self.links.len() as f64;
+            let [lo, mean, hi] = min_mean_max(&self.links.iter().map(|l| l.3).collect::<Vec<_>>());
             write!(s, "; crosslink length min {lo:.6e} mean {mean:.6e} max {hi:.6e} (for r0)").unwrap();
         }
         s
