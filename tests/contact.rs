@@ -21,23 +21,8 @@ use cellmd::deck::validate_file;
 use cellmd::integrate::fire::FireSettings;
 use cellmd::mesh::point_triangle;
 use cellmd::run::{RunOptions, Simulation};
-use common::{merge_topologies, position_bits, Case};
+use common::{merge_topologies, position_bits, two_cells, two_cells_with_edges, Case};
 use glam::DVec3;
-
-/// Two level-`level` cells of radius `radius`, centres on the x axis a `gap` apart at their surfaces.
-fn two_cells(level: u32, radius: f64, gap: f64) -> String {
-    two_cells_with_edges(level, radius, gap, None)
-}
-
-/// As [`two_cells`], with mesh edges as bonds of type `edges`.
-fn two_cells_with_edges(level: u32, radius: f64, gap: f64, edges: Option<&str>) -> String {
-    let half = radius + gap / 2.0;
-    let left =
-        IcosphereCell { level, radius, centre: DVec3::new(-half, 0.0, 0.0), bond_type: edges.map(String::from), ..Default::default() };
-    let nodes = icosphere_cell(&left).shells[0].nodes as u64;
-    let right = IcosphereCell { centre: DVec3::new(half, 0.0, 0.0), body_id: 2, first_id: nodes + 1, ..left.clone() };
-    merge_topologies(&[&icosphere_cell(&left).text, &icosphere_cell(&right).text])
-}
 
 const SHELLS: &str = "body cell turgor k 1000 dp0 100 v0 32.4\nbody cell surface_tension gamma 100\n";
 const BARRIER: &str = "contact cell cell contact_barrier dhat 0.1 kappa 200\n";

@@ -22,6 +22,11 @@
 //! 3. **Gather**: each particle sums its slots in ascending pair order, as
 //!    surface terms are gathered: bit-identical on any thread count.
 //!
+//! Area-weighted terms ([`Law::ContactArea`]: adhesion) reuse the candidate
+//! list: after the pair pass each node finds its nearest candidate face per
+//! rule (see `src/backend/adhesion.rs`); their distance forces join the
+//! pairs' slots, their area forces the particles' face slots.
+//!
 //! [`Contacts::fill_step_limits`] gives the explicit integrator each
 //! particle's largest safe displacement: 0.4 × the distance of its closest
 //! candidate pair and at most 0.4·d̂ (pairs outside the list are beyond d̂).
@@ -32,6 +37,7 @@
 use glam::{DMat3, DVec3};
 use rayon::prelude::*;
 
+use super::adhesion::Adhesion;
 use super::stiffness::StiffnessBlock;
 use super::virial::{add6, outer};
 use crate::forcefield::TermType;
@@ -46,38 +52,63 @@ pub const STEP_FRACTION: f64 = 0.4;
 /// A face of a contact body: its corners (particle indices) and its body.
 type Face = ([u32; 3], u32);
 
+/// The nodes and faces of the bodies some contact rule names (fixed for a model).
+#[derive(Default)]
+pub(super) struct ContactMesh {
+    /// Particles that are nodes of those bodies (ascending), and their body.
+    pub(super) nodes: Vec<u32>,
+    pub(super) node_body: Vec<u32>,
+    /// Faces of those bodies.
+    pub(super) faces: Vec<Face>,
+}
+
+impl ContactMesh {
+    /// The compact index of contact node `p` (a particle).
+    pub(super) fn compact(&self, p: u32) -> usize {
+        self.nodes.binary_search(&p).expect("a contact node")
+    }
+}
+
+/// The candidate pairs and, at the last evaluation, their geometry and forces.
+#[derive(Default)]
+pub(super) struct Candidates {
+    /// (compact node, face), sorted; node k's pairs are `offsets[k]..offsets[k + 1]`.
+    pub(super) pairs: Vec<[u32; 2]>,
+    pub(super) offsets: Vec<u32>,
+    /// Per pair: the closest point of the face to the node, and the forces
+    /// [node, corner 0, corner 1, corner 2] of every term on the pair.
+    pub(super) points: Vec<PointTriangle>,
+    pub(super) forces: Vec<[DVec3; 4]>,
+}
+
 /// Candidate pairs, their per-pair results and each particle's slots.
 #[derive(Default)]
 pub(super) struct Contacts {
-    /// Particles that are nodes of bodies some contact rule names (ascending), and their body.
-    nodes: Vec<u32>,
-    node_body: Vec<u32>,
-    /// Faces of those bodies.
-    faces: Vec<Face>,
+    mesh: ContactMesh,
     /// Faces by their first corner (compact node index), CSR.
     first_offsets: Vec<u32>,
     first_faces: Vec<u32>,
-    /// Contact rules between a node of body type a and a face of body type b, at `a·types + b`.
-    rules: Vec<Vec<u32>>,
+    /// Node–face rules ([`Law::Contact`]) between a node of body type a and a
+    /// face of body type b, at `a·types + b`; `any` also counts area-weighted ones.
+    barriers: Vec<Vec<u32>>,
+    any: Vec<bool>,
     body_types: usize,
     /// The largest contact range d̂ (also the skin).
     dhat: f64,
     /// Contact-node positions at the last build (`None`: never built).
     reference: Option<Vec<DVec3>>,
     builds: u64,
-    /// Candidate pairs (compact node, face), sorted; per pair its distance and forces.
-    pairs: Vec<[u32; 2]>,
-    distance: Vec<f64>,
-    forces: Vec<[DVec3; 4]>,
+    candidates: Candidates,
     /// Particle i's slots are `slots[offsets[i]..offsets[i + 1]]`: (pair, role 0–3).
     offsets: Vec<u32>,
     slots: Vec<[u32; 2]>,
+    adhesion: Adhesion,
 }
 
-/// b(d) of one contact term (zero beyond its range).
+/// b(d) of one node–face term (zero beyond its range).
 #[inline]
 fn radial(term: &TermType, d: f64) -> Radial {
-    let Law::Contact { eval, range } = term.interaction.law() else { unreachable!("contact law") };
+    let Law::Contact { eval, range } = term.interaction.law() else { unreachable!("node–face law") };
     if d < range(&term.params) {
         eval(&term.params, d)
     } else {
@@ -91,15 +122,17 @@ impl Contacts {
             return Self::default();
         }
         let types = model.body_type_names.len();
-        let mut rules = vec![Vec::new(); types * types];
-        for a in 0..types {
-            for b in 0..types {
-                rules[a * types + b] = model.contact_rules_between(a as u32, b as u32).map(|r| r as u32).collect();
-            }
-        }
+        let barriers: Vec<Vec<u32>> = (0..types * types)
+            .map(|ab| {
+                let rules = model.contact_rules_between((ab / types) as u32, (ab % types) as u32);
+                rules.filter(|&r| matches!(model.contact_rules[r].interaction.law(), Law::Contact { .. })).map(|r| r as u32).collect()
+            })
+            .collect();
+        let any: Vec<bool> =
+            (0..types * types).map(|ab| model.contact_rules_between((ab / types) as u32, (ab % types) as u32).next().is_some()).collect();
         let named = |b: usize| {
             let t = model.bodies[b].body_type as usize;
-            (0..types).any(|u| !rules[t * types + u].is_empty() || !rules[u * types + t].is_empty())
+            (0..types).any(|u| any[t * types + u] || any[u * types + t])
         };
         let (mut nodes, mut node_body, mut faces): (Vec<u32>, Vec<u32>, Vec<Face>) = (Vec::new(), Vec::new(), Vec::new());
         for (b, body) in model.bodies.iter().enumerate().filter(|(b, _)| named(*b)) {
@@ -111,27 +144,20 @@ impl Contacts {
         let mut order: Vec<usize> = (0..nodes.len()).collect();
         order.sort_unstable_by_key(|&k| nodes[k]);
         let (nodes, node_body): (Vec<u32>, Vec<u32>) = order.iter().map(|&k| (nodes[k], node_body[k])).unzip();
-        let compact = |p: u32| nodes.binary_search(&p).expect("a contact node");
-        let mut rows = vec![Vec::new(); nodes.len()];
-        for (f, (corners, _)) in faces.iter().enumerate() {
-            rows[compact(corners[0])].push(f as u32);
+        let mesh = ContactMesh { nodes, node_body, faces };
+        let mut rows = vec![Vec::new(); mesh.nodes.len()];
+        for (f, (corners, _)) in mesh.faces.iter().enumerate() {
+            rows[mesh.compact(corners[0])].push(f as u32);
         }
         let (first_offsets, first_faces) = csr(rows);
-        let dhat = model
-            .contact_rules
-            .iter()
-            .map(|t| match t.interaction.law() {
-                Law::Contact { range, .. } => range(&t.params),
-                _ => unreachable!("contact law"),
-            })
-            .fold(0.0, f64::max);
+        let dhat = model.contact_rules.iter().filter_map(|t| t.interaction.law().contact_range(&t.params)).fold(0.0, f64::max);
         Self {
-            nodes,
-            node_body,
-            faces,
+            adhesion: Adhesion::new(model, &mesh),
+            mesh,
             first_offsets,
             first_faces,
-            rules,
+            barriers,
+            any,
             body_types: types,
             dhat,
             offsets: vec![0; model.len() + 1],
@@ -141,7 +167,7 @@ impl Contacts {
 
     /// Whether there is anything to evaluate.
     pub(super) fn is_empty(&self) -> bool {
-        self.nodes.is_empty()
+        self.mesh.nodes.is_empty()
     }
 
     /// Candidate-list builds so far.
@@ -149,16 +175,16 @@ impl Contacts {
         self.builds
     }
 
-    fn rules_between(&self, node_body: u32, face_body: u32, model: &Model) -> &[u32] {
+    /// Index of the body-type pair (node's body, face's body) in the rule tables.
+    fn type_pair(&self, node_body: u32, face_body: u32, model: &Model) -> usize {
         let t = |b: u32| model.bodies[b as usize].body_type as usize;
-        &self.rules[t(node_body) * self.body_types + t(face_body)]
+        t(node_body) * self.body_types + t(face_body)
     }
 
-    /// Image-consistent closest point of pair `k`'s face to its node.
-    #[inline]
-    fn geometry(&self, k: usize, x: &[DVec3], images: &Images) -> PointTriangle {
-        let [node, face] = self.pairs[k];
-        closest(x, images, self.nodes[node as usize], self.faces[face as usize].0)
+    /// The node–face rules of pair `k`.
+    fn barriers_of(&self, k: usize, model: &Model) -> &[u32] {
+        let [node, face] = self.candidates.pairs[k];
+        &self.barriers[self.type_pair(self.mesh.node_body[node as usize], self.mesh.faces[face as usize].1, model)]
     }
 
     /// Rebuilds the candidate list if never built or a contact node moved more than d̂/2.
@@ -169,7 +195,7 @@ impl Contacts {
         let images = sim_box.images();
         let half = 0.5 * self.dhat;
         let stale = self.reference.as_ref().is_none_or(|reference| {
-            self.nodes.par_iter().zip(reference.par_iter()).any(|(&p, x0)| {
+            self.mesh.nodes.par_iter().zip(reference.par_iter()).any(|(&p, x0)| {
                 let d = images.minimum_image(x[p as usize] - *x0).length();
                 d.is_nan() || d > half
             })
@@ -182,8 +208,9 @@ impl Contacts {
 
     fn rebuild(&mut self, model: &Model, x: &[DVec3], sim_box: &SimBox) -> Result<(), String> {
         let images = sim_box.images();
-        let compact_x: Vec<DVec3> = self.nodes.iter().map(|&p| x[p as usize]).collect();
+        let compact_x: Vec<DVec3> = self.mesh.nodes.iter().map(|&p| x[p as usize]).collect();
         let longest = self
+            .mesh
             .faces
             .par_iter()
             .map(|(c, _)| {
@@ -195,18 +222,18 @@ impl Contacts {
         let mut list = NeighborList::new(search + longest, 0.0);
         list.build(&compact_x, sim_box, &Exclusions::none()).map_err(|e| format!("contact search: {e}"))?;
         let this = &*self;
-        let rows: Vec<Vec<u32>> = (0..this.nodes.len())
+        let rows: Vec<Vec<u32>> = (0..this.mesh.nodes.len())
             .into_par_iter()
             .map(|k| {
-                let body = this.node_body[k];
+                let body = this.mesh.node_body[k];
                 let mut mine = Vec::new();
                 for &j in list.neighbors(k) {
                     let j = j as usize;
                     for &f in &this.first_faces[this.first_offsets[j] as usize..this.first_offsets[j + 1] as usize] {
-                        let (corners, face_body) = this.faces[f as usize];
+                        let (corners, face_body) = this.mesh.faces[f as usize];
                         if face_body != body
-                            && !this.rules_between(body, face_body, model).is_empty()
-                            && closest(x, &images, this.nodes[k], corners).distance < search
+                            && this.any[this.type_pair(body, face_body, model)]
+                            && closest(x, &images, this.mesh.nodes[k], corners).distance < search
                         {
                             mine.push(f);
                         }
@@ -216,57 +243,67 @@ impl Contacts {
                 mine
             })
             .collect();
-        self.pairs = rows.iter().enumerate().flat_map(|(k, faces)| faces.iter().map(move |&f| [k as u32, f])).collect();
+        let (offsets, faces) = csr(rows);
+        let candidates = &mut self.candidates;
+        candidates.pairs = (0..offsets.len() - 1)
+            .flat_map(|k| faces[offsets[k] as usize..offsets[k + 1] as usize].iter().map(move |&f| [k as u32, f]))
+            .collect();
+        candidates.offsets = offsets;
         let mut slots = vec![Vec::new(); model.len()];
-        for (k, &[node, face]) in self.pairs.iter().enumerate() {
-            let (corners, _) = self.faces[face as usize];
-            for (role, p) in [self.nodes[node as usize], corners[0], corners[1], corners[2]].into_iter().enumerate() {
+        for (k, &[node, face]) in candidates.pairs.iter().enumerate() {
+            let (corners, _) = self.mesh.faces[face as usize];
+            for (role, p) in [self.mesh.nodes[node as usize], corners[0], corners[1], corners[2]].into_iter().enumerate() {
                 slots[p as usize].push([k as u32, role as u32]);
             }
         }
         (self.offsets, self.slots) = csr(slots);
-        self.distance.resize(self.pairs.len(), 0.0);
-        self.forces.resize(self.pairs.len(), [DVec3::ZERO; 4]);
+        let pairs = candidates.pairs.len();
+        candidates.points.resize(pairs, PointTriangle { distance: f64::INFINITY, weights: [0.0; 3], normal: DVec3::ZERO });
+        candidates.forces.resize(pairs, [DVec3::ZERO; 4]);
         self.reference = Some(compact_x);
         self.builds += 1;
         Ok(())
     }
 
-    /// Evaluates every candidate pair into its slot (the list must be current: [`Self::update`]).
+    /// Evaluates every candidate pair into its slot, then the area-weighted
+    /// terms (the list must be current: [`Self::update`]).
     pub(super) fn prepare(&mut self, model: &Model, x: &[DVec3], images: &Images) {
         let this = &*self;
-        let results: Vec<(f64, [DVec3; 4])> = (0..this.pairs.len())
+        let results: Vec<(PointTriangle, [DVec3; 4])> = (0..this.candidates.pairs.len())
             .into_par_iter()
             .with_min_len(256)
             .map(|k| {
-                let pt = this.geometry(k, x, images);
-                let [node, face] = this.pairs[k];
+                let [node, face] = this.candidates.pairs[k];
+                let pt = closest(x, images, this.mesh.nodes[node as usize], this.mesh.faces[face as usize].0);
                 let mut forces = [DVec3::ZERO; 4];
-                for &r in this.rules_between(this.node_body[node as usize], this.faces[face as usize].1, model) {
+                for &r in this.barriers_of(k, model) {
                     let f = node_face_forces(&radial(&model.contact_rules[r as usize], pt.distance), &pt);
                     forces.iter_mut().zip(f).for_each(|(a, b)| *a += b);
                 }
-                (pt.distance, forces)
+                (pt, forces)
             })
             .collect();
-        for (k, (d, f)) in results.into_iter().enumerate() {
-            self.distance[k] = d;
-            self.forces[k] = f;
+        for (k, (pt, f)) in results.into_iter().enumerate() {
+            self.candidates.points[k] = pt;
+            self.candidates.forces[k] = f;
         }
+        self.adhesion.prepare(model, &self.mesh, &mut self.candidates, x, images);
     }
 
-    /// Contact force on particle `i`: its slots in ascending pair order.
+    /// Contact force on particle `i`: its pair slots in ascending pair order,
+    /// then its area-weighted face slots.
     #[inline]
     pub(super) fn force_on(&self, i: usize) -> DVec3 {
-        self.slots[self.offsets[i] as usize..self.offsets[i + 1] as usize]
+        let pairs = self.slots[self.offsets[i] as usize..self.offsets[i + 1] as usize]
             .iter()
-            .map(|&[k, role]| self.forces[k as usize][role as usize])
-            .fold(DVec3::ZERO, |a, b| a + b)
+            .map(|&[k, role]| self.candidates.forces[k as usize][role as usize])
+            .fold(DVec3::ZERO, |a, b| a + b);
+        pairs + self.adhesion.force_on(i)
     }
 
     /// The smallest node–face distance over the candidate pairs (∞ when there are none).
     pub(super) fn min_distance(&self) -> f64 {
-        self.distance.iter().copied().fold(f64::INFINITY, f64::min)
+        self.candidates.points.iter().map(|pt| pt.distance).fold(f64::INFINITY, f64::min)
     }
 
     /// Each particle's largest safe displacement in the next step (∞ for
@@ -275,32 +312,29 @@ impl Contacts {
         limits.clear();
         limits.resize(n, f64::INFINITY);
         let cap = STEP_FRACTION * self.dhat;
-        self.nodes.iter().for_each(|&p| limits[p as usize] = cap);
+        self.mesh.nodes.iter().for_each(|&p| limits[p as usize] = cap);
         limits.par_iter_mut().enumerate().with_min_len(1024).for_each(|(i, limit)| {
             for &[k, _] in &self.slots[self.offsets[i] as usize..self.offsets[i + 1] as usize] {
-                *limit = limit.min(STEP_FRACTION * self.distance[k as usize]);
+                *limit = limit.min(STEP_FRACTION * self.candidates.points[k as usize].distance);
             }
         });
     }
 
     /// Appends each candidate pair's Gauss–Newton stiffness blocks
     /// max(b″, 0)·g_a g_bᵀ, g = (n̂, −w_0 n̂, −w_1 n̂, −w_2 n̂) over (node, corners),
-    /// in pair order (see `src/backend/stiffness.rs`).
-    pub(super) fn stiffness(&self, model: &Model, x: &[DVec3], images: &Images, blocks: &mut Vec<StiffnessBlock>) {
-        for k in 0..self.pairs.len() {
-            let pt = self.geometry(k, x, images);
-            let [node, face] = self.pairs[k];
-            let (corners, face_body) = self.faces[face as usize];
-            let curvature: f64 = self
-                .rules_between(self.node_body[node as usize], face_body, model)
-                .iter()
-                .map(|&r| radial(&model.contact_rules[r as usize], pt.distance).d2e_dr2)
-                .sum();
+    /// in pair order, at the positions of the last [`Self::prepare`] (see
+    /// `src/backend/stiffness.rs`). Area-weighted terms (adhesion) add none.
+    pub(super) fn stiffness(&self, model: &Model, blocks: &mut Vec<StiffnessBlock>) {
+        for (k, pt) in self.candidates.points.iter().enumerate() {
+            let curvature: f64 =
+                self.barriers_of(k, model).iter().map(|&r| radial(&model.contact_rules[r as usize], pt.distance).d2e_dr2).sum();
             if curvature <= 0.0 {
                 continue;
             }
+            let [node, face] = self.candidates.pairs[k];
+            let corners = self.mesh.faces[face as usize].0;
             let nn = DMat3::from_cols(pt.normal * pt.normal.x, pt.normal * pt.normal.y, pt.normal * pt.normal.z) * curvature;
-            let particles = [self.nodes[node as usize], corners[0], corners[1], corners[2]];
+            let particles = [self.mesh.nodes[node as usize], corners[0], corners[1], corners[2]];
             let g = [1.0, -pt.weights[0], -pt.weights[1], -pt.weights[2]];
             for a in 0..4 {
                 for b in 0..4 {
@@ -310,30 +344,36 @@ impl Contacts {
         }
     }
 
-    /// Energies per registry entry and the virial (d·n̂ ⊗ f_node per pair), pair by pair.
+    /// Energies per registry entry and the virial, pair by pair (d·n̂ ⊗ f_node)
+    /// then the area-weighted terms, at the positions of the last [`Self::prepare`].
     pub(super) fn energy(&self, model: &Model, x: &[DVec3], images: &Images, energy: &mut [f64], virial: &mut [f64; 6]) {
-        for k in 0..self.pairs.len() {
-            let pt = self.geometry(k, x, images);
-            let [node, face] = self.pairs[k];
-            for &r in self.rules_between(self.node_body[node as usize], self.faces[face as usize].1, model) {
+        for (k, pt) in self.candidates.points.iter().enumerate() {
+            for &r in self.barriers_of(k, model) {
                 let term = &model.contact_rules[r as usize];
                 energy[registry_index(term)] += radial(term, pt.distance).energy;
             }
-            add6(virial, outer(pt.distance * pt.normal, self.forces[k][0]));
+            add6(virial, outer(pt.distance * pt.normal, self.candidates.forces[k][0]));
         }
+        self.adhesion.energy(model, &self.mesh, x, images, energy, virial);
     }
+}
+
+/// Corners of face `corners`, image-consistent around the first.
+#[inline]
+pub(super) fn face_corners(x: &[DVec3], images: &Images, corners: [u32; 3]) -> [DVec3; 3] {
+    let a = x[corners[0] as usize];
+    corners.map(|q| a + images.minimum_image(x[q as usize] - a))
 }
 
 /// Closest point of face `corners` to particle `p`, image-consistent around corner 0.
 #[inline]
 fn closest(x: &[DVec3], images: &Images, p: u32, corners: [u32; 3]) -> PointTriangle {
-    let a = x[corners[0] as usize];
-    let around = |q: u32| a + images.minimum_image(x[q as usize] - a);
-    point_triangle(around(p), [a, around(corners[1]), around(corners[2])])
+    let face = face_corners(x, images, corners);
+    point_triangle(face[0] + images.minimum_image(x[p as usize] - face[0]), face)
 }
 
 /// Rows to CSR (offsets, flat).
-fn csr<T>(rows: Vec<Vec<T>>) -> (Vec<u32>, Vec<T>) {
+pub(super) fn csr<T>(rows: Vec<Vec<T>>) -> (Vec<u32>, Vec<T>) {
     let mut offsets = Vec::with_capacity(rows.len() + 1);
     let mut flat = Vec::new();
     offsets.push(0);

@@ -1,6 +1,7 @@
 //! Force backends. [`cpu`] is the reference (f64, deterministic, rayon); the
 //! GPU backend must match it within each interaction's declared epsilon.
 
+mod adhesion;
 mod bonded;
 mod contact;
 pub mod cpu;

@@ -140,7 +140,7 @@ impl CpuBackend {
                 }
             }
         }
-        self.contacts().stiffness(model, x, &images, &mut blocks);
+        self.contacts().stiffness(model, &mut blocks);
         for external in &model.externals {
             let Law::OneBody(eval) = external.term.interaction.law() else { unreachable!("external law is one-body") };
             for &m in &external.members {

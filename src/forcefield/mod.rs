@@ -11,6 +11,7 @@
 //! pair  actin actin    soft_repulsion k 100 sigma 0.05
 //! body  cell           turgor k 7e5 dp0 40 v0 4189
 //! contact cell cell    contact_barrier dhat 0.1 kappa 100
+//! contact cell cell    contact_adhesion w 50 d_on 0.1 d_off 0.4
 //! ```
 //!
 //! Parameters are `name value` pairs in any order, checked against the
@@ -21,8 +22,11 @@
 //! and so do several `body` lines for one body type (the `type` of a body in
 //! the topology's `[ bodies ]`): each line is one many-body term evaluated on
 //! every body of that type. A `contact` line names two body types (possibly
-//! the same) and a node–face term that acts between every node of a body of
-//! one type and every face of a different body of the other.
+//! the same) and a contact term between different bodies of those types: a
+//! node–face term (`contact_barrier`) acts between every node of one body and
+//! every face of the other, an area-weighted one (`contact_adhesion`) on each
+//! face by its corners' distances to the other body. Several `contact` lines
+//! for one pair add up (a barrier and an adhesion).
 //!
 //! A `bond` line may end with kinetic rules (see [`crate::kinetics`]):
 //! `bond clutch harmonic k 5 r0 0.02 kinetics catch_slip kc0 10 xc 0.002 ks0 0.05 xs 0.001`.

@@ -35,7 +35,7 @@ pub struct BodyRule {
     pub term: TermType,
 }
 
-/// A node–face term between bodies of two types (`contact TYPE_A TYPE_B INTERACTION ...`).
+/// A contact term between bodies of two types (`contact TYPE_A TYPE_B INTERACTION ...`).
 #[derive(Clone, Debug)]
 pub struct ContactRule {
     pub type_a: Token,

@@ -15,7 +15,7 @@
 //! Not on the GPU (refused by [`GpuBackend::new`], and by `device gpu`
 //! before a run; `device auto` falls back to the CPU): bond kinetics, the
 //! surface terms of bodies (`Law::Surface`) and contact terms between bodies
-//! (`Law::Contact`), which have no kernel yet.
+//! (`Law::Contact`, `Law::ContactArea`), which have no kernel yet.
 //!
 //! # Precision
 //!

@@ -9,8 +9,8 @@
 //!
 //! Only law families with a GPU kernel take part ([`Law::runs_on_gpu`]).
 //! Surface laws ([`Law::Surface`]: turgor, surface tension, bending of closed
-//! bodies) and contact laws ([`Law::Contact`]: node–face barriers between
-//! bodies) have none yet: they have no evaluator file, no dispatch case, and
+//! bodies) and contact laws ([`Law::Contact`], [`Law::ContactArea`]: node–face
+//! barriers and adhesion between bodies) have none yet: they have no evaluator file, no dispatch case, and
 //! the GPU backend refuses decks that use them, so such a deck never runs on
 //! the GPU without its surface forces. A surface-law WGSL file without the
 //! kernel to call it is refused by a test, so a shader cannot pretend to
@@ -51,7 +51,7 @@ fn dispatch() -> String {
             Law::Radial { .. } => (&mut radial, format!("{name}_radial(p, r)")),
             Law::ThreeBody(_) => (&mut three, format!("{name}_three(p, ri, rj, rk)")),
             Law::OneBody(_) => (&mut one, format!("{name}_one(p, x)")),
-            Law::Surface(_) | Law::Contact { .. } => continue,
+            Law::Surface(_) | Law::Contact { .. } | Law::ContactArea { .. } => continue,
         };
         writeln!(out, "        case {index}u: {{ return {call}; }}").unwrap();
     }

@@ -19,7 +19,9 @@
 //! Contact between different bodies uses [`Law::Contact`]: an energy b(d) of
 //! the distance d from a node of one body to a face of another
 //! ([`crate::mesh::point_triangle`]), spread onto the node and the face's
-//! corners by [`node_face_forces`].
+//! corners by [`node_face_forces`]. Adhesion uses [`Law::ContactArea`]: an
+//! energy per unit area of each face, switched on by its corners' distances
+//! to the nearest face of another body.
 //!
 //! Laws carry what later solvers need: [`Radial`] returns d²E/dr², from which
 //! the analytic pair Hessian `E''·ûûᵀ + (E'/r)(I − ûûᵀ)` follows; state that
@@ -70,6 +72,7 @@ mod area_conservation;
 mod asymmetric;
 mod cable;
 mod constant_force;
+mod contact_adhesion;
 mod contact_barrier;
 mod cosine_angle;
 mod fene;
@@ -110,6 +113,7 @@ pub static REGISTRY: &[&dyn Interaction] = &[
     &area_conservation::AreaConservation,
     &helfrich_bending::HelfrichBending,
     &contact_barrier::ContactBarrier,
+    &contact_adhesion::ContactAdhesion,
 ];
 
 /// Looks an interaction type up by its registered name.
@@ -223,13 +227,30 @@ pub enum Law {
     /// (E ≡ 0 for d ≥ `range`); the CPU backend finds the node–face pairs
     /// and spreads the force with [`node_face_forces`]. No GPU kernel yet.
     Contact { eval: fn(&[f64], f64) -> Radial, range: fn(&[f64]) -> f64 },
+    /// Adhesion-like terms weighted by area: E = ε·Σ_t A_t·s_a·s_b·s_c over
+    /// the faces t of a body, ε = `density` (energy per area, negative for
+    /// adhesion) and s_k = `switch`(d_k) ∈ [0, 1] of each corner, d_k its
+    /// distance to the nearest face of another body the rule pairs it with
+    /// (s ≡ 0 for d ≥ `range`): a face counts in proportion to how fully all
+    /// three corners touch. The CPU backend finds the nearest faces (with the
+    /// node–face candidates of [`Law::Contact`]) and adds both the area and
+    /// the distance gradients. No GPU kernel yet.
+    ContactArea { switch: fn(&[f64], f64) -> Radial, density: fn(&[f64]) -> f64, range: fn(&[f64]) -> f64 },
 }
 
 impl Law {
     /// Whether the GPU backend has a kernel for this law family (and so each
     /// interaction of the family a `shaders/interactions/NAME.wgsl` evaluator).
     pub fn runs_on_gpu(&self) -> bool {
-        !matches!(self, Law::Surface(_) | Law::Contact { .. })
+        !matches!(self, Law::Surface(_) | Law::Contact { .. } | Law::ContactArea { .. })
+    }
+
+    /// The range of a contact law (node–face or area-weighted): beyond it E ≡ 0.
+    pub fn contact_range(&self, params: &[f64]) -> Option<f64> {
+        match self {
+            Law::Contact { range, .. } | Law::ContactArea { range, .. } => Some(range(params)),
+            _ => None,
+        }
     }
 }
 
@@ -439,7 +460,7 @@ mod tests {
                 | (Kind::Angle, Law::ThreeBody(_))
                 | (Kind::External, Law::OneBody(_))
                 | (Kind::Body, Law::Surface(_))
-                | (Kind::Contact, Law::Contact { .. }) => {}
+                | (Kind::Contact, Law::Contact { .. } | Law::ContactArea { .. }) => {}
                 _ => panic!("{}: kind and law disagree", i.name()),
             }
         }

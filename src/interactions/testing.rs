@@ -13,6 +13,9 @@
 //!
 //! [`Law::Surface`] laws need a mesh besides positions: their checks are the
 //! `assert_surface_*` functions, which run the same tests on a body.
+//! [`Law::ContactArea`] laws need whole bodies and their nearest faces: the
+//! engine evaluates them, and [`assert_checks_of`] runs the same tests on
+//! any energy-and-forces function of all positions (e.g. the CPU backend's).
 
 use glam::{DMat3, DVec3};
 
@@ -44,6 +47,7 @@ pub fn evaluate(law: Law, params: &[f64], positions: &[DVec3]) -> (f64, Vec<DVec
             (out.energy, super::node_face_forces(&out, &pt).to_vec())
         }
         Law::Surface(_) => panic!("a surface law needs its mesh: use evaluate_surface"),
+        Law::ContactArea { .. } => panic!("an area-weighted contact law needs whole bodies: use assert_checks_of on the engine"),
     }
 }
 
@@ -81,7 +85,7 @@ fn largest_force(forces: &[DVec3]) -> f64 {
 }
 
 /// Energy and forces as a function of all positions (one law, one term).
-type EnergyAndForces<'a> = dyn Fn(&[DVec3]) -> (f64, Vec<DVec3>) + 'a;
+pub type EnergyAndForces<'a> = dyn Fn(&[DVec3]) -> (f64, Vec<DVec3>) + 'a;
 
 fn force_is_minus_gradient(name: &str, eval: &EnergyAndForces, positions: &[DVec3], h: f64, force_floor: f64) {
     let (_, forces) = eval(positions);
@@ -174,10 +178,17 @@ pub fn assert_surface_checks(
     force_floor: f64,
 ) {
     let law = interaction.law();
-    let eval = |x: &[DVec3]| evaluate_surface(law, params, mesh, x);
-    force_is_minus_gradient(interaction.name(), &eval, positions, h, force_floor);
-    momentum_conserved(interaction.name(), &eval, positions);
-    invariant_under_rigid_motion(interaction.name(), &eval, positions);
+    assert_checks_of(interaction.name(), &|x| evaluate_surface(law, params, mesh, x), positions, h, force_floor);
+}
+
+/// F = −∇E (central differences, step `h`), Σf = 0, Σ r×f = 0 and rigid-motion
+/// invariance of any internal energy-and-forces function `eval` of all
+/// positions (named `name` in messages): for many-body terms only the engine
+/// evaluates, such as [`Law::ContactArea`].
+pub fn assert_checks_of(name: &str, eval: &EnergyAndForces, positions: &[DVec3], h: f64, force_floor: f64) {
+    force_is_minus_gradient(name, eval, positions, h, force_floor);
+    momentum_conserved(name, eval, positions);
+    invariant_under_rigid_motion(name, eval, positions);
 }
 
 /// All forces of a surface law vanish at a rest configuration of the body.
@@ -213,9 +224,11 @@ fn x_len(faces: &[[u32; 3]]) -> usize {
     faces.iter().flatten().map(|&p| p as usize + 1).max().unwrap_or(0)
 }
 
-/// For a radial or contact law, d²E/dr² matches a central difference of dE/dr at `r`.
+/// For a radial or contact law, d²E/dr² (s″ of an area-weighted law's switch) matches a central difference of dE/dr at `r`.
 pub fn assert_radial_curvature(interaction: &dyn Interaction, params: &[f64], r: f64, h: f64) {
-    let (Law::Radial { eval, .. } | Law::Contact { eval, .. }) = interaction.law() else { panic!("{} is not radial", interaction.name()) };
+    let (Law::Radial { eval, .. } | Law::Contact { eval, .. } | Law::ContactArea { switch: eval, .. }) = interaction.law() else {
+        panic!("{} is not radial", interaction.name())
+    };
     let numeric = (eval(params, r + h).de_dr - eval(params, r - h).de_dr) / (2.0 * h);
     let analytic = eval(params, r).d2e_dr2;
     let scale = analytic.abs().max(numeric.abs()).max(1e-300);

@@ -133,3 +133,20 @@ pub fn merge_topologies(texts: &[&str]) -> String {
 pub fn position_bits(sim: &Simulation) -> Vec<[u64; 3]> {
     sim.state.positions.iter().map(|x| x.to_array().map(f64::to_bits)).collect()
 }
+
+/// Two level-`level` icosphere cells (no edge bonds) of radius `radius`,
+/// centres on the x axis a `gap` apart at their surfaces; bodies 1 and 2.
+pub fn two_cells(level: u32, radius: f64, gap: f64) -> String {
+    two_cells_with_edges(level, radius, gap, None)
+}
+
+/// As [`two_cells`], with the mesh edges as bonds of type `edges`.
+pub fn two_cells_with_edges(level: u32, radius: f64, gap: f64, edges: Option<&str>) -> String {
+    use cellmd::build::{icosphere_cell, IcosphereCell};
+    let half = radius + gap / 2.0;
+    let left =
+        IcosphereCell { level, radius, centre: glam::DVec3::new(-half, 0.0, 0.0), bond_type: edges.map(String::from), ..Default::default() };
+    let nodes = icosphere_cell(&left).shells[0].nodes as u64;
+    let right = IcosphereCell { centre: glam::DVec3::new(half, 0.0, 0.0), body_id: 2, first_id: nodes + 1, ..left.clone() };
+    merge_topologies(&[&icosphere_cell(&left).text, &icosphere_cell(&right).text])
+}
