@@ -15,7 +15,7 @@
 //! |---|---|---|
 //! | [`icosphere()`], [`icosphere_cell`] | `icosphere` | one cell as a closed triangulated shell (optionally with a nucleus) |
 //! | [`filament()`] | `filament` | one straight bead chain with bonds and bending angles |
-//! | [`network()`] | `network` | Mikado network: random straight filaments in a periodic box, crosslinked where they cross |
+//! | [`network()`] | `network` | Mikado network: random straight filaments in a periodic box (or a slab between two faces, `--slab`), crosslinked where they cross |
 //! | [`aster()`] | `aster` | microtubules radiating from a centrosome node |
 //! | [`cortex()`] | `cortex` | great-circle filaments on a sphere, optionally crosslinked |
 //! | [`branched()`] | `branched` | Arp2/3 network: mother filaments with daughters at 70° ± a spread |
@@ -78,7 +78,7 @@ pub use self::cortex::{cortex, CortexArgs};
 pub use self::filament::{filament, FilamentArgs};
 pub use self::filopodium::{filopodium, FilopodiumArgs};
 pub use self::icosphere::{icosphere, icosphere_cell, IcosphereArgs, IcosphereCell, Nucleus};
-pub use self::network::{network, NetworkArgs};
+pub use self::network::{network, NetworkArgs, SlabAxis};
 
 /// The `cellmd build` subcommands: one per generator.
 #[derive(clap::Subcommand, Clone, Debug)]
@@ -230,6 +230,11 @@ impl Writer {
     pub fn particle(&mut self, type_name: &str, x: DVec3, body: Option<u64>) -> u64 {
         self.particles.push((type_name.to_string(), x, body));
         self.first_id + self.particles.len() as u64 - 1
+    }
+
+    /// Particles of type `type_name` written so far.
+    pub fn count_type(&self, type_name: &str) -> usize {
+        self.particles.iter().filter(|p| p.0 == type_name).count()
     }
 
     /// The position of particle `id`.
@@ -530,7 +535,19 @@ impl Chain {
     /// Writes one chain through `points`: beads, bonds between neighbours and
     /// angles on every consecutive triple. Returns the bead ids.
     pub(crate) fn write(&self, w: &mut Writer, points: &[DVec3]) -> Vec<u64> {
-        let ids: Vec<u64> = points.iter().map(|p| w.particle(&self.particle_type, *p, None)).collect();
+        self.write_with_ends(w, points, [&self.particle_type, &self.particle_type])
+    }
+
+    /// [`write`](Self::write) with the first and last beads of particle types
+    /// `ends` (anchored ends); the others are `--particle-type`.
+    pub(crate) fn write_with_ends(&self, w: &mut Writer, points: &[DVec3], ends: [&str; 2]) -> Vec<u64> {
+        let last = points.len() - 1;
+        let type_of = |k: usize| match k {
+            0 => ends[0],
+            k if k == last => ends[1],
+            _ => &self.particle_type,
+        };
+        let ids: Vec<u64> = points.iter().enumerate().map(|(k, p)| w.particle(type_of(k), *p, None)).collect();
         for pair in ids.windows(2) {
             w.bond(&self.bond_type, pair[0], pair[1]);
         }
