@@ -631,6 +631,33 @@ impl Crosslinks {
         }
     }
 
+    /// For each crosslink between bead i and its partner j, the bond of the
+    /// same type from i to whichever neighbour of j along j's filament is
+    /// nearer to i (separations through `minimum_image`).
+    pub fn pins(&self, filaments: &[(Vec<u64>, Vec<DVec3>)], minimum_image: impl Fn(DVec3) -> DVec3) -> Self {
+        let mut place = std::collections::HashMap::new();
+        for (f, (ids, _)) in filaments.iter().enumerate() {
+            place.extend(ids.iter().enumerate().map(|(k, id)| (*id, (f, k))));
+        }
+        let position = |id: u64| {
+            let (f, k) = place[&id];
+            filaments[f].1[k]
+        };
+        let links = self
+            .links
+            .iter()
+            .filter_map(|&(t, i, j, _)| {
+                let (f, k) = place[&j];
+                let ids = &filaments[f].0;
+                let neighbours = [k.checked_sub(1), (k + 1 < ids.len()).then_some(k + 1)];
+                let distance = |n: usize| minimum_image(filaments[f].1[n] - position(i)).length();
+                let nearer = neighbours.into_iter().flatten().min_by(|&a, &b| distance(a).total_cmp(&distance(b)))?;
+                Some((t, i, ids[nearer], distance(nearer)))
+            })
+            .collect();
+        Self { links }
+    }
+
     /// `M crosslinks (a 12, b 9); length min … mean … max …`.
     pub fn summary(&self, types: &CrosslinkerTypes) -> String {
         let counts: Vec<String> =

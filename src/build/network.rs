@@ -24,6 +24,11 @@ pub struct NetworkArgs {
     /// Crosslinker bond types and the fraction of crosslinks each takes, `NAME:FRACTION,…`.
     #[arg(long, default_value = "crosslink")]
     pub crosslinker_types: CrosslinkerTypes,
+    /// Pin each crosslink: its bead is also bonded (same type) to the nearer
+    /// neighbour of its partner, a triangle that keeps the two filaments from
+    /// sliding past each other while they still turn freely about it.
+    #[arg(long)]
+    pub pin_crosslinks: bool,
     /// Make this axis a fixed (non-periodic) boundary: a slab between the faces
     /// 0 and L, filaments cut at them, each cut end anchored (for shear).
     #[arg(long, value_enum)]
@@ -55,6 +60,7 @@ impl Default for NetworkArgs {
             planar: true,
             capture: 0.1,
             crosslinker_types: CrosslinkerTypes::default(),
+            pin_crosslinks: false,
             slab: None,
             base_type: "base".into(),
             plate_type: "plate".into(),
@@ -70,7 +76,9 @@ impl Default for NetworkArgs {
 /// `--planar`, in the plane z = LZ/2 with directions uniform in it). Where
 /// two filaments come within `--capture` of each other, their closest pair of
 /// beads (minimum image) is crosslinked by one bond: one crosslink per pair
-/// of filaments. Each crosslink's bond type is drawn from
+/// of filaments (with `--pin-crosslinks`, a second bond of the same type
+/// joins the bead to its partner's nearer neighbour: a pin joint rather than
+/// a link that can swing). Each crosslink's bond type is drawn from
 /// `--crosslinker-types NAME:FRACTION,…` so each type can carry its own
 /// stiffness in the force field. Positions are written wrapped into the box;
 /// bonds across the boundary are measured by minimum image, as the engine
@@ -154,6 +162,10 @@ pub fn network(a: &NetworkArgs) -> Result<Built, String> {
     let pairs = closest_pairs(&filaments, capture, minimum_image);
     let links = Crosslinks::from_pairs(pairs, &a.crosslinker_types, &draws, 2);
     links.write(&mut w, &a.crosslinker_types);
+    let pins = a.pin_crosslinks.then(|| links.pins(&filaments, minimum_image));
+    if let Some(pins) = &pins {
+        pins.write(&mut w, &a.crosslinker_types);
+    }
     w.set_box([0, 1, 2].map(|axis| (0.0, l[axis], periodic[axis])));
     w.wrap_periodic();
     let mut lines = vec![
@@ -183,6 +195,10 @@ pub fn network(a: &NetworkArgs) -> Result<Built, String> {
         ),
         bending,
     ];
+    if let Some(pins) = &pins {
+        lines
+            .push(format!("pinned: each crosslink's bead also bonded to its partner's nearer neighbour ({} more bonds)", pins.links.len()));
+    }
     if let Some(axis) = slab {
         let name = ["x", "y", "z"][axis];
         let count = |t: &str| w.count_type(t);
@@ -282,6 +298,30 @@ mod tests {
         // The same filaments as the periodic network, less the beads of one-bead pieces (at most one per cut end).
         let whole = parse(&network(&args(3)).unwrap()).positions.len();
         assert!(top.positions.len() <= whole && top.positions.len() + base.len() + plate.len() >= whole);
+    }
+
+    /// Pinned: every crosslink i–j comes with a bond i–j' of its type, j' the
+    /// neighbour of j on j's filament nearer to i.
+    #[test]
+    fn pinned_crosslinks_bond_the_bead_to_its_partners_nearer_neighbour() {
+        let plain = parse(&network(&args(4)).unwrap());
+        let pinned = parse(&network(&NetworkArgs { pin_crosslinks: true, ..args(4) }).unwrap());
+        let d =
+            |i: u32, j: u32| (pinned.positions[j as usize] - pinned.positions[i as usize]).map(|c| c - 5.0 * (c / 5.0).round()).length();
+        let crosslinks = |t: &crate::topology::Topology| t.bonds.iter().filter(|b| b.type_name.text != "segment").count();
+        let n = crosslinks(&plain);
+        assert_eq!(crosslinks(&pinned), 2 * n);
+        let links: Vec<[u32; 2]> = pinned.bonds.iter().filter(|b| b.type_name.text != "segment").map(|b| b.particles).collect();
+        for (&[i, j], &[pi, pj]) in links[..n].iter().zip(&links[n..]) {
+            assert_eq!(pi, i);
+            let beads_per = 21;
+            assert_eq!(pj / beads_per, j / beads_per, "the pin joins another filament");
+            assert_eq!(pj.abs_diff(j), 1, "the pin's partner is not next to j");
+            let other = if pj > j { j.checked_sub(1) } else { Some(j + 1) };
+            if let Some(o) = other.filter(|&o| o / beads_per == j / beads_per) {
+                assert!(d(i, pj) <= d(i, o), "the pin took the farther neighbour");
+            }
+        }
     }
 
     #[test]
