@@ -73,18 +73,19 @@ fn network() {
     assert!(said.contains("40 filaments × 21 beads") && said.contains("xl_stiff") && said.contains("xl_soft"), "{said}");
 }
 
-/// A slab for shear: its cut ends are the `base` and `plate` types, which a
-/// force field declares `fixed`.
+/// A slab for shear with pinned crosslinks: its cut ends are the `base` and
+/// `plate` types, which a force field declares `fixed`.
 #[test]
 fn network_slab() {
     let ff = format!("{CHAIN_FF}particle base fixed\nparticle plate fixed\nbond crosslink harmonic k 100 r0 0\n");
     let args =
         ["network", "--filaments", "40", "--length", "2", "--segments", "20", "--box", "5", "5", "1", "--planar", "--capture", "0.1"];
-    let said = build_and_check(&[&args[..], &["--slab", "y", "--seed", "2"]].concat(), &ff, "");
+    let said = build_and_check(&[&args[..], &["--slab", "y", "--pin-crosslinks", "--seed", "2"]].concat(), &ff, "");
     assert!(
         said.contains("planar, slab box 5 × 5 × 1") && said.contains("slab: y fixed at 0 and 5, the filaments cut there into"),
         "{said}"
     );
+    assert!(said.contains("pinned: each crosslink's bead also bonded to its partner's nearer neighbour"), "{said}");
 }
 
 #[test]
