@@ -79,6 +79,21 @@ fn network() {
     assert!(said.contains("40 filaments × 21 beads") && said.contains("xl_stiff") && said.contains("xl_soft"), "{said}");
 }
 
+/// A slab for shear with pinned crosslinks: its cut ends are the `base` and
+/// `plate` types, which a force field declares `fixed`.
+#[test]
+fn network_slab() {
+    let ff = format!("{CHAIN_FF}particle base fixed\nparticle plate fixed\nbond crosslink harmonic k 100 r0 0\n");
+    let args =
+        ["network", "--filaments", "40", "--length", "2", "--segments", "20", "--box", "5", "5", "1", "--planar", "--capture", "0.1"];
+    let said = build_and_check(&[&args[..], &["--slab", "y", "--pin-crosslinks", "--seed", "2"]].concat(), &ff, "");
+    assert!(
+        said.contains("planar, slab box 5 × 5 × 1") && said.contains("slab: y fixed at 0 and 5, the filaments cut there into"),
+        "{said}"
+    );
+    assert!(said.contains("pinned: each crosslink's bead also bonded to its partner's nearer neighbour"), "{said}");
+}
+
 #[test]
 fn aster() {
     let ff =
@@ -187,6 +202,27 @@ fn bad_options_exit_with_status_2_and_say_what_was_expected() {
         (
             &["network", "--filaments", "3", "--length", "1", "--segments", "3", "--box", "5", "5", "5", "--capture", "0"][..],
             "expected --capture > 0, found 0",
+        ),
+        (
+            &[
+                "network",
+                "--filaments",
+                "3",
+                "--length",
+                "1",
+                "--segments",
+                "3",
+                "--box",
+                "5",
+                "5",
+                "5",
+                "--capture",
+                "0.1",
+                "--planar",
+                "--slab",
+                "z",
+            ][..],
+            "expected --slab x or y for a --planar network",
         ),
         (
             &["cortex", "--radius", "1", "--filaments", "3", "--length", "1", "--segments", "3", "--capture", "-0.1"][..],

@@ -95,6 +95,32 @@ fn thermo_prints_requested_columns_to_csv() {
     assert!((row[4] + 2.25 / 40f64.powi(3)).abs() < 1e-15, "pxx = {}", row[4]);
 }
 
+/// `displace_atoms` moves a fixed anchor across the periodic boundary at
+/// x = 5; `xu/GROUP` follows it unwrapped, `fx/GROUP` reads the spring's
+/// pull on it (k = 3, r0 = 1, bead at x = 1), `fx/all` sums to zero, and
+/// `minimize` relaxes the bead without moving the loaded anchor.
+#[test]
+fn displace_atoms_moves_a_group_and_group_columns_read_its_position_and_load() {
+    let top = "[ particles ]\n1 a 0 0 0\n2 p 1 0 0\n[ bonds ]\ns 1 2\n";
+    let ff = "particle a fixed\nparticle p drag 1\nbond s harmonic k 3 r0 1\n";
+    let body = "units lj\ntopology t.top\nforcefield f.ff\nbox x -5 5 p y -5 5 f z -5 5 f\ntimestep 0.01\n\
+                group anchor type a\nthermo 0 xu/anchor fx/anchor fx/all\nthermo_file t.csv\n\
+                displace_atoms anchor move 4.5 0 0\nrun 0\ndisplace_atoms anchor move 1 0 0\nrun 0\nminimize ftol 1e-10\nrun 0\n";
+    let case = Case::new(&[("t.top", top), ("f.ff", ff), ("deck.in", body)]);
+    let sim = case.run();
+    let csv = std::fs::read_to_string(case.path("t.csv")).unwrap();
+    let rows: Vec<Vec<f64>> = csv.lines().skip(1).map(|l| l.split(',').map(|v| v.parse().unwrap()).collect()).collect();
+    assert_eq!(csv.lines().next().unwrap(), "xu/anchor[σ],fx/anchor[ε/σ],fx/all[ε/σ]");
+    // Anchor at 4.5: the bead 3.5 away, stretched by 2.5, pulls it by 3·2.5 towards −x.
+    assert_eq!(rows[0][0], 4.5);
+    assert!((rows[0][1] + 7.5).abs() < 1e-12 && rows[0][2].abs() < 1e-12, "{:?}", rows[0]);
+    // Anchor at 5.5 (wrapped to −4.5): the bead 4.5 away through the boundary.
+    assert!((rows[1][0] - 5.5).abs() < 1e-12 && (rows[1][1] + 10.5).abs() < 1e-12, "{:?}", rows[1]);
+    assert_eq!((sim.state.positions[0].x, sim.state.images[0][0]), (-4.5, 1));
+    // Relaxed: the bead sits r0 from the anchor, which has not moved.
+    assert!((rows[2][0] - 5.5).abs() < 1e-12 && rows[2][1].abs() < 1e-9, "{:?}", rows[2]);
+}
+
 #[test]
 fn the_same_deck_twice_writes_identical_files() {
     let body = "temperature 1\nseed 4\ndump a every 10 mcap a.mcap\nthermo 10\nthermo_file t.csv\nrun 50\n";

@@ -41,6 +41,14 @@ fn interactions_map_to_their_exact_lammps_forms() {
     assert!(!input.contains("write_dump"));
 }
 
+/// `displace_atoms … move` is LAMMPS' own command (in box units).
+#[test]
+fn displace_atoms_exports_as_lammps_displace_atoms() {
+    let out = export(&deck("group tip id 2:3\ndisplace_atoms tip move 0.5 0 -0.25\n").plan(), ExportOptions::default()).unwrap();
+    let expected = "group m_tip id 2:3\ndisplace_atoms m_tip move 0.5 0.0 -0.25 units box\ngroup m_tip delete\n";
+    assert!(out.input.contains(expected), "{}", out.input);
+}
+
 #[test]
 fn what_lammps_cannot_express_is_refused_by_name() {
     let oblique = export(&deck("external slope all wall nx 1 nz 1 k 20\n").plan(), ExportOptions::default()).unwrap_err();

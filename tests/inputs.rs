@@ -1,5 +1,6 @@
-//! Every deck in `inputs/` runs (shortened through its `steps` and
-//! `fire_iterations` variables) and writes outputs that read back.
+//! Every deck in `inputs/` runs (shortened through its `steps`,
+//! `fire_iterations` and, for quasi-static decks, `relax_steps` (steps per
+//! relaxation phase) variables) and writes outputs that read back.
 
 use std::path::Path;
 
@@ -7,7 +8,7 @@ use cellmd::deck::validate_file;
 use cellmd::run::{RunOptions, Simulation};
 
 fn shortened() -> Vec<(String, String)> {
-    vec![("steps".into(), "200".into()), ("fire_iterations".into(), "100".into())]
+    vec![("steps".into(), "200".into()), ("fire_iterations".into(), "100".into()), ("relax_steps".into(), "4".into())]
 }
 
 #[test]

@@ -15,7 +15,7 @@
 //! |---|---|---|
 //! | [`icosphere()`], [`icosphere_cell`] | `icosphere` | one cell as a closed triangulated shell (optionally with a nucleus) |
 //! | [`filament()`] | `filament` | one straight bead chain with bonds and bending angles |
-//! | [`network()`] | `network` | Mikado network: random straight filaments in a periodic box, crosslinked where they cross |
+//! | [`network()`] | `network` | Mikado network: random straight filaments in a periodic box (or a slab between two faces, `--slab`), crosslinked where they cross |
 //! | [`aster()`] | `aster` | microtubules radiating from a centrosome node |
 //! | [`cortex()`] | `cortex` | great-circle filaments on a sphere, optionally crosslinked |
 //! | [`branched()`] | `branched` | Arp2/3 network: mother filaments with daughters at 70° ± a spread |
@@ -83,7 +83,7 @@ pub use self::cortex::{cortex, CortexArgs};
 pub use self::filament::{filament, FilamentArgs};
 pub use self::filopodium::{filopodium, FilopodiumArgs};
 pub use self::icosphere::{icosphere, icosphere_cell, IcosphereArgs, IcosphereCell, Nucleus, ShellOptions};
-pub use self::network::{network, NetworkArgs};
+pub use self::network::{network, NetworkArgs, SlabAxis};
 pub use self::sheet::{sheet, SheetArgs};
 pub use self::tensegrity::{tensegrity, TensegrityArgs};
 
@@ -260,6 +260,11 @@ impl Writer {
     /// Gives particle `id` another type.
     pub fn set_type(&mut self, id: u64, type_name: &str) {
         self.particles[(id - self.first_id) as usize].0 = type_name.to_string();
+    }
+
+    /// Particles of type `type_name` written so far.
+    pub fn count_type(&self, type_name: &str) -> usize {
+        self.particles.iter().filter(|p| p.0 == type_name).count()
     }
 
     /// The position of particle `id`.
@@ -572,7 +577,19 @@ impl Chain {
     /// Writes one chain through `points`: beads, bonds between neighbours and
     /// angles on every consecutive triple. Returns the bead ids.
     pub(crate) fn write(&self, w: &mut Writer, points: &[DVec3]) -> Vec<u64> {
-        let ids: Vec<u64> = points.iter().map(|p| w.particle(&self.particle_type, *p, None)).collect();
+        self.write_with_ends(w, points, [&self.particle_type, &self.particle_type])
+    }
+
+    /// [`write`](Self::write) with the first and last beads of particle types
+    /// `ends` (anchored ends); the others are `--particle-type`.
+    pub(crate) fn write_with_ends(&self, w: &mut Writer, points: &[DVec3], ends: [&str; 2]) -> Vec<u64> {
+        let last = points.len() - 1;
+        let type_of = |k: usize| match k {
+            0 => ends[0],
+            k if k == last => ends[1],
+            _ => &self.particle_type,
+        };
+        let ids: Vec<u64> = points.iter().enumerate().map(|(k, p)| w.particle(type_of(k), *p, None)).collect();
         for pair in ids.windows(2) {
             w.bond(&self.bond_type, pair[0], pair[1]);
         }
@@ -654,6 +671,33 @@ impl Crosslinks {
         for &(t, i, j, _) in &self.links {
             w.bond(&types.0[t].0, i, j);
         }
+    }
+
+    /// For each crosslink between bead i and its partner j, the bond of the
+    /// same type from i to whichever neighbour of j along j's filament is
+    /// nearer to i (separations through `minimum_image`).
+    pub fn pins(&self, filaments: &[(Vec<u64>, Vec<DVec3>)], minimum_image: impl Fn(DVec3) -> DVec3) -> Self {
+        let mut place = std::collections::HashMap::new();
+        for (f, (ids, _)) in filaments.iter().enumerate() {
+            place.extend(ids.iter().enumerate().map(|(k, id)| (*id, (f, k))));
+        }
+        let position = |id: u64| {
+            let (f, k) = place[&id];
+            filaments[f].1[k]
+        };
+        let links = self
+            .links
+            .iter()
+            .filter_map(|&(t, i, j, _)| {
+                let (f, k) = place[&j];
+                let ids = &filaments[f].0;
+                let neighbours = [k.checked_sub(1), (k + 1 < ids.len()).then_some(k + 1)];
+                let distance = |n: usize| minimum_image(filaments[f].1[n] - position(i)).length();
+                let nearer = neighbours.into_iter().flatten().min_by(|&a, &b| distance(a).total_cmp(&distance(b)))?;
+                Some((t, i, ids[nearer], distance(nearer)))
+            })
+            .collect();
+        Self { links }
     }
 
     /// `M crosslinks (a 12, b 9); length min … mean … max …`.

@@ -79,6 +79,18 @@ pub enum ThermoColumn {
         bond_type: usize,
         lag: usize,
     },
+    /// Summed force on a group's particles along an axis (`fx/GROUP`,
+    /// `fy/GROUP`, `fz/GROUP`); on `fixed` particles, the reaction of their anchors.
+    GroupForce {
+        group: Group,
+        axis: usize,
+    },
+    /// Mean unwrapped coordinate of a group's particles along an axis
+    /// (`xu/GROUP`, `yu/GROUP`, `zu/GROUP`).
+    GroupPosition {
+        group: Group,
+        axis: usize,
+    },
 }
 
 /// A named trajectory output.
@@ -93,7 +105,7 @@ pub struct DumpSpec {
 }
 
 /// A named particle group (deck `group`).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Group {
     pub name: String,
     /// Internal indices, ascending.
@@ -123,6 +135,12 @@ pub enum Action {
     Undump(String),
     External(External),
     Unexternal(String),
+    /// Moves every particle of a group by `delta` at once (`displace_atoms
+    /// GROUP move DX DY DZ`), wrapping periodic axes.
+    Displace {
+        group: Group,
+        delta: glam::DVec3,
+    },
     /// Changes one parameter of a bond type, angle type or pair rule.
     Coeff {
         target: CoeffTarget,

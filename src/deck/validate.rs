@@ -22,7 +22,7 @@ use crate::topology::{parse_box_axis, parse_topology, BoxAxis, Topology};
 use crate::units::UnitSystem;
 
 /// The commands a deck understands (for "expected ..." messages).
-const COMMANDS: &str = "units, variable, topology, forcefield, box, special_bonds, temperature, timestep, seed, device, integrator, neighbor, thermo, thermo_file, events, lifetimes, dump, undump, group, external, unexternal, coeff, constrain, unconstrain, minimize, run, write_state, read_state, print";
+const COMMANDS: &str = "units, variable, topology, forcefield, box, special_bonds, temperature, timestep, seed, device, integrator, neighbor, thermo, thermo_file, events, lifetimes, dump, undump, group, external, unexternal, displace_atoms, coeff, constrain, unconstrain, minimize, run, write_state, read_state, print";
 
 /// Commands that define the system and must come before it is first used.
 const SETUP: [&str; 5] = ["units", "topology", "forcefield", "box", "special_bonds"];
@@ -87,6 +87,16 @@ fn non_negative(token: &Token, what: &str) -> Result<f64, InputError> {
     }
 }
 
+/// Whether a thermo column prefix names a group measurement: (force (`fx`,
+/// `fy`, `fz`) or mean unwrapped position (`xu`, `yu`, `zu`), axis).
+fn group_column(prefix: &str) -> Option<(bool, usize)> {
+    match prefix {
+        "fx" | "fy" | "fz" => Some((true, usize::from(prefix.as_bytes()[1] - b'x'))),
+        "xu" | "yu" | "zu" => Some((false, usize::from(prefix.as_bytes()[0] - b'x'))),
+        _ => None,
+    }
+}
+
 /// `key value` options after a command; each key at most once.
 fn options<'a>(tokens: &'a [Token], allowed: &[&str], usage: &str) -> Result<HashMap<String, &'a Token>, InputError> {
     let mut out = HashMap::new();
@@ -111,6 +121,13 @@ impl Validator {
         } else {
             self.deck_dir.join(p)
         }
+    }
+
+    /// The group a token names (`all` or one a `group` command defined before).
+    fn group_named(&self, token: &Token) -> Result<&Group, InputError> {
+        self.groups.get(&token.text).ok_or_else(|| {
+            token.error(format!("found group `{}`, expected `all` or a group defined by a `group` command before", token.text))
+        })
     }
 
     /// The model, built on first use from the setup commands seen so far.
@@ -209,7 +226,7 @@ impl Validator {
 
     fn thermo_columns(&self, tokens: &[Token]) -> Result<Vec<ThermoColumn>, InputError> {
         const FIXED: &str =
-            "step, time, pe, pe/NAME, fmax, fnorm, press, pxx, pyy, pzz, pxy, pxz, pyz, nbuild, solver_iterations, solver_residual, ctension/BONDTYPE, breaks, rebinds, forms, resets, nbound/BONDTYPE, tension/BONDTYPE, volume/BODYTYPE, area/BODYTYPE, planetension/AXIS/POS, gamma/BODYTYPE, e2e/BONDTYPE, tcorr/BONDTYPE/LAG, mindist, nclamp";
+            "step, time, pe, pe/NAME, fmax, fnorm, press, pxx, pyy, pzz, pxy, pxz, pyz, nbuild, solver_iterations, solver_residual, ctension/BONDTYPE, breaks, rebinds, forms, resets, nbound/BONDTYPE, tension/BONDTYPE, volume/BODYTYPE, area/BODYTYPE, planetension/AXIS/POS, gamma/BODYTYPE, e2e/BONDTYPE, tcorr/BONDTYPE/LAG, fx/GROUP, fy/GROUP, fz/GROUP, xu/GROUP, yu/GROUP, zu/GROUP, mindist, nclamp";
         let bond_type = |t: &Token, name: &str| {
             self.forcefield.bond_types.iter().position(|b| b.label.text == name).ok_or_else(|| {
                 let names: Vec<&str> = self.forcefield.bond_types.iter().map(|b| b.label.text.as_str()).collect();
@@ -266,6 +283,15 @@ impl Validator {
                         Some(("area", name)) => ThermoColumn::BodyArea(body_type(t, name)?),
                         Some(("gamma", name)) => ThermoColumn::CorticalTension(body_type(t, name)?),
                         Some(("e2e", name)) => ThermoColumn::EndToEnd(bond_type(t, name)?),
+                        Some((prefix, name)) if group_column(prefix).is_some() => {
+                            let (force, axis) = group_column(prefix).expect("matched");
+                            let group = self.group_named(&t.with_text(name.to_string()))?.clone();
+                            if force {
+                                ThermoColumn::GroupForce { group, axis }
+                            } else {
+                                ThermoColumn::GroupPosition { group, axis }
+                            }
+                        }
                         Some(("planetension", rest)) => {
                             let usage = format!("found `{other}`, expected planetension/AXIS/POS with AXIS x, y or z and POS a number");
                             let (axis, pos) = rest.split_once('/').ok_or_else(|| t.error(usage.clone()))?;
@@ -365,6 +391,23 @@ impl Validator {
             return Err(s[1].error(format!("group `{name}` is empty; expected a selection that matches particles")));
         }
         self.groups.insert(name.clone(), Group { name, members });
+        Ok(())
+    }
+
+    /// `displace_atoms GROUP move DX DY DZ` (LAMMPS' syntax, lengths in box units).
+    fn displace_atoms(&mut self, s: &[Token]) -> Result<(), InputError> {
+        const USAGE: &str = "displace_atoms GROUP move DX DY DZ";
+        expect_len(s, 5..=5, USAGE)?;
+        self.model(&s[0])?;
+        let group = self.group_named(&s[1])?.clone();
+        if s[2].text != "move" {
+            return Err(s[2].error(format!("found style `{}`, expected `move` (`{USAGE}`)", s[2].text)));
+        }
+        let mut delta = DVec3::ZERO;
+        for (a, (t, name)) in s[3..].iter().zip(["DX", "DY", "DZ"]).enumerate() {
+            delta[a] = parse_f64(t, &format!("a displacement {name} (length)"))?;
+        }
+        self.actions.push(Action::Displace { group, delta });
         Ok(())
     }
 
@@ -529,6 +572,10 @@ impl Validator {
                 expect_len(s, 1..=usize::MAX, "thermo N [column ...]")?;
                 let every = parse_u64(&s[1], "a thermo interval in steps")?;
                 let columns = if s.len() > 2 {
+                    // Group columns name groups, which exist once the system does.
+                    if let Some(t) = s[2..].iter().find(|t| t.text.split_once('/').is_some_and(|(p, _)| group_column(p).is_some())) {
+                        self.model(t)?;
+                    }
                     self.thermo_columns(&s[2..])?
                 } else {
                     vec![ThermoColumn::Step, ThermoColumn::Time, ThermoColumn::Pe, ThermoColumn::Fmax, ThermoColumn::Press]
@@ -584,9 +631,7 @@ impl Validator {
                 expect_len(s, 3..=usize::MAX, "external NAME GROUP INTERACTION [param value]...")?;
                 let units = self.units;
                 self.model(kw)?;
-                let group = self.groups.get(&s[2].text).ok_or_else(|| {
-                    s[2].error(format!("found group `{}`, expected `all` or a group defined by a `group` command before", s[2].text))
-                })?;
+                let group = self.group_named(&s[2])?;
                 let term = parse_params(&s[1], &s[3], &s[4..], Kind::External, units)?;
                 let external = External { term, group: group.name.clone(), members: group.members.clone() };
                 self.externals.insert(s[1].text.clone());
@@ -599,6 +644,7 @@ impl Validator {
                 }
                 self.actions.push(Action::Unexternal(s[1].text.clone()));
             }
+            "displace_atoms" => self.displace_atoms(s)?,
             "coeff" => self.coeff(s)?,
             "constrain" | "unconstrain" => {
                 let usage =

@@ -650,6 +650,13 @@ impl Writer<'_> {
                 Action::External(e) => self.external(e)?,
                 Action::Unexternal(name) => self.unexternal(name),
                 Action::Coeff { target, param, value } => self.coeff(target, *param, *value)?,
+                Action::Displace { group, delta } => {
+                    let name = ident("m_", &group.name);
+                    let mut ids: Vec<u64> = group.members.iter().map(|&m| self.model.ids[m as usize]).collect();
+                    self.line(format!("group {name} id {}", id_ranges(&mut ids)));
+                    self.line(format!("displace_atoms {name} move {} {} {} units box", num(delta.x), num(delta.y), num(delta.z)));
+                    self.line(format!("group {name} delete"));
+                }
                 Action::Minimize(_) => {
                     return Err(
                         "`minimize` (FIRE with drag-scaled masses) has no exact LAMMPS equivalent; export the deck without it".into()

@@ -15,6 +15,13 @@
 //! closest contact), the whole move is scaled by s = min(1, minᵢ Lᵢ/|Δxᵢ|),
 //! a line search that keeps every body outside every other; the velocities
 //! are kept, so FIRE's own Δt adaptation is unchanged.
+//!
+//! A particle of infinite mass (a `fixed` type, γ = ∞) never moves: its force
+//! is the reaction of its anchor, not a residual, so it is left out of P, of
+//! the mixing and of the convergence test (LAMMPS zeroes such forces with
+//! `fix setforce 0 0 0` before minimising). Without this, the mixing step
+//! v ← …α|v|F̂ would move an anchor that carries load, and a loaded anchor
+//! would keep max |F| above `ftol` for ever.
 
 use glam::DVec3;
 
@@ -77,6 +84,11 @@ pub fn fire_minimize<E>(
     loop {
         limits.clear();
         let energy = evaluate(state, &mut f, &mut limits)?;
+        for (f, m) in f.iter_mut().zip(mass) {
+            if m.is_infinite() {
+                *f = DVec3::ZERO;
+            }
+        }
         let max_force = f.iter().map(|x| x.length()).fold(0.0, f64::max);
         if max_force < settings.ftol || iterations >= settings.max_iterations {
             return Ok(FireReport { converged: max_force < settings.ftol, iterations, energy, max_force, clamped });
@@ -168,5 +180,27 @@ mod tests {
         assert_eq!(clamp_fraction(&moves, &[2.0, f64::INFINITY]), 1.0);
         assert_eq!(clamp_fraction(&moves, &[0.25, 0.5]), 0.25);
         assert_eq!(clamp_fraction(&moves, &[1.0, 0.1]), 0.2);
+    }
+
+    /// A spring of stiffness k and rest length 1 from a fixed anchor at the
+    /// origin to a bead, the bead also pulled by 2 along x: the bead settles at
+    /// x = 1 + 2/k, the anchor never moves although it carries the load.
+    #[test]
+    fn a_loaded_anchor_of_infinite_mass_stays_put_and_does_not_block_convergence() {
+        let sim_box = SimBox::new(DVec3::splat(-10.0), DVec3::splat(10.0), [false; 3]);
+        let mut state = State::new(vec![DVec3::ZERO, DVec3::new(1.5, 0.2, 0.0)]);
+        let (k, pull) = (4.0, DVec3::new(2.0, 0.0, 0.0));
+        let settings = FireSettings { ftol: 1e-10, ..Default::default() };
+        let report = fire_minimize::<()>(&mut state, &sim_box, &[f64::INFINITY, 1e-2], 1e-2, &settings, |s, f, _| {
+            let d = s.positions[1] - s.positions[0];
+            let spring = -k * (d.length() - 1.0) * d.normalize();
+            f.clear();
+            f.extend([-spring, spring + pull]);
+            Ok(0.5 * k * (d.length() - 1.0).powi(2) - pull.dot(s.positions[1]))
+        })
+        .unwrap();
+        assert!(report.converged, "{report:?}");
+        assert_eq!(state.positions[0], DVec3::ZERO);
+        assert!((state.positions[1] - DVec3::new(1.0 + 2.0 / k, 0.0, 0.0)).length() < 1e-9, "{:?}", state.positions[1]);
     }
 }

@@ -228,6 +228,7 @@ impl Simulation {
                 self.model.externals.retain(|e| e.term.label.text != *name);
                 self.forces_current = false;
             }
+            Action::Displace { group, delta } => self.displace(&group.members, *delta)?,
             Action::Coeff { target, param, value } => {
                 let term = match target {
                     CoeffTarget::BondType(k) => &mut self.model.bond_types[*k],
@@ -269,6 +270,22 @@ impl Simulation {
             }
             Action::Print(text) => self.say(text),
         }
+        Ok(())
+    }
+
+    /// `displace_atoms`: moves `members` by `delta` (wrapped on periodic axes,
+    /// image counters kept, so unwrapped coordinates move by `delta`); the
+    /// neighbour list is rebuilt if the move needs it.
+    fn displace(&mut self, members: &[u32], delta: DVec3) -> Result<(), RunError> {
+        for &i in members {
+            let i = i as usize;
+            self.state.positions[i] += delta;
+            self.sim_box.wrap(&mut self.state.positions[i], &mut self.state.images[i]);
+        }
+        if let Some(backend) = self.backend.as_mut() {
+            backend.update_neighbors(&self.state, &self.sim_box, true).map_err(RunError::Setup)?;
+        }
+        self.forces_current = false;
         Ok(())
     }
 

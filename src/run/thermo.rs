@@ -25,6 +25,8 @@
 //! | `gamma/BODYTYPE` | cortical tension γ = ⟨Σ_cut T·\|û·n̂\|⟩/(2πR) over diametral planes of each body, mean over the type's bodies ([`planes`](crate::measure::planes)) | pN/µm |
 //! | `e2e/BONDTYPE` | mean end-to-end distance of the chains of bonds of the type ([`filaments`](crate::measure::filaments)) | µm |
 //! | `tcorr/BONDTYPE/LAG` | tangent correlation ⟨t_s·t_{s+LAG}⟩ along those chains, LAG in bonds | – |
+//! | `fx/GROUP`, `fy/GROUP`, `fz/GROUP` | Σ_{i∈GROUP} F_i along the axis; on `fixed` particles the reaction of their anchors (a sheared plate's load) | pN |
+//! | `xu/GROUP`, `yu/GROUP`, `zu/GROUP` | mean unwrapped coordinate (1/N)Σ_{i∈GROUP} (x_i + n_i·L) along the axis | µm |
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -93,6 +95,8 @@ pub fn column_label(c: &ThermoColumn, model: &crate::system::Model) -> String {
         ThermoColumn::CorticalTension(t) => format!("gamma/{}", model.body_type_names[*t]),
         ThermoColumn::EndToEnd(t) => format!("e2e/{}", model.bond_types[*t].label.text),
         ThermoColumn::TangentCorrelation { bond_type, lag } => format!("tcorr/{}/{lag}", model.bond_types[*bond_type].label.text),
+        ThermoColumn::GroupForce { group, axis } => format!("f{}/{}", ["x", "y", "z"][*axis], group.name),
+        ThermoColumn::GroupPosition { group, axis } => format!("{}u/{}", ["x", "y", "z"][*axis], group.name),
     }
 }
 
@@ -109,7 +113,8 @@ pub fn column_unit(c: &ThermoColumn, units: UnitSystem) -> &'static str {
         ThermoColumn::MinDistance => units.label(Dim::Length),
         ThermoColumn::Tension(_) | ThermoColumn::ConstraintTension(_) | ThermoColumn::PlaneTension { .. } => units.label(Dim::Force),
         ThermoColumn::CorticalTension(_) => units.label(Dim::Tension),
-        ThermoColumn::EndToEnd(_) => units.label(Dim::Length),
+        ThermoColumn::EndToEnd(_) | ThermoColumn::GroupPosition { .. } => units.label(Dim::Length),
+        ThermoColumn::GroupForce { .. } => units.label(Dim::Force),
         ThermoColumn::Time => units.label(Dim::Time),
         ThermoColumn::Pe | ThermoColumn::PeOf(_) => units.label(Dim::Energy),
         ThermoColumn::Fmax | ThermoColumn::Fnorm => units.label(Dim::Force),
@@ -167,6 +172,11 @@ pub fn column_value(c: &ThermoColumn, t: &ThermoInputs) -> f64 {
         ThermoColumn::EndToEnd(ty) => filaments::end_to_end(&filaments::chains(t.model, *ty), t.positions, t.sim_box),
         ThermoColumn::TangentCorrelation { bond_type, lag } => {
             filaments::tangent_correlation(&filaments::chains(t.model, *bond_type), t.positions, t.sim_box, *lag)
+        }
+        ThermoColumn::GroupForce { group, axis } => group.members.iter().map(|&i| t.forces.forces[i as usize][*axis]).sum(),
+        ThermoColumn::GroupPosition { group, axis } => {
+            let unwrapped = |i: usize| t.sim_box.unwrap(t.state.positions[i], t.state.images[i])[*axis];
+            group.members.iter().map(|&i| unwrapped(i as usize)).sum::<f64>() / group.members.len() as f64
         }
     }
 }
