@@ -144,8 +144,13 @@ pub fn two_cells(level: u32, radius: f64, gap: f64) -> String {
 pub fn two_cells_with_edges(level: u32, radius: f64, gap: f64, edges: Option<&str>) -> String {
     use cellmd::build::{icosphere_cell, IcosphereCell};
     let half = radius + gap / 2.0;
-    let left =
-        IcosphereCell { level, radius, centre: glam::DVec3::new(-half, 0.0, 0.0), bond_type: edges.map(String::from), ..Default::default() };
+    let left = IcosphereCell {
+        level,
+        radius,
+        centre: glam::DVec3::new(-half, 0.0, 0.0),
+        bond_type: edges.map(String::from),
+        ..Default::default()
+    };
     let nodes = icosphere_cell(&left).shells[0].nodes as u64;
     let right = IcosphereCell { centre: glam::DVec3::new(half, 0.0, 0.0), body_id: 2, first_id: nodes + 1, ..left.clone() };
     merge_topologies(&[&icosphere_cell(&left).text, &icosphere_cell(&right).text])
