@@ -76,7 +76,7 @@ mod tests {
 
     #[test]
     fn floor_pushes_up_only_below_it() {
-        let p = params_of(&Wall, &[("d", 1.0), ("k", 50.0)]); // default normal +z
+        let p = params_of(&Wall, &[("nz", 1.0), ("d", 1.0), ("k", 50.0)]);
         let below = eval(&p, DVec3::new(3.0, -4.0, 0.8));
         assert!((below.energy - 0.5 * 50.0 * 0.04).abs() < 1e-12);
         assert!((below.force - DVec3::new(0.0, 0.0, 10.0)).length() < 1e-12);
