@@ -25,6 +25,7 @@
 
 use glam::DVec3;
 
+use super::overdamped::clamp_fraction;
 use crate::system::{SimBox, State};
 
 /// Options of the deck `minimize` command.
@@ -52,11 +53,6 @@ pub struct FireReport {
     pub max_force: f64,
     /// Iterations whose move the contact step clamp shortened.
     pub clamped: u64,
-}
-
-/// The largest s ∈ (0, 1] with s·|Δxᵢ| ≤ Lᵢ for every particle (1 when `limits` is empty).
-pub fn clamp_fraction(moves: &[DVec3], limits: &[f64]) -> f64 {
-    limits.iter().zip(moves).map(|(limit, dx)| if dx.length() > *limit { limit / dx.length() } else { 1.0 }).fold(1.0, f64::min)
 }
 
 /// Minimises with FIRE. `evaluate` fills the forces at a state, and the
@@ -171,15 +167,6 @@ mod tests {
         .unwrap();
         assert!(report.clamped > 10, "{report:?}");
         assert!(lowest > 1.0 && lowest < 1.0 + 1e-3, "closest approach {lowest}");
-    }
-
-    #[test]
-    fn clamp_fraction_is_the_largest_safe_scale() {
-        let moves = [DVec3::new(1.0, 0.0, 0.0), DVec3::new(0.0, 0.5, 0.0)];
-        assert_eq!(clamp_fraction(&moves, &[]), 1.0);
-        assert_eq!(clamp_fraction(&moves, &[2.0, f64::INFINITY]), 1.0);
-        assert_eq!(clamp_fraction(&moves, &[0.25, 0.5]), 0.25);
-        assert_eq!(clamp_fraction(&moves, &[1.0, 0.1]), 0.2);
     }
 
     /// A spring of stiffness k and rest length 1 from a fixed anchor at the

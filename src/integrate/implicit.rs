@@ -43,8 +43,7 @@ use faer::sparse::{SparseColMat, Triplet};
 use faer::{dyn_stack::MemBuffer, dyn_stack::MemStack, Col, Mat, Par, Side};
 use glam::DVec3;
 
-use super::fire::clamp_fraction;
-use super::overdamped::{Blowup, OverdampedSettings};
+use super::overdamped::{clamp_fraction, Blowup, OverdampedSettings};
 use super::rng::noise3;
 use crate::backend::stiffness::StiffnessBlock;
 use crate::system::{Model, SimBox, State};

@@ -69,6 +69,13 @@ fn step_fraction(a: f64, b: f64, limit: f64) -> f64 {
     u * u
 }
 
+/// The largest s ∈ (0, 1] with s·|Δxᵢ| ≤ Lᵢ for every particle (1 when
+/// `limits` is empty): the clamp of a step with no noise part (FIRE moves,
+/// implicit steps), the b = 0 case of `step_fraction`.
+pub fn clamp_fraction(moves: &[DVec3], limits: &[f64]) -> f64 {
+    limits.iter().zip(moves).map(|(limit, dx)| if dx.length() > *limit { limit / dx.length() } else { 1.0 }).fold(1.0, f64::min)
+}
+
 /// Advances `state` by one step of length `dt` at temperature `kt`, shortened
 /// to s·dt when a particle would move farther than its entry of `limits`
 /// (see the module docs). Returns s (1 for a full step).
@@ -144,7 +151,8 @@ pub fn overdamped_step(
 
 #[cfg(test)]
 mod tests {
-    use super::step_fraction;
+    use super::{clamp_fraction, step_fraction};
+    use glam::DVec3;
 
     #[test]
     fn the_step_fraction_keeps_drift_plus_noise_within_the_limit() {
@@ -156,5 +164,14 @@ mod tests {
         }
         assert_eq!(step_fraction(1.0, 0.0, 0.25), 0.25);
         assert_eq!(step_fraction(0.0, 1.0, 0.25), 0.0625);
+    }
+
+    #[test]
+    fn clamp_fraction_is_the_largest_safe_scale() {
+        let moves = [DVec3::new(1.0, 0.0, 0.0), DVec3::new(0.0, 0.5, 0.0)];
+        assert_eq!(clamp_fraction(&moves, &[]), 1.0);
+        assert_eq!(clamp_fraction(&moves, &[2.0, f64::INFINITY]), 1.0);
+        assert_eq!(clamp_fraction(&moves, &[0.25, 0.5]), 0.25);
+        assert_eq!(clamp_fraction(&moves, &[1.0, 0.1]), 0.2);
     }
 }
