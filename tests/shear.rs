@@ -41,7 +41,7 @@ fn network_of(seed: u64) -> String {
         capture: 0.08,
         pin_crosslinks: true,
         slab: Some(SlabAxis::Y),
-        common: Common { seed, output: "network_shear.top".into() },
+        common: Common { seed, output: "network_shear.top".into(), rest_from_geometry: false },
         ..NetworkArgs::default()
     };
     network(&args).unwrap().text

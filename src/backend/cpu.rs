@@ -253,7 +253,7 @@ impl CpuBackend {
         self.surfaces.prepare(model, x, &images);
         self.contacts.prepare(model, x, &images);
         let bond_state = state.bonds.as_ref();
-        if bond_state.is_some() {
+        if model.has_kinetics() {
             self.bonded.tensions(model, x, &images, bond_state, &mut self.bond_tension, &mut self.bond_length);
         }
         let (pairs, bonded, surfaces, contacts) = (&self.pairs, &self.bonded, &self.surfaces, &self.contacts);

@@ -47,7 +47,7 @@ impl Default for AsterArgs {
             anchor_bond_type: "anchor".into(),
             anchor_angle_type: None,
             box_half_width: None,
-            common: Common { seed: 1, output: "aster.top".into() },
+            common: Common { seed: 1, output: "aster.top".into(), rest_from_geometry: false },
         }
     }
 }
@@ -81,6 +81,7 @@ pub fn aster(a: &AsterArgs) -> Result<Built, String> {
     let (_, bending) = a.chain.bending_line(ell, 5200.0)?;
     let turn = Draws::new(a.common.seed, stream::ASTER).rotation(0, 0);
     let mut w = Writer::new(1);
+    w.set_rest_from_geometry(a.common.rest_from_geometry);
     let hub = w.particle(&a.centre_type, centre, None);
     for k in 0..a.microtubules {
         let d = (turn * fibonacci(k, a.microtubules)).normalize();
@@ -154,7 +155,7 @@ mod tests {
 
     #[test]
     fn the_seed_turns_the_aster() {
-        let a = |seed| AsterArgs { common: Common { seed, output: "a.top".into() }, ..AsterArgs::default() };
+        let a = |seed| AsterArgs { common: Common { seed, output: "a.top".into(), rest_from_geometry: false }, ..AsterArgs::default() };
         assert_eq!(aster(&a(2)).unwrap().text, aster(&a(2)).unwrap().text);
         assert_ne!(aster(&a(2)).unwrap().text, aster(&a(3)).unwrap().text);
         assert_eq!(aster(&AsterArgs { microtubules: 0, ..a(1) }).unwrap_err(), "expected --microtubules >= 1, found 0");

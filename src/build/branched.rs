@@ -58,7 +58,7 @@ impl Default for BranchedArgs {
             centre: vec![0.0; 3],
             extent: None,
             box_half_width: None,
-            common: Common { seed: 1, output: "branched.top".into() },
+            common: Common { seed: 1, output: "branched.top".into(), rest_from_geometry: false },
         }
     }
 }
@@ -105,6 +105,7 @@ pub fn branched(a: &BranchedArgs) -> Result<Built, String> {
     let (_, bending) = a.chain.bending_line(ell, 17.0)?;
     let draws = Draws::new(a.common.seed, stream::BRANCHED);
     let mut w = Writer::new(1);
+    w.set_rest_from_geometry(a.common.rest_from_geometry);
     let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
     for m in 0..a.mothers as u64 {
         let [ux, uy] = draws.uniform2(m, 0);
@@ -191,7 +192,11 @@ mod tests {
 
     #[test]
     fn the_spread_is_used_and_the_seed_decides() {
-        let a = |seed| BranchedArgs { mothers: 30, common: Common { seed, output: "b.top".into() }, ..BranchedArgs::default() };
+        let a = |seed| BranchedArgs {
+            mothers: 30,
+            common: Common { seed, output: "b.top".into(), rest_from_geometry: false },
+            ..BranchedArgs::default()
+        };
         let built = branched(&a(4)).unwrap();
         assert!(built.summary().contains("branch angles 70 ± 7 degrees"));
         let top = parse(&built);

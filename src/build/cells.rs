@@ -61,7 +61,7 @@ impl Default for CellsArgs {
             centre: vec![0.0; 3],
             box_size: Vec::new(),
             shell: ShellOptions::default(),
-            common: Common { seed: 1, output: PathBuf::from("cells.top") },
+            common: Common { seed: 1, output: PathBuf::from("cells.top"), rest_from_geometry: false },
         }
     }
 }
@@ -174,6 +174,7 @@ pub fn cells(a: &CellsArgs) -> Result<Built, String> {
     };
     let (unit, mesh) = unit_icosphere(a.level);
     let mut w = Writer::new(1);
+    w.set_rest_from_geometry(a.common.rest_from_geometry);
     let per_cell = if nucleus.is_some() { 2 } else { 1 };
     let cell_bond = a.shell.bond_types().0;
     for (k, c) in centres.iter().enumerate() {
@@ -259,7 +260,10 @@ mod tests {
         let top = parse(&built);
         assert_eq!(top.bodies[1].1.text, "nucleus");
         assert_eq!(cells(&a).unwrap().text, built.text);
-        assert_ne!(cells(&CellsArgs { common: Common { seed: 2, output: "c.top".into() }, ..a.clone() }).unwrap().text, built.text);
+        assert_ne!(
+            cells(&CellsArgs { common: Common { seed: 2, output: "c.top".into(), rest_from_geometry: false }, ..a.clone() }).unwrap().text,
+            built.text
+        );
         let err = cells(&CellsArgs { count: Some(500), ..a.clone() }).unwrap_err();
         assert!(err.starts_with("too many cells: at most ") && err.contains("spheroid of radius 4"), "{err}");
     }
@@ -280,7 +284,13 @@ mod tests {
         let some = cells(&CellsArgs { count: Some(10), ..a.clone() }).unwrap();
         assert_eq!(some.bodies, 10);
         assert_ne!(
-            cells(&CellsArgs { count: Some(10), common: Common { seed: 9, output: "c.top".into() }, ..a.clone() }).unwrap().text,
+            cells(&CellsArgs {
+                count: Some(10),
+                common: Common { seed: 9, output: "c.top".into(), rest_from_geometry: false },
+                ..a.clone()
+            })
+            .unwrap()
+            .text,
             some.text
         );
         let err = cells(&CellsArgs { count: Some(17), ..a.clone() }).unwrap_err();

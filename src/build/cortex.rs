@@ -41,7 +41,7 @@ impl Default for CortexArgs {
             capture: None,
             crosslinker_types: CrosslinkerTypes::default(),
             box_half_width: None,
-            common: Common { seed: 1, output: "cortex.top".into() },
+            common: Common { seed: 1, output: "cortex.top".into(), rest_from_geometry: false },
         }
     }
 }
@@ -70,6 +70,7 @@ pub fn cortex(a: &CortexArgs) -> Result<Built, String> {
     let (_, bending) = a.chain.bending_line(chord, 17.0)?;
     let draws = Draws::new(a.common.seed, stream::CORTEX);
     let mut w = Writer::new(1);
+    w.set_rest_from_geometry(a.common.rest_from_geometry);
     let mut filaments = Vec::new();
     for f in 0..a.filaments as u64 {
         let p = draws.unit_vector(f, 0);
@@ -145,7 +146,7 @@ mod tests {
 
     #[test]
     fn determinism_and_errors() {
-        let a = |seed| CortexArgs { common: Common { seed, output: "c.top".into() }, ..CortexArgs::default() };
+        let a = |seed| CortexArgs { common: Common { seed, output: "c.top".into(), rest_from_geometry: false }, ..CortexArgs::default() };
         assert_eq!(cortex(&a(1)).unwrap().text, cortex(&a(1)).unwrap().text);
         assert_ne!(cortex(&a(1)).unwrap().text, cortex(&a(2)).unwrap().text);
         assert!(!cortex(&a(1)).unwrap().text.contains("crosslink "));

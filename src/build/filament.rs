@@ -33,7 +33,7 @@ impl Default for FilamentArgs {
             direction: None,
             random_direction: false,
             box_half_width: None,
-            common: Common { seed: 1, output: "filament.top".into() },
+            common: Common { seed: 1, output: "filament.top".into(), rest_from_geometry: false },
         }
     }
 }
@@ -59,6 +59,7 @@ pub fn filament(a: &FilamentArgs) -> Result<Built, String> {
     let (_, bending) = a.chain.bending_line(ell, 17.0)?;
     let points: Vec<DVec3> = (0..=n).map(|k| start + direction * (k as f64 * ell)).collect();
     let mut w = Writer::new(1);
+    w.set_rest_from_geometry(a.common.rest_from_geometry);
     a.chain.write(&mut w, &points);
     if let Some(h) = a.box_half_width {
         w.fixed_cube(start + direction * (0.5 * a.chain.length), h)?;
@@ -117,10 +118,15 @@ mod tests {
 
     #[test]
     fn random_directions_follow_the_seed_only() {
-        let a = |seed| FilamentArgs { random_direction: true, common: Common { seed, output: "f.top".into() }, ..FilamentArgs::default() };
+        let a = |seed| FilamentArgs {
+            random_direction: true,
+            common: Common { seed, output: "f.top".into(), rest_from_geometry: false },
+            ..FilamentArgs::default()
+        };
         assert_eq!(filament(&a(3)).unwrap().text, filament(&a(3)).unwrap().text);
         assert_ne!(filament(&a(3)).unwrap().text, filament(&a(4)).unwrap().text);
-        let straight = |seed| FilamentArgs { common: Common { seed, output: "f.top".into() }, ..FilamentArgs::default() };
+        let straight =
+            |seed| FilamentArgs { common: Common { seed, output: "f.top".into(), rest_from_geometry: false }, ..FilamentArgs::default() };
         assert_eq!(filament(&straight(3)).unwrap().text, filament(&straight(4)).unwrap().text);
     }
 

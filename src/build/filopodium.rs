@@ -51,7 +51,7 @@ impl Default for FilopodiumArgs {
             crosslink_probability: 1.0,
             crosslinker_types: "fascin".parse().unwrap(),
             box_half_width: None,
-            common: Common { seed: 1, output: "filopodium.top".into() },
+            common: Common { seed: 1, output: "filopodium.top".into(), rest_from_geometry: false },
         }
     }
 }
@@ -109,6 +109,7 @@ pub fn filopodium(a: &FilopodiumArgs) -> Result<Built, String> {
     let e2 = axis.cross(e1);
     let sites = hexagonal_sites(a.filaments as usize);
     let mut w = Writer::new(1);
+    w.set_rest_from_geometry(a.common.rest_from_geometry);
     let mut filaments = Vec::new();
     for &(x, y) in &sites {
         let foot = base + (e1 * x + e2 * y) * spacing;
@@ -200,7 +201,7 @@ mod tests {
             filaments: 19,
             crosslink_probability: 0.5,
             crosslinker_types: "fascin:0.7,fimbrin:0.3".parse().unwrap(),
-            common: Common { seed, output: "f.top".into() },
+            common: Common { seed, output: "f.top".into(), rest_from_geometry: false },
             ..FilopodiumArgs::default()
         };
         let built = filopodium(&a(1)).unwrap();

@@ -24,6 +24,8 @@ pub struct IcosphereCell {
     pub box_half_width: Option<f64>,
     /// A nucleus inside the cell (body `body_id + 1`, nodes after the cell's).
     pub nucleus: Option<Nucleus>,
+    /// Write each edge's length as built as its own rest length r0.
+    pub rest_from_geometry: bool,
 }
 
 /// A nucleus: a concentric icosphere of the cell's level.
@@ -49,6 +51,7 @@ impl Default for IcosphereCell {
             first_id: 1,
             box_half_width: None,
             nucleus: None,
+            rest_from_geometry: false,
         }
     }
 }
@@ -144,6 +147,9 @@ pub struct IcosphereArgs {
     /// Also write a fixed (non-periodic) cubic [ box ] of this half-width around the centre.
     #[arg(allow_negative_numbers = true, long = "box", value_name = "HALF_WIDTH")]
     pub box_half_width: Option<f64>,
+    /// Write each bond's length as built as its own rest length r0 (`type i j r0`), so the shell starts force-free.
+    #[arg(long)]
+    pub rest_from_geometry: bool,
     /// The topology file to write.
     #[arg(short, long)]
     pub output: PathBuf,
@@ -180,6 +186,7 @@ pub fn icosphere(a: &IcosphereArgs) -> Result<Built, String> {
         first_id: a.first_id,
         box_half_width: a.box_half_width,
         nucleus,
+        rest_from_geometry: a.rest_from_geometry,
     }))
 }
 
@@ -243,6 +250,7 @@ pub fn icosphere_cell(spec: &IcosphereCell) -> Built {
     let (x, faces) = icosphere_mesh(spec.level, spec.radius);
     let mesh = SurfaceMesh::new(x.len(), faces).expect("an icosphere is a closed mesh");
     let mut w = Writer::new(spec.first_id);
+    w.set_rest_from_geometry(spec.rest_from_geometry);
     w.set_bonds_comment("# the mesh edges");
     let cell = ShellSpec {
         mesh: &mesh,
@@ -362,6 +370,7 @@ mod tests {
             body_id: 1,
             first_id: 1,
             box_half_width: None,
+            rest_from_geometry: false,
             output: "x.top".into(),
         };
         assert_eq!(icosphere(&args(3.0)).unwrap_err(), "expected 0 < --nucleus RADIUS < --radius 3, found 3");

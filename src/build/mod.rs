@@ -161,6 +161,9 @@ pub struct Common {
     /// Seed of the counter-based random numbers: the same seed writes the same file.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Write each bond's length as built as its own rest length r0 (`type i j r0`), so the structure starts force-free.
+    #[arg(long)]
+    pub rest_from_geometry: bool,
     /// The topology file to write.
     #[arg(short, long)]
     pub output: PathBuf,
@@ -225,6 +228,8 @@ pub(crate) struct Writer {
     particles: Vec<(String, DVec3, Option<u64>)>,
     bonds: Vec<(String, u64, u64)>,
     bonds_comment: String,
+    /// Write each bond's length as built as its rest length (`type i j r0`).
+    rest_from_geometry: bool,
     angles: Vec<(String, [u64; 3])>,
     bodies: Vec<(u64, String)>,
     triangles: Vec<(u64, [u64; 3])>,
@@ -239,6 +244,7 @@ impl Writer {
             particles: Vec::new(),
             bonds: Vec::new(),
             bonds_comment: "# type  i  j".into(),
+            rest_from_geometry: false,
             angles: Vec::new(),
             bodies: Vec::new(),
             triangles: Vec::new(),
@@ -289,6 +295,23 @@ impl Writer {
         self.triangles.push((body, ids));
     }
 
+    /// Whether each bond's line ends with its length as built, its own rest length.
+    pub fn set_rest_from_geometry(&mut self, on: bool) {
+        self.rest_from_geometry = on;
+    }
+
+    /// The length of the bond between `i` and `j` as written: the minimum
+    /// image on the `[ box ]`'s periodic axes, as the engine measures it.
+    fn bond_length(&self, i: u64, j: u64) -> f64 {
+        let mut d = self.position(j) - self.position(i);
+        if let Some(axes) = self.box_axes {
+            let sim_box =
+                crate::system::SimBox::new(DVec3::from_array(axes.map(|a| a.0)), DVec3::from_array(axes.map(|a| a.1)), axes.map(|a| a.2));
+            d = sim_box.minimum_image(d);
+        }
+        d.length()
+    }
+
     pub fn set_bonds_comment(&mut self, comment: &str) {
         self.bonds_comment = comment.to_string();
     }
@@ -327,7 +350,10 @@ impl Writer {
 
     /// The topology text: `title` and the generator's command atop, then the
     /// summary `lines` as comments, then the sections.
-    pub fn finish(self, title: &str, command: &str, lines: Vec<String>) -> Built {
+    pub fn finish(self, title: &str, command: &str, mut lines: Vec<String>) -> Built {
+        if self.rest_from_geometry && !self.bonds.is_empty() {
+            lines.push("rest lengths: each bond's r0 is its length as built (--rest-from-geometry, 4th field of [ bonds ]): the type's r0 does not apply to them".into());
+        }
         let mut t = String::new();
         writeln!(t, "# {title}\n# (written by `cellmd build {command}`)").unwrap();
         for line in &lines {
@@ -349,9 +375,14 @@ impl Writer {
             }
         }
         if !self.bonds.is_empty() {
-            writeln!(t, "[ bonds ]\n{}", self.bonds_comment).unwrap();
+            let r0 = if self.rest_from_geometry { "  r0" } else { "" };
+            writeln!(t, "[ bonds ]\n{}{r0}", self.bonds_comment).unwrap();
             for (type_name, i, j) in &self.bonds {
-                writeln!(t, "{type_name} {i} {j}").unwrap();
+                if self.rest_from_geometry {
+                    writeln!(t, "{type_name} {i} {j} {:?}", self.bond_length(*i, *j)).unwrap();
+                } else {
+                    writeln!(t, "{type_name} {i} {j}").unwrap();
+                }
             }
         }
         if !self.angles.is_empty() {

@@ -64,7 +64,7 @@ impl Default for NetworkArgs {
             slab: None,
             base_type: "base".into(),
             plate_type: "plate".into(),
-            common: Common { seed: 1, output: "network.top".into() },
+            common: Common { seed: 1, output: "network.top".into(), rest_from_geometry: false },
         }
     }
 }
@@ -118,6 +118,7 @@ pub fn network(a: &NetworkArgs) -> Result<Built, String> {
     let (_, bending) = a.chain.bending_line(ell, 17.0)?;
     let draws = Draws::new(a.common.seed, stream::NETWORK);
     let mut w = Writer::new(1);
+    w.set_rest_from_geometry(a.common.rest_from_geometry);
     let mut filaments = Vec::with_capacity(a.filaments as usize);
     for f in 0..a.filaments as u64 {
         let [ux, uy] = draws.uniform2(f, 0);
@@ -224,7 +225,7 @@ mod tests {
     fn args(seed: u64) -> NetworkArgs {
         NetworkArgs {
             crosslinker_types: "xl_stiff:0.5,xl_soft:0.5".parse().unwrap(),
-            common: Common { seed, output: "n.top".into() },
+            common: Common { seed, output: "n.top".into(), rest_from_geometry: false },
             ..NetworkArgs::default()
         }
     }

@@ -155,7 +155,7 @@ impl Default for SheetArgs {
             spoke_bond_type: "spoke".into(),
             junction_bond_type: "junction".into(),
             box_half_width: None,
-            common: Common { seed: 1, output: "sheet.top".into() },
+            common: Common { seed: 1, output: "sheet.top".into(), rest_from_geometry: false },
         }
     }
 }
@@ -231,6 +231,7 @@ pub fn sheet(a: &SheetArgs) -> Result<Built, String> {
         lattice_point((x, y), d) + shift + DVec2::new(c, s) * (a.jitter * d * u.sqrt())
     };
     let mut w = Writer::new(1);
+    w.set_rest_from_geometry(a.common.rest_from_geometry);
     let at = |p: DVec2| DVec3::new(p.x, p.y, centre.z);
     // Per cell: its particle ids (centre first, then the ring).
     let mut cells: Vec<Vec<u64>> = Vec::with_capacity(keys.len());
@@ -389,7 +390,11 @@ mod tests {
 
     #[test]
     fn the_jitter_moves_shared_corners_together_and_follows_the_seed() {
-        let a = |seed, jitter| SheetArgs { jitter, common: Common { seed, output: "s.top".into() }, ..SheetArgs::default() };
+        let a = |seed, jitter| SheetArgs {
+            jitter,
+            common: Common { seed, output: "s.top".into(), rest_from_geometry: false },
+            ..SheetArgs::default()
+        };
         let built = sheet(&a(3, 0.1)).unwrap();
         assert_eq!(sheet(&a(3, 0.1)).unwrap().text, built.text);
         assert_ne!(sheet(&a(4, 0.1)).unwrap().text, built.text);

@@ -181,7 +181,7 @@ impl Default for TensegrityArgs {
             adhesion_type: "focal_adhesion".into(),
             centrosome_type: "centrosome".into(),
             box_half_width: None,
-            common: Common { seed: 1, output: "tensegrity.top".into() },
+            common: Common { seed: 1, output: "tensegrity.top".into(), rest_from_geometry: false },
         }
     }
 }
@@ -251,6 +251,7 @@ pub fn tensegrity(a: &TensegrityArgs) -> Result<Built, String> {
     let (fibre, strut) = (lowest(&unit, adhesions), draw_struts(&unit, struts, towards, sigma, &draws));
 
     let mut w = Writer::new(1);
+    w.set_rest_from_geometry(a.common.rest_from_geometry);
     let (cortex_bond, _) = a.shell.bond_types();
     let cortex = ShellSpec {
         mesh: &mesh,
@@ -412,7 +413,7 @@ mod tests {
     fn the_struts_cluster_around_the_centrosome_by_seed() {
         let a = |seed, spread| TensegrityArgs {
             spread,
-            common: Common { seed, output: "t.top".into() },
+            common: Common { seed, output: "t.top".into(), rest_from_geometry: false },
             microtubules: Some(40),
             ..TensegrityArgs::default()
         };
@@ -463,7 +464,7 @@ mod tests {
             focal_adhesions: 30,
             fibre_segments: 3,
             bodies: true,
-            common: Common { seed: 3, output: "t.top".into() },
+            common: Common { seed: 3, output: "t.top".into(), rest_from_geometry: false },
             ..TensegrityArgs::default()
         };
         let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/topologies/tensegrity_cell.top")).unwrap();

@@ -81,6 +81,6 @@ pub fn run_lammps(plan: &Plan, lmp: &Lmp, dir: &Path) -> Result<(Probes, String)
     let deck = lammps::export(plan, ExportOptions { probes: true })?;
     lammps::write(&deck, dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let version = lmp.run(dir)?;
-    let bond_types: Vec<String> = plan.model.bond_types.iter().map(|t| t.label.text.clone()).collect();
+    let bond_types = crate::export::bond_types::LammpsBondTypes::new(&plan.model).labels(&plan.model);
     Ok((lammps_probes(dir, &bond_types)?, version))
 }

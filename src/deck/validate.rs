@@ -449,6 +449,12 @@ impl Validator {
         if !(s.len() - start).is_multiple_of(2) || s.len() == start {
             return Err(s.last().unwrap().error("expected `PARAM VALUE` pairs"));
         }
+        // Per bond type: bonds with their own r0, and the index of `r0`.
+        let mut own_rest = vec![0usize; model.bond_types.len()];
+        for (b, rest) in model.bond_rest.iter().enumerate() {
+            own_rest[model.bond_type[b] as usize] += usize::from(rest.is_some());
+        }
+        let rest_index: Vec<usize> = model.bond_kinetics.iter().map(|k| k.rest_index.unwrap_or(usize::MAX)).collect();
         let mut edits = Vec::new();
         for target in targets {
             let term = match &target {
@@ -466,6 +472,16 @@ impl Validator {
                         names.join(", ")
                     ))
                 })?;
+                if let CoeffTarget::BondType(k) = target {
+                    if own_rest[k] > 0 && index == rest_index[k] {
+                        return Err(pair[0].error(format!(
+                            "bond type `{}` has {} bond{} with its own rest length in the topology, which `coeff` cannot change; expected a parameter other than `r0`",
+                            term.label.text,
+                            own_rest[k],
+                            if own_rest[k] == 1 { "" } else { "s" }
+                        )));
+                    }
+                }
                 let spec = &term.interaction.params()[index];
                 let value = parse_f64(&pair[1], &format!("a value for `{}` in {}", spec.name, units.label(spec.dim)))?;
                 spec.check(value).map_err(|e| pair[1].error(format!("expected {e}")))?;

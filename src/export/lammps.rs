@@ -17,6 +17,10 @@
 //! get `cellmd_probe_init.bonds` / `cellmd_probe_final.bonds` (the bound
 //! bonds: type, atom, atom).
 //!
+//! Bonds with their own rest length (the topology's `type i j r0`) become
+//! LAMMPS bond types of their own, one per distinct (type, r0)
+//! ([`LammpsBondTypes`]); LAMMPS type t + 1 remains cellmd type t.
+//!
 //! Bond kinetics: LAMMPS has no force-dependent bond kinetics, but two
 //! cellmd rules have an exact counterpart, and only these are exported:
 //! - a `threshold` with a `strain` S only (no `force`, `spread` or `rate`) on
@@ -40,6 +44,7 @@
 use std::collections::BTreeMap;
 use std::fmt::Write;
 
+use super::bond_types::LammpsBondTypes;
 use super::styles::{self, num, PairStyled, Styled};
 use crate::deck::{Action, CoeffTarget, Plan};
 use crate::forcefield::TermType;
@@ -189,7 +194,7 @@ fn id_ranges(ids: &mut [u64]) -> String {
 }
 
 /// Writes the data file.
-fn data_file(plan: &Plan, title: &str) -> String {
+fn data_file(plan: &Plan, bond_types: &LammpsBondTypes, title: &str) -> String {
     let m = &plan.model;
     let b = &plan.sim_box;
     let mut s = format!("{title}\n\n{} atoms\n{} bonds\n{} angles\n", m.len(), m.bonds.len(), m.angles.len());
@@ -197,7 +202,7 @@ fn data_file(plan: &Plan, title: &str) -> String {
         s,
         "{} atom types\n{} bond types\n{} angle types\n",
         m.type_names.len(),
-        m.bond_types.len().max(1),
+        bond_types.len().max(1),
         m.angle_types.len().max(1)
     );
     for (a, (lo, hi)) in ["x", "y", "z"].iter().zip(b.lo.to_array().iter().zip(b.hi.to_array())) {
@@ -216,8 +221,8 @@ fn data_file(plan: &Plan, title: &str) -> String {
     }
     if !m.bonds.is_empty() {
         s += "\nBonds\n\n";
-        for (k, (&[i, j], t)) in m.bonds.iter().zip(&m.bond_type).enumerate() {
-            let _ = writeln!(s, "{} {} {} {}", k + 1, t + 1, m.ids[i as usize], m.ids[j as usize]);
+        for (k, &[i, j]) in m.bonds.iter().enumerate() {
+            let _ = writeln!(s, "{} {} {} {}", k + 1, bond_types.of_bond(k) + 1, m.ids[i as usize], m.ids[j as usize]);
         }
     }
     if !m.angles.is_empty() {
@@ -242,7 +247,7 @@ fn bonded_extent(plan: &Plan) -> f64 {
 /// The LAMMPS fixes that stand for a deck's bond kinetics.
 #[derive(Clone, Debug, Default)]
 struct KineticFixes {
-    /// Bond types broken by `fix bond/break`.
+    /// LAMMPS bond types (from 0) broken by `fix bond/break`.
     breaks: Vec<usize>,
     /// Bind rules done by `fix bond/create`.
     creates: Vec<usize>,
@@ -255,9 +260,11 @@ impl KineticFixes {
     }
 }
 
-/// The `fix bond/break` length Rmax = r0·(1 + S) of a bond type whose only
-/// rule is a deterministic strain threshold; any other kinetics is refused.
-fn bond_break_length(model: &Model, t: usize) -> Result<f64, String> {
+/// The `fix bond/break` length Rmax = r0·(1 + S) of LAMMPS bond type `l`
+/// (at its own r0), whose cellmd type's only rule is a deterministic strain
+/// threshold; any other kinetics is refused.
+fn bond_break_length(model: &Model, bond_types: &LammpsBondTypes, l: usize) -> Result<f64, String> {
+    let t = bond_types.cellmd_type(l);
     let kinetics = &model.bond_kinetics[t];
     let label = &model.bond_types[t].label.text;
     let names: Vec<&str> = kinetics.rules.iter().map(|r| r.rule.name()).collect();
@@ -266,7 +273,7 @@ fn bond_break_length(model: &Model, t: usize) -> Result<f64, String> {
             let strain = deterministic_strain(&r.params).ok_or_else(|| {
                 format!("bond type `{label}`: only a `threshold` with a `strain` alone (no `force`, `spread` or `rate`) maps to LAMMPS `fix bond/break`; export the deck without it")
             })?;
-            let r0 = kinetics.rest_index.map(|k| model.bond_types[t].params[k]).ok_or_else(|| {
+            let r0 = kinetics.rest_index.map(|k| bond_types.term(model, l).params[k]).ok_or_else(|| {
                 format!("bond type `{label}`: its law `{}` has no `r0`, so its strain threshold has no LAMMPS length", model.bond_types[t].interaction.name())
             })?;
             Ok(r0 * (1.0 + strain))
@@ -279,13 +286,13 @@ fn bond_break_length(model: &Model, t: usize) -> Result<f64, String> {
 }
 
 /// The fixes for a deck's kinetics, or why LAMMPS cannot express them.
-fn kinetic_fixes(plan: &Plan) -> Result<KineticFixes, String> {
+fn kinetic_fixes(plan: &Plan, bond_types: &LammpsBondTypes) -> Result<KineticFixes, String> {
     let m = &plan.model;
     let mut fixes = KineticFixes::default();
-    for (t, kinetics) in m.bond_kinetics.iter().enumerate() {
-        if !kinetics.rules.is_empty() {
-            bond_break_length(m, t)?;
-            fixes.breaks.push(t);
+    for l in 0..bond_types.len() {
+        if !m.bond_kinetics[bond_types.cellmd_type(l)].rules.is_empty() {
+            bond_break_length(m, bond_types, l)?;
+            fixes.breaks.push(l);
         }
     }
     let steps: Vec<f64> = plan.actions.iter().filter_map(|a| if let Action::Timestep(dt) = a { Some(*dt) } else { None }).collect();
@@ -351,6 +358,8 @@ struct Writer<'a> {
     options: ExportOptions,
     out: String,
     bonds: Hybrid,
+    /// LAMMPS bond types: one per (cellmd type, r0).
+    bond_types: LammpsBondTypes,
     angles: Hybrid,
     pairs: Pairs,
     /// Active externals: LAMMPS fix id and cellmd interaction name.
@@ -521,10 +530,10 @@ impl Writer<'_> {
         }
     }
 
-    /// `fix bond/break` for bond type `t` at its current r0.
-    fn bond_break(&mut self, t: usize) -> Result<(), String> {
-        let rmax = bond_break_length(&self.model, t)?;
-        self.line(format!("fix cellmd_break{} all bond/break 1 {} {}", t + 1, t + 1, num(rmax)));
+    /// `fix bond/break` for LAMMPS bond type `l` at its current r0.
+    fn bond_break(&mut self, l: usize) -> Result<(), String> {
+        let rmax = bond_break_length(&self.model, &self.bond_types, l)?;
+        self.line(format!("fix cellmd_break{} all bond/break 1 {} {}", l + 1, l + 1, num(rmax)));
         Ok(())
     }
 
@@ -588,12 +597,14 @@ impl Writer<'_> {
         match target {
             CoeffTarget::BondType(k) => {
                 self.model.bond_types[*k].params[param] = value;
-                let s = styles::bond(&self.model.bond_types[*k])?;
-                self.line(format!("bond_coeff {} {} {}", k + 1, s.style, s.coeffs));
-                if self.kinetic.breaks.contains(k) {
-                    // A new r0 moves the break length.
-                    self.line(format!("unfix cellmd_break{}", k + 1));
-                    self.bond_break(*k)?;
+                for l in self.bond_types.of_cellmd_type(*k).collect::<Vec<_>>() {
+                    let s = styles::bond(&self.bond_types.term(&self.model, l))?;
+                    self.line(format!("bond_coeff {} {} {}", l + 1, s.style, s.coeffs));
+                    if self.kinetic.breaks.contains(&l) {
+                        // A new r0 moves the break length.
+                        self.line(format!("unfix cellmd_break{}", l + 1));
+                        self.bond_break(l)?;
+                    }
                 }
             }
             CoeffTarget::AngleType(k) => {
@@ -697,8 +708,10 @@ pub fn export(plan: &Plan, options: ExportOptions) -> Result<LammpsDeck, String>
     if let Some(term) = model.body_rules.first().or(model.contact_rules.first()) {
         return Err(styles::unsupported(term));
     }
-    let kinetic = kinetic_fixes(plan)?;
-    let bonds = Hybrid::new(&model.bond_types, styles::bond)?;
+    let bond_types = LammpsBondTypes::new(&model);
+    let kinetic = kinetic_fixes(plan, &bond_types)?;
+    let terms: Vec<TermType> = (0..bond_types.len()).map(|l| bond_types.term(&model, l)).collect();
+    let bonds = Hybrid::new(&terms, styles::bond)?;
     let angles = Hybrid::new(&model.angle_types, styles::angle)?;
     let pairs = Pairs::new(&model)?;
     // Externals and coefficients that only appear later are checked when written.
@@ -709,6 +722,7 @@ pub fn export(plan: &Plan, options: ExportOptions) -> Result<LammpsDeck, String>
         options,
         out: String::new(),
         bonds,
+        bond_types,
         angles,
         pairs,
         fixes: Vec::new(),
@@ -728,7 +742,7 @@ pub fn export(plan: &Plan, options: ExportOptions) -> Result<LammpsDeck, String>
     w.line("# Overdamped dynamics: fix brownian per particle type, gamma_t = the type's drag.");
     w.setup()?;
     w.actions()?;
-    Ok(LammpsDeck { data: data_file(plan, &title), input: w.out })
+    Ok(LammpsDeck { data: data_file(plan, &w.bond_types, &title), input: w.out })
 }
 
 /// Writes `data.lammps` and `in.lammps` into `dir` (created if needed).

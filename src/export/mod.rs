@@ -4,8 +4,11 @@
 //! file and input script that compute the same energies and forces and run the
 //! same overdamped dynamics (`cellmd export-lammps DECK OUTDIR`). The
 //! correspondence of every interaction type is in [`styles`]; an interaction
-//! LAMMPS cannot express is an error that names it.
+//! LAMMPS cannot express is an error that names it. Bonds with their own
+//! rest lengths get one LAMMPS bond type per distinct (type, r0)
+//! ([`bond_types`]).
 
+pub mod bond_types;
 pub mod lammps;
 pub mod styles;
 

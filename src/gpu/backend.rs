@@ -678,7 +678,7 @@ fn initial_capacity(n: usize, sim_box: &SimBox, range: f64, has_pairs: bool) -> 
     ((1.25 * mean + 8.0).ceil() as u32).clamp(32, n.max(32) as u32).next_multiple_of(8)
 }
 
-/// [`pack`] for the model at `state`: with bond kinetics, only the bound bonds
+/// [`pack`] for the model at `state`: with bond state, only the bound bonds
 /// (with their own rest lengths and scales) and the exclusions they make.
 fn pack_state(model: &Model, state: &State, settings: &StepSettings) -> Result<super::pack::Packed, String> {
     let bound = state.bonds.as_ref().map(|b| b.bound.as_slice());

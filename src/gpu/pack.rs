@@ -10,8 +10,9 @@
 //!   amplitude √(2kT·dt/γ) (computed in f64; both 0 for a `fixed` type).
 //!
 //! Terms are numbered bond types, then angle types, then pair rules, then
-//! externals, then — with bond kinetics — one term per bound bond of a type
-//! with kinetic rules, holding that bond's own rest length. Each term also has
+//! externals, then — with bond state — one term per bound bond of a type
+//! with kinetic rules or with a rest length of its own (the topology's
+//! per-bond r0), holding that bond's own rest length. Each term also has
 //! a force scale (`fparams`, at `topo_offsets[11]`): a kinetic bond's
 //! maturation scale, 1 for every other term. Unbound bonds are left out of the
 //! bond ends, and `exclusions` must be those of the bound bonds. Bond kinetics
@@ -106,7 +107,8 @@ fn push_csr<T: Copy>(rows: &[Vec<T>], offsets: &mut Vec<u32>, flat: &mut Vec<T>)
 }
 
 /// Packs the model for `dt` and `kt` (mobilities and noise amplitudes depend
-/// on them) and the bond state `bonds`, if the model has bond kinetics.
+/// on them) and the bond state `bonds`, if bonds have state
+/// ([`Model::has_bond_state`]).
 pub fn pack(model: &Model, exclusions: &Exclusions, dt: f64, kt: f64, bonds: Option<&BondState>) -> Result<Packed, String> {
     let n = model.len();
     let nt = model.type_names.len();
@@ -115,10 +117,11 @@ pub fn pack(model: &Model, exclusions: &Exclusions, dt: f64, kt: f64, bonds: Opt
     let angle_base = model.bond_types.len();
     let pair_base = angle_base + model.angle_types.len();
     let external_base = pair_base + model.pair_rules.len();
-    // Kinetic bonds (bound, of a type with kinetic rules): (bond, own term).
+    // Bonds with their own parameters (bound, and of a type with kinetic
+    // rules or with a rest length of their own): (bond, own term).
     let kinetic: Vec<usize> = match bonds {
         Some(state) => (0..model.bonds.len())
-            .filter(|&b| state.bound[b] && !model.bond_kinetics[model.bond_type[b] as usize].rules.is_empty())
+            .filter(|&b| state.bound[b] && (state.rest[b].is_some() || !model.bond_kinetics[model.bond_type[b] as usize].rules.is_empty()))
             .collect(),
         None => Vec::new(),
     };
@@ -146,7 +149,7 @@ pub fn pack(model: &Model, exclusions: &Exclusions, dt: f64, kt: f64, bonds: Opt
             let t = model.bond_type[b] as usize;
             let mut params = model.bond_types[t].params.clone();
             if let Some(k) = model.bond_kinetics[t].rest_index {
-                params[k] = model.rest_length(b, state);
+                params[k] = model.rest_length(b, Some(state));
             }
             push_params(&model.bond_types[t].label.text, &params)?;
             scales.push(state.scale[b] as f32);

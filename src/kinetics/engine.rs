@@ -34,12 +34,14 @@ fn uniform(x: u32) -> f64 {
 }
 
 /// The bond state at the start of a deck: every bond bound, age 0, rest
-/// lengths from the types that evolve them, maturation scale at age 0.
+/// lengths from the topology's per-bond r0 or from the types that evolve
+/// them ([`Model::initial_rest_length`]), maturation scale at age 0. `None`
+/// when bonds carry no state ([`Model::has_bond_state`]).
 pub fn initial_bond_state(model: &Model) -> Option<BondState> {
-    if !model.has_kinetics() {
+    if !model.has_bond_state() {
         return None;
     }
-    let mut state = BondState::new(model.bond_type.iter().map(|&t| model.evolving_rest_length(t as usize)).collect());
+    let mut state = BondState::new((0..model.bonds.len()).map(|b| model.initial_rest_length(b)).collect());
     for (b, &t) in model.bond_type.iter().enumerate() {
         state.scale[b] = maturation_scale(model, t as usize, 0.0);
     }
@@ -234,7 +236,7 @@ fn decide(model: &Model, bonds: &BondState, b: usize, force: f64, length: f64, s
         }
         return out;
     }
-    let rest = model.rest_length(b, bonds);
+    let rest = model.rest_length(b, Some(bonds));
     let strain = if rest > 0.0 { (length - rest) / rest } else { 0.0 };
     let mut rate = 0.0;
     let mut immediate = false;

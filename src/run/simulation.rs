@@ -243,10 +243,10 @@ impl Simulation {
             }
             Action::Constrain { bond_type, tolerance, max_iterations } => {
                 self.constraints.list.retain(|c| self.model.bond_type[c.bond] as usize != *bond_type);
-                let term = &self.model.bond_types[*bond_type];
-                let r0 = term.params[crate::interactions::param_index(term.interaction, "r0").expect("checked by the deck")];
+                // Each bond at its rest length now (its own, or the type's `r0`; the deck checked it has one).
                 let bonds = (0..self.model.bonds.len()).filter(|&b| self.model.bond_type[b] as usize == *bond_type);
-                self.constraints.list.extend(bonds.map(|bond| Constraint { bond, length: r0 }));
+                let (model, state) = (&self.model, self.state.bonds.as_ref());
+                self.constraints.list.extend(bonds.map(|bond| Constraint { bond, length: model.rest_length(bond, state) }));
                 self.constraints.list.sort_by_key(|c| c.bond);
                 self.constraints.tolerance = *tolerance;
                 self.constraints.max_iterations = *max_iterations;
@@ -579,7 +579,7 @@ impl Simulation {
                     )));
                 }
             }
-            if self.state.bonds.is_some() {
+            if self.model.has_kinetics() {
                 self.kinetics_step()?;
             }
             let final_step = self.state.step == last;
@@ -709,7 +709,7 @@ impl Simulation {
             integrator: self.integrator,
         };
         let mut gpu = GpuBackend::new(context, &self.model, &self.state, &self.sim_box, &settings).map_err(RunError::Setup)?;
-        let kinetics = self.state.bonds.is_some();
+        let kinetics = self.model.has_kinetics();
         let evolving = self.model.bond_kinetics.iter().flat_map(|k| &k.rules).any(|r| r.rule.evolves_every_step());
         while self.state.step < last {
             let next_output = self.next_output_step(last).min(self.state.step + GPU_SYNC_STEPS);

@@ -64,6 +64,10 @@ pub struct Model {
     pub bond_kinetics: Vec<BondTypeKinetics>,
     pub bonds: Vec<[u32; 2]>,
     pub bond_type: Vec<u32>,
+    /// The topology's per-bond rest lengths (`type i j r0`), by topology
+    /// bond; `None`: the bond type's `r0`. Only the source of each bond's
+    /// initial [`BondState::rest`](crate::kinetics::BondState); forces read the state.
+    pub bond_rest: Vec<Option<f64>>,
     /// How many of `bonds` come from the topology (the rest were formed).
     pub topology_bonds: usize,
     /// Bond formation rules (`bind` lines).
@@ -96,6 +100,29 @@ pub struct Model {
     pub bodies: Vec<Body>,
 }
 
+/// Per-bond rest lengths need a bond law with `r0`, and must give valid
+/// parameters when they replace it.
+fn check_bond_rest(topology: &Topology, ff: &ForceField, bond_type: &[u32]) -> Result<(), InputError> {
+    for (b, rest) in topology.bond_rest.iter().enumerate() {
+        let Some((r0, token)) = rest else { continue };
+        let t = bond_type[b] as usize;
+        let term = &ff.bond_types[t];
+        let name = term.interaction.name();
+        let Some(k) = ff.bond_kinetics[t].rest_index else {
+            return Err(token.error(format!(
+                "found a rest length for a bond of type `{}`, whose law `{name}` has no `r0`; expected `type i j` without one",
+                term.label.text
+            )));
+        };
+        let mut params = term.params.clone();
+        params[k] = *r0;
+        term.interaction
+            .validate(&params)
+            .map_err(|e| token.error(format!("invalid `{name}` parameters with this bond's r0 = {r0}: expected {e}")))?;
+    }
+    Ok(())
+}
+
 fn resolve(name: &Token, table: &[TermType], what: &str) -> Result<u32, InputError> {
     table.iter().position(|t| t.label.text == name.text).map(|i| i as u32).ok_or_else(|| {
         let names: Vec<&str> = table.iter().map(|t| t.label.text.as_str()).collect();
@@ -120,7 +147,8 @@ impl Model {
             })?;
             types.push(t as u32);
         }
-        let bond_type = topology.bonds.iter().map(|b| resolve(&b.type_name, &ff.bond_types, "bond")).collect::<Result<_, _>>()?;
+        let bond_type: Vec<u32> = topology.bonds.iter().map(|b| resolve(&b.type_name, &ff.bond_types, "bond")).collect::<Result<_, _>>()?;
+        check_bond_rest(topology, ff, &bond_type)?;
         let bind_rules = ff
             .bind_lines
             .iter()
@@ -199,6 +227,7 @@ impl Model {
             topology_bonds: topology.bonds.len(),
             bind_rules,
             bond_type,
+            bond_rest: topology.bond_rest.iter().map(|r| r.as_ref().map(|(r0, _)| *r0)).collect(),
             angle_types: ff.angle_types.clone(),
             angles: topology.angles.iter().map(|a| a.particles).collect(),
             angle_type,
@@ -226,9 +255,16 @@ impl Model {
         self.ids.is_empty()
     }
 
-    /// Whether any bond type has kinetic rules (bonds then carry state).
+    /// Whether any bond type has kinetic rules or bind rules (bonds then
+    /// carry state, and the kinetics engine runs every step).
     pub fn has_kinetics(&self) -> bool {
         self.bond_kinetics.iter().any(|k| !k.rules.is_empty()) || !self.bind_rules.is_empty()
+    }
+
+    /// Whether bonds carry state ([`BondState`](crate::kinetics::BondState)):
+    /// with kinetics, or when some bond has its own rest length.
+    pub fn has_bond_state(&self) -> bool {
+        self.has_kinetics() || self.bond_rest.iter().any(Option::is_some)
     }
 
     /// Makes the bond list the topology's plus the bonds `formed` in a run.
@@ -249,10 +285,18 @@ impl Model {
         kinetics.rest_index.filter(|_| evolves).map(|k| self.bond_types[bond_type].params[k])
     }
 
-    /// The rest length bond `b` has now (NaN if its law has none).
-    pub fn rest_length(&self, b: usize, bonds: &crate::kinetics::BondState) -> f64 {
+    /// The rest length bond `b` starts a deck with, when it has its own: the
+    /// topology's per-bond r0, else its type's `r0` if its rules evolve it;
+    /// `None`: the type's `r0` always applies.
+    pub fn initial_rest_length(&self, b: usize) -> Option<f64> {
+        self.bond_rest.get(b).copied().flatten().or_else(|| self.evolving_rest_length(self.bond_type[b] as usize))
+    }
+
+    /// The rest length bond `b` has now, from its state if bonds have one
+    /// (NaN if its law has none).
+    pub fn rest_length(&self, b: usize, bonds: Option<&crate::kinetics::BondState>) -> f64 {
         let t = self.bond_type[b] as usize;
-        bonds.rest[b].or_else(|| self.bond_kinetics[t].rest_index.map(|k| self.bond_types[t].params[k])).unwrap_or(f64::NAN)
+        bonds.and_then(|s| s.rest[b]).or_else(|| self.bond_kinetics[t].rest_index.map(|k| self.bond_types[t].params[k])).unwrap_or(f64::NAN)
     }
 
     /// Whether any body has surface terms (the CPU backend evaluates them;

@@ -12,8 +12,9 @@
 //! 1     actin  0.0   0.0   0.5
 //! 2     actin  0.1   0.0   0.5
 //! [ bonds ]
-//! # type           i  j          (particle ids)
+//! # type           i  j  [r0]    (particle ids; r0: this bond's own rest length)
 //! actin_segment    1  2
+//! actin_segment    2  3  0.1047
 //! [ angles ]
 //! # type           i  j  k       (j is the vertex)
 //! [ bodies ]
@@ -26,6 +27,18 @@
 //! the force field. Names of particle, bond and angle types are resolved
 //! against the force field when the deck is validated, so unknown names are
 //! reported at their position in this file.
+//!
+//! A bond line may end with the bond's own rest length r0 (length units: µm
+//! under `units cell`; a positive finite number). It replaces the bond type's
+//! `r0` for that bond alone, everywhere a rest length is used; it is the
+//! bond's initial rest length in its state ([`BondState::rest`]), so kinetic
+//! rules that move the rest length (plastic reset, motor, ratchet) start from
+//! it. Only a bond type whose law has an `r0` parameter accepts one (checked
+//! when the deck is validated, at the value's position). `cellmd build …
+//! --rest-from-geometry` writes every bond's length as built here, so an
+//! irregular mesh starts force-free.
+//!
+//! [`BondState::rest`]: crate::kinetics::BondState
 //!
 //! Each body must be a closed, consistently oriented 2-manifold of sphere
 //! topology (every edge in exactly two faces, once in each direction; one fan

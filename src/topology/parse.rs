@@ -32,6 +32,9 @@ pub struct Topology {
     pub positions: Vec<DVec3>,
     pub body_of: Vec<Option<u64>>,
     pub bonds: Vec<TypedTerm<2>>,
+    /// Each bond's own rest length r0 (the optional fourth field of its
+    /// `[ bonds ]` line) with its token; `None`: its bond type's `r0`.
+    pub bond_rest: Vec<Option<(f64, Token)>>,
     pub angles: Vec<TypedTerm<3>>,
     /// (body id, body type name).
     pub bodies: Vec<(u64, Token)>,
@@ -69,13 +72,15 @@ fn section_of(statement: &Statement) -> Option<Result<Section, InputError>> {
     Some(Ok(section))
 }
 
-/// Checks the number of fields of a record.
+/// Checks the number of fields of a record; a surplus is reported at the
+/// first field too many, a shortfall at the last field.
 fn expect_fields(statement: &Statement, allowed: &[usize], layout: &str) -> Result<(), InputError> {
     let n = statement.tokens.len();
     if allowed.contains(&n) {
         return Ok(());
     }
-    let at = statement.tokens.get(allowed[0].min(n)).unwrap_or(statement.tokens.last().unwrap());
+    let most = allowed.iter().copied().max().unwrap_or(0);
+    let at = statement.tokens.get(most).unwrap_or(statement.tokens.last().unwrap());
     Err(at.error(format!("found {n} fields, expected `{layout}`")))
 }
 
@@ -131,8 +136,11 @@ impl Parser {
         Ok(())
     }
 
-    fn term<const N: usize>(&self, s: &Statement, layout: &str) -> Result<TypedTerm<N>, InputError> {
-        expect_fields(s, &[N + 1], layout)?;
+    /// A bonded term of `N` particles; `extra` more fields are allowed after
+    /// them (read by the caller).
+    fn term<const N: usize>(&self, s: &Statement, extra: usize, layout: &str) -> Result<TypedTerm<N>, InputError> {
+        let allowed: Vec<usize> = (N + 1..=N + 1 + extra).collect();
+        expect_fields(s, &allowed, layout)?;
         let mut particles = [0u32; N];
         for (k, slot) in particles.iter_mut().enumerate() {
             *slot = self.particle_index(&s.tokens[k + 1])?;
@@ -178,6 +186,16 @@ impl Parser {
         self.topology.triangles.push((body, particles));
         self.face_tokens.push(s.tokens[0].clone());
         Ok(())
+    }
+}
+
+/// A bond's own rest length: a positive finite length.
+fn parse_rest_length(token: &Token) -> Result<f64, InputError> {
+    let r0 = parse_f64(token, "the bond's own rest length r0")?;
+    if r0 > 0.0 {
+        Ok(r0)
+    } else {
+        Err(token.error(format!("found rest length r0 = {r0}, expected a positive length (r0 > 0)")))
     }
 }
 
@@ -235,11 +253,13 @@ pub fn parse_topology(file: &Arc<SourceFile>) -> Result<Topology, InputError> {
             Some(Section::Box) => parser.axis(s, &mut seen_axes)?,
             Some(Section::Particles) => parser.particle(s)?,
             Some(Section::Bonds) => {
-                let bond = parser.term::<2>(s, "type i j")?;
+                let bond = parser.term::<2>(s, 1, "type i j [r0]")?;
                 parser.topology.bonds.push(bond);
+                let rest = s.tokens.get(3).map(|t| Ok::<_, InputError>((parse_rest_length(t)?, t.clone()))).transpose()?;
+                parser.topology.bond_rest.push(rest);
             }
             Some(Section::Angles) => {
-                let angle = parser.term::<3>(s, "type i j k")?;
+                let angle = parser.term::<3>(s, 0, "type i j k")?;
                 parser.topology.angles.push(angle);
             }
             Some(Section::Bodies) => parser.body(s)?,
@@ -297,5 +317,26 @@ mod tests {
         assert!(parse("[ atoms ]\n").unwrap_err().starts_with("t.top:1:1: found section `[atoms]`"));
         assert!(parse("[ particles ]\n1 a 0 0 0\n1 a 1 0 0\n").unwrap_err().contains("already used at line 2"));
         assert!(parse("[ particles ]\n1 a 0 zero 0\n").unwrap_err().starts_with("t.top:2:7: found `zero`, expected the y coordinate"));
+    }
+
+    #[test]
+    fn a_bond_may_end_with_its_own_rest_length() {
+        let two = "[ particles ]\n1 a 0 0 0\n2 a 1 0 0\n3 a 2 0 0\n[ bonds ]\n";
+        let top = parse(&format!("{two}s 1 2 0.75\ns 2 3\n")).unwrap();
+        assert_eq!(top.bond_rest.len(), 2);
+        assert_eq!(top.bond_rest[0].as_ref().map(|(r0, t)| (*r0, t.col)), Some((0.75, 7)));
+        assert!(top.bond_rest[1].is_none());
+        for (line, expected) in [
+            ("s 1 2 -0.5", "t.top:6:7: found rest length r0 = -0.5, expected a positive length (r0 > 0)"),
+            ("s 1 2 0", "t.top:6:7: found rest length r0 = 0, expected a positive length (r0 > 0)"),
+            ("s 1 2 long", "t.top:6:7: found `long`, expected the bond's own rest length r0 (a number)"),
+            ("s 1 2 inf", "t.top:6:7: found `inf`, expected the bond's own rest length r0 (a finite number)"),
+            ("s 1 2 1.0 3", "t.top:6:11: found 5 fields, expected `type i j [r0]`"),
+            ("s 1", "t.top:6:3: found 2 fields, expected `type i j [r0]`"),
+        ] {
+            assert_eq!(parse(&format!("{two}{line}\n")).unwrap_err(), expected, "{line}");
+        }
+        // Angles take no extra field.
+        assert_eq!(parse(&format!("{two}[ angles ]\nb 1 2 3 1.0\n")).unwrap_err(), "t.top:7:9: found 5 fields, expected `type i j k`");
     }
 }
