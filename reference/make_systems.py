@@ -8,6 +8,8 @@ reference/threshold (deterministic strain threshold = fix bond/break) and
 reference/bind (certain mutual-nearest binding = fix bond/create), on frozen
 particles (see kinetics()). Deterministic (fixed seeds); rerun only to change
 the systems, then `reference/regenerate` to record LAMMPS' answers.
+Likewise reference/per_bond_r0: bonds with their own rest lengths, which the
+export writes as one LAMMPS bond type per distinct (type, r0).
 """
 import math
 import os
@@ -299,6 +301,44 @@ def kinetics():
     })
 
 
+def per_bond_r0():
+    """Bonds with their own rest lengths (`type i j r0` in the topology): the
+    four bond laws with an r0, most bonds at their own r0 (0.8-1.2 of their
+    length as placed, so all are loaded), some at the type's r0 (no field),
+    some giving exactly the type's r0 (the export keeps those on the type's
+    LAMMPS bond type); the export makes one LAMMPS bond type per other
+    distinct (type, r0)."""
+    rng = random.Random(53)
+    laws = {"h": 1.0, "c": 1.0, "s": 0.9, "a": 1.0}
+    ff = (TYPES + "bond h harmonic k 50 r0 1.0\nbond c cable k 40 r0 1.0 tau 0.05\n"
+          + "bond s spring k 30 r0 0.9 tau -0.05\nbond a asymmetric k_tension 60 k_compression 15 r0 1.0\n")
+    n_chains, length, box = 12, 10, 6.0
+    pts = chains(rng, n_chains, length, 1.3, 0.7, box)
+    types = ["a" if (k // length) % 3 else "b" for k in range(len(pts))]
+    lines = []
+    for c in range(n_chains):
+        for k in range(length - 1):
+            i, j = c * length + k, c * length + k + 1
+            name = "hcsa"[(c + k) % 4]
+            r = math.dist(pts[i], pts[j])
+            if k % 4 == 3:
+                lines.append(f"{name} {i + 1} {j + 1}\n")
+            elif k % 4 == 2 and c % 2:
+                lines.append(f"{name} {i + 1} {j + 1} {laws[name]!r}\n")
+            else:
+                lines.append(f"{name} {i + 1} {j + 1} {fmt(r * rng.uniform(0.8, 1.2))}\n")
+    rtop = f"[ box ]\nx 0 {box} p\ny 0 {box} p\nz 0 {box} p\n" + particles_block(pts, types) + "[ bonds ]\n" + "".join(lines)
+    small = [[0.1, 0.2, 0.3], [1.2, 0.5, 0.1], [1.7, 1.2, 0.6], [2.4, 0.9, 1.5]]
+    stop = particles_block(small, ["a", "b", "a", "b"]) + "[ bonds ]\nh 1 2 0.9\nh 2 3\nc 3 4 1.1\n"
+    write("per_bond_r0", {
+        "per_bond_r0.ff": ff,
+        "small.top": stop,
+        "random.top": rtop,
+        "small.in": deck("small.top", "per_bond_r0.ff", "x -5 5 f y -5 5 f z -5 5 f", 1e-3),
+        "random.in": deck("random.top", "per_bond_r0.ff", f"x 0 {box} p y 0 {box} p z 0 {box} p", 1e-3),
+    })
+
+
 if __name__ == "__main__":
     for name, ff in BOND_FF.items():
         bonded(name, ff, "bond")
@@ -308,3 +348,4 @@ if __name__ == "__main__":
         pairs(name, ff)
     externals()
     kinetics()
+    per_bond_r0()

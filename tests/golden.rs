@@ -11,6 +11,10 @@
 //! bond/break`; `bind.yaml`: `fix bond/create`) also record the bound bonds
 //! at the start and after the run, and cellmd must end with the same set.
 //!
+//! `per_bond_r0.yaml` checks a feature rather than one type: bonds with their
+//! own rest lengths (`type i j r0`), exported as one LAMMPS bond type per
+//! distinct (type, r0).
+//!
 //! The surface (`body`) types have no LAMMPS style: their golden files come
 //! from OpenMM custom forces (`reference/openmm_surfaces.py`; the generator
 //! header says which engine produced a file).
@@ -114,8 +118,9 @@ fn random_cases_are_not_toys() {
                 assert!(changed >= 50 && kept >= 20, "{}: {changed} bonds changed and {kept} kept: not a test of kinetics", path.display());
                 continue;
             }
-            // The interaction acts, and the run moves the particles.
-            let energy: f64 = probes.init.energies.iter().filter(|(k, _)| k.split('+').any(|p| p == name)).map(|(_, e)| e.abs()).sum();
+            // The interaction (or, for a feature's file, every term) acts, and the run moves the particles.
+            let acts = |k: &str| k.split('+').any(|p| p == name) || cellmd::interactions::lookup(name).is_none();
+            let energy: f64 = probes.init.energies.iter().filter(|(k, _)| acts(k)).map(|(_, e)| e.abs()).sum();
             assert!(energy > 0.0, "{}: `{name}` has no energy", path.display());
             assert!(
                 last.positions.iter().zip(&probes.init.positions).any(|(a, b)| (*a - *b).length() > 1e-3),
@@ -123,6 +128,24 @@ fn random_cases_are_not_toys() {
                 path.display()
             );
         }
+    }
+}
+
+/// `per_bond_r0.yaml` can fail: the same decks with every bond at its
+/// type's r0 (the per-bond values dropped) disagree with LAMMPS.
+#[test]
+fn per_bond_r0_golden_file_tells_the_type_r0_apart() {
+    let path = Path::new("reference/per_bond_r0.yaml");
+    for doc in documents(path) {
+        let deck = Path::new("reference").join(doc.get("deck").unwrap());
+        let mut plan = validate_file(&deck, &[]).unwrap();
+        let own = plan.model.bond_rest.iter().filter(|r| r.is_some()).count();
+        assert!(own >= 2, "{}: only {own} bonds with their own r0", deck.display());
+        plan.model.bond_rest.iter_mut().for_each(|r| *r = None);
+        let reference = golden::probes_of(&doc).unwrap();
+        let agreement = Agreement::new(&cellmd_probes(&plan).unwrap(), &reference).unwrap();
+        println!("{}: without the per-bond r0, worst relative error {:.2e} at step 0", deck.display(), agreement.init.worst());
+        assert!(!agreement.agrees(golden::tolerance_of(&doc).unwrap()), "{}: dropping the per-bond r0 changed nothing", deck.display());
     }
 }
 
