@@ -21,11 +21,13 @@ fn context() -> GpuContext {
     })
 }
 
+/// The plan's initial state, with bond state where bonds have one (per-bond rest lengths).
 fn initial_state(plan: &Plan) -> State {
     let mut state = State::new(plan.positions.clone());
     for (x, image) in state.positions.iter_mut().zip(state.images.iter_mut()) {
         plan.sim_box.wrap(x, image);
     }
+    state.bonds = cellmd::kinetics::initial_bond_state(&plan.model);
     state
 }
 
@@ -323,7 +325,7 @@ fn every_input_deck_runs_on_the_gpu_like_on_the_cpu() {
             refused += 1;
             continue;
         }
-        if setup.state.bonds.is_some() {
+        if setup.model.has_kinetics() {
             // Bond kinetics need kT > 0: see `kinetics_decks_give_the_same_events_on_the_gpu`.
             continue;
         }
@@ -517,7 +519,7 @@ fn kinetics_decks_give_the_same_events_on_the_gpu() {
         let vars = [("steps".into(), "400".into()), ("fire_iterations".into(), "10".into())];
         let plan = cellmd::deck::validate_file(&deck, &vars).unwrap();
         let setup = Simulation::before_first_run(&plan, RunOptions::default()).unwrap();
-        if setup.state.bonds.is_none() || setup.cpu_only_feature().is_some() {
+        if !setup.model.has_kinetics() || setup.cpu_only_feature().is_some() {
             // No kinetics, or refused by the GPU (checked in `every_input_deck_runs_on_the_gpu_like_on_the_cpu`).
             continue;
         }
@@ -610,4 +612,38 @@ fn evolving_bonds_follow_the_cpu_on_the_gpu() {
         assert!((c - g).abs() <= 1e-5 * c, "bond {b}: rest length {c} on the CPU, {g} on the GPU");
         assert!((cb.scale[b] - gb.scale[b]).abs() <= 1e-5 * cb.scale[b], "bond {b}: scale");
     }
+}
+
+/// Bonds with their own rest lengths (the LAMMPS-checked `per_bond_r0`
+/// case): the GPU's forces at the start agree with the CPU's and differ from
+/// those with every bond at its type's r0, and a 2000-step run stays within
+/// 1e-5 of the distance travelled of the CPU's.
+#[test]
+fn per_bond_rest_lengths_match_the_cpu_on_the_gpu() {
+    let deck = std::path::Path::new("reference/per_bond_r0/random.in");
+    let plan = cellmd::deck::validate_file(deck, &[]).unwrap();
+    let state = initial_state(&plan);
+    assert!(state.bonds.is_some() && !plan.model.has_kinetics());
+    let evaluate = |state: &State| {
+        let mut cpu = CpuBackend::new(&plan.model, state, &plan.sim_box, 0.3).unwrap();
+        let mut forces = Forces::default();
+        cpu.compute(&plan.model, state, &plan.sim_box, &mut forces);
+        let mut gpu = GpuBackend::new(&context(), &plan.model, state, &plan.sim_box, &settings(0.3, 1e-3, 0.0)).unwrap();
+        gpu.evaluate().unwrap();
+        (forces, gpu.forces_and_energies())
+    };
+    let (cpu, gpu) = evaluate(&state);
+    let (force_error, energy_error) = compare_forces(&cpu, &gpu);
+    let (_, type_r0_gpu) = evaluate(&State { bonds: None, ..state.clone() });
+    let (difference, _) = compare_forces(&cpu, &type_r0_gpu);
+    println!("per-bond r0: GPU − CPU force {force_error:.2e}, energy {energy_error:.2e}; at the types' r0 instead: {difference:.2e}");
+    assert!(force_error < 1e-5 && energy_error < 1e-5, "force {force_error:e}, energy {energy_error:e}");
+    assert!(difference > 1e-2, "the per-bond r0 change the forces by only {difference:e}");
+    let (start, cpu) = run_deck_deterministic(deck, DevicePreference::Cpu, 2000, false).unwrap();
+    let (_, gpu) = run_deck_deterministic(deck, DevicePreference::Gpu, 2000, false).unwrap();
+    let unwrap = |s: &State, i: usize| plan.sim_box.unwrap(s.positions[i], s.images[i]);
+    let travelled = (0..start.len()).map(|i| (unwrap(&cpu, i) - unwrap(&start, i)).length()).fold(0.0, f64::max);
+    let deviation = (0..start.len()).map(|i| (unwrap(&cpu, i) - unwrap(&gpu, i)).length()).fold(0.0, f64::max);
+    println!("per-bond r0, 2000 steps: GPU − CPU {deviation:.3e} after travelling up to {travelled:.3e}");
+    assert!(travelled > 0.1 && deviation <= 1e-5 * travelled, "GPU − CPU {deviation:e} after {travelled:e}");
 }
