@@ -369,27 +369,46 @@ fn ratchet_growth_slows_exponentially_with_load() {
 /// Plastic reset under a constant pull: between resets the extension x
 /// relaxes as x' = (F − k·x)/γ, and a reset (L0 ← L) happens when x
 /// reaches s·L0, so the n-th interval lasts −(γ/k)·ln(1 − k·s·L0ₙ/F) with
-/// L0ₙ₊₁ = (1 + s)·L0ₙ.
-#[test]
-fn plastic_resets_follow_the_exact_time_course() {
+/// L0ₙ₊₁ = (1 + s)·L0ₙ. Returns the reset times of a bond that starts at
+/// rest at L0₀ = `start`: the type's r0 = 1, or the bond's own r0 (`own`,
+/// the topology's fourth field) with the type's r0 left at 1.
+fn plastic_resets(start: f64, own: bool) -> (Vec<f64>, Vec<f64>) {
     let (k, gamma, f, s, dt): (f64, f64, f64, f64, f64) = (1.0, 1.0, 1.0, 0.2, 1e-5);
-    let top = "[ particles ]\n1 a 0 0 0\n2 bead 0 0 1\n[ bonds ]\nb 1 2\n";
+    let rest = if own { format!(" {start:?}") } else { String::new() };
+    let top = format!("[ particles ]\n1 a 0 0 0\n2 bead 0 0 {start:?}\n[ bonds ]\nb 1 2{rest}\n");
     let ff = format!("particle a fixed\nparticle bead drag {gamma}\nbond b harmonic k {k} r0 1 kinetics plastic threshold {s}\n");
     let deck = format!(
         "units lj\ntopology t.top\nforcefield f.ff\nbox x -10 10 f y -10 10 f z -10 100 f\ntimestep {dt}\ngroup bead id 2\n\
          external pull bead constant_force fz {f}\nevents events.csv\nrun 200000\n"
     );
-    let c = Case::new(&[("t.top", top), ("f.ff", &ff), ("deck.in", &deck)]);
+    let c = Case::new(&[("t.top", &top), ("f.ff", &ff), ("deck.in", &deck)]);
     c.run();
     let resets: Vec<f64> = events(&c).iter().filter(|e| e.1 == "reset").map(|e| e.0 as f64 * dt).collect();
-    let (mut t, mut l0) = (0.0, 1.0);
-    for (n, &measured) in resets.iter().take(5).enumerate() {
+    let (mut t, mut l0, mut exact) = (0.0, start, Vec::new());
+    while exact.len() < resets.len().max(5) && k * s * l0 < f {
         t += -(gamma / k) * (1.0 - k * s * l0 / f).ln();
         l0 *= 1.0 + s;
-        // Euler error O(dt) per interval plus the one-step lag of a reset.
-        assert!((measured - t).abs() < 10.0 * dt * (n + 1) as f64, "reset {n} at t = {measured}, exact {t}");
+        exact.push(t);
     }
-    assert!(resets.len() >= 5, "only {} resets", resets.len());
+    (resets, exact)
+}
+
+#[test]
+fn plastic_resets_follow_the_exact_time_course() {
+    let dt = 1e-5;
+    let mut first = Vec::new();
+    for (start, own) in [(1.0, false), (0.7, true)] {
+        let (resets, exact) = plastic_resets(start, own);
+        first.push(resets[0]);
+        assert!(resets.len() >= 5, "L0 = {start}: only {} resets", resets.len());
+        for (n, (&measured, &t)) in resets.iter().zip(&exact).take(5).enumerate() {
+            // Euler error O(dt) per interval plus the one-step lag of a reset.
+            assert!((measured - t).abs() < 10.0 * dt * (n + 1) as f64, "L0 = {start}: reset {n} at t = {measured}, exact {t}");
+        }
+        println!("plastic from L0 = {start} (own r0: {own}): resets at {:?}, exact {:?}", &resets[..5], &exact[..5]);
+    }
+    // The bond's own r0 is what the course starts from: from the type's r0 the first reset comes 0.07 later.
+    assert!((first[0] - first[1]).abs() > 0.05, "first resets {first:?}");
 }
 
 /// Maturation: a bond's energy is E_full·(1 − exp(−age/τ)) at every step.
