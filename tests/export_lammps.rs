@@ -153,3 +153,30 @@ fn kinetics_lammps_cannot_express_are_refused_with_the_reason() {
         }
     }
 }
+
+/// Bonds with their own r0: one LAMMPS bond type per distinct (type, r0)
+/// after the cellmd types (a per-bond r0 equal to its type's stays on the
+/// type's); `coeff` rewrites every LAMMPS type of its cellmd type, and a
+/// strain threshold breaks each at its own r0·(1 + S).
+#[test]
+fn per_bond_rest_lengths_become_bond_types_of_their_own() {
+    let top =
+        "[ particles ]\n1 a 0 0 0\n2 a 1.1 0 0\n3 a 1.1 0.5 0\n4 a 2 0.5 0\n[ bonds ]\ns 1 2 1.2\nt 2 3\ns 3 4 1.0\ns 1 3 1.2\nt 1 4 0.7\n";
+    let ff = "particle a fixed\nbond s harmonic k 5 r0 1.0 kinetics threshold strain 0.25\nbond t harmonic k 3 r0 0.5\n";
+    let deck = "units lj\ntopology t.top\nforcefield f.ff\nbox x -5 5 f y -5 5 f z -5 5 f\ntimestep 0.01\nrun 1\ncoeff bond s k 8\nrun 1\n";
+    let case = Case::new(&[("t.top", top), ("f.ff", ff), ("deck.in", deck)]);
+    let out = export(&case.plan(), ExportOptions::default()).unwrap();
+    assert!(out.data.contains("\n4 bond types\n"), "{}", out.data);
+    assert!(out.data.contains("\nBonds\n\n1 3 1 2\n2 2 2 3\n3 1 3 4\n4 3 1 3\n5 4 1 4\n"), "{}", out.data);
+    for block in [
+        "bond_coeff 1 harmonic 2.5 1.0\nbond_coeff 2 harmonic 1.5 0.5\nbond_coeff 3 harmonic 2.5 1.2\nbond_coeff 4 harmonic 1.5 0.7\n",
+        "fix cellmd_break1 all bond/break 1 1 1.25\nfix cellmd_break3 all bond/break 1 3 1.5\n",
+        "bond_coeff 1 harmonic 4.0 1.0\nunfix cellmd_break1\nfix cellmd_break1 all bond/break 1 1 1.25\n\
+         bond_coeff 3 harmonic 4.0 1.2\nunfix cellmd_break3\nfix cellmd_break3 all bond/break 1 3 1.5\n",
+    ] {
+        assert!(out.input.contains(block), "in.lammps lacks\n{block}\n{}", out.input);
+    }
+    // Without per-bond r0 the numbering is cellmd's.
+    let plain = Case::new(&[("t.top", &top.replace(" 1.2\n", "\n").replace(" 0.7\n", "\n")), ("f.ff", ff), ("deck.in", deck)]);
+    assert!(export(&plain.plan(), ExportOptions::default()).unwrap().data.contains("\n2 bond types\n"));
+}
