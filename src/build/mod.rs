@@ -24,6 +24,16 @@
 //! | [`sheet()`] | `sheet` | a 2D epithelial sheet (seed 001): hexagonal cells as rings of nodes (or single particles) joined by junction bonds |
 //! | [`tensegrity()`] | `tensegrity` | a tensegrity cell (seed 003): cortex and nucleus shells, radial microtubule struts, actin cables and stress fibres from focal adhesions |
 //!
+//! **Rest lengths** (`--rest-from-geometry`, every generator): by default a
+//! bond line is `type i j`, and the force field's `r0` of the type applies to
+//! all its bonds; where a structure's bonds of one type differ in length (a
+//! jittered sheet, icosphere edges, crosslinks, actin cables) it then starts
+//! pre-stressed. With the flag each bond line ends with the bond's length as
+//! built (minimum image on a periodic `[ box ]`), its own r0, so the structure
+//! starts force-free. It is opt-in: a per-bond r0 cannot be changed by
+//! `coeff bond TYPE r0` (the deck refuses it), exports as one LAMMPS bond type
+//! per distinct length, and some structures are meant to start loaded.
+//!
 //! **Filaments** (of `filament`, `network`, `aster`, `cortex`, `branched`
 //! and `filopodium`) are chains of beads with a
 //! bond between consecutive beads and an angle on every consecutive triple

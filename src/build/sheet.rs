@@ -78,13 +78,16 @@
 //! comes from its reduced model, cells as particles joined by junction
 //! springs, which `--nodes-per-edge 0` writes.
 //!
-//! cellmd gives all bonds of a type one rest length. With N = 1 — each cell
-//! the vertex model's hexagon, with its own copy of the shared corners — a
-//! regular sheet has all edges, all spokes and all junctions equal, so it is
-//! at rest as built. With N ≥ 2 the spokes to the corners are longer than
+//! A bond type's `r0` is one rest length for all its bonds. With N = 1 — each
+//! cell the vertex model's hexagon, with its own copy of the shared corners —
+//! a regular sheet has all edges, all spokes and all junctions equal, so it
+//! is at rest as built. With N ≥ 2 the spokes to the corners are longer than
 //! those to the sides' middles (R against √3/2·R), and one r0 leaves the ring
 //! pre-stressed: it rounds up. A jittered sheet has a spread of lengths of
 //! every type; the summary prints it (the force field takes the mean as r0).
+//! `--rest-from-geometry` instead writes each bond's length as built as its
+//! own r0 (`type i j r0`), so any sheet starts force-free; a pre-strain
+//! (`spring`/`cable` τ) still acts on top of it.
 
 use std::collections::BTreeMap;
 use std::f64::consts::TAU;

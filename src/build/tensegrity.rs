@@ -67,7 +67,10 @@
 //! so at equilibrium the cables are in tension and the struts in compression
 //! with no load from outside: the structure holds its shape by prestress
 //! (seed 003, after Ingber's cellular tensegrity). Without pre-strain the
-//! same structure built at its rest lengths carries no force at all.
+//! same structure built at its rest lengths carries no force at all: exactly
+//! so with `--rest-from-geometry` (each bond's length as built is its own
+//! r0, e.g. the actin cables, whose lengths spread), and τ then pre-strains
+//! every cable relative to its own length.
 //!
 //! It holds only while its cables stay taut, and nothing here resists a
 //! change of volume: struts pivot about their ends, so a pre-stressed cable

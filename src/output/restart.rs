@@ -13,7 +13,7 @@
 //!   "ids": [40, 7, 12, 3],
 //!   "positions": [[0.30000000000000004, 1e-300, -0.0], ...],
 //!   "images": [[0, 0, 0], [-1, 2, 0], ...],
-//!   "bond_params": [[0.8], ...]
+//!   "bonds": {"bound": [true, ...], "age": [0.2, ...], "rest": [0.95, null, ...], "scale": [1.0, ...], "formed": []}
 //! }
 //! ```
 //!
@@ -21,8 +21,12 @@
 //!   against the topology ([`RestartData::check_ids`]) so a restart is never
 //!   applied to a different system or ordering.
 //! * `positions` are stored (wrapped) positions, `images` their counters.
-//! * `bond_params` is reserved for per-bond stateful parameters (e.g. a rest
-//!   length or a bound flag under kinetics), one list per bond; it may be empty.
+//! * `bonds` is the bond state ([`BondState`](crate::kinetics::BondState)),
+//!   present when bonds have one (kinetics, or per-bond rest lengths from
+//!   the topology): per bond whether it is bound, its age, its own rest
+//!   length (`null`: its type's `r0`) and stiffness scale, then the bonds
+//!   formed during the run. A restart thus keeps per-bond rest lengths,
+//!   including those that kinetic rules have moved.
 //! * Unknown keys are ignored, so later versions may add fields.
 //!
 //! Every f64 round-trips bit-exactly: serde_json prints the shortest string
