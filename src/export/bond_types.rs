@@ -53,12 +53,8 @@ impl LammpsBondTypes {
     }
 
     /// Number of LAMMPS bond types.
-    pub fn len(&self) -> usize {
+    pub fn count(&self) -> usize {
         self.types.len()
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.types.is_empty()
     }
 
     /// The LAMMPS type (from 0) of topology bond `b`.

@@ -202,7 +202,7 @@ fn data_file(plan: &Plan, bond_types: &LammpsBondTypes, title: &str) -> String {
         s,
         "{} atom types\n{} bond types\n{} angle types\n",
         m.type_names.len(),
-        bond_types.len().max(1),
+        bond_types.count().max(1),
         m.angle_types.len().max(1)
     );
     for (a, (lo, hi)) in ["x", "y", "z"].iter().zip(b.lo.to_array().iter().zip(b.hi.to_array())) {
@@ -289,7 +289,7 @@ fn bond_break_length(model: &Model, bond_types: &LammpsBondTypes, l: usize) -> R
 fn kinetic_fixes(plan: &Plan, bond_types: &LammpsBondTypes) -> Result<KineticFixes, String> {
     let m = &plan.model;
     let mut fixes = KineticFixes::default();
-    for l in 0..bond_types.len() {
+    for l in 0..bond_types.count() {
         if !m.bond_kinetics[bond_types.cellmd_type(l)].rules.is_empty() {
             bond_break_length(m, bond_types, l)?;
             fixes.breaks.push(l);
@@ -710,7 +710,7 @@ pub fn export(plan: &Plan, options: ExportOptions) -> Result<LammpsDeck, String>
     }
     let bond_types = LammpsBondTypes::new(&model);
     let kinetic = kinetic_fixes(plan, &bond_types)?;
-    let terms: Vec<TermType> = (0..bond_types.len()).map(|l| bond_types.term(&model, l)).collect();
+    let terms: Vec<TermType> = (0..bond_types.count()).map(|l| bond_types.term(&model, l)).collect();
     let bonds = Hybrid::new(&terms, styles::bond)?;
     let angles = Hybrid::new(&model.angle_types, styles::angle)?;
     let pairs = Pairs::new(&model)?;
