@@ -470,14 +470,47 @@ fn thermal_runs_have_the_same_statistics_and_the_same_first_steps() {
     assert!(worst < 3.0 * 4.0 * amplitude * 2f64.powi(-22), "GPU − CPU after 3 steps {worst:e}: the noise streams differ");
 }
 
-/// A neighbour list larger than the adapter can bind is refused with a
-/// message (wgpu would abort the process). On llvmpipe (128 MiB bindings) the
-/// 100 000 dense particles below need about 150 MiB.
+/// A neighbour list larger than one storage binding is bound in chunks of
+/// particles (nb_build and forces dispatched per chunk): with the binding
+/// capped so that the 400-particle random system takes several chunks, the
+/// list, the forces and ten steps are bit for bit those of the unchunked
+/// list, and the list still equals the brute-force pair set. A cap below
+/// 64 particles' rows is refused with a message (wgpu would abort).
 #[test]
-fn a_neighbour_list_beyond_the_binding_limit_is_an_error_not_an_abort() {
+fn a_neighbour_list_beyond_one_binding_is_bound_in_chunks() {
+    let case = soft_random_case();
+    let plan = case.plan();
+    let state = initial_state(&plan);
+    let skin = 0.4;
+    let new = || GpuBackend::new(&context(), &plan.model, &state, &plan.sim_box, &settings(skin, 1e-3, 0.0)).unwrap();
+    let (mut whole, mut chunked) = (new(), new());
+    let row = 4 * (1 + chunked.neighbor_capacity() as u64);
+    chunked.limit_neighbor_binding(150 * row).unwrap(); // 128 particles per chunk: 4 chunks, the last partial
+    assert_eq!((whole.neighbor_chunks(), chunked.neighbor_chunks()), (1, 4));
+    whole.evaluate().unwrap();
+    chunked.evaluate().unwrap();
+    assert_eq!(whole.neighbor_lists(), chunked.neighbor_lists());
+    assert_eq!(whole.forces_and_energies(), chunked.forces_and_energies());
+    let range = plan.model.max_pair_cutoff() + skin;
+    assert_same_pairs(&chunked.neighbor_lists(), &brute_force_pairs(&plan, &state, range), range, "chunked");
+    whole.run(0, 10).unwrap();
+    chunked.run(0, 10).unwrap();
+    let (mut a, mut b) = (state.clone(), state.clone());
+    whole.download(&mut a);
+    chunked.download(&mut b);
+    assert_eq!(a.positions, b.positions);
+    let refused = chunked.limit_neighbor_binding(63 * row).unwrap_err();
+    assert!(refused.contains("neighbour list") && refused.contains("64 particles"), "{refused}");
+}
+
+/// The 100 000 dense particles below need a neighbour list of about 150 MiB
+/// (more than llvmpipe's 128 MiB bindings): the list is chunked where it must
+/// be, and the forces match the CPU's.
+#[test]
+fn a_large_dense_system_runs_with_its_list_chunked_where_needed() {
     let context = context();
     let n = 100_000;
-    let (l, range) = (10.0f64, 1.0f64);
+    let l = 10.0f64;
     let mut top = String::from("[ particles ]\n");
     let mut seed = 99u64;
     let mut next = || {
@@ -491,16 +524,23 @@ fn a_neighbour_list_beyond_the_binding_limit_is_an_error_not_an_abort() {
     let case = common::Case::new(&[("t.top", &top), ("f.ff", "particle a drag 1\npair a a soft A 1 rc 0.9\n"), ("deck.in", &deck)]);
     let plan = case.plan();
     let state = initial_state(&plan);
-    let mean = n as f64 / l.powi(3) * 4.0 / 3.0 * std::f64::consts::PI * range.powi(3);
-    let needed = 4.0 * n as f64 * (1.25 * mean + 9.0);
-    let limit = context.limits.max_storage_buffer_binding_size as f64;
-    match GpuBackend::new(&context, &plan.model, &state, &plan.sim_box, &settings(0.1, 1e-3, 0.0)) {
-        Err(e) => {
-            assert!(needed > limit, "refused although {needed} bytes fit in {limit}: {e}");
-            assert!(e.contains("neighbour list") && e.contains("MiB"), "{e}");
-        }
-        Ok(_) => assert!(needed <= limit, "accepted {needed} bytes beyond the limit {limit}"),
-    }
+    let mut gpu = GpuBackend::new(&context, &plan.model, &state, &plan.sim_box, &settings(0.1, 1e-3, 0.0)).unwrap();
+    gpu.evaluate().unwrap();
+    let bytes = 4 * n as u64 * (1 + gpu.neighbor_capacity() as u64);
+    let limit = context.limits.max_storage_buffer_binding_size;
+    eprintln!(
+        "list {:.0} MiB, binding limit {:.0} MiB, {} chunks",
+        bytes as f64 / 1048576.0,
+        limit as f64 / 1048576.0,
+        gpu.neighbor_chunks()
+    );
+    assert_eq!(gpu.neighbor_chunks() > 1, bytes > limit);
+    let mut cpu = CpuBackend::new(&plan.model, &state, &plan.sim_box, 0.1).unwrap();
+    let mut forces = Forces::default();
+    cpu.compute(&plan.model, &state, &plan.sim_box, &mut forces);
+    let (force_error, energy_error) = compare_forces(&forces, &gpu.forces_and_energies());
+    eprintln!("force error {force_error:e}, energy error {energy_error:e}");
+    assert!(force_error < 1e-5 && energy_error < 1e-5, "force error {force_error:e}, energy error {energy_error:e}");
 }
 
 /// Every `inputs/` deck with bond kinetics, 400 steps per `run` at its own temperature
@@ -646,4 +686,45 @@ fn per_bond_rest_lengths_match_the_cpu_on_the_gpu() {
     let deviation = (0..start.len()).map(|i| (unwrap(&cpu, i) - unwrap(&gpu, i)).length()).fold(0.0, f64::max);
     println!("per-bond r0, 2000 steps: GPU − CPU {deviation:.3e} after travelling up to {travelled:.3e}");
     assert!(travelled > 0.1 && deviation <= 1e-5 * travelled, "GPU − CPU {deviation:e} after {travelled:e}");
+}
+
+/// `--device auto` announces its choice at start — a hardware adapter when
+/// one exists, otherwise the CPU with the adapters it passed over (CI: only
+/// llvmpipe, so the CPU) — and the run it then makes is bit for bit the run
+/// of the device it announced.
+#[test]
+fn device_auto_announces_its_choice_and_runs_on_it() {
+    let deck = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("inputs/dimer.in");
+    let run = |device: &str| {
+        let dir = tempfile::tempdir().unwrap();
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_cellmd"))
+            .args(["run", deck.to_str().unwrap(), "-o", dir.path().to_str().unwrap(), "--device", device])
+            .output()
+            .unwrap();
+        let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+        assert!(out.status.success(), "--device {device}: {stdout}{}", String::from_utf8_lossy(&out.stderr));
+        let mut files: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .map(|p| (p.file_name().unwrap().to_string_lossy().into_owned(), std::fs::read(&p).unwrap()))
+            .collect();
+        files.sort();
+        (stdout, files)
+    };
+    let (auto_said, auto_files) = run("auto");
+    let announcement = auto_said.lines().find(|l| l.starts_with("device")).unwrap_or_else(|| panic!("no device line in:\n{auto_said}"));
+    println!("{announcement}");
+    let (_, announced_files) = match GpuContext::open(true) {
+        Ok(hardware) => {
+            assert_eq!(announcement, format!("device: GPU {}", hardware.describe()));
+            run("gpu")
+        }
+        Err(e) => {
+            assert_eq!(announcement, format!("device auto: {e}; running on the CPU"));
+            assert!(e.contains(&context().info.name), "the fallback should name the adapters it passed over: {e}");
+            run("cpu")
+        }
+    };
+    assert!(!auto_files.is_empty());
+    assert!(auto_files == announced_files, "the auto run differs from the run on the device it announced");
 }

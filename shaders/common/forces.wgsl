@@ -11,8 +11,8 @@
 
 @compute @workgroup_size(256)
 fn forces(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) local: u32) {
-    let i = linear_index(wg, local);
-    if i >= P.n || halted() {
+    let i = chunk_particle(wg, local);
+    if !in_chunk(i) || halted() {
         return;
     }
     let ti = topo[i];
@@ -20,10 +20,10 @@ fn forces(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index)
     var e = 0.0;
 
     // Pairs.
-    let count = min(nlist[i], P.nlist_cap);
-    let base = P.n + i * P.nlist_cap;
+    let row = nlist_row(i);
+    let count = min(nlist[row], P.nlist_cap);
     for (var k = 0u; k < count; k++) {
-        let j = nlist[base + k];
+        let j = nlist[row + 1u + k];
         let pair = ti * P.n_types + topo[j];
         let d = separation(i, j);
         let r2 = dot(d, d);

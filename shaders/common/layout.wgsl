@@ -43,9 +43,35 @@ struct Params {
 @group(0) @binding(5) var<storage, read> fparams: array<f32>;
 @group(0) @binding(6) var<storage, read_write> cell_count: array<atomic<u32>>;
 @group(0) @binding(7) var<storage, read_write> cell_data: array<u32>;
+// The neighbour-list rows of the bound chunk of particles (src/gpu/nlist.rs):
+// particle i's row starts at (i − chunk.first)·(1 + nlist_cap), its count
+// first, then its neighbours. `nb_build` and `forces` run once per chunk.
 @group(0) @binding(8) var<storage, read_write> nlist: array<u32>;
 @group(0) @binding(9) var<storage, read_write> force: array<vec4<f32>>;
 @group(0) @binding(10) var<storage, read_write> status: array<atomic<u32>>;
+
+struct Chunk {
+    first: u32,  // first particle of the chunk
+    count: u32,  // particles in the chunk
+    pad0: u32,
+    pad1: u32,
+}
+@group(0) @binding(11) var<uniform> chunk: Chunk;
+
+// The particle of invocation (wg, local) of a per-chunk dispatch, and
+// whether it is one (the dispatch is rounded up to whole workgroups).
+fn chunk_particle(wg: vec3<u32>, local: u32) -> u32 {
+    return chunk.first + linear_index(wg, local);
+}
+
+fn in_chunk(i: u32) -> bool {
+    return i < chunk.first + chunk.count;
+}
+
+// Start of particle i's row in the bound chunk.
+fn nlist_row(i: u32) -> u32 {
+    return (i - chunk.first) * (1u + P.nlist_cap);
+}
 
 // Words of `status` (read back by the host at every synchronisation).
 const ST_HALTED: u32 = 0u;        // bit 0: neighbour list overflow, bit 1: blow-up

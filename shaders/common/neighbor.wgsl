@@ -68,6 +68,7 @@ fn nb_decide() {
     write_args(0u, particle_groups, go);
     write_args(1u, cell_groups, go);
     write_args(2u, 1u, go);
+    write_args(3u, (chunk.count + WORKGROUP - 1u) / WORKGROUP, go); // nb_build per chunk (chunk 0 is the largest)
     if go {
         atomicStore(&status[ST_MAX_DISP2], 0u);
         atomicStore(&status[ST_FORCE_REBUILD], 0u);
@@ -228,13 +229,13 @@ fn stencil_cell(v: i32, axis: u32) -> i32 {
 
 @compute @workgroup_size(256)
 fn nb_build(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) local: u32) {
-    let i = linear_index(wg, local);
-    if i >= P.n {
+    let i = chunk_particle(wg, local);
+    if !in_chunk(i) {
         return;
     }
     let ci = cell_coords(i);
     var count = 0u;
-    let base = P.n + i * P.nlist_cap;
+    let row = nlist_row(i);
     for (var dz = 0; dz < stencil_len(2u); dz++) {
         let z = stencil_cell(stencil_start(ci.z, 2u) + dz, 2u);
         if z < 0 { continue; }
@@ -252,7 +253,7 @@ fn nb_build(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_inde
                     let d = separation(i, j);
                     if dot(d, d) < P.range2 && !is_excluded(i, j) {
                         if count < P.nlist_cap {
-                            nlist[base + count] = j;
+                            nlist[row + 1u + count] = j;
                         }
                         count++;
                     }
@@ -260,7 +261,7 @@ fn nb_build(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_inde
             }
         }
     }
-    nlist[i] = count;
+    nlist[row] = count;
     if count > P.nlist_cap {
         atomicMax(&status[ST_OVERFLOW_NEED], count);
         atomicOr(&status[ST_HALTED], HALT_OVERFLOW);

@@ -17,6 +17,7 @@ use glam::DVec3;
 use wgpu::util::DeviceExt;
 
 use super::context::GpuContext;
+use super::nlist::NeighbourStorage;
 use super::pack::{cell_grid, pack, FixedPoint, Params};
 use super::shader;
 use crate::integrate::overdamped::OverdampedSettings;
@@ -107,7 +108,9 @@ pub struct GpuBackend {
     fparams: wgpu::Buffer,
     cell_count: wgpu::Buffer,
     cell_data: wgpu::Buffer,
-    nlist: wgpu::Buffer,
+    nlist: NeighbourStorage,
+    /// The largest storage binding the neighbour list's chunks may take.
+    nlist_binding_limit: u64,
     force: wgpu::Buffer,
     status: wgpu::Buffer,
     args: wgpu::Buffer,
@@ -135,10 +138,6 @@ fn check_binding(ctx: &GpuContext, what: &str, bytes: u64) -> Result<(), String>
         ));
     }
     Ok(())
-}
-
-fn nlist_bytes(n: u32, cap: u32) -> u64 {
-    4 * n as u64 * (1 + cap as u64)
 }
 
 fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
@@ -224,7 +223,6 @@ impl GpuBackend {
         };
         let particle_bytes = 3 * 16 * n as u64;
         check_binding(ctx, "the particle state", particle_bytes)?;
-        check_binding(ctx, "the neighbour list", nlist_bytes(n as u32, params.nlist_cap))?;
         check_binding(ctx, "the cell list", 4 * (cells as u64 + 1 + scan_blocks as u64 + n as u64))?;
         check_binding(ctx, "the topology", 4 * packed.topo.len() as u64)?;
         let uniform = init("params", words(&[params]), wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST);
@@ -236,10 +234,11 @@ impl GpuBackend {
         let fparams = init("fparams", words(&pad16(packed.fparams)), uploads);
         let cell_count = zeros("cell_count", 4 * cells as u64, rw);
         let cell_data = zeros("cell_data", 4 * (cells as u64 + 1 + scan_blocks as u64 + n as u64), rw);
-        let nlist = zeros("nlist", nlist_bytes(n as u32, params.nlist_cap), rw);
+        let nlist_binding_limit = ctx.limits.max_storage_buffer_binding_size.min(ctx.limits.max_buffer_size);
+        let nlist = NeighbourStorage::new(ctx, n as u32, params.nlist_cap, nlist_binding_limit)?;
         let force = zeros("force", 16 * n as u64, rw);
         let status = zeros("status", 4 * STATUS_WORDS as u64, rw);
-        let args = zeros("dispatch_args", 4 * 9, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT);
+        let args = zeros("dispatch_args", 4 * 12, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT);
 
         let mut entries = vec![wgpu::BindGroupLayoutEntry {
             binding: 0,
@@ -248,6 +247,18 @@ impl GpuBackend {
             count: None,
         }];
         entries.extend((1..=10).map(|b| storage_entry(b, b == 4 || b == 5)));
+        // The neighbour list and its chunk's uniform are bound per chunk (nlist.rs).
+        entries[8].ty = wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only: false },
+            has_dynamic_offset: true,
+            min_binding_size: None,
+        };
+        entries.push(wgpu::BindGroupLayoutEntry {
+            binding: 11,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Uniform, has_dynamic_offset: true, min_binding_size: None },
+            count: None,
+        });
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("cellmd main"), entries: &entries });
         let args_layout = device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("cellmd args"), entries: &[storage_entry(0, false)] });
@@ -298,7 +309,8 @@ impl GpuBackend {
         let main_group = bind_main(
             device,
             &layout,
-            [&uniform, &state_buffer, &next, &reference, &topo, &fparams, &cell_count, &cell_data, &nlist, &force, &status],
+            [&uniform, &state_buffer, &next, &reference, &topo, &fparams, &cell_count, &cell_data, &force, &status],
+            &nlist,
         );
         let mut backend = Self {
             params,
@@ -314,6 +326,7 @@ impl GpuBackend {
             cell_count,
             cell_data,
             nlist,
+            nlist_binding_limit,
             force,
             status,
             args,
@@ -333,9 +346,8 @@ impl GpuBackend {
 
     fn bind_main(&self) -> wgpu::BindGroup {
         let s = self;
-        let buffers =
-            [&s.uniform, &s.state, &s.next, &s.reference, &s.topo, &s.fparams, &s.cell_count, &s.cell_data, &s.nlist, &s.force, &s.status];
-        bind_main(&self.ctx.device, &self.layout, buffers)
+        let buffers = [&s.uniform, &s.state, &s.next, &s.reference, &s.topo, &s.fparams, &s.cell_count, &s.cell_data, &s.force, &s.status];
+        bind_main(&self.ctx.device, &self.layout, buffers, &s.nlist)
     }
 
     /// The adapter this backend runs on.
@@ -363,6 +375,22 @@ impl GpuBackend {
     /// Neighbour-list capacity per particle.
     pub fn neighbor_capacity(&self) -> u32 {
         self.params.nlist_cap
+    }
+
+    /// Chunks the neighbour list is bound in (1 unless it exceeds one binding).
+    pub fn neighbor_chunks(&self) -> u32 {
+        self.nlist.chunks
+    }
+
+    /// Caps the bytes of one neighbour-list binding (the adapter's limit by
+    /// default) and lays the list out again; lowering it exercises the
+    /// chunked list on small systems. An error when 64 particles' rows do not fit.
+    pub fn limit_neighbor_binding(&mut self, bytes: u64) -> Result<(), String> {
+        self.nlist_binding_limit = bytes.min(self.nlist_binding_limit);
+        self.nlist = NeighbourStorage::new(&self.ctx, self.params.n, self.params.nlist_cap, self.nlist_binding_limit)?;
+        self.main_group = self.bind_main();
+        self.pending_rebuild = true;
+        Ok(())
     }
 
     /// Uploads positions and images (and asks for a neighbour rebuild).
@@ -440,10 +468,11 @@ impl GpuBackend {
     pub fn neighbor_lists(&self) -> Vec<Vec<u32>> {
         let n = self.params.n as usize;
         let cap = self.params.nlist_cap as usize;
-        let data: Vec<u32> = bytemuck::cast_slice(&self.read(&self.nlist, 4 * (n * (1 + cap)) as u64)).to_vec();
+        let data: Vec<u32> = bytemuck::cast_slice(&self.read(&self.nlist.list, 4 * (n * (1 + cap)) as u64)).to_vec();
         (0..n)
             .map(|i| {
-                let mut row = data[n + i * cap..n + i * cap + (data[i] as usize).min(cap)].to_vec();
+                let start = i * (1 + cap);
+                let mut row = data[start + 1..start + 1 + (data[start] as usize).min(cap)].to_vec();
                 row.sort_unstable();
                 row
             })
@@ -479,36 +508,35 @@ impl GpuBackend {
     pub fn profile(&mut self, repetitions: u32) -> Result<PhaseTimes, String> {
         self.evaluate()?;
         let saved = self.read(&self.state, 48 * self.params.n as u64);
-        let particles = self.params.n.div_ceil(WORKGROUP);
-        let cells = self.params.grid[3].div_ceil(WORKGROUP);
+        let particles = Over::Particles;
+        let cells = Over::Groups(self.params.grid[3].div_ceil(WORKGROUP));
         let k = &self.kernels;
-        let mut build: Vec<(&wgpu::ComputePipeline, u32)> = Vec::new();
+        let mut build: Vec<(&wgpu::ComputePipeline, Over)> = Vec::new();
         if self.has_pairs {
             build = vec![
                 (&k.clear, cells),
                 (&k.count, particles),
                 (&k.scan_blocks, cells),
-                (&k.scan_totals, 1),
+                (&k.scan_totals, Over::Groups(1)),
                 (&k.scan_add, cells),
                 (&k.scatter, particles),
                 (&k.sort, cells),
-                (&k.build, particles),
+                (&k.build, Over::Chunks),
             ];
         }
-        let time = |this: &Self, kernels: &[(&wgpu::ComputePipeline, u32)], decide: bool| {
+        let time = |this: &Self, kernels: &[(&wgpu::ComputePipeline, Over)], decide: bool| {
             let run = |reps: u32| {
                 let started = std::time::Instant::now();
                 let mut encoder = this.ctx.device.create_command_encoder(&Default::default());
                 {
                     let mut pass = encoder.begin_compute_pass(&Default::default());
-                    pass.set_bind_group(0, &this.main_group, &[]);
+                    pass.set_bind_group(0, &this.main_group, &this.nlist.offsets(0));
                     if decide {
                         pass.set_bind_group(1, &this.args_group, &[]);
                     }
                     for _ in 0..reps {
-                        for (pipeline, groups) in kernels {
-                            pass.set_pipeline(pipeline);
-                            pass.dispatch_workgroups((*groups).min(this.params.groups_x), groups.div_ceil(this.params.groups_x), 1);
+                        for (pipeline, over) in kernels {
+                            this.dispatch(&mut pass, pipeline, *over);
                         }
                     }
                 }
@@ -519,10 +547,10 @@ impl GpuBackend {
             run(1);
             run(repetitions) / repetitions as f64
         };
-        let check = if self.has_pairs { time(self, &[(&k.displacement, particles), (&k.decide, 1)], true) } else { 0.0 };
+        let check = if self.has_pairs { time(self, &[(&k.displacement, particles), (&k.decide, Over::Groups(1))], true) } else { 0.0 };
         let neighbor_build = if self.has_pairs { time(self, &build, false) } else { 0.0 };
-        let forces = time(self, &[(&k.forces, particles)], false);
-        let integrate = time(self, &[(&k.integrate, particles), (&k.commit, particles), (&k.advance, 1)], false);
+        let forces = time(self, &[(&k.forces, Over::Chunks)], false);
+        let integrate = time(self, &[(&k.integrate, particles), (&k.commit, particles), (&k.advance, Over::Groups(1))], false);
         let started = std::time::Instant::now();
         for _ in 0..repetitions {
             self.read(&self.state, 48 * self.params.n as u64);
@@ -533,19 +561,36 @@ impl GpuBackend {
         Ok(PhaseTimes { check, neighbor_build, forces, integrate, readback })
     }
 
+    /// Dispatches `pipeline` over `over`: wider than the dispatch width,
+    /// split along y; over the neighbour-list chunks, once per chunk with the
+    /// chunk bound (chunk 0 is bound again afterwards).
+    fn dispatch(&self, pass: &mut wgpu::ComputePass, pipeline: &wgpu::ComputePipeline, over: Over) {
+        pass.set_pipeline(pipeline);
+        let direct = |pass: &mut wgpu::ComputePass, groups: u32| {
+            pass.dispatch_workgroups(groups.min(self.params.groups_x), groups.div_ceil(self.params.groups_x), 1);
+        };
+        match over {
+            Over::Groups(groups) => direct(pass, groups),
+            Over::Particles => direct(pass, self.params.n.div_ceil(WORKGROUP)),
+            Over::Chunks => {
+                for c in 0..self.nlist.chunks {
+                    pass.set_bind_group(0, &self.main_group, &self.nlist.offsets(c));
+                    direct(pass, self.nlist.per_chunk.div_ceil(WORKGROUP));
+                }
+                if self.nlist.chunks > 1 {
+                    pass.set_bind_group(0, &self.main_group, &self.nlist.offsets(0));
+                }
+            }
+        }
+    }
+
     /// Encodes one neighbour check/rebuild and force pass, and optionally the
     /// integration of one step.
     fn encode_step(&self, pass: &mut wgpu::ComputePass, integrate: bool) {
-        let particles = (self.params.n).div_ceil(WORKGROUP);
         let k = &self.kernels;
-        let direct = |pass: &mut wgpu::ComputePass, pipeline: &wgpu::ComputePipeline, groups: u32| {
-            pass.set_pipeline(pipeline);
-            let gx = groups.min(self.params.groups_x);
-            pass.dispatch_workgroups(gx, groups.div_ceil(self.params.groups_x), 1);
-        };
-        pass.set_bind_group(0, &self.main_group, &[]);
+        pass.set_bind_group(0, &self.main_group, &self.nlist.offsets(0));
         if self.has_pairs {
-            direct(pass, &k.displacement, particles);
+            self.dispatch(pass, &k.displacement, Over::Particles);
             pass.set_pipeline(&k.decide);
             pass.set_bind_group(1, &self.args_group, &[]);
             pass.dispatch_workgroups(1, 1, 1);
@@ -560,13 +605,16 @@ impl GpuBackend {
             indirect(pass, &k.scan_add, 1);
             indirect(pass, &k.scatter, 0);
             indirect(pass, &k.sort, 1);
-            indirect(pass, &k.build, 0);
+            for c in 0..self.nlist.chunks {
+                pass.set_bind_group(0, &self.main_group, &self.nlist.offsets(c));
+                indirect(pass, &k.build, 3);
+            }
         }
-        direct(pass, &k.forces, particles);
+        self.dispatch(pass, &k.forces, Over::Chunks);
         if integrate {
-            direct(pass, &k.integrate, particles);
-            direct(pass, &k.commit, particles);
-            direct(pass, &k.advance, 1);
+            self.dispatch(pass, &k.integrate, Over::Particles);
+            self.dispatch(pass, &k.commit, Over::Particles);
+            self.dispatch(pass, &k.advance, Over::Groups(1));
         }
     }
 
@@ -582,14 +630,8 @@ impl GpuBackend {
         }
         let need = status[ST_OVERFLOW_NEED] as u64;
         let cap = (need + need / 4 + 8).next_multiple_of(8) as u32;
-        check_binding(&self.ctx, &format!("the neighbour list ({need} neighbours for some particle)"), nlist_bytes(self.params.n, cap))?;
+        self.nlist = NeighbourStorage::new(&self.ctx, self.params.n, cap, self.nlist_binding_limit)?;
         self.params.nlist_cap = cap;
-        self.nlist = self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("nlist"),
-            size: nlist_bytes(self.params.n, cap),
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
         self.main_group = self.bind_main();
         self.grown += 1;
         Ok(true)
@@ -654,10 +696,30 @@ impl GpuBackend {
     }
 }
 
-/// The main bind group: the eleven buffers of layout.wgsl, in binding order.
-fn bind_main(device: &wgpu::Device, layout: &wgpu::BindGroupLayout, buffers: [&wgpu::Buffer; 11]) -> wgpu::BindGroup {
-    let entries: Vec<wgpu::BindGroupEntry> =
-        buffers.iter().enumerate().map(|(b, buf)| wgpu::BindGroupEntry { binding: b as u32, resource: buf.as_entire_binding() }).collect();
+/// How many workgroups a kernel runs.
+#[derive(Clone, Copy)]
+enum Over {
+    Groups(u32),
+    /// One invocation per particle.
+    Particles,
+    /// One invocation per particle, dispatched per neighbour-list chunk.
+    Chunks,
+}
+
+/// The main bind group: the buffers of layout.wgsl in binding order, the
+/// neighbour list (binding 8) and its chunk uniform (binding 11) bound per chunk.
+fn bind_main(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    buffers: [&wgpu::Buffer; 10],
+    nlist: &NeighbourStorage,
+) -> wgpu::BindGroup {
+    let mut entries: Vec<wgpu::BindGroupEntry> = buffers
+        .iter()
+        .zip((0..8).chain(9..11))
+        .map(|(buf, b)| wgpu::BindGroupEntry { binding: b, resource: buf.as_entire_binding() })
+        .collect();
+    entries.extend(nlist.entries());
     device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("cellmd main"), layout, entries: &entries })
 }
 

@@ -5,6 +5,8 @@
 //!   evaluator file per interaction type, validated by naga.
 //! - [`pack`]: the model flattened into the buffers the kernels read.
 //! - [`backend`]: buffers, pipelines and the GPU-resident step loop.
+//! - [`nlist`]: the neighbour list's buffer, bound in chunks of particles
+//!   where it exceeds the adapter's largest storage binding.
 //!
 //! What runs where: each step — neighbour-list check and (when due) rebuild,
 //! forces, overdamped integration — runs on the GPU without reading anything
@@ -33,6 +35,7 @@
 
 pub mod backend;
 pub mod context;
+mod nlist;
 pub mod pack;
 pub mod shader;
 
