@@ -15,9 +15,10 @@
 //!   term keeps K̃ ⪰ Σ_t H_t: it only adds stiffness where a term alone is
 //!   concave, and leaves every convex term exact.
 //! - [`SurfaceHessian`]: what a surface (body) term hands the backend — local
-//!   stencil Hessians (projected there) and Gauss–Newton rank-one terms
-//!   w·g gᵀ over the whole body (a volume or total-area term couples every
-//!   node, so it stays a vector instead of a dense block).
+//!   stencil Hessians (projected there), local Gauss–Newton terms w·g gᵀ
+//!   (PSD as they stand) and Gauss–Newton terms over the whole body (a volume
+//!   or total-area term couples every node, so it stays a vector instead of
+//!   a dense block).
 //!
 //! Area terms share one stencil, [`SurfaceHessian::push_face`]: a face energy
 //! e(A_t) with tension τ = e′(A_t) and curvature c = e″(A_t) has the 9×9 Hessian
@@ -62,7 +63,9 @@ pub fn project_psd(h: &Mat<f64>) -> Mat<f64> {
     if (0..dim).all(|e| s[e] >= 0.0) {
         return h.clone();
     }
-    Mat::from_fn(dim, dim, |r, c| (0..dim).map(|e| s[e].max(0.0) * u[(r, e)] * u[(c, e)]).sum())
+    // V·Vᵀ with V the eigenvectors scaled by √max(λ, 0).
+    let scaled = Mat::from_fn(dim, dim, |r, e| u[(r, e)] * s[e].max(0.0).sqrt());
+    &scaled * scaled.transpose()
 }
 
 /// The 3×3 block (a, b) of a 3k×3k matrix.
@@ -78,6 +81,15 @@ pub struct LocalHessian {
     pub matrix: Mat<f64>,
 }
 
+/// A Gauss–Newton term w·g gᵀ (w ≥ 0) on a stencil `nodes`: positive
+/// semi-definite as it stands, assembled as blocks without projection.
+#[derive(Clone, Debug)]
+pub struct LocalRankOne {
+    pub weight: f64,
+    pub nodes: Vec<u32>,
+    pub gradient: Vec<DVec3>,
+}
+
 /// A Gauss–Newton term w·g gᵀ (w ≥ 0), g over every node of the body.
 #[derive(Clone, Debug)]
 pub struct RankOne {
@@ -86,10 +98,14 @@ pub struct RankOne {
 }
 
 /// The second-order model of one surface term on one body: the sum of the
-/// stencils' projections and the rank-one terms is its block of K̃.
+/// stencils' projections and the Gauss–Newton terms is its block of K̃.
 #[derive(Clone, Debug, Default)]
 pub struct SurfaceHessian {
+    /// Local Hessians, projected onto their PSD part by the backend.
     pub stencils: Vec<LocalHessian>,
+    /// Local Gauss–Newton terms (PSD already).
+    pub gauss_newton: Vec<LocalRankOne>,
+    /// Gauss–Newton terms over the whole body (applied matrix-free).
     pub rank_one: Vec<RankOne>,
 }
 

@@ -30,9 +30,12 @@
 //!     and indefinite — its projection would add stiffness of order |ΔP|·ℓ
 //!     that no mode has, while the part itself is O(ℓ/R) of the tension's at a
 //!     Young–Laplace balance ΔP = 2γ/R;
-//!   - `helfrich_bending`: each node's energy 2κu_i²/A_i on its one-ring,
-//!     its Hessian by central differences of the ring's analytic forces
-//!     (exact before projection).
+//!   - `helfrich_bending`: node i's energy f(u_i, A_i) = 2κu_i²/A_i
+//!     (u_i = M_i − C0·A_i/2) is convex in (u, A) with Hessian
+//!     (4κ/A)·v vᵀ, v = (1, −u/A); linearising u_i and A_i gives the
+//!     generalised Gauss–Newton term (4κ/A_i)·g gᵀ, g = ∇u_i − (u_i/A_i)·∇A_i
+//!     on node i's one-ring (analytic, PSD as it stands). Left out:
+//!     ∂E/∂M_i·∇²M_i + ∂E/∂A_i·∇²A_i, O(ℓ/R) of what is kept.
 //!
 //!   `contact_adhesion` adds no blocks: its area part and switch distances
 //!   enter the step through F only.

@@ -21,7 +21,7 @@
 //! relative to the body's centroid) are summed body by body, term by term,
 //! sequentially: results never depend on the thread count.
 
-use glam::DVec3;
+use glam::{DMat3, DVec3};
 use rayon::prelude::*;
 
 use super::stiffness::{push_blocks, RankOneTerm, StiffnessBlock};
@@ -150,9 +150,9 @@ impl Surfaces {
     }
 
     /// Appends the surface terms' stiffness at the last evaluation's
-    /// positions: every stencil's PSD projection as blocks (stencils in
-    /// parallel, appended in body, term and stencil order) and returns the
-    /// rank-one terms in the same order.
+    /// positions: every stencil's PSD projection (stencils in parallel) and
+    /// every local Gauss–Newton term as blocks, in body, term and stencil
+    /// order, and returns the whole-body rank-one terms in the same order.
     pub(super) fn stiffness(&self, model: &Model, blocks: &mut Vec<StiffnessBlock>) -> Vec<RankOneTerm> {
         let mut rank_one = Vec::new();
         for (b, scratch) in self.bodies.iter().enumerate() {
@@ -173,6 +173,15 @@ impl Surfaces {
                     })
                     .collect();
                 blocks.extend(projected.into_iter().flatten());
+                for term in &local.gauss_newton {
+                    let particles: Vec<u32> = term.nodes.iter().map(|&k| body.nodes[k as usize]).collect();
+                    for (&i, gi) in particles.iter().zip(&term.gradient) {
+                        for (&j, gj) in particles.iter().zip(&term.gradient) {
+                            let block = DMat3::from_cols(*gi * gj.x, *gi * gj.y, *gi * gj.z) * term.weight;
+                            blocks.push(StiffnessBlock { i, j, block });
+                        }
+                    }
+                }
                 rank_one.extend(local.rank_one.into_iter().map(|r| RankOneTerm {
                     weight: r.weight,
                     particles: body.nodes.clone(),

@@ -208,7 +208,7 @@ pub fn assert_surface_zero_force_at_rest(
 /// The second-order model of a surface law ([`SurfaceHessian`]) against
 /// second differences of its energy (step `h`), on one body:
 ///
-/// - its stencils and rank-one terms summed, unprojected, equal the Hessian
+/// - its stencils and Gauss–Newton terms summed, unprojected, equal the Hessian
 ///   of E − `dropped` (the part of E whose curvature the model leaves out on
 ///   purpose, frozen at `positions`; zero for an exact model) to
 ///   `tolerance` × the largest entry;
@@ -265,6 +265,17 @@ pub fn assert_surface_hessian(
                 for (r, c) in (0..9).map(|n| (n / 3, n % 3)) {
                     raw[(3 * p as usize + r, 3 * q as usize + c)] += stencil.matrix[(3 * a + r, 3 * b + c)];
                     projected[(3 * p as usize + r, 3 * q as usize + c)] += psd[(3 * a + r, 3 * b + c)];
+                }
+            }
+        }
+    }
+    for term in &model.gauss_newton {
+        assert!(term.weight >= 0.0, "{name}: Gauss–Newton weight {}", term.weight);
+        for (&p, gp) in term.nodes.iter().zip(&term.gradient) {
+            for (&q, gq) in term.nodes.iter().zip(&term.gradient) {
+                for (r, c) in (0..9).map(|n| (n / 3, n % 3)) {
+                    raw[(3 * p as usize + r, 3 * q as usize + c)] += term.weight * gp[r] * gq[c];
+                    projected[(3 * p as usize + r, 3 * q as usize + c)] += term.weight * gp[r] * gq[c];
                 }
             }
         }
