@@ -23,7 +23,7 @@ use faer::linalg::solvers::Solve;
 use faer::matrix_free::LinOp;
 use faer::sparse::{SparseColMat, Triplet};
 use faer::{Col, Mat, MatMut, MatRef, Par, Side};
-use glam::DVec3;
+use glam::{DMat3, DVec3};
 
 use crate::backend::stiffness::Stiffness;
 
@@ -41,17 +41,26 @@ impl SystemMatrix {
         let n = drag.len();
         let dim = 3 * n;
         let fixed = |i: usize| drag[i].is_infinite();
-        let mut triplets = Vec::with_capacity(dim + 9 * stiffness.blocks.len());
-        for (i, gamma) in drag.iter().enumerate() {
-            let diagonal = if fixed(i) { 1.0 } else { gamma / dt };
-            for a in 0..3 {
-                triplets.push(Triplet::new(3 * i + a, 3 * i + a, diagonal));
+        // The diagonal, then the blocks between mobile particles, merged per
+        // (i, j) in column order (a stable sort: duplicates add in term order)
+        // so the triplets arrive sorted, 9 per distinct block.
+        let diagonal = drag.iter().enumerate().map(|(i, gamma)| (i, i, DMat3::IDENTITY * if fixed(i) { 1.0 } else { gamma / dt }));
+        let couplings =
+            stiffness.blocks.iter().filter(|b| !fixed(b.i as usize) && !fixed(b.j as usize)).map(|b| (b.i as usize, b.j as usize, b.block));
+        let mut blocks: Vec<(usize, usize, DMat3)> = diagonal.chain(couplings).collect();
+        blocks.sort_by_key(|&(i, j, _)| (j, i));
+        let mut triplets = Vec::with_capacity(9 * blocks.len());
+        let mut k = 0;
+        while k < blocks.len() {
+            let (i, j, mut block) = blocks[k];
+            k += 1;
+            while k < blocks.len() && (blocks[k].0, blocks[k].1) == (i, j) {
+                block += blocks[k].2;
+                k += 1;
             }
-        }
-        for b in stiffness.blocks.iter().filter(|b| !fixed(b.i as usize) && !fixed(b.j as usize)) {
             for col in 0..3 {
                 for row in 0..3 {
-                    triplets.push(Triplet::new(3 * b.i as usize + row, 3 * b.j as usize + col, b.block.col(col)[row]));
+                    triplets.push(Triplet::new(3 * i + row, 3 * j + col, block.col(col)[row]));
                 }
             }
         }
@@ -155,7 +164,6 @@ impl LinOp<f64> for SystemMatrix {
 mod tests {
     use super::*;
     use crate::backend::stiffness::{RankOneTerm, StiffnessBlock};
-    use glam::DMat3;
 
     /// Products and the Woodbury solve agree with the dense matrix.
     #[test]
