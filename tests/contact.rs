@@ -7,7 +7,7 @@
 //! - The cells flatten against each other (a contact patch of many nodes).
 //! - The step clamp acts (and keeps the distance positive) when the time step
 //!   is too large for the barrier, with noise too.
-//! - The implicit integrator (step clamp + the barrier's stiffness blocks)
+//! - The implicit integrator (step clamp, the barrier's and the cells' stiffness blocks)
 //!   and FIRE (step clamp) squeeze meshed cells together between plates
 //!   without interpenetration, and settle.
 //! - Runs are bit-identical on 1 and 2 threads; the GPU backend refuses
