@@ -8,6 +8,7 @@
 //! | [`deck`] | deck commands → validated [`deck::Plan`] |
 //! | [`topology`] | particles, bonds, angles, triangles, bodies (checked: closed, oriented, sphere topology) |
 //! | [`mesh`] | closed triangulated surfaces: edges and wings, volume, area, bending angles, the icosphere |
+//! | [`hessian`] | local Hessians (finite differences, PSD projection) and surface terms' second-order models for the implicit step |
 //! | [`forcefield`] | particle/bond/angle/pair types checked against each interaction's schema |
 //! | [`interactions`] | the registry: one file per interaction type (its evaluator + docs) |
 //! | [`system`] | box, f64 state and the resolved [`system::Model`] |
@@ -29,6 +30,7 @@ pub mod deck;
 pub mod export;
 pub mod forcefield;
 pub mod gpu;
+pub mod hessian;
 pub mod input;
 pub mod integrate;
 pub mod interactions;

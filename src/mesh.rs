@@ -10,7 +10,13 @@
 //! # Geometry
 //!
 //! - Face area A_t = ½|(x_b − x_a) × (x_c − x_a)| with gradient
-//!   ∂A_t/∂x_a = ½ (x_b − x_c) × n̂ (cyclic in a, b, c).
+//!   ∂A_t/∂x_a = ½ (x_b − x_c) × n̂ (cyclic in a, b, c). Its Hessian, with
+//!   n = (x_b − x_a) × (x_c − x_a), P = I − n̂n̂ᵀ, [v]ₓ the cross-product
+//!   matrix and e_a = x_b − x_c (cyclic): ∂²A_t/∂x_k∂x_l =
+//!   −[e_k]ₓ P [e_l]ₓ/(2|n|) + ½M_kl, where M_kk = 0, M_ab = M_bc = M_ca =
+//!   −[n̂]ₓ and M_ba = M_cb = M_ac = [n̂]ₓ (the second-order part of n̂·n).
+//!   Indefinite: a face shrinks to second order when two corners slide
+//!   apart across each other.
 //! - Enclosed volume by the divergence theorem,
 //!   V = (1/6) Σ_t (x_a − o)·((x_b − o) × (x_c − o)), independent of the
 //!   origin o for a closed surface; ∂V/∂x_a = (1/6) Σ_t (x_b − o) × (x_c − o),
@@ -41,7 +47,7 @@
 
 use std::collections::HashMap;
 
-use glam::DVec3;
+use glam::{DMat3, DVec3};
 
 /// An edge (i, j) of a closed mesh and its wings: face (i, j, a) and face (j, i, b).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -196,6 +202,33 @@ pub fn triangle_area_gradient([a, b, c]: [DVec3; 3]) -> (f64, [DVec3; 3]) {
     let twice = n.length();
     let unit = n / twice;
     (0.5 * twice, [0.5 * (b - c).cross(unit), 0.5 * (c - a).cross(unit), 0.5 * (a - b).cross(unit)])
+}
+
+/// The cross-product matrix [v]ₓ: [v]ₓ·u = v × u.
+#[inline]
+pub fn cross_matrix(v: DVec3) -> DMat3 {
+    DMat3::from_cols(DVec3::new(0.0, v.z, -v.y), DVec3::new(-v.z, 0.0, v.x), DVec3::new(v.y, -v.x, 0.0))
+}
+
+/// The Hessian ∂²A/∂x_k∂x_l of a triangle's area, as 3×3 blocks [k][l]
+/// (see the module docs).
+pub fn triangle_area_hessian([a, b, c]: [DVec3; 3]) -> [[DMat3; 3]; 3] {
+    let n = (b - a).cross(c - a);
+    let twice = n.length();
+    let unit = n / twice;
+    let projector = DMat3::IDENTITY - DMat3::from_cols(unit * unit.x, unit * unit.y, unit * unit.z);
+    let edges = [b - c, c - a, a - b].map(cross_matrix);
+    let turn = cross_matrix(unit);
+    std::array::from_fn(|k| {
+        std::array::from_fn(|l| {
+            let second = match (l + 3 - k) % 3 {
+                0 => DMat3::ZERO,
+                1 => -0.5 * turn,
+                _ => 0.5 * turn,
+            };
+            -(edges[k] * projector * edges[l]) / (2.0 * twice) + second
+        })
+    })
 }
 
 /// Bending angle of edge (i, j) with wings a (face (i, j, a)) and b (face
@@ -465,6 +498,32 @@ mod tests {
         // The regions themselves.
         let region = |p: DVec3| point_triangle(p, tri).weights.iter().filter(|w| **w > 0.0).count();
         assert_eq!(cases.map(region), [3, 2, 2, 2, 1, 1, 1]);
+    }
+
+    #[test]
+    fn the_area_hessian_matches_second_differences_of_the_area() {
+        let tri = [DVec3::new(0.1, -0.2, 0.3), DVec3::new(1.3, 0.1, -0.2), DVec3::new(0.4, 0.9, 0.5)];
+        let analytic = triangle_area_hessian(tri);
+        let h = 1e-4;
+        let moved = |k: usize, a: usize, s: f64, l: usize, b: usize, t: f64| {
+            let mut x = tri;
+            x[k][a] += s;
+            x[l][b] += t;
+            triangle_area(x)
+        };
+        let mut largest: f64 = 0.0;
+        for (k, l, a, b) in (0..81).map(|n| (n / 27, n / 9 % 3, n / 3 % 3, n % 3)) {
+            let fd =
+                (moved(k, a, h, l, b, h) - moved(k, a, h, l, b, -h) - moved(k, a, -h, l, b, h) + moved(k, a, -h, l, b, -h)) / (4.0 * h * h);
+            let exact = analytic[k][l].col(b)[a];
+            assert!((fd - exact).abs() < 1e-6, "corner {k} axis {a}, corner {l} axis {b}: {fd} vs {exact}");
+            largest = largest.max(exact.abs());
+        }
+        assert!(largest > 0.1);
+        // Indefinite: some motion shrinks the face to second order.
+        let matrix = faer::Mat::<f64>::from_fn(9, 9, |r, c| analytic[r / 3][c / 3].col(c % 3)[r % 3]);
+        let eigen = matrix.self_adjoint_eigenvalues(faer::Side::Lower).unwrap();
+        assert!(eigen[0] < -0.1 && eigen[8] > 0.1, "eigenvalues {eigen:?}");
     }
 
     #[test]

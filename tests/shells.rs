@@ -20,7 +20,7 @@ use cellmd::build::{icosphere_cell, IcosphereCell};
 use cellmd::deck::validate_file;
 use cellmd::gpu::DevicePreference;
 use cellmd::run::{RunOptions, Simulation};
-use common::{merge_topologies, position_bits, Case};
+use common::{merge_topologies, position_bits, stretch_particles, Case};
 use glam::DVec3;
 
 /// Enclosed volume and area of body 0 of a simulation.
@@ -142,23 +142,7 @@ fn helfrich_energy_of_a_sphere_converges_to_8_pi_kappa() {
 fn volume_is_conserved_at_zero_temperature_while_the_cell_rounds_up() {
     let (k, gamma): (f64, f64) = (1e5, 300.0);
     let mut cell = icosphere_cell(&IcosphereCell { level: 3, radius: 5.0, bond_type: None, ..Default::default() });
-    // Stretch the written positions into an ellipsoid.
-    let mut text = String::new();
-    let mut in_particles = false;
-    for line in cell.text.lines() {
-        if line.starts_with('[') {
-            in_particles = line == "[ particles ]";
-        }
-        let f: Vec<&str> = line.split_whitespace().collect();
-        if in_particles && f.len() == 6 && !line.starts_with('#') {
-            let (x, y, z): (f64, f64, f64) = (f[2].parse().unwrap(), f[3].parse().unwrap(), f[4].parse().unwrap());
-            text += &format!("{} {} {:?} {:?} {:?} {}\n", f[0], f[1], 1.3 * x, y, 0.8 * z, f[5]);
-        } else {
-            text += line;
-            text += "\n";
-        }
-    }
-    cell.text = text;
+    cell.text = stretch_particles(&cell.text, DVec3::new(1.3, 1.0, 0.8));
     let probe = Case::new(&[
         ("cell.top", &cell.text),
         ("cell.ff", "particle node drag 1\nbody cell surface_tension gamma 1\n"),

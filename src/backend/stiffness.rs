@@ -13,13 +13,32 @@
 //!   (a compressed spring's negative transverse stiffness, the concave side
 //!   of a potential), which an implicit step must not amplify.
 //! - **Angles and externals**: the block Hessian of the term alone by central
-//!   differences of its own analytic forces (step 1e-6 of its size),
-//!   symmetrised, then projected onto the positive semi-definite cone
-//!   (negative eigenvalues set to 0, faer's self-adjoint eigensolver).
+//!   differences of its own analytic forces, projected onto the positive
+//!   semi-definite cone ([`crate::hessian`]: symmetrised, negative
+//!   eigenvalues set to 0).
+//! - **Surface terms of bodies** ([`crate::hessian::SurfaceHessian`], each
+//!   term's `hessian` in its interaction file): local stencils projected like
+//!   the angles, and Gauss–Newton rank-one terms w·g gᵀ kept as vectors
+//!   ([`RankOneTerm`]; the implicit step applies them matrix-free):
+//!   - `surface_tension`: γ·∇²A_t per face (analytic, exact before
+//!     projection); `area_conservation`: per face
+//!     (k_l/a0)·∇A_t∇A_tᵀ + τ_t·∇²A_t with τ_t = dE/dA_t, and the global
+//!     term's (k_a/A0)·∇A∇Aᵀ — together the exact Hessian;
+//!   - `turgor` and `turgor_log`: E″(V)·∇V∇Vᵀ (K/V0, resp. K/V). The
+//!     pressure part −ΔP·∇²V is left out: V is linear in each node, so ∇²V
+//!     has zero diagonal blocks and every local piece of it is traceless
+//!     and indefinite — its projection would add stiffness of order |ΔP|·ℓ
+//!     that no mode has, while the part itself is O(ℓ/R) of the tension's at a
+//!     Young–Laplace balance ΔP = 2γ/R;
+//!   - `helfrich_bending`: node i's energy f(u_i, A_i) = 2κu_i²/A_i
+//!     (u_i = M_i − C0·A_i/2) is convex in (u, A) with Hessian
+//!     (4κ/A)·v vᵀ, v = (1, −u/A); linearising u_i and A_i gives the
+//!     generalised Gauss–Newton term (4κ/A_i)·g gᵀ, g = ∇u_i − (u_i/A_i)·∇A_i
+//!     on node i's one-ring (analytic, PSD as it stands). Left out:
+//!     ∂E/∂M_i·∇²M_i + ∂E/∂A_i·∇²A_i, O(ℓ/R) of what is kept.
 //!
-//! - **Surface terms of bodies** (turgor, tension, bending) contribute no
-//!   block yet: they enter the implicit step through F only, so their own
-//!   explicit stability limit still applies to them.
+//!   `contact_adhesion` adds no blocks: its area part and switch distances
+//!   enter the step through F only.
 //! - **Contact pairs between bodies** (node p, face corners x_k, distance d
 //!   to the closest point q = Σ w_k x_k): the Gauss–Newton block
 //!   max(b″, 0)·g gᵀ with g = ∂d/∂(p, x_0, x_1, x_2) = (n̂, −w_0 n̂, −w_1 n̂,
@@ -29,16 +48,32 @@
 //!   step also applies the contact step clamp.
 //!
 //! Blocks come in term order (bonds, angles, pairs by particle and ascending
-//! neighbour, externals), so the assembled matrix is the same on any thread
-//! count.
+//! neighbour, contact pairs, externals, then bodies by body, term and
+//! stencil), so the assembled matrix is the same on any thread count.
 
-use faer::{Mat, Side};
+use faer::Mat;
 use glam::{DMat3, DVec3};
 
 use super::bonded::eval_angle;
 use super::cpu::CpuBackend;
+use crate::hessian::{block, finite_difference_hessian, project_psd};
 use crate::interactions::{Law, Radial};
 use crate::system::{Images, Model, SimBox, State};
+
+/// A Gauss–Newton term w·g gᵀ of K̃ (w ≥ 0): g[k] on particle `particles[k]`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RankOneTerm {
+    pub weight: f64,
+    pub particles: Vec<u32>,
+    pub gradient: Vec<DVec3>,
+}
+
+/// K̃ = Σ blocks + Σ rank-one terms.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Stiffness {
+    pub blocks: Vec<StiffnessBlock>,
+    pub rank_one: Vec<RankOneTerm>,
+}
 
 /// One 3×3 block K̃_ij of the stiffness matrix (particle indices i, j).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -65,49 +100,24 @@ fn push_pair(blocks: &mut Vec<StiffnessBlock>, i: u32, j: u32, h: DMat3) {
     blocks.push(StiffnessBlock { i: j, j: i, block: -h });
 }
 
-/// The Hessian of a term with `k` particles from its forces by central
-/// differences, symmetrised and projected onto the PSD cone; blocks appended
-/// for every pair of its particles.
-fn projected_term_blocks<const K: usize>(
-    particles: [u32; K],
-    at: [DVec3; K],
-    forces: impl Fn([DVec3; K]) -> [DVec3; K],
-    blocks: &mut Vec<StiffnessBlock>,
-) {
-    let size = at.iter().map(|x| (*x - at[0]).length()).fold(0.0, f64::max).max(at[0].length()).max(1e-3);
-    let h = 1e-6 * size;
-    let dim = 3 * K;
-    let mut hessian = Mat::<f64>::zeros(dim, dim);
-    for b in 0..K {
-        for axis in 0..3 {
-            let mut plus = at;
-            let mut minus = at;
-            plus[b][axis] += h;
-            minus[b][axis] -= h;
-            let (fp, fm) = (forces(plus), forces(minus));
-            for a in 0..K {
-                for row in 0..3 {
-                    hessian[(3 * a + row, 3 * b + axis)] = -(fp[a][row] - fm[a][row]) / (2.0 * h);
-                }
-            }
-        }
-    }
-    let symmetric = Mat::<f64>::from_fn(dim, dim, |r, c| 0.5 * (hessian[(r, c)] + hessian[(c, r)]));
-    let Ok(eigen) = symmetric.self_adjoint_eigen(Side::Lower) else { return };
-    let (u, s) = (eigen.U(), eigen.S().column_vector());
-    let projected = Mat::<f64>::from_fn(dim, dim, |r, c| (0..dim).map(|e| s[e].max(0.0) * u[(r, e)] * u[(c, e)]).sum());
-    for a in 0..K {
-        for b in 0..K {
-            let column = |col: usize| DVec3::from_array([0, 1, 2].map(|row| projected[(3 * a + row, 3 * b + col)]));
-            let block = DMat3::from_cols(column(0), column(1), column(2));
-            blocks.push(StiffnessBlock { i: particles[a], j: particles[b], block });
+/// Appends the blocks of the 3k×3k matrix `h` over `particles`.
+pub(super) fn push_blocks(particles: &[u32], h: &Mat<f64>, blocks: &mut Vec<StiffnessBlock>) {
+    for (a, &i) in particles.iter().enumerate() {
+        for (b, &j) in particles.iter().enumerate() {
+            blocks.push(StiffnessBlock { i, j, block: block(h, a, b) });
         }
     }
 }
 
+/// The PSD projection of a term's finite-difference Hessian, as blocks.
+fn projected_term_blocks(particles: &[u32], at: &[DVec3], forces: impl Fn(&[DVec3]) -> Vec<DVec3>, blocks: &mut Vec<StiffnessBlock>) {
+    push_blocks(particles, &project_psd(&finite_difference_hessian(at, forces)), blocks);
+}
+
 impl CpuBackend {
-    /// The blocks of K̃ at `state` (neighbour list as last built).
-    pub fn stiffness(&self, model: &Model, state: &State, sim_box: &SimBox) -> Vec<StiffnessBlock> {
+    /// K̃ at `state` (neighbour list, contact candidates and surface positions
+    /// as at the last force evaluation).
+    pub fn stiffness(&self, model: &Model, state: &State, sim_box: &SimBox) -> Stiffness {
         let x = &state.positions;
         let images: Images = sim_box.images();
         let bond_state = state.bonds.as_ref();
@@ -123,7 +133,7 @@ impl CpuBackend {
             let (at, _) = eval_angle(model, a, x, &images);
             let term = &model.angle_types[model.angle_type[a] as usize];
             let Law::ThreeBody(eval) = term.interaction.law() else { unreachable!("angle law is three-body") };
-            projected_term_blocks(model.angles[a], at, |p| eval(&term.params, p).forces, &mut blocks);
+            projected_term_blocks(&model.angles[a], &at, |p| eval(&term.params, [p[0], p[1], p[2]]).forces.to_vec(), &mut blocks);
         }
         if let Some(list) = self.neighbor_list() {
             for i in 0..model.len() {
@@ -145,10 +155,11 @@ impl CpuBackend {
             let Law::OneBody(eval) = external.term.interaction.law() else { unreachable!("external law is one-body") };
             for &m in &external.members {
                 let at = sim_box.unwrap(x[m as usize], state.images[m as usize]);
-                projected_term_blocks([m], [at], |p| [eval(&external.term.params, p[0]).force], &mut blocks);
+                projected_term_blocks(&[m], &[at], |p| vec![eval(&external.term.params, p[0]).force], &mut blocks);
             }
         }
-        blocks
+        let rank_one = self.surfaces().stiffness(model, &mut blocks);
+        Stiffness { blocks, rank_one }
     }
 }
 
@@ -172,26 +183,5 @@ mod tests {
             let column = -(force(d + e) - force(d - e)) / 2e-6;
             assert!((column - h.col(axis)).length() < 1e-8, "axis {axis}: {column} vs {}", h.col(axis));
         }
-    }
-
-    /// Projection keeps a PSD Hessian and removes negative curvature.
-    #[test]
-    fn projected_blocks_are_positive_semidefinite() {
-        // A compressed spring between two particles: exact Hessian indefinite.
-        let (k, r0) = (2.0, 2.0);
-        let forces = |p: [DVec3; 2]| {
-            let d = p[1] - p[0];
-            let f = k * (d.length() - r0) * d / d.length();
-            [f, -f]
-        };
-        let mut blocks = Vec::new();
-        projected_term_blocks([0, 1], [DVec3::ZERO, DVec3::new(1.0, 0.0, 0.0)], forces, &mut blocks);
-        // v = transverse relative motion: exact vᵀHv = 2·k(r − r0)/r < 0; projected ≥ 0.
-        let v = [DVec3::new(0.0, 1.0, 0.0), DVec3::new(0.0, -1.0, 0.0)];
-        let quadratic: f64 = blocks.iter().map(|b| v[b.i as usize].dot(b.block * v[b.j as usize])).sum();
-        assert!(quadratic.abs() < 1e-6, "transverse curvature {quadratic} should be projected to 0");
-        let axial = [DVec3::new(-1.0, 0.0, 0.0), DVec3::new(1.0, 0.0, 0.0)];
-        let stiff: f64 = blocks.iter().map(|b| axial[b.i as usize].dot(b.block * axial[b.j as usize])).sum();
-        assert!((stiff - 4.0 * k).abs() < 1e-5, "axial curvature {stiff}, expected 4k");
     }
 }

@@ -12,14 +12,21 @@
 //!    body, then the body's terms in force-field order — as angles are
 //!    gathered in [`bonded`](super::bonded).
 //!
+//! **Stiffness** (for `integrator implicit`): each term's second-order model
+//! at the same image-consistent positions ([`SurfaceHessian`]: stencil
+//! Hessians, projected here onto their PSD part, and Gauss–Newton rank-one
+//! terms over the whole body), see `src/backend/stiffness.rs`.
+//!
 //! Energies and the virial W = Σ_k r_k ⊗ f_k (image-consistent positions
 //! relative to the body's centroid) are summed body by body, term by term,
 //! sequentially: results never depend on the thread count.
 
-use glam::DVec3;
+use glam::{DMat3, DVec3};
 use rayon::prelude::*;
 
+use super::stiffness::{push_blocks, RankOneTerm, StiffnessBlock};
 use super::virial::{add6, outer};
+use crate::hessian::{project_psd, SurfaceHessian};
 use crate::interactions::Law;
 use crate::system::{registry_index, Images, Model};
 
@@ -94,7 +101,7 @@ impl Surfaces {
             body.mesh.unwrap_into(|k| x[body.nodes[k as usize] as usize], |d| images.minimum_image(d), &mut scratch.x);
             for (r, &rule) in scratch.rules.iter().enumerate() {
                 let term = &model.body_rules[rule];
-                let Law::Surface(eval) = term.interaction.law() else { unreachable!("body law is a surface law") };
+                let Law::Surface { eval, .. } = term.interaction.law() else { unreachable!("body law is a surface law") };
                 let forces = &mut scratch.forces[r];
                 forces.fill(DVec3::ZERO);
                 scratch.energy[r] = eval(&term.params, &body.mesh, &scratch.x, forces);
@@ -140,6 +147,49 @@ impl Surfaces {
                 visit(&model.bodies[b].nodes, &scratch.x, forces);
             }
         }
+    }
+
+    /// Appends the surface terms' stiffness at the last evaluation's
+    /// positions: every stencil's PSD projection (stencils in parallel) and
+    /// every local Gauss–Newton term as blocks, in body, term and stencil
+    /// order, and returns the whole-body rank-one terms in the same order.
+    pub(super) fn stiffness(&self, model: &Model, blocks: &mut Vec<StiffnessBlock>) -> Vec<RankOneTerm> {
+        let mut rank_one = Vec::new();
+        for (b, scratch) in self.bodies.iter().enumerate() {
+            let body = &model.bodies[b];
+            for &rule in &scratch.rules {
+                let term = &model.body_rules[rule];
+                let Law::Surface { hessian, .. } = term.interaction.law() else { unreachable!("body law is a surface law") };
+                let mut local = SurfaceHessian::default();
+                hessian(&term.params, &body.mesh, &scratch.x, &mut local);
+                let projected: Vec<Vec<StiffnessBlock>> = local
+                    .stencils
+                    .par_iter()
+                    .map(|stencil| {
+                        let particles: Vec<u32> = stencil.nodes.iter().map(|&k| body.nodes[k as usize]).collect();
+                        let mut out = Vec::with_capacity(particles.len() * particles.len());
+                        push_blocks(&particles, &project_psd(&stencil.matrix), &mut out);
+                        out
+                    })
+                    .collect();
+                blocks.extend(projected.into_iter().flatten());
+                for term in &local.gauss_newton {
+                    let particles: Vec<u32> = term.nodes.iter().map(|&k| body.nodes[k as usize]).collect();
+                    for (&i, gi) in particles.iter().zip(&term.gradient) {
+                        for (&j, gj) in particles.iter().zip(&term.gradient) {
+                            let block = DMat3::from_cols(*gi * gj.x, *gi * gj.y, *gi * gj.z) * term.weight;
+                            blocks.push(StiffnessBlock { i, j, block });
+                        }
+                    }
+                }
+                rank_one.extend(local.rank_one.into_iter().map(|r| RankOneTerm {
+                    weight: r.weight,
+                    particles: body.nodes.clone(),
+                    gradient: r.gradient,
+                }));
+            }
+        }
+        rank_one
     }
 
     /// The surface terms on particle `i` with their forces (diagnostics):

@@ -51,7 +51,7 @@ fn dispatch() -> String {
             Law::Radial { .. } => (&mut radial, format!("{name}_radial(p, r)")),
             Law::ThreeBody(_) => (&mut three, format!("{name}_three(p, ri, rj, rk)")),
             Law::OneBody(_) => (&mut one, format!("{name}_one(p, x)")),
-            Law::Surface(_) | Law::Contact { .. } | Law::ContactArea { .. } => continue,
+            Law::Surface { .. } | Law::Contact { .. } | Law::ContactArea { .. } => continue,
         };
         writeln!(out, "        case {index}u: {{ return {call}; }}").unwrap();
     }

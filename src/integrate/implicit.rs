@@ -45,7 +45,8 @@ use glam::DVec3;
 
 use super::overdamped::{clamp_fraction, Blowup, OverdampedSettings};
 use super::rng::noise3;
-use crate::backend::stiffness::StiffnessBlock;
+use super::system_matrix::SystemMatrix;
+use crate::backend::stiffness::Stiffness;
 use crate::system::{Model, SimBox, State};
 
 /// The linear solver of `integrator implicit`.
@@ -96,7 +97,7 @@ pub fn implicit_step(
     model: &Model,
     state: &mut State,
     forces: &[DVec3],
-    stiffness: &[StiffnessBlock],
+    stiffness: &Stiffness,
     sim_box: &SimBox,
     dt: f64,
     kt: f64,
@@ -110,22 +111,8 @@ pub fn implicit_step(
     let dim = 3 * n;
     let gamma = |i: usize| model.type_drag[model.types[i] as usize];
     let fixed = |i: usize| gamma(i).is_infinite();
-    let mut triplets = Vec::with_capacity(dim + 9 * stiffness.len());
-    for i in 0..n {
-        let diagonal = if fixed(i) { 1.0 } else { gamma(i) / dt };
-        for a in 0..3 {
-            triplets.push(Triplet::new(3 * i + a, 3 * i + a, diagonal));
-        }
-    }
-    for b in stiffness.iter().filter(|b| !fixed(b.i as usize) && !fixed(b.j as usize)) {
-        for col in 0..3 {
-            for row in 0..3 {
-                triplets.push(Triplet::new(3 * b.i as usize + row, 3 * b.j as usize + col, b.block.col(col)[row]));
-            }
-        }
-    }
-    let matrix =
-        SparseColMat::<usize, f64>::try_new_from_triplets(dim, dim, &triplets).map_err(|e| ImplicitError::Solve(format!("{e:?}")))?;
+    let drag: Vec<f64> = (0..n).map(gamma).collect();
+    let matrix = SystemMatrix::new(&drag, dt, stiffness).map_err(ImplicitError::Solve)?;
     let mut rhs = Col::<f64>::zeros(dim);
     let mut guess = Mat::<f64>::zeros(dim, 1);
     for i in (0..n).filter(|&i| !fixed(i)) {
@@ -148,12 +135,11 @@ pub fn implicit_step(
             solve.report
         }
         LinearSolver::Cholesky => {
-            let llt = matrix.sp_cholesky(Side::Lower).map_err(|e| ImplicitError::Solve(format!("sparse Cholesky: {e:?}")))?;
-            guess = llt.solve(rhs.as_mat());
+            guess = matrix.solve_direct(&rhs).map_err(ImplicitError::Solve)?;
             SolveReport { iterations: 1, relative_residual: relative_residual(&matrix, &guess, &rhs), step_fraction: 1.0 }
         }
         LinearSolver::Cg => {
-            let diagonal: Col<f64> = Col::from_fn(dim, |k| 1.0 / matrix.get(k, k).copied().unwrap_or(1.0));
+            let diagonal: Col<f64> = matrix.diagonal().iter().map(|d| 1.0 / d).collect();
             let precond = diagonal.as_diagonal();
             let params = CgParams {
                 initial_guess: InitialGuessStatus::MaybeNonZero,
@@ -162,18 +148,10 @@ pub fn implicit_step(
                 max_iters: implicit.max_iterations,
                 ..Default::default()
             };
-            let mut memory = MemBuffer::new(conjugate_gradient_scratch(precond, matrix.as_ref(), 1, Par::Seq));
-            let info = conjugate_gradient(
-                guess.as_mut(),
-                precond,
-                matrix.as_ref(),
-                rhs.as_mat(),
-                params,
-                |_| {},
-                Par::Seq,
-                MemStack::new(&mut memory),
-            )
-            .map_err(|e| ImplicitError::Solve(format!("conjugate gradients: {e:?}")))?;
+            let mut memory = MemBuffer::new(conjugate_gradient_scratch(precond, &matrix, 1, Par::Seq));
+            let info =
+                conjugate_gradient(guess.as_mut(), precond, &matrix, rhs.as_mat(), params, |_| {}, Par::Seq, MemStack::new(&mut memory))
+                    .map_err(|e| ImplicitError::Solve(format!("conjugate gradients: {e:?}")))?;
             SolveReport { iterations: info.iter_count, relative_residual: info.rel_residual, step_fraction: 1.0 }
         }
     };
@@ -218,7 +196,7 @@ struct ProjectedSolve {
 /// factorised once per step by sparse Cholesky. Fixed particles have
 /// D⁻¹ = 0, so they never move; a bond with both ends fixed is skipped.
 fn projected_cg(
-    matrix: &SparseColMat<usize, f64>,
+    matrix: &SystemMatrix,
     rhs: &Col<f64>,
     mobile: &[bool],
     constrained: &ConstrainedBonds,
@@ -227,7 +205,8 @@ fn projected_cg(
     implicit: &ImplicitSettings,
 ) -> Result<ProjectedSolve, ImplicitError> {
     let dim = rhs.nrows();
-    let dinv: Vec<f64> = (0..dim).map(|k| if mobile[k / 3] { 1.0 / matrix.get(k, k).copied().unwrap_or(1.0) } else { 0.0 }).collect();
+    let diagonal = matrix.diagonal();
+    let dinv: Vec<f64> = (0..dim).map(|k| if mobile[k / 3] { 1.0 / diagonal[k] } else { 0.0 }).collect();
     let images = sim_box.images();
     let rows: Vec<(usize, usize, DVec3)> = constrained
         .pairs
@@ -297,7 +276,7 @@ fn projected_cg(
     let mut iterations = 0;
     let mut residual = z.norm_l2() / reference;
     while residual > implicit.tolerance && iterations < implicit.max_iterations {
-        let ap = matrix * &p;
+        let ap = matrix.times(&p);
         let curvature: f64 = p.transpose() * &ap;
         if curvature <= 0.0 {
             return Err(ImplicitError::Solve(format!("projected conjugate gradients: non-positive curvature {curvature:e}")));
@@ -319,7 +298,7 @@ fn projected_cg(
             implicit.tolerance
         )));
     }
-    let lambda = multipliers(&(matrix * &x - rhs));
+    let lambda = multipliers(&(matrix.times(&x) - rhs));
     Ok(ProjectedSolve {
         x: Mat::from_fn(dim, 1, |k, _| x[k]),
         lambda: (0..m).map(|k| lambda[k]).collect(),
@@ -327,8 +306,8 @@ fn projected_cg(
     })
 }
 
-fn relative_residual(matrix: &SparseColMat<usize, f64>, x: &Mat<f64>, rhs: &Col<f64>) -> f64 {
-    let residual = matrix * x - rhs.as_mat();
+fn relative_residual(matrix: &SystemMatrix, x: &Mat<f64>, rhs: &Col<f64>) -> f64 {
+    let residual = matrix.times(&x.col(0).to_owned()) - rhs;
     let norm = rhs.norm_l2();
     if norm == 0.0 {
         residual.norm_l2()

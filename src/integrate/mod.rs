@@ -5,3 +5,4 @@ pub mod fire;
 pub mod implicit;
 pub mod overdamped;
 pub mod rng;
+pub mod system_matrix;

@@ -2,8 +2,9 @@
 
 use glam::DVec3;
 
-use super::{Kind, Law, ParamSpec, SurfaceMesh};
-use crate::mesh::triangle_area_gradient;
+use super::{Kind, Law, ParamSpec, SurfaceHessian, SurfaceMesh};
+use crate::hessian::RankOne;
+use crate::mesh::{triangle_area, triangle_area_gradient};
 use crate::units::Dim;
 
 const KA: usize = 0;
@@ -26,22 +27,28 @@ fn validate(p: &[f64]) -> Result<(), String> {
     }
 }
 
+/// dE/dA_t = k_a(A − A0)/A0 + k_l(A_t − a0)/a0 of a face of area `face`
+/// on a body of area `area` with `faces` faces.
+fn face_tension(p: &[f64], area: f64, face: f64, faces: usize) -> f64 {
+    let a0_face = p[A0] / faces as f64;
+    p[KA] * (area - p[A0]) / p[A0] + p[KL] * (face - a0_face) / a0_face
+}
+
 fn eval(p: &[f64], mesh: &SurfaceMesh, x: &[DVec3], forces: &mut [DVec3]) -> f64 {
     let (ka, kl, a0) = (p[KA], p[KL], p[A0]);
-    let a0_face = a0 / mesh.triangles().len() as f64;
-    let mut areas = Vec::with_capacity(mesh.triangles().len());
+    let faces = mesh.triangles().len();
+    let a0_face = a0 / faces as f64;
+    let mut areas = Vec::with_capacity(faces);
     let mut area = 0.0;
     let mut local_energy = 0.0;
-    for t in 0..mesh.triangles().len() {
+    for t in 0..faces {
         let (a, grad) = triangle_area_gradient(mesh.corners(t, x));
         area += a;
         local_energy += 0.5 * kl * (a - a0_face).powi(2) / a0_face;
         areas.push((a, grad));
     }
-    // dE/dA_t = k_a(A − A0)/A0 + k_l(A_t − a0)/a0.
-    let global = ka * (area - a0) / a0;
     for (face, (a, grad)) in mesh.triangles().iter().zip(&areas) {
-        let de_da = global + kl * (a - a0_face) / a0_face;
+        let de_da = face_tension(p, area, *a, faces);
         for (node, g) in face.iter().zip(grad) {
             forces[*node as usize] -= de_da * *g;
         }
@@ -49,12 +56,31 @@ fn eval(p: &[f64], mesh: &SurfaceMesh, x: &[DVec3], forces: &mut [DVec3]) -> f64
     0.5 * ka * (area - a0).powi(2) / a0 + local_energy
 }
 
+/// The exact Hessian: per face c·∇A_t∇A_tᵀ + τ_t·∇²A_t with τ_t = dE/dA_t
+/// and c = k_l/a0, plus the global term's rank-one (k_a/A0)·∇A∇Aᵀ.
+fn hessian(p: &[f64], mesh: &SurfaceMesh, x: &[DVec3], out: &mut SurfaceHessian) {
+    let faces = mesh.triangles().len();
+    let areas: Vec<f64> = (0..faces).map(|t| triangle_area(mesh.corners(t, x))).collect();
+    let area: f64 = areas.iter().sum();
+    let mut gradient = vec![DVec3::ZERO; x.len()];
+    for (t, face) in mesh.triangles().iter().enumerate() {
+        let corners = mesh.corners(t, x);
+        out.push_face(*face, corners, face_tension(p, area, areas[t], faces), p[KL] * faces as f64 / p[A0]);
+        for (node, g) in face.iter().zip(triangle_area_gradient(corners).1) {
+            gradient[*node as usize] += g;
+        }
+    }
+    if p[KA] > 0.0 {
+        out.rank_one.push(RankOne { weight: p[KA] / p[A0], gradient });
+    }
+}
+
 interaction!(
     AreaConservation,
     "area_conservation",
     Kind::Body,
     "Area elasticity of a closed body, global ½k_a(A − A0)²/A0 and per face ½k_l Σ(A_t − A0/N)²/(A0/N)",
-    Law::Surface(eval),
+    Law::Surface { eval, hessian },
     validate = validate
 );
 
@@ -94,5 +120,15 @@ mod tests {
         let local = params_of(&AreaConservation, &[("kl", 40.0), ("a0", area)]);
         let (e, f) = evaluate_surface(AreaConservation.law(), &local, &mesh, &x);
         assert!(e > 0.0 && f.iter().any(|f| f.length() > 1e-3));
+    }
+
+    #[test]
+    fn stiffness_is_the_exact_hessian_per_face_projected_plus_the_global_rank_one() {
+        let (mesh, x) = deformed_icosphere(1, 1.5, 0.05);
+        let area = mesh.area(&x);
+        for (ka, kl, a0) in [(100.0, 0.0, 0.9 * area), (0.0, 50.0, 1.1 * area), (80.0, 30.0, area)] {
+            let p = params_of(&AreaConservation, &[("ka", ka), ("kl", kl), ("a0", a0)]);
+            assert_surface_hessian(&AreaConservation, &p, &mesh, &x, |_| 0.0, 1e-4, 1e-5);
+        }
     }
 }

@@ -30,6 +30,7 @@
 
 use glam::DVec3;
 
+pub use crate::hessian::SurfaceHessian;
 pub use crate::mesh::SurfaceMesh;
 use crate::units::Dim;
 
@@ -221,8 +222,14 @@ pub enum Law {
     /// and its node positions (image-consistent, local numbering), adds the
     /// force on each node to `forces` and returns the energy. The CPU backend
     /// evaluates it; the GPU backend has no kernel for this family yet and
-    /// refuses decks that use it ([`Law::runs_on_gpu`]).
-    Surface(fn(params: &[f64], mesh: &SurfaceMesh, x: &[DVec3], forces: &mut [DVec3]) -> f64),
+    /// refuses decks that use it ([`Law::runs_on_gpu`]). `hessian` gives the
+    /// term's second-order model at x for the implicit step: local stencil
+    /// Hessians (projected onto their PSD part by the backend) and
+    /// Gauss–Newton rank-one terms ([`SurfaceHessian`]).
+    Surface {
+        eval: fn(params: &[f64], mesh: &SurfaceMesh, x: &[DVec3], forces: &mut [DVec3]) -> f64,
+        hessian: fn(params: &[f64], mesh: &SurfaceMesh, x: &[DVec3], out: &mut SurfaceHessian),
+    },
     /// b(d) of the distance d from a node of one body to a face of another
     /// (E ≡ 0 for d ≥ `range`); the CPU backend finds the node–face pairs
     /// and spreads the force with [`node_face_forces`]. No GPU kernel yet.
@@ -242,7 +249,7 @@ impl Law {
     /// Whether the GPU backend has a kernel for this law family (and so each
     /// interaction of the family a `shaders/interactions/NAME.wgsl` evaluator).
     pub fn runs_on_gpu(&self) -> bool {
-        !matches!(self, Law::Surface(_) | Law::Contact { .. } | Law::ContactArea { .. })
+        !matches!(self, Law::Surface { .. } | Law::Contact { .. } | Law::ContactArea { .. })
     }
 
     /// The range of a contact law (node–face or area-weighted): beyond it E ≡ 0.
@@ -459,7 +466,7 @@ mod tests {
                 (Kind::Bond | Kind::Pair, Law::Radial { .. })
                 | (Kind::Angle, Law::ThreeBody(_))
                 | (Kind::External, Law::OneBody(_))
-                | (Kind::Body, Law::Surface(_))
+                | (Kind::Body, Law::Surface { .. })
                 | (Kind::Contact, Law::Contact { .. } | Law::ContactArea { .. }) => {}
                 _ => panic!("{}: kind and law disagree", i.name()),
             }

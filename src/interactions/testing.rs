@@ -20,7 +20,9 @@
 use glam::{DMat3, DVec3};
 
 pub use super::Interaction;
-use super::{Law, SurfaceMesh};
+use super::{Law, SurfaceHessian, SurfaceMesh};
+use crate::hessian::project_psd;
+use faer::{Col, Mat};
 
 /// Energy and per-particle forces of `law` at `positions` (1, 2 or 3
 /// particles; 4 for a contact law: node, then the face's corners).
@@ -46,14 +48,14 @@ pub fn evaluate(law: Law, params: &[f64], positions: &[DVec3]) -> (f64, Vec<DVec
             let out = if pt.distance < range(params) { eval(params, pt.distance) } else { super::Radial::ZERO };
             (out.energy, super::node_face_forces(&out, &pt).to_vec())
         }
-        Law::Surface(_) => panic!("a surface law needs its mesh: use evaluate_surface"),
+        Law::Surface { .. } => panic!("a surface law needs its mesh: use evaluate_surface"),
         Law::ContactArea { .. } => panic!("an area-weighted contact law needs whole bodies: use assert_checks_of on the engine"),
     }
 }
 
 /// Energy and per-node forces of a surface law on `mesh` at `positions`.
 pub fn evaluate_surface(law: Law, params: &[f64], mesh: &SurfaceMesh, positions: &[DVec3]) -> (f64, Vec<DVec3>) {
-    let Law::Surface(eval) = law else { panic!("not a surface law") };
+    let Law::Surface { eval, .. } = law else { panic!("not a surface law") };
     let mut forces = vec![DVec3::ZERO; positions.len()];
     let energy = eval(params, mesh, positions, &mut forces);
     (energy, forces)
@@ -203,6 +205,105 @@ pub fn assert_surface_zero_force_at_rest(
     zero_force_at_rest(interaction.name(), &|x| evaluate_surface(law, params, mesh, x), rest, force_scale);
 }
 
+/// The second-order model of a surface law ([`SurfaceHessian`]) against
+/// second differences of its energy (step `h`), on one body:
+///
+/// - its stencils and Gauss–Newton terms summed, unprojected, equal the Hessian
+///   of E − `dropped` (the part of E whose curvature the model leaves out on
+///   purpose, frozen at `positions`; zero for an exact model) to
+///   `tolerance` × the largest entry;
+/// - K̃ = Σ P(stencil) + Σ w·g gᵀ, with P the backend's PSD projection, is
+///   positive semi-definite and K̃ ⪰ the unprojected sum (projection only
+///   adds stiffness where a stencil is concave);
+/// - K̃ annihilates rigid translations (no spurious stiffness).
+///
+/// Returns the smallest eigenvalue of the unprojected model over its largest
+/// (negative when the law is concave somewhere, i.e. projection acted).
+pub fn assert_surface_hessian(
+    interaction: &dyn Interaction,
+    params: &[f64],
+    mesh: &SurfaceMesh,
+    positions: &[DVec3],
+    dropped: impl Fn(&[DVec3]) -> f64,
+    h: f64,
+    tolerance: f64,
+) -> f64 {
+    let name = interaction.name();
+    let Law::Surface { eval, hessian } = interaction.law() else { panic!("{name}: not a surface law") };
+    let energy = |x: &[DVec3]| {
+        let mut forces = vec![DVec3::ZERO; x.len()];
+        eval(params, mesh, x, &mut forces) - dropped(x)
+    };
+    let dim = 3 * positions.len();
+    let mut moved = positions.to_vec();
+    let mut at = |shifts: &[(usize, f64)]| {
+        for &(k, d) in shifts {
+            moved[k / 3][k % 3] += d;
+        }
+        let e = energy(&moved);
+        moved.copy_from_slice(positions);
+        e
+    };
+    let e0 = at(&[]);
+    let mut exact = Mat::<f64>::zeros(dim, dim);
+    for k in 0..dim {
+        exact[(k, k)] = (at(&[(k, h)]) - 2.0 * e0 + at(&[(k, -h)])) / (h * h);
+        for l in 0..k {
+            let mixed = at(&[(k, h), (l, h)]) - at(&[(k, h), (l, -h)]) - at(&[(k, -h), (l, h)]) + at(&[(k, -h), (l, -h)]);
+            exact[(k, l)] = mixed / (4.0 * h * h);
+            exact[(l, k)] = exact[(k, l)];
+        }
+    }
+    let mut model = SurfaceHessian::default();
+    hessian(params, mesh, positions, &mut model);
+    let mut raw = Mat::<f64>::zeros(dim, dim);
+    let mut projected = Mat::<f64>::zeros(dim, dim);
+    for stencil in &model.stencils {
+        let psd = project_psd(&stencil.matrix);
+        for (a, &p) in stencil.nodes.iter().enumerate() {
+            for (b, &q) in stencil.nodes.iter().enumerate() {
+                for (r, c) in (0..9).map(|n| (n / 3, n % 3)) {
+                    raw[(3 * p as usize + r, 3 * q as usize + c)] += stencil.matrix[(3 * a + r, 3 * b + c)];
+                    projected[(3 * p as usize + r, 3 * q as usize + c)] += psd[(3 * a + r, 3 * b + c)];
+                }
+            }
+        }
+    }
+    for term in &model.gauss_newton {
+        assert!(term.weight >= 0.0, "{name}: Gauss–Newton weight {}", term.weight);
+        for (&p, gp) in term.nodes.iter().zip(&term.gradient) {
+            for (&q, gq) in term.nodes.iter().zip(&term.gradient) {
+                for (r, c) in (0..9).map(|n| (n / 3, n % 3)) {
+                    raw[(3 * p as usize + r, 3 * q as usize + c)] += term.weight * gp[r] * gq[c];
+                    projected[(3 * p as usize + r, 3 * q as usize + c)] += term.weight * gp[r] * gq[c];
+                }
+            }
+        }
+    }
+    for term in &model.rank_one {
+        assert!(term.weight >= 0.0, "{name}: Gauss–Newton weight {}", term.weight);
+        let g = Col::<f64>::from_fn(dim, |k| term.gradient[k / 3][k % 3]);
+        let outer = term.weight * &g * g.transpose();
+        raw += &outer;
+        projected += &outer;
+    }
+    let scale = (0..dim).flat_map(|r| (0..dim).map(move |c| (r, c))).map(|(r, c)| exact[(r, c)].abs()).fold(0.0, f64::max);
+    let error = (0..dim).flat_map(|r| (0..dim).map(move |c| (r, c))).map(|(r, c)| (raw[(r, c)] - exact[(r, c)]).abs()).fold(0.0, f64::max);
+    assert!(error < tolerance * scale, "{name}: model Hessian differs from second differences of E by {error:e} (largest entry {scale:e})");
+    let eigenvalues = |m: &Mat<f64>| m.self_adjoint_eigenvalues(faer::Side::Lower).expect("symmetric eigenvalues");
+    let lowest = eigenvalues(&projected)[0];
+    assert!(lowest > -1e-9 * scale, "{name}: K̃ has a negative eigenvalue {lowest:e} (largest entry {scale:e})");
+    let excess = eigenvalues(&(&projected - &raw))[0];
+    assert!(excess > -1e-9 * scale, "{name}: K̃ − H has a negative eigenvalue {excess:e}: projection removed stiffness");
+    for axis in 0..3 {
+        let shift = Col::<f64>::from_fn(dim, |k| f64::from(u8::from(k % 3 == axis)));
+        let residual = (&projected * &shift).norm_l2();
+        assert!(residual < tolerance * scale * shift.norm_l2(), "{name}: K̃ resists a translation along axis {axis}: |K̃·t| = {residual:e}");
+    }
+    let spectrum = eigenvalues(&raw);
+    spectrum[0] / spectrum[dim - 1]
+}
+
 /// A deformed icosphere for surface-law tests: the icosphere of `level` and
 /// `radius`, stretched into an ellipsoid (1.3, 1, 0.8) and each node moved
 /// by a deterministic pseudo-random offset of up to `jitter` × radius.
@@ -240,7 +341,7 @@ pub fn assert_radial_curvature(interaction: &dyn Interaction, params: &[f64], r:
 /// `internal` is false for external fields (which need not conserve momentum).
 pub fn assert_all_checks(interaction: &dyn Interaction, params: &[f64], positions: &[DVec3], h: f64, force_floor: f64) {
     assert_force_is_minus_gradient(interaction, params, positions, h, force_floor);
-    if !matches!(interaction.law(), Law::OneBody(_) | Law::Surface(_)) {
+    if !matches!(interaction.law(), Law::OneBody(_) | Law::Surface { .. }) {
         assert_momentum_conserved(interaction, params, positions);
         assert_invariant_under_rigid_motion(interaction, params, positions);
     }

@@ -2,7 +2,8 @@
 
 use glam::DVec3;
 
-use super::{Kind, Law, ParamSpec, SurfaceMesh};
+use super::{Kind, Law, ParamSpec, SurfaceHessian, SurfaceMesh};
+use crate::hessian::RankOne;
 use crate::units::Dim;
 
 const K: usize = 0;
@@ -33,12 +34,22 @@ fn eval(p: &[f64], mesh: &SurfaceMesh, x: &[DVec3], forces: &mut [DVec3]) -> f64
     energy
 }
 
+/// The Gauss–Newton model E″(V)·∇V∇Vᵀ = (K/V0)·∇V∇Vᵀ (see the docs: the
+/// pressure part −ΔP·∇²V is left out).
+fn hessian(p: &[f64], mesh: &SurfaceMesh, x: &[DVec3], out: &mut SurfaceHessian) {
+    if p[K] > 0.0 {
+        let mut gradient = vec![DVec3::ZERO; x.len()];
+        mesh.volume_gradient(x, &mut gradient);
+        out.rank_one.push(RankOne { weight: p[K] / p[V0], gradient });
+    }
+}
+
 interaction!(
     Turgor,
     "turgor",
     Kind::Body,
     "Pressure of the enclosed volume, ΔP = ΔP0 + K(V0 − V)/V0, E = −ΔP0(V − V0) + K(V − V0)²/(2V0)",
-    Law::Surface(eval)
+    Law::Surface { eval, hessian }
 );
 
 #[cfg(test)]
@@ -94,5 +105,18 @@ mod tests {
             let e = pressure_and_energy(&p, v).1;
             assert!((e + integral).abs() < 1e-9 * (1.0 + e.abs()), "V = {v}: E = {e}, −∫ΔP dV = {}", -integral);
         }
+    }
+
+    #[test]
+    fn stiffness_is_the_gauss_newton_volume_term() {
+        let (mesh, x) = deformed_icosphere(1, 1.5, 0.05);
+        let v = mesh.volume(&x);
+        // At V = V0 with ΔP0 = 0 there is no pressure: (K/V0)·∇V∇Vᵀ is the exact Hessian.
+        let p = params_of(&Turgor, &[("k", 1000.0), ("v0", v)]);
+        assert_surface_hessian(&Turgor, &p, &mesh, &x, |_| 0.0, 1e-4, 1e-5);
+        // Under pressure it leaves out −ΔP·∇²V, and only that.
+        let p = params_of(&Turgor, &[("k", 700.0), ("dp0", 40.0), ("v0", 1.2 * v)]);
+        let (pressure, _) = pressure_and_energy(&p, v);
+        assert_surface_hessian(&Turgor, &p, &mesh, &x, |y| -pressure * mesh.volume(y), 1e-4, 1e-5);
     }
 }

@@ -2,7 +2,8 @@
 
 use glam::DVec3;
 
-use super::{Kind, Law, ParamSpec, SurfaceMesh};
+use super::{Kind, Law, ParamSpec, SurfaceHessian, SurfaceMesh};
+use crate::hessian::RankOne;
 use crate::units::Dim;
 
 const K: usize = 0;
@@ -37,12 +38,22 @@ fn eval(p: &[f64], mesh: &SurfaceMesh, x: &[DVec3], forces: &mut [DVec3]) -> f64
     energy
 }
 
+/// The Gauss–Newton model E″(V)·∇V∇Vᵀ = (K/V)·∇V∇Vᵀ, as for
+/// [`turgor`](super::turgor) (nothing for a collapsed body, V ≤ 0).
+fn hessian(p: &[f64], mesh: &SurfaceMesh, x: &[DVec3], out: &mut SurfaceHessian) {
+    let mut gradient = vec![DVec3::ZERO; x.len()];
+    let volume = mesh.volume_gradient(x, &mut gradient);
+    if p[K] > 0.0 && volume > 0.0 {
+        out.rank_one.push(RankOne { weight: p[K] / volume, gradient });
+    }
+}
+
 interaction!(
     TurgorLog,
     "turgor_log",
     Kind::Body,
     "Pressure of the enclosed volume by the log law, ΔP = ΔP0 − K·ln(V/V0) (SimuCell3D)",
-    Law::Surface(eval)
+    Law::Surface { eval, hessian }
 );
 
 #[cfg(test)]
@@ -82,5 +93,16 @@ mod tests {
             assert!((log_law - linear).abs() < 800.0 * (dv / 2.0f64).powi(2));
         }
         assert!(pressure_and_energy(&p, 0.0).0.is_nan() && pressure_and_energy(&p, -1.0).1.is_nan());
+    }
+
+    #[test]
+    fn stiffness_is_the_gauss_newton_volume_term() {
+        let (mesh, x) = deformed_icosphere(1, 1.5, 0.05);
+        let v = mesh.volume(&x);
+        for (dp0, v0) in [(0.0, v), (40.0, 0.7 * v)] {
+            let p = params_of(&TurgorLog, &[("k", 900.0), ("dp0", dp0), ("v0", v0)]);
+            let (pressure, _) = pressure_and_energy(&p, v);
+            assert_surface_hessian(&TurgorLog, &p, &mesh, &x, |y| -pressure * mesh.volume(y), 1e-4, 1e-5);
+        }
     }
 }

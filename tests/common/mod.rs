@@ -155,3 +155,24 @@ pub fn two_cells_with_edges(level: u32, radius: f64, gap: f64, edges: Option<&st
     let right = IcosphereCell { centre: glam::DVec3::new(half, 0.0, 0.0), body_id: 2, first_id: nodes + 1, ..left.clone() };
     merge_topologies(&[&icosphere_cell(&left).text, &icosphere_cell(&right).text])
 }
+
+/// A topology text with every particle's position scaled by `scale` (axis by
+/// axis about the origin): an icosphere cell becomes an ellipsoid.
+pub fn stretch_particles(text: &str, scale: glam::DVec3) -> String {
+    let mut out = String::new();
+    let mut in_particles = false;
+    for line in text.lines() {
+        if line.starts_with('[') {
+            in_particles = line == "[ particles ]";
+        }
+        let f: Vec<&str> = line.split_whitespace().collect();
+        if in_particles && f.len() >= 5 && !line.starts_with('#') {
+            let x = glam::DVec3::new(f[2].parse().unwrap(), f[3].parse().unwrap(), f[4].parse().unwrap()) * scale;
+            out += &format!("{} {} {:?} {:?} {:?} {}\n", f[0], f[1], x.x, x.y, x.z, f[5..].join(" "));
+        } else {
+            out += line;
+            out += "\n";
+        }
+    }
+    out
+}
