@@ -171,12 +171,19 @@ fn point(cellmd: &Snapshot, reference: &Snapshot, start: Option<&Snapshot>) -> R
         .energies
         .iter()
         .map(|(key, &r)| {
-            let ours = key.split('+').map(|k| cellmd.energies.get(k).copied().unwrap_or(0.0)).sum();
+            // A reference group `a+b` (one LAMMPS style for several cellmd
+            // types) is the sum of cellmd's a and b — unless the other side is
+            // itself a reference document with the same group.
+            let ours = cellmd
+                .energies
+                .get(key)
+                .copied()
+                .unwrap_or_else(|| key.split('+').map(|k| cellmd.energies.get(k).copied().unwrap_or(0.0)).sum());
             EnergyRow { key: key.clone(), cellmd: ours, reference: Some(r), scale }
         })
         .collect();
     for (key, &e) in &cellmd.energies {
-        if !reference.energies.keys().any(|k| k.split('+').any(|p| p == key)) {
+        if !reference.energies.keys().any(|k| k == key || k.split('+').any(|p| p == key)) {
             energies.push(EnergyRow { key: key.clone(), cellmd: e, reference: None, scale });
         }
     }

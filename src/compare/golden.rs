@@ -236,6 +236,21 @@ mod tests {
         assert_eq!(probes_of(&docs[1]).unwrap(), probes);
     }
 
+    /// A regenerated document is compared with the committed one
+    /// (`reference/regenerate --check`): a grouped energy `a+b` on both
+    /// sides is the same row, not a + b looked up separately.
+    #[test]
+    fn a_document_with_grouped_energies_agrees_with_itself_and_not_with_a_change() {
+        let mut s = Snapshot { step: 0, ids: vec![1], forces: vec![DVec3::X], positions: vec![DVec3::ZERO], ..Default::default() };
+        s.energies.insert("cable+spring".into(), 2.5);
+        s.energies.insert("harmonic".into(), 1.0);
+        let probes = Probes { init: s.clone(), last: None };
+        assert!(crate::compare::Agreement::new(&probes, &probes).unwrap().agrees(Default::default()));
+        s.energies.insert("cable+spring".into(), 2.6);
+        let changed = Probes { init: s, last: None };
+        assert!(!crate::compare::Agreement::new(&changed, &probes).unwrap().agrees(Default::default()));
+    }
+
     #[test]
     fn text_outside_the_subset_is_an_error_with_its_line() {
         let err = parse("---\nkey: 1\n  stray indented line\n").unwrap_err();
