@@ -1,17 +1,16 @@
 //! Bonded terms on the CPU, gathered per particle.
 //!
-//! - **Bonds**: each particle evaluates its own bonds from its own side
-//!   (d = minimum_image(x_other − x_i)). A bond is thus evaluated twice, once
-//!   per end; the minimum image is odd in d ([`Images`]), so the two forces
-//!   are exact negatives. This needs no per-term scratch: slots would cost
-//!   2 × 24 bytes per bond (144 bytes per bead of a cubic network).
+//! - **Bonds**: each bond is evaluated once, in the row of its lower-index
+//!   end ([`Bonded::row_bonds`]), from the force-only evaluator, and its
+//!   force goes to both ends by Newton's third law through the ordered
+//!   scatter of [`super::newton`], with the pair forces.
 //! - **Angles**: pass 1 evaluates every angle once, in parallel, into its
 //!   three slots; each particle then gathers its slots in term order.
 //! - **Energies and virial** (thermo steps only): every term once, in term
 //!   order, sequentially.
 //!
-//! Each particle's bonded force is the sum over its bonds (ascending bond
-//! index), then its angle slots (ascending), so the order is fixed by the data.
+//! Each particle's angle force is the sum of its slots (ascending), so the
+//! order is fixed by the data.
 //!
 //! With bond kinetics, each bond also has a state: an unbound bond carries no
 //! force, and a bond may have its own rest length and a stiffness scale
@@ -44,41 +43,45 @@ fn by_particle(n: usize, owner: impl Iterator<Item = u32> + Clone) -> (Vec<u32>,
     (offsets, entries)
 }
 
+/// A [`Law::Radial`]'s `eval` and `force`.
+type RadialEval = fn(&[f64], f64) -> Radial;
+type RadialForce = fn(&[f64], f64) -> f64;
+
 /// Per-particle bond and angle-slot lists, and the angle slots.
 #[derive(Default)]
 pub(super) struct Bonded {
-    /// Particle i's bond ends are `bond_ends[bond_offsets[i]..bond_offsets[i + 1]]`;
-    /// end `e` is end `e % 2` of bond `e / 2`.
-    bond_offsets: Vec<u32>,
-    bond_ends: Vec<u32>,
+    /// The bonds whose lower-index end is particle i are
+    /// `owned_bonds[owned_offsets[i]..owned_offsets[i + 1]]`, ascending.
+    owned_offsets: Vec<u32>,
+    owned_bonds: Vec<u32>,
     angle_offsets: Vec<u32>,
     /// Slot `s` is the force of angle `s / 3` on its particle `s % 3`.
     angle_slot_ids: Vec<u32>,
     angle_slots: Vec<DVec3>,
-    /// Evaluator per bond type, re-resolved every evaluation.
-    bond_eval: Vec<fn(&[f64], f64) -> Radial>,
+    /// Evaluator and force-only evaluator per bond type, re-resolved every evaluation.
+    bond_laws: Vec<(RadialEval, RadialForce)>,
 }
 
 impl Bonded {
     pub(super) fn new(model: &Model) -> Self {
         let n = model.len();
-        let (bond_offsets, bond_ends) = by_particle(n, model.bonds.iter().flatten().copied());
+        let (owned_offsets, owned_bonds) = by_particle(n, model.bonds.iter().map(|&[i, j]| i.min(j)));
         let (angle_offsets, angle_slot_ids) = by_particle(n, model.angles.iter().flatten().copied());
         Self {
-            bond_offsets,
-            bond_ends,
+            owned_offsets,
+            owned_bonds,
             angle_offsets,
             angle_slots: vec![DVec3::ZERO; angle_slot_ids.len()],
             angle_slot_ids,
-            bond_eval: Vec::new(),
+            bond_laws: Vec::new(),
         }
     }
 
-    /// The evaluator of each bond type's law.
+    /// The evaluators of each bond type's law.
     pub(super) fn resolve_laws(&mut self, model: &Model) {
-        self.bond_eval.clear();
-        self.bond_eval.extend(model.bond_types.iter().map(|t| match t.interaction.law() {
-            Law::Radial { eval, .. } => eval,
+        self.bond_laws.clear();
+        self.bond_laws.extend(model.bond_types.iter().map(|t| match t.interaction.law() {
+            Law::Radial { eval, force, .. } => (eval, force),
             _ => unreachable!("bond law is radial"),
         }));
     }
@@ -91,43 +94,82 @@ impl Bonded {
         });
     }
 
-    /// Bond `b` of type `t` at length `r`, with its state if it has one
-    /// (`None` when it is unbound).
+    /// `law(params)` of bond `b` of type `t` with its state if it has one
+    /// (its own rest length), and the stiffness scale to apply to the result;
+    /// `None` when it is unbound.
     #[inline(always)]
-    pub(super) fn bond_radial(&self, b: usize, t: usize, r: f64, model: &Model, state: Option<&BondState>) -> Option<Radial> {
+    fn with_params<R>(
+        &self,
+        b: usize,
+        t: usize,
+        model: &Model,
+        state: Option<&BondState>,
+        law: impl FnOnce(&[f64]) -> R,
+    ) -> Option<(R, f64)> {
         let params = &model.bond_types[t].params;
-        let Some(s) = state else { return Some((self.bond_eval[t])(params, r)) };
+        let Some(s) = state else { return Some((law(params), 1.0)) };
         if !s.bound[b] {
             return None;
         }
-        let mut radial = match (model.bond_kinetics[t].rest_index, s.rest[b]) {
+        let out = match (model.bond_kinetics[t].rest_index, s.rest[b]) {
             (Some(k), Some(rest)) => {
                 let mut own = [0.0; MAX_BOND_PARAMS];
                 own[..params.len()].copy_from_slice(params);
                 own[k] = rest;
-                (self.bond_eval[t])(&own[..params.len()], r)
+                law(&own[..params.len()])
             }
-            _ => (self.bond_eval[t])(params, r),
+            _ => law(params),
         };
-        if s.scale[b] != 1.0 {
-            radial.energy *= s.scale[b];
-            radial.de_dr *= s.scale[b];
-            radial.d2e_dr2 *= s.scale[b];
+        Some((out, s.scale[b]))
+    }
+
+    /// Bond `b` of type `t` at length `r`, with its state if it has one
+    /// (`None` when it is unbound).
+    #[inline(always)]
+    pub(super) fn bond_radial(&self, b: usize, t: usize, r: f64, model: &Model, state: Option<&BondState>) -> Option<Radial> {
+        let (mut radial, scale) = self.with_params(b, t, model, state, |p| (self.bond_laws[t].0)(p, r))?;
+        if scale != 1.0 {
+            radial.energy *= scale;
+            radial.de_dr *= scale;
+            radial.d2e_dr2 *= scale;
         }
         Some(radial)
     }
 
-    /// Bond end `e` (on particle `i`): its bond type and its force on `i`.
+    /// Bond `b` seen from its particle `i`: its type and its force on `i`,
+    /// from the force-only evaluator.
     #[inline(always)]
-    fn bond_force(&self, e: u32, i: usize, model: &Model, x: &[DVec3], images: &Images, state: Option<&BondState>) -> (usize, DVec3) {
-        let b = e as usize / 2;
-        let other = model.bonds[b][1 - e as usize % 2] as usize;
+    fn bond_force(&self, b: usize, i: usize, model: &Model, x: &[DVec3], images: &Images, state: Option<&BondState>) -> (usize, DVec3) {
+        let [p, q] = model.bonds[b];
+        let other = if p as usize == i { q } else { p } as usize;
         let t = model.bond_type[b] as usize;
         let d = images.minimum_image(x[other] - x[i]);
-        let r = d.length();
-        match self.bond_radial(b, t, r, model, state) {
-            Some(radial) => (t, radial.force_along(d, r)),
-            None => (t, DVec3::ZERO),
+        let r2 = d.length_squared();
+        match self.with_params(b, t, model, state, |p| (self.bond_laws[t].1)(p, r2)) {
+            Some((over_r, scale)) if over_r != 0.0 => (t, d * (over_r * scale)),
+            _ => (t, DVec3::ZERO),
+        }
+    }
+
+    /// The bonds owned by particle `i` (lower-index end), ascending: calls
+    /// `visit(j, f)` with the other end j and the force f on `i` (−f acts on j)
+    /// of each bond that exerts one.
+    #[inline(always)]
+    pub(super) fn row_bonds(
+        &self,
+        i: usize,
+        model: &Model,
+        x: &[DVec3],
+        images: &Images,
+        state: Option<&BondState>,
+        mut visit: impl FnMut(usize, DVec3),
+    ) {
+        for &b in &self.owned_bonds[self.owned_offsets[i] as usize..self.owned_offsets[i + 1] as usize] {
+            let (_, f) = self.bond_force(b as usize, i, model, x, images, state);
+            if f != DVec3::ZERO {
+                let [p, q] = model.bonds[b as usize];
+                visit((p + q) as usize - i, f);
+            }
         }
     }
 
@@ -151,13 +193,10 @@ impl Bonded {
         });
     }
 
-    /// Bonded force on particle `i`: its bonds, then its angle slots.
+    /// Angle force on particle `i`: its angle slots.
     #[inline]
-    pub(super) fn force_on(&self, i: usize, model: &Model, x: &[DVec3], images: &Images, state: Option<&BondState>) -> DVec3 {
+    pub(super) fn angle_force_on(&self, i: usize) -> DVec3 {
         let mut f = DVec3::ZERO;
-        for &e in &self.bond_ends[self.bond_offsets[i] as usize..self.bond_offsets[i + 1] as usize] {
-            f += self.bond_force(e, i, model, x, images, state).1;
-        }
         for &s in &self.angle_slot_ids[self.angle_offsets[i] as usize..self.angle_offsets[i + 1] as usize] {
             f += self.angle_slots[s as usize];
         }
@@ -203,8 +242,8 @@ impl Bonded {
         state: Option<&BondState>,
     ) -> Vec<(&'static str, usize, DVec3)> {
         let mut parts = Vec::new();
-        for &e in &self.bond_ends[self.bond_offsets[i] as usize..self.bond_offsets[i + 1] as usize] {
-            let (t, f) = self.bond_force(e, i, model, x, images, state);
+        for (b, _) in model.bonds.iter().enumerate().filter(|(_, ends)| ends.contains(&(i as u32))) {
+            let (t, f) = self.bond_force(b, i, model, x, images, state);
             parts.push(("bond", t, f));
         }
         for &s in &self.angle_slot_ids[self.angle_offsets[i] as usize..self.angle_offsets[i + 1] as usize] {
