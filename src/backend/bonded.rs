@@ -1,16 +1,16 @@
-//! Bonded terms on the CPU, gathered per particle.
+//! Bonded terms on the CPU, each evaluated once per force pass.
 //!
-//! - **Bonds**: each bond is evaluated once, in the row of its lower-index
-//!   end ([`Bonded::row_bonds`]), from the force-only evaluator, and its
-//!   force goes to both ends by Newton's third law through the ordered
-//!   scatter of [`super::newton`], with the pair forces.
-//! - **Angles**: pass 1 evaluates every angle once, in parallel, into its
-//!   three slots; each particle then gathers its slots in term order.
+//! - **Bonds**: in the row of the bond's lower-index end
+//!   ([`Bonded::row_bonds`]), from the force-only evaluator; the force goes
+//!   to both ends by Newton's third law through the ordered scatter of
+//!   [`super::newton`], with the pair forces.
+//! - **Angles**: in the row of the angle's lowest-index particle
+//!   ([`Bonded::row_angles`]), the three forces through the same scatter.
 //! - **Energies and virial** (thermo steps only): every term once, in term
 //!   order, sequentially.
 //!
-//! Each particle's angle force is the sum of its slots (ascending), so the
-//! order is fixed by the data.
+//! A row visits its bonds, then its angles, in ascending term index, so the
+//! order of every sum is fixed by the data (see [`super::newton`]).
 //!
 //! With bond kinetics, each bond also has a state: an unbound bond carries no
 //! force, and a bond may have its own rest length and a stiffness scale
@@ -47,51 +47,42 @@ fn by_particle(n: usize, owner: impl Iterator<Item = u32> + Clone) -> (Vec<u32>,
 type RadialEval = fn(&[f64], f64) -> Radial;
 type RadialForce = fn(&[f64], f64) -> f64;
 
-/// Per-particle bond and angle-slot lists, and the angle slots.
+/// The bonds and angles owned by each particle, and the resolved laws.
 #[derive(Default)]
 pub(super) struct Bonded {
     /// The bonds whose lower-index end is particle i are
     /// `owned_bonds[owned_offsets[i]..owned_offsets[i + 1]]`, ascending.
     owned_offsets: Vec<u32>,
     owned_bonds: Vec<u32>,
+    /// The angles whose lowest-index particle is i, likewise.
     angle_offsets: Vec<u32>,
-    /// Slot `s` is the force of angle `s / 3` on its particle `s % 3`.
-    angle_slot_ids: Vec<u32>,
-    angle_slots: Vec<DVec3>,
+    owned_angles: Vec<u32>,
     /// Evaluator and force-only evaluator per bond type, re-resolved every evaluation.
     bond_laws: Vec<(RadialEval, RadialForce)>,
+    /// Evaluator per angle type, likewise.
+    angle_laws: Vec<fn(&[f64], [DVec3; 3]) -> ThreeBody>,
 }
 
 impl Bonded {
     pub(super) fn new(model: &Model) -> Self {
         let n = model.len();
         let (owned_offsets, owned_bonds) = by_particle(n, model.bonds.iter().map(|&[i, j]| i.min(j)));
-        let (angle_offsets, angle_slot_ids) = by_particle(n, model.angles.iter().flatten().copied());
-        Self {
-            owned_offsets,
-            owned_bonds,
-            angle_offsets,
-            angle_slots: vec![DVec3::ZERO; angle_slot_ids.len()],
-            angle_slot_ids,
-            bond_laws: Vec::new(),
-        }
+        let (angle_offsets, owned_angles) = by_particle(n, model.angles.iter().map(|a| a.iter().copied().min().unwrap()));
+        Self { owned_offsets, owned_bonds, angle_offsets, owned_angles, bond_laws: Vec::new(), angle_laws: Vec::new() }
     }
 
-    /// The evaluators of each bond type's law.
+    /// The evaluators of each bond and angle type's law.
     pub(super) fn resolve_laws(&mut self, model: &Model) {
         self.bond_laws.clear();
         self.bond_laws.extend(model.bond_types.iter().map(|t| match t.interaction.law() {
             Law::Radial { eval, force, .. } => (eval, force),
             _ => unreachable!("bond law is radial"),
         }));
-    }
-
-    /// Pass 1: resolves bond evaluators and fills the angle slots.
-    pub(super) fn prepare(&mut self, model: &Model, x: &[DVec3], images: &Images) {
-        self.resolve_laws(model);
-        self.angle_slots.par_chunks_mut(3).enumerate().with_min_len(1024).for_each(|(a, slots)| {
-            slots.copy_from_slice(&eval_angle(model, a, x, images).1.forces);
-        });
+        self.angle_laws.clear();
+        self.angle_laws.extend(model.angle_types.iter().map(|t| match t.interaction.law() {
+            Law::ThreeBody(eval) => eval,
+            _ => unreachable!("angle law is three-body"),
+        }));
     }
 
     /// `law(params)` of bond `b` of type `t` with its state if it has one
@@ -193,14 +184,18 @@ impl Bonded {
         });
     }
 
-    /// Angle force on particle `i`: its angle slots.
-    #[inline]
-    pub(super) fn angle_force_on(&self, i: usize) -> DVec3 {
-        let mut f = DVec3::ZERO;
-        for &s in &self.angle_slot_ids[self.angle_offsets[i] as usize..self.angle_offsets[i + 1] as usize] {
-            f += self.angle_slots[s as usize];
+    /// The angles owned by particle `i` (lowest-index particle), ascending:
+    /// calls `visit(p, f)` with each of the angle's particles and its force.
+    #[inline(always)]
+    pub(super) fn row_angles(&self, i: usize, model: &Model, x: &[DVec3], images: &Images, mut visit: impl FnMut(usize, DVec3)) {
+        for &a in &self.owned_angles[self.angle_offsets[i] as usize..self.angle_offsets[i + 1] as usize] {
+            let a = a as usize;
+            let t = model.angle_type[a] as usize;
+            let out = (self.angle_laws[t])(&model.angle_types[t].params, angle_positions(model, a, x, images));
+            for (&p, f) in model.angles[a].iter().zip(out.forces) {
+                visit(p as usize, f);
+            }
         }
-        f
     }
 
     /// Bonded energies (per registry entry, added to `energy`) and virial
@@ -246,23 +241,30 @@ impl Bonded {
             let (t, f) = self.bond_force(b, i, model, x, images, state);
             parts.push(("bond", t, f));
         }
-        for &s in &self.angle_slot_ids[self.angle_offsets[i] as usize..self.angle_offsets[i + 1] as usize] {
-            parts.push(("angle", model.angle_type[s as usize / 3] as usize, self.angle_slots[s as usize]));
+        for (a, ends) in model.angles.iter().enumerate() {
+            if let Some(k) = ends.iter().position(|&p| p as usize == i) {
+                parts.push(("angle", model.angle_type[a] as usize, eval_angle(model, a, x, images).1.forces[k]));
+            }
         }
         parts
     }
 }
 
-/// Angle `a` at image-consistent positions (i and k at their minimum image around the vertex j).
+/// The positions of angle `a`, image-consistent: i and k at their minimum
+/// image around the vertex j.
+#[inline(always)]
+fn angle_positions(model: &Model, a: usize, x: &[DVec3], images: &Images) -> [DVec3; 3] {
+    let [i, j, k] = model.angles[a];
+    let xj = x[j as usize];
+    [xj + images.minimum_image(x[i as usize] - xj), xj, xj + images.minimum_image(x[k as usize] - xj)]
+}
+
+/// Angle `a` at image-consistent positions (see `angle_positions`).
 #[inline]
 pub(super) fn eval_angle(model: &Model, a: usize, x: &[DVec3], images: &Images) -> ([DVec3; 3], ThreeBody) {
-    let [i, j, k] = model.angles[a];
     let term = &model.angle_types[model.angle_type[a] as usize];
     let Law::ThreeBody(eval) = term.interaction.law() else { unreachable!("angle law is three-body") };
-    let xj = x[j as usize];
-    let xi = xj + images.minimum_image(x[i as usize] - xj);
-    let xk = xj + images.minimum_image(x[k as usize] - xj);
-    let at = [xi, xj, xk];
+    let at = angle_positions(model, a, x, images);
     (at, eval(&term.params, at))
 }
 

@@ -9,10 +9,10 @@
 //!   ([`PairTable`](super::pair_table)), each pair's force added to both
 //!   particles by Newton's third law in the ordered scatter/gather of
 //!   [`newton`](super::newton) (first pass, and the start of the second).
-//! - **Bonds**: each once, in the row of its lower-index end, in the same
-//!   scatter as the pairs (see [`bonded`](super::bonded)).
-//! - **Angles**: through per-term slots, gathered per particle in the second
-//!   pass.
+//! - **Bonds and angles**: each once, in the row of its lowest-index
+//!   particle, in the same scatter as the pairs (see [`bonded`](super::bonded)).
+//! - The second pass gathers, per particle, the spills of the scatter, then
+//!   the slots of surface and contact terms.
 //! - **Externals**: per member particle, on the unwrapped position.
 //! - **Surface terms** of closed bodies (turgor, tension, bending): each body
 //!   once, in parallel over bodies, into per-node slots that each particle
@@ -257,7 +257,7 @@ impl CpuBackend {
         if has_pairs {
             self.pairs.update(model, &self.pair_rule_column);
         }
-        self.bonded.prepare(model, x, &images);
+        self.bonded.resolve_laws(model);
         self.surfaces.prepare(model, x, &images);
         self.contacts.prepare(model, x, &images);
         let bond_state = state.bonds.as_ref();
@@ -268,29 +268,30 @@ impl CpuBackend {
         let (has_surfaces, has_contacts) = (!surfaces.is_empty(), !contacts.is_empty());
         let geometry = PairGeometry { x, types: &model.types, list: &self.neighbors, images };
         out.forces.resize(n, DVec3::ZERO);
-        let has_bonds = !model.bonds.is_empty();
+        let scattered = has_pairs || !model.bonds.is_empty() || !model.angles.is_empty();
         let terms = ScatterTerms { pairs: has_pairs.then_some(pairs), geometry: &geometry, bonded, model, bond_state };
         let columns = self.pair_interactions.len();
-        let pair_energy = match (has_pairs || has_bonds, energies) {
+        let pair_energy = match (scattered, energies) {
             (false, _) => None,
             (true, false) => terms.scatter::<false>(&mut self.newton, &mut out.forces, columns),
             (true, true) => terms.scatter::<true>(&mut self.newton, &mut out.forces, columns),
         };
         let newton = &self.newton;
         out.forces.par_chunks_mut(BLOCK).enumerate().for_each(|(t, block)| {
-            if has_pairs || has_bonds {
+            if scattered {
                 newton.gather(t, block);
             } else {
                 block.fill(DVec3::ZERO);
             }
-            for (k, f) in block.iter_mut().enumerate() {
-                let i = t * BLOCK + k;
-                *f += bonded.angle_force_on(i);
-                if has_surfaces {
-                    *f += surfaces.force_on(i);
-                }
-                if has_contacts {
-                    *f += contacts.force_on(i);
+            if has_surfaces || has_contacts {
+                for (k, f) in block.iter_mut().enumerate() {
+                    let i = t * BLOCK + k;
+                    if has_surfaces {
+                        *f += surfaces.force_on(i);
+                    }
+                    if has_contacts {
+                        *f += contacts.force_on(i);
+                    }
                 }
             }
         });
@@ -372,8 +373,8 @@ impl CpuBackend {
     }
 }
 
-/// The two-particle terms of the first pass: pairs (when the model has
-/// any) and bonds, row by row.
+/// The terms of the first pass: pairs (when the model has any), bonds and
+/// angles, row by row.
 struct ScatterTerms<'a> {
     pairs: Option<&'a PairTable>,
     geometry: &'a PairGeometry<'a>,
@@ -383,8 +384,8 @@ struct ScatterTerms<'a> {
 }
 
 impl ScatterTerms<'_> {
-    /// The scatter (first pass): in each row, its pairs then its bonds, each
-    /// force on both particles; with `ENERGY` also the energy per pair column
+    /// The scatter (first pass): in each row, its pairs, bonds and angles,
+    /// each force on all of the term's particles; with `ENERGY` also the energy per pair column
     /// and the pair virial, each block's in row order and the blocks' in block
     /// order (`None` without `ENERGY`: nothing is allocated then).
     fn scatter<const ENERGY: bool>(&self, newton: &mut Newton, forces: &mut [DVec3], columns: usize) -> Option<(Vec<f64>, [f64; 6])> {
@@ -396,6 +397,7 @@ impl ScatterTerms<'_> {
                     pairs.row_forces::<ENERGY>(i, self.geometry, &mut near, energy, virial, |j, f| scatter.pair(i, j, f));
                 }
                 self.bonded.row_bonds(i, self.model, x, images, self.bond_state, |j, f| scatter.pair(i, j, f));
+                self.bonded.row_angles(i, self.model, x, images, |p, f| scatter.add(p, f));
             }
         };
         if !ENERGY {

@@ -9,10 +9,11 @@
 //! - Particles are cut into blocks of [`BLOCK`] consecutive indices (a
 //!   constant, never the thread count).
 //! - **Scatter** (parallel over blocks): block b visits its rows in ascending
-//!   index order; a term on (i, j) with i in the block adds f to i and −f to
-//!   j directly in the block's own slice of the force array when j is in the
-//!   block too, and otherwise appends (j, −f) to the block's *spill* bucket
-//!   for j's block.
+//!   index order; a term of row i (a pair (i, j), or any term whose forces
+//!   the row adds particle by particle) adds its force on each particle
+//!   directly in the block's own slice of the force array when the particle
+//!   is in the block, and otherwise appends (particle, force) to the block's
+//!   *spill* bucket for that particle's block.
 //! - **Gather** (parallel over blocks): block t adds to its particles the
 //!   spills addressed to it by blocks 0, 1, 2, … in block order, each bucket
 //!   in the order it was filled.
@@ -54,6 +55,15 @@ pub(super) struct Scatter<'a> {
 }
 
 impl Scatter<'_> {
+    /// Adds f to particle `p` (anywhere).
+    #[inline(always)]
+    pub(super) fn add(&mut self, p: usize, f: DVec3) {
+        match self.local.get_mut(p.wrapping_sub(self.start)) {
+            Some(fp) => *fp += f,
+            None => self.spill[p / BLOCK].push((p as u32, f)),
+        }
+    }
+
     /// Adds f to particle `i` (in this block) and −f to particle `j` (anywhere).
     #[inline(always)]
     pub(super) fn pair(&mut self, i: usize, j: usize, f: DVec3) {
