@@ -46,6 +46,8 @@ fn by_particle(n: usize, owner: impl Iterator<Item = u32> + Clone) -> (Vec<u32>,
 /// A [`Law::Radial`]'s `eval` and `force`.
 type RadialEval = fn(&[f64], f64) -> Radial;
 type RadialForce = fn(&[f64], f64) -> f64;
+/// A [`Law::ThreeBody`]'s evaluator.
+type ThreeBodyEval = fn(&[f64], [DVec3; 3]) -> ThreeBody;
 
 /// The bonds and angles owned by each particle, and the resolved laws.
 #[derive(Default)]
@@ -60,7 +62,7 @@ pub(super) struct Bonded {
     /// Evaluator and force-only evaluator per bond type, re-resolved every evaluation.
     bond_laws: Vec<(RadialEval, RadialForce)>,
     /// Evaluator per angle type, likewise.
-    angle_laws: Vec<fn(&[f64], [DVec3; 3]) -> ThreeBody>,
+    angle_laws: Vec<ThreeBodyEval>,
 }
 
 impl Bonded {

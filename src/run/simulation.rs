@@ -415,7 +415,7 @@ impl Simulation {
         }
         self.forces_current = true;
         self.energies_current = energies;
-        if let Some(i) = self.forces.forces.par_iter().position_first(|f| !f.is_finite()) {
+        if let Some(i) = self.forces.forces.par_iter().with_min_len(4096).position_first(|f| !f.is_finite()) {
             return Err(self.blowup(i, "non-finite force".into()));
         }
         Ok(())
