@@ -40,7 +40,7 @@ fn brute_force(case: &Case) -> (Forces, Vec<DVec3>) {
             let r = d.length();
             for &rule in model.pair_rules_between(model.types[i], model.types[j]) {
                 let term = &model.pair_rules[rule as usize];
-                let Law::Radial { eval, range } = term.interaction.law() else { unreachable!() };
+                let Law::Radial { eval, range, .. } = term.interaction.law() else { unreachable!() };
                 if r < range(&term.params) {
                     let out = eval(&term.params, r);
                     let f_i = out.de_dr * d / r;

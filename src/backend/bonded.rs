@@ -1,17 +1,16 @@
-//! Bonded terms on the CPU, gathered per particle.
+//! Bonded terms on the CPU, each evaluated once per force pass.
 //!
-//! - **Bonds**: each particle evaluates its own bonds from its own side
-//!   (d = minimum_image(x_other − x_i)). A bond is thus evaluated twice, once
-//!   per end; the minimum image is odd in d ([`Images`]), so the two forces
-//!   are exact negatives. This needs no per-term scratch: slots would cost
-//!   2 × 24 bytes per bond (144 bytes per bead of a cubic network).
-//! - **Angles**: pass 1 evaluates every angle once, in parallel, into its
-//!   three slots; each particle then gathers its slots in term order.
+//! - **Bonds**: in the row of the bond's lower-index end
+//!   ([`Bonded::row_bonds`]), from the force-only evaluator; the force goes
+//!   to both ends by Newton's third law through the ordered scatter of
+//!   [`super::newton`], with the pair forces.
+//! - **Angles**: in the row of the angle's lowest-index particle
+//!   ([`Bonded::row_angles`]), the three forces through the same scatter.
 //! - **Energies and virial** (thermo steps only): every term once, in term
 //!   order, sequentially.
 //!
-//! Each particle's bonded force is the sum over its bonds (ascending bond
-//! index), then its angle slots (ascending), so the order is fixed by the data.
+//! A row visits its bonds, then its angles, in ascending term index, so the
+//! order of every sum is fixed by the data (see [`super::newton`]).
 //!
 //! With bond kinetics, each bond also has a state: an unbound bond carries no
 //! force, and a bond may have its own rest length and a stiffness scale
@@ -44,90 +43,126 @@ fn by_particle(n: usize, owner: impl Iterator<Item = u32> + Clone) -> (Vec<u32>,
     (offsets, entries)
 }
 
-/// Per-particle bond and angle-slot lists, and the angle slots.
+/// A [`Law::Radial`]'s `eval` and `force`.
+type RadialEval = fn(&[f64], f64) -> Radial;
+type RadialForce = fn(&[f64], f64) -> f64;
+/// A [`Law::ThreeBody`]'s evaluator.
+type ThreeBodyEval = fn(&[f64], [DVec3; 3]) -> ThreeBody;
+
+/// The bonds and angles owned by each particle, and the resolved laws.
 #[derive(Default)]
 pub(super) struct Bonded {
-    /// Particle i's bond ends are `bond_ends[bond_offsets[i]..bond_offsets[i + 1]]`;
-    /// end `e` is end `e % 2` of bond `e / 2`.
-    bond_offsets: Vec<u32>,
-    bond_ends: Vec<u32>,
+    /// The bonds whose lower-index end is particle i are
+    /// `owned_bonds[owned_offsets[i]..owned_offsets[i + 1]]`, ascending.
+    owned_offsets: Vec<u32>,
+    owned_bonds: Vec<u32>,
+    /// The angles whose lowest-index particle is i, likewise.
     angle_offsets: Vec<u32>,
-    /// Slot `s` is the force of angle `s / 3` on its particle `s % 3`.
-    angle_slot_ids: Vec<u32>,
-    angle_slots: Vec<DVec3>,
-    /// Evaluator per bond type, re-resolved every evaluation.
-    bond_eval: Vec<fn(&[f64], f64) -> Radial>,
+    owned_angles: Vec<u32>,
+    /// Evaluator and force-only evaluator per bond type, re-resolved every evaluation.
+    bond_laws: Vec<(RadialEval, RadialForce)>,
+    /// Evaluator per angle type, likewise.
+    angle_laws: Vec<ThreeBodyEval>,
 }
 
 impl Bonded {
     pub(super) fn new(model: &Model) -> Self {
         let n = model.len();
-        let (bond_offsets, bond_ends) = by_particle(n, model.bonds.iter().flatten().copied());
-        let (angle_offsets, angle_slot_ids) = by_particle(n, model.angles.iter().flatten().copied());
-        Self {
-            bond_offsets,
-            bond_ends,
-            angle_offsets,
-            angle_slots: vec![DVec3::ZERO; angle_slot_ids.len()],
-            angle_slot_ids,
-            bond_eval: Vec::new(),
-        }
+        let (owned_offsets, owned_bonds) = by_particle(n, model.bonds.iter().map(|&[i, j]| i.min(j)));
+        let (angle_offsets, owned_angles) = by_particle(n, model.angles.iter().map(|a| a.iter().copied().min().unwrap()));
+        Self { owned_offsets, owned_bonds, angle_offsets, owned_angles, bond_laws: Vec::new(), angle_laws: Vec::new() }
     }
 
-    /// The evaluator of each bond type's law.
+    /// The evaluators of each bond and angle type's law.
     pub(super) fn resolve_laws(&mut self, model: &Model) {
-        self.bond_eval.clear();
-        self.bond_eval.extend(model.bond_types.iter().map(|t| match t.interaction.law() {
-            Law::Radial { eval, .. } => eval,
+        self.bond_laws.clear();
+        self.bond_laws.extend(model.bond_types.iter().map(|t| match t.interaction.law() {
+            Law::Radial { eval, force, .. } => (eval, force),
             _ => unreachable!("bond law is radial"),
+        }));
+        self.angle_laws.clear();
+        self.angle_laws.extend(model.angle_types.iter().map(|t| match t.interaction.law() {
+            Law::ThreeBody(eval) => eval,
+            _ => unreachable!("angle law is three-body"),
         }));
     }
 
-    /// Pass 1: resolves bond evaluators and fills the angle slots.
-    pub(super) fn prepare(&mut self, model: &Model, x: &[DVec3], images: &Images) {
-        self.resolve_laws(model);
-        self.angle_slots.par_chunks_mut(3).enumerate().with_min_len(1024).for_each(|(a, slots)| {
-            slots.copy_from_slice(&eval_angle(model, a, x, images).1.forces);
-        });
+    /// `law(params)` of bond `b` of type `t` with its state if it has one
+    /// (its own rest length), and the stiffness scale to apply to the result;
+    /// `None` when it is unbound.
+    #[inline(always)]
+    fn with_params<R>(
+        &self,
+        b: usize,
+        t: usize,
+        model: &Model,
+        state: Option<&BondState>,
+        law: impl FnOnce(&[f64]) -> R,
+    ) -> Option<(R, f64)> {
+        let params = &model.bond_types[t].params;
+        let Some(s) = state else { return Some((law(params), 1.0)) };
+        if !s.bound[b] {
+            return None;
+        }
+        let out = match (model.bond_kinetics[t].rest_index, s.rest[b]) {
+            (Some(k), Some(rest)) => {
+                let mut own = [0.0; MAX_BOND_PARAMS];
+                own[..params.len()].copy_from_slice(params);
+                own[k] = rest;
+                law(&own[..params.len()])
+            }
+            _ => law(params),
+        };
+        Some((out, s.scale[b]))
     }
 
     /// Bond `b` of type `t` at length `r`, with its state if it has one
     /// (`None` when it is unbound).
     #[inline(always)]
     pub(super) fn bond_radial(&self, b: usize, t: usize, r: f64, model: &Model, state: Option<&BondState>) -> Option<Radial> {
-        let params = &model.bond_types[t].params;
-        let Some(s) = state else { return Some((self.bond_eval[t])(params, r)) };
-        if !s.bound[b] {
-            return None;
-        }
-        let mut radial = match (model.bond_kinetics[t].rest_index, s.rest[b]) {
-            (Some(k), Some(rest)) => {
-                let mut own = [0.0; MAX_BOND_PARAMS];
-                own[..params.len()].copy_from_slice(params);
-                own[k] = rest;
-                (self.bond_eval[t])(&own[..params.len()], r)
-            }
-            _ => (self.bond_eval[t])(params, r),
-        };
-        if s.scale[b] != 1.0 {
-            radial.energy *= s.scale[b];
-            radial.de_dr *= s.scale[b];
-            radial.d2e_dr2 *= s.scale[b];
+        let (mut radial, scale) = self.with_params(b, t, model, state, |p| (self.bond_laws[t].0)(p, r))?;
+        if scale != 1.0 {
+            radial.energy *= scale;
+            radial.de_dr *= scale;
+            radial.d2e_dr2 *= scale;
         }
         Some(radial)
     }
 
-    /// Bond end `e` (on particle `i`): its bond type and its force on `i`.
+    /// Bond `b` seen from its particle `i`: its type and its force on `i`,
+    /// from the force-only evaluator.
     #[inline(always)]
-    fn bond_force(&self, e: u32, i: usize, model: &Model, x: &[DVec3], images: &Images, state: Option<&BondState>) -> (usize, DVec3) {
-        let b = e as usize / 2;
-        let other = model.bonds[b][1 - e as usize % 2] as usize;
+    fn bond_force(&self, b: usize, i: usize, model: &Model, x: &[DVec3], images: &Images, state: Option<&BondState>) -> (usize, DVec3) {
+        let [p, q] = model.bonds[b];
+        let other = if p as usize == i { q } else { p } as usize;
         let t = model.bond_type[b] as usize;
         let d = images.minimum_image(x[other] - x[i]);
-        let r = d.length();
-        match self.bond_radial(b, t, r, model, state) {
-            Some(radial) => (t, radial.force_along(d, r)),
-            None => (t, DVec3::ZERO),
+        let r2 = d.length_squared();
+        match self.with_params(b, t, model, state, |p| (self.bond_laws[t].1)(p, r2)) {
+            Some((over_r, scale)) if over_r != 0.0 => (t, d * (over_r * scale)),
+            _ => (t, DVec3::ZERO),
+        }
+    }
+
+    /// The bonds owned by particle `i` (lower-index end), ascending: calls
+    /// `visit(j, f)` with the other end j and the force f on `i` (−f acts on j)
+    /// of each bond that exerts one.
+    #[inline(always)]
+    pub(super) fn row_bonds(
+        &self,
+        i: usize,
+        model: &Model,
+        x: &[DVec3],
+        images: &Images,
+        state: Option<&BondState>,
+        mut visit: impl FnMut(usize, DVec3),
+    ) {
+        for &b in &self.owned_bonds[self.owned_offsets[i] as usize..self.owned_offsets[i + 1] as usize] {
+            let (_, f) = self.bond_force(b as usize, i, model, x, images, state);
+            if f != DVec3::ZERO {
+                let [p, q] = model.bonds[b as usize];
+                visit((p + q) as usize - i, f);
+            }
         }
     }
 
@@ -151,17 +186,18 @@ impl Bonded {
         });
     }
 
-    /// Bonded force on particle `i`: its bonds, then its angle slots.
-    #[inline]
-    pub(super) fn force_on(&self, i: usize, model: &Model, x: &[DVec3], images: &Images, state: Option<&BondState>) -> DVec3 {
-        let mut f = DVec3::ZERO;
-        for &e in &self.bond_ends[self.bond_offsets[i] as usize..self.bond_offsets[i + 1] as usize] {
-            f += self.bond_force(e, i, model, x, images, state).1;
+    /// The angles owned by particle `i` (lowest-index particle), ascending:
+    /// calls `visit(p, f)` with each of the angle's particles and its force.
+    #[inline(always)]
+    pub(super) fn row_angles(&self, i: usize, model: &Model, x: &[DVec3], images: &Images, mut visit: impl FnMut(usize, DVec3)) {
+        for &a in &self.owned_angles[self.angle_offsets[i] as usize..self.angle_offsets[i + 1] as usize] {
+            let a = a as usize;
+            let t = model.angle_type[a] as usize;
+            let out = (self.angle_laws[t])(&model.angle_types[t].params, angle_positions(model, a, x, images));
+            for (&p, f) in model.angles[a].iter().zip(out.forces) {
+                visit(p as usize, f);
+            }
         }
-        for &s in &self.angle_slot_ids[self.angle_offsets[i] as usize..self.angle_offsets[i + 1] as usize] {
-            f += self.angle_slots[s as usize];
-        }
-        f
     }
 
     /// Bonded energies (per registry entry, added to `energy`) and virial
@@ -203,27 +239,34 @@ impl Bonded {
         state: Option<&BondState>,
     ) -> Vec<(&'static str, usize, DVec3)> {
         let mut parts = Vec::new();
-        for &e in &self.bond_ends[self.bond_offsets[i] as usize..self.bond_offsets[i + 1] as usize] {
-            let (t, f) = self.bond_force(e, i, model, x, images, state);
+        for (b, _) in model.bonds.iter().enumerate().filter(|(_, ends)| ends.contains(&(i as u32))) {
+            let (t, f) = self.bond_force(b, i, model, x, images, state);
             parts.push(("bond", t, f));
         }
-        for &s in &self.angle_slot_ids[self.angle_offsets[i] as usize..self.angle_offsets[i + 1] as usize] {
-            parts.push(("angle", model.angle_type[s as usize / 3] as usize, self.angle_slots[s as usize]));
+        for (a, ends) in model.angles.iter().enumerate() {
+            if let Some(k) = ends.iter().position(|&p| p as usize == i) {
+                parts.push(("angle", model.angle_type[a] as usize, eval_angle(model, a, x, images).1.forces[k]));
+            }
         }
         parts
     }
 }
 
-/// Angle `a` at image-consistent positions (i and k at their minimum image around the vertex j).
+/// The positions of angle `a`, image-consistent: i and k at their minimum
+/// image around the vertex j.
+#[inline(always)]
+fn angle_positions(model: &Model, a: usize, x: &[DVec3], images: &Images) -> [DVec3; 3] {
+    let [i, j, k] = model.angles[a];
+    let xj = x[j as usize];
+    [xj + images.minimum_image(x[i as usize] - xj), xj, xj + images.minimum_image(x[k as usize] - xj)]
+}
+
+/// Angle `a` at image-consistent positions (see `angle_positions`).
 #[inline]
 pub(super) fn eval_angle(model: &Model, a: usize, x: &[DVec3], images: &Images) -> ([DVec3; 3], ThreeBody) {
-    let [i, j, k] = model.angles[a];
     let term = &model.angle_types[model.angle_type[a] as usize];
     let Law::ThreeBody(eval) = term.interaction.law() else { unreachable!("angle law is three-body") };
-    let xj = x[j as usize];
-    let xi = xj + images.minimum_image(x[i as usize] - xj);
-    let xk = xj + images.minimum_image(x[k as usize] - xj);
-    let at = [xi, xj, xk];
+    let at = angle_positions(model, a, x, images);
     (at, eval(&term.params, at))
 }
 

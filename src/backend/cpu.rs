@@ -1,14 +1,18 @@
 //! CPU reference backend: f64, plain loops, deterministic on any thread count.
 //!
-//! One parallel pass over particles computes each particle's force as the
-//! sum of its own terms, in an order fixed by the data, with no write
+//! Two parallel passes over fixed blocks of particles compute each
+//! particle's force as a sum in an order fixed by the data, with no write
 //! conflicts, float atomics or order-dependent reductions:
 //!
-//! - **Pairs**: a full neighbour list (each pair appears in both particles'
-//!   lists, sorted by index), with the pair rules resolved per type pair
-//!   ([`PairTable`](super::pair_table)).
-//! - **Bonded terms**: bonds from each end, angles through per-term slots
-//!   (see [`bonded`](super::bonded)).
+//! - **Pairs**: a half neighbour list (each pair once, rows sorted by
+//!   index), the pair rules resolved per type pair
+//!   ([`PairTable`](super::pair_table)), each pair's force added to both
+//!   particles by Newton's third law in the ordered scatter/gather of
+//!   [`newton`](super::newton) (first pass, and the start of the second).
+//! - **Bonds and angles**: each once, in the row of its lowest-index
+//!   particle, in the same scatter as the pairs (see [`bonded`](super::bonded)).
+//! - The second pass gathers, per particle, the spills of the scatter, then
+//!   the slots of surface and contact terms.
 //! - **Externals**: per member particle, on the unwrapped position.
 //! - **Surface terms** of closed bodies (turgor, tension, bending): each body
 //!   once, in parallel over bodies, into per-node slots that each particle
@@ -21,8 +25,8 @@
 //!
 //! Energies and the virial are needed only on thermo steps:
 //! [`CpuBackend::compute_forces`] skips them, [`CpuBackend::compute`]
-//! adds them (bonded terms in term order; pair terms per particle, reduced in
-//! fixed chunks with [`chunked`]).
+//! adds them (bonded terms in term order; pair terms in the pair pass, per
+//! block, reduced in block order) without changing a bit of the forces.
 //!
 //! The virial tensor is W = Σ_terms Σ_k r_k ⊗ f_k over image-consistent term
 //! positions (for a pair, r_ij ⊗ f_ij); the pressure tensor reported in thermo
@@ -33,11 +37,12 @@ use rayon::prelude::*;
 
 use super::bonded::Bonded;
 use super::contact::Contacts;
-use super::pair_table::{PairGeometry, PairTable};
-use super::sum::chunked;
+use super::newton::{Newton, Scatter, BLOCK};
+use super::pair_table::{Near, PairGeometry, PairTable};
 use super::surface::Surfaces;
 use super::virial::add6;
 use crate::interactions::{Law, REGISTRY};
+use crate::kinetics::BondState;
 use crate::neighbor::{Exclusions, NeighborList};
 use crate::system::{registry_index, Model, SimBox, State};
 
@@ -80,6 +85,8 @@ pub struct CpuBackend {
     surfaces: Surfaces,
     contacts: Contacts,
     pairs: PairTable,
+    /// Spill buckets of the Newton's-third-law pair scatter.
+    newton: Newton,
     /// Registry indices of the pair interactions in use (the energy columns).
     pair_interactions: Vec<usize>,
     /// For each pair rule, its energy column.
@@ -98,12 +105,13 @@ impl CpuBackend {
         pair_interactions.dedup();
         let pair_rule_column = model.pair_rules.iter().map(|r| pair_interactions.binary_search(&registry_index(r)).unwrap()).collect();
         let mut backend = Self {
-            neighbors: NeighborList::new(model.max_pair_cutoff(), skin),
+            neighbors: NeighborList::half(model.max_pair_cutoff(), skin),
             exclusions: Exclusions::from_pairs(model.len(), &model.excluded_pairs(state.bonds.as_ref().map(|b| b.bound.as_slice()))),
             bonded: Bonded::new(model),
             surfaces: Surfaces::new(model),
             contacts: Contacts::new(model),
             pairs: PairTable::default(),
+            newton: Newton::default(),
             pair_interactions,
             pair_rule_column,
             bond_tension: Vec::new(),
@@ -220,7 +228,7 @@ impl CpuBackend {
         &self.contacts
     }
 
-    /// The neighbour list, or None when the model has no pair terms.
+    /// The half neighbour list, or None when the model has no pair terms.
     pub(super) fn neighbor_list(&self) -> Option<&NeighborList> {
         (!self.pair_interactions.is_empty()).then_some(&self.neighbors)
     }
@@ -249,7 +257,7 @@ impl CpuBackend {
         if has_pairs {
             self.pairs.update(model, &self.pair_rule_column);
         }
-        self.bonded.prepare(model, x, &images);
+        self.bonded.resolve_laws(model);
         self.surfaces.prepare(model, x, &images);
         self.contacts.prepare(model, x, &images);
         let bond_state = state.bonds.as_ref();
@@ -260,14 +268,31 @@ impl CpuBackend {
         let (has_surfaces, has_contacts) = (!surfaces.is_empty(), !contacts.is_empty());
         let geometry = PairGeometry { x, types: &model.types, list: &self.neighbors, images };
         out.forces.resize(n, DVec3::ZERO);
-        out.forces.par_iter_mut().enumerate().with_min_len(256).for_each(|(i, f)| {
-            let pair = if has_pairs { pairs.force_on(i, &geometry) } else { DVec3::ZERO };
-            *f = pair + bonded.force_on(i, model, x, &images, bond_state);
-            if has_surfaces {
-                *f += surfaces.force_on(i);
+        let scattered = has_pairs || !model.bonds.is_empty() || !model.angles.is_empty();
+        let terms = ScatterTerms { pairs: has_pairs.then_some(pairs), geometry: &geometry, bonded, model, bond_state };
+        let columns = self.pair_interactions.len();
+        let pair_energy = match (scattered, energies) {
+            (false, _) => None,
+            (true, false) => terms.scatter::<false>(&mut self.newton, &mut out.forces, columns),
+            (true, true) => terms.scatter::<true>(&mut self.newton, &mut out.forces, columns),
+        };
+        let newton = &self.newton;
+        out.forces.par_chunks_mut(BLOCK).enumerate().for_each(|(t, block)| {
+            if scattered {
+                newton.gather(t, block);
+            } else {
+                block.fill(DVec3::ZERO);
             }
-            if has_contacts {
-                *f += contacts.force_on(i);
+            if has_surfaces || has_contacts {
+                for (k, f) in block.iter_mut().enumerate() {
+                    let i = t * BLOCK + k;
+                    if has_surfaces {
+                        *f += surfaces.force_on(i);
+                    }
+                    if has_contacts {
+                        *f += contacts.force_on(i);
+                    }
+                }
             }
         });
         if energies {
@@ -277,38 +302,14 @@ impl CpuBackend {
             bonded.energy(model, x, &images, bond_state, &mut out.energy_by_interaction, &mut out.virial);
             surfaces.energy(model, &mut out.energy_by_interaction, &mut out.virial);
             contacts.energy(model, x, &images, &mut out.energy_by_interaction, &mut out.virial);
-            if has_pairs {
-                self.pair_energy(&geometry, out);
+            if let Some((energy, virial)) = pair_energy {
+                for (c, &reg) in self.pair_interactions.iter().enumerate() {
+                    out.energy_by_interaction[reg] += energy[c];
+                }
+                add6(&mut out.virial, virial);
             }
         }
         apply_externals(model, state, sim_box, out, energies);
-    }
-
-    /// Pair energies per interaction and the pair virial: per particle (half
-    /// of each pair), summed in fixed chunks of particles.
-    fn pair_energy(&self, geometry: &PairGeometry, out: &mut Forces) {
-        let columns = self.pair_interactions.len();
-        let partial = chunked(geometry.x.len(), |range| {
-            let (mut energy, mut virial) = (vec![0.0; columns], [0.0; 6]);
-            let mut mine = vec![0.0; columns];
-            for i in range {
-                mine.fill(0.0);
-                let mut w = [0.0; 6];
-                self.pairs.energy_of(i, geometry, &mut mine, &mut w);
-                energy.iter_mut().zip(&mine).for_each(|(e, m)| *e += m);
-                add6(&mut virial, w);
-            }
-            (energy, virial)
-        });
-        let (mut energy, mut virial) = (vec![0.0; columns], [0.0; 6]);
-        for (e, w) in partial {
-            energy.iter_mut().zip(&e).for_each(|(a, b)| *a += b);
-            add6(&mut virial, w);
-        }
-        for (c, &reg) in self.pair_interactions.iter().enumerate() {
-            out.energy_by_interaction[reg] += energy[c];
-        }
-        add6(&mut out.virial, virial);
     }
 
     /// Per-entry forces on particle `i` (slow; for diagnostics only).
@@ -337,12 +338,12 @@ impl CpuBackend {
         }
         if !self.pair_interactions.is_empty() {
             let x = &state.positions;
-            for &j in self.neighbors.neighbors(i) {
+            for j in self.neighbors.partners(i) {
                 let d = images.minimum_image(x[j as usize] - x[i]);
                 let r = d.length();
                 for &rule in model.pair_rules_between(model.types[i], model.types[j as usize]) {
                     let term = &model.pair_rules[rule as usize];
-                    let Law::Radial { eval, range } = term.interaction.law() else { continue };
+                    let Law::Radial { eval, range, .. } = term.interaction.law() else { continue };
                     if r < range(&term.params) {
                         let radial = eval(&term.params, r);
                         let label = format!("{} {}-{}", term.label.text, model.ids[i], model.ids[j as usize]);
@@ -369,6 +370,51 @@ impl CpuBackend {
             }
         }
         parts
+    }
+}
+
+/// The terms of the first pass: pairs (when the model has any), bonds and
+/// angles, row by row.
+struct ScatterTerms<'a> {
+    pairs: Option<&'a PairTable>,
+    geometry: &'a PairGeometry<'a>,
+    bonded: &'a Bonded,
+    model: &'a Model,
+    bond_state: Option<&'a BondState>,
+}
+
+impl ScatterTerms<'_> {
+    /// The scatter (first pass): in each row, its pairs, bonds and angles,
+    /// each force on all of the term's particles; with `ENERGY` also the energy per pair column
+    /// and the pair virial, each block's in row order and the blocks' in block
+    /// order (`None` without `ENERGY`: nothing is allocated then).
+    fn scatter<const ENERGY: bool>(&self, newton: &mut Newton, forces: &mut [DVec3], columns: usize) -> Option<(Vec<f64>, [f64; 6])> {
+        let PairGeometry { x, images, .. } = self.geometry;
+        let rows = |range: std::ops::Range<usize>, scatter: &mut Scatter, energy: &mut [f64], virial: &mut [f64; 6]| {
+            let mut near = Near::default();
+            for i in range {
+                if let Some(pairs) = self.pairs {
+                    pairs.row_forces::<ENERGY>(i, self.geometry, &mut near, energy, virial, |j, f| scatter.pair(i, j, f));
+                }
+                self.bonded.row_bonds(i, self.model, x, images, self.bond_state, |j, f| scatter.pair(i, j, f));
+                self.bonded.row_angles(i, self.model, x, images, |p, f| scatter.add(p, f));
+            }
+        };
+        if !ENERGY {
+            newton.scatter(forces, |range, scatter| rows(range, scatter, &mut [], &mut [0.0; 6]));
+            return None;
+        }
+        let blocks = newton.scatter(forces, |range, scatter| {
+            let (mut energy, mut virial) = (vec![0.0; columns], [0.0; 6]);
+            rows(range, scatter, &mut energy, &mut virial);
+            (energy, virial)
+        });
+        let (mut energy, mut virial) = (vec![0.0; columns], [0.0; 6]);
+        for (e, w) in blocks {
+            energy.iter_mut().zip(&e).for_each(|(a, b)| *a += b);
+            add6(&mut virial, w);
+        }
+        Some((energy, virial))
     }
 }
 

@@ -8,10 +8,14 @@
 //! loop does one table look-up per neighbour and skips pairs beyond every
 //! cutoff before taking a square root.
 //!
-//! The kernels of a type pair keep the force field's rule order, and each
-//! particle sums over its neighbours in list order (ascending index), so the
-//! summation order, and therefore every bit of the result, is fixed by the
-//! data.
+//! The list is a half list (each pair once, in the row of its lower index):
+//! [`PairTable::row_forces`] gives each pair's force once, for the
+//! Newton's-third-law accumulation of [`super::newton`], from the laws'
+//! force-only evaluators (no energy, no square root where the law needs
+//! none); energies and the virial are added in the same pass on thermo
+//! steps, so forces have the same bits with or without them. The kernels of
+//! a type pair keep the force field's rule order and rows are in ascending
+//! partner order, so every sum has an order fixed by the data.
 
 use glam::DVec3;
 
@@ -24,11 +28,48 @@ use crate::system::{Images, Model};
 #[derive(Clone, Copy)]
 struct Kernel {
     eval: fn(&[f64], f64) -> Radial,
+    /// (dE/dr)/r from r² ([`Law::Radial`]).
+    force: fn(&[f64], f64) -> f64,
     /// Range of this rule's parameters in [`PairTable::params`].
     params: (u32, u32),
     cutoff: f64,
     /// Column of this rule's interaction among the pair interactions in use.
     column: u32,
+}
+
+/// Candidates per batch of [`PairTable::row_forces`].
+const BATCH: usize = 64;
+
+/// Scratch of [`PairTable::row_forces`]: one batch's candidates within
+/// reach (partner, separation, r²). One per block of rows, on the stack.
+pub(super) struct Near {
+    j: [u32; BATCH],
+    d: [DVec3; BATCH],
+    r2: [f64; BATCH],
+}
+
+impl Near {
+    /// Keeps the candidates of `batch` within reach of x_i (r² < `reach2(j)`),
+    /// in order, without a branch; returns how many.
+    #[inline(always)]
+    fn keep(&mut self, batch: &[u32], xi: DVec3, x: &[DVec3], images: &Images, reach2: impl Fn(u32) -> f64) -> usize {
+        let mut kept = 0;
+        for &j in batch {
+            let d = images.minimum_image(x[j as usize] - xi);
+            let r2 = d.length_squared();
+            self.j[kept] = j;
+            self.d[kept] = d;
+            self.r2[kept] = r2;
+            kept += usize::from(r2 < reach2(j));
+        }
+        kept
+    }
+}
+
+impl Default for Near {
+    fn default() -> Self {
+        Self { j: [0; BATCH], d: [DVec3::ZERO; BATCH], r2: [0.0; BATCH] }
+    }
 }
 
 /// What the pair loop reads: positions, types, the neighbour list, the box.
@@ -67,12 +108,13 @@ impl PairTable {
                 let mut reach = 0.0f64;
                 for &rule in model.pair_rules_between(a, b) {
                     let term = &model.pair_rules[rule as usize];
-                    let Law::Radial { eval, range } = term.interaction.law() else { unreachable!("pair law is radial") };
+                    let Law::Radial { eval, force, range } = term.interaction.law() else { unreachable!("pair law is radial") };
                     let cutoff = range(&term.params);
                     let first = self.params.len() as u32;
                     self.params.extend_from_slice(&term.params);
                     self.kernels.push(Kernel {
                         eval,
+                        force,
                         params: (first, self.params.len() as u32),
                         cutoff,
                         column: rule_column[rule as usize] as u32,
@@ -87,9 +129,9 @@ impl PairTable {
         }
     }
 
-    /// Calls `visit(column, d, r, radial, j)` for every pair term acting on
-    /// particle `i` (d = x_j − x_i, minimum image), neighbours in list order
-    /// and rules in force-field order.
+    /// Calls `visit(column, d, r, radial, j)` for every pair term between
+    /// particle `i` and a partner `j > i` (d = x_j − x_i, minimum image),
+    /// partners in list order and rules in force-field order.
     #[inline(always)]
     pub(super) fn for_each_term(&self, i: usize, g: &PairGeometry, mut visit: impl FnMut(usize, DVec3, f64, Radial, u32)) {
         let PairGeometry { x, types, list, images } = g;
@@ -103,29 +145,74 @@ impl PairTable {
                 continue;
             }
             let r = r2.sqrt();
-            for k in &self.kernels[self.start[pair] as usize..self.start[pair + 1] as usize] {
+            for k in self.kernels_of(pair) {
                 if r < k.cutoff {
-                    visit(k.column as usize, d, r, (k.eval)(&self.params[k.params.0 as usize..k.params.1 as usize], r), j);
+                    visit(k.column as usize, d, r, (k.eval)(self.params_of(k), r), j);
                 }
             }
         }
     }
 
-    /// Sum of the pair forces on particle `i`.
-    #[inline]
-    pub(super) fn force_on(&self, i: usize, g: &PairGeometry) -> DVec3 {
-        let mut f = DVec3::ZERO;
-        self.for_each_term(i, g, |_, d, r, radial, _| f += radial.force_along(d, r));
-        f
+    /// The pair forces of row `i` (its partners `j > i`): calls `visit(j, f)`
+    /// with the force f on `i` (−f acts on `j`) of every pair that exerts
+    /// one, in list order. With `ENERGY`, also adds each term's energy to its
+    /// column of `energy` and r_ij ⊗ f_ij to `virial`; the forces are the
+    /// same bits either way.
+    ///
+    /// The row is walked in batches: first every candidate's separation and
+    /// r², keeping those within reach without a branch (most candidates of
+    /// a list with a skin are out of reach, in no predictable pattern), then
+    /// the laws on the kept ones.
+    #[inline(always)]
+    pub(super) fn row_forces<const ENERGY: bool>(
+        &self,
+        i: usize,
+        g: &PairGeometry,
+        near: &mut Near,
+        energy: &mut [f64],
+        virial: &mut [f64; 6],
+        mut visit: impl FnMut(usize, DVec3),
+    ) {
+        let PairGeometry { x, types, list, images } = g;
+        let xi = x[i];
+        let row = types[i] as usize * self.n_types;
+        for batch in list.neighbors(i).chunks(BATCH) {
+            // One particle type (the common case): one reach, no type look-up.
+            let kept = match self.skip2[..] {
+                [reach2] => near.keep(batch, xi, x, images, |_| reach2),
+                _ => near.keep(batch, xi, x, images, |j| self.skip2[row + types[j as usize] as usize]),
+            };
+            for k in 0..kept {
+                let (j, d, r2) = (near.j[k] as usize, near.d[k], near.r2[k]);
+                let mut over_r = 0.0;
+                for kernel in self.kernels_of(row + types[j] as usize) {
+                    over_r += (kernel.force)(self.params_of(kernel), r2);
+                    if ENERGY {
+                        let r = r2.sqrt();
+                        if r < kernel.cutoff {
+                            energy[kernel.column as usize] += (kernel.eval)(self.params_of(kernel), r).energy;
+                        }
+                    }
+                }
+                if over_r != 0.0 {
+                    let f = d * over_r;
+                    if ENERGY {
+                        // r_ij ⊗ f_ij with r_ij = x_i − x_j = −d.
+                        add6(virial, outer(-d, f));
+                    }
+                    visit(j, f);
+                }
+            }
+        }
     }
 
-    /// Adds half the pair energy of particle `i` per column to `energy` and
-    /// half its pair virial to `virial` (thermo steps only).
-    pub(super) fn energy_of(&self, i: usize, g: &PairGeometry, energy: &mut [f64], virial: &mut [f64; 6]) {
-        self.for_each_term(i, g, |column, d, r, radial, _| {
-            energy[column] += 0.5 * radial.energy;
-            // r_ij ⊗ f_ij with r_ij = −d, counted half from each side.
-            add6(virial, outer(-0.5 * d, radial.force_along(d, r)));
-        });
+    #[inline(always)]
+    fn kernels_of(&self, pair: usize) -> &[Kernel] {
+        &self.kernels[self.start[pair] as usize..self.start[pair + 1] as usize]
+    }
+
+    #[inline(always)]
+    fn params_of(&self, k: &Kernel) -> &[f64] {
+        &self.params[k.params.0 as usize..k.params.1 as usize]
     }
 }

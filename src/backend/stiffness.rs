@@ -137,12 +137,12 @@ impl CpuBackend {
         }
         if let Some(list) = self.neighbor_list() {
             for i in 0..model.len() {
-                for &j in list.neighbors(i).iter().filter(|&&j| j as usize > i) {
+                for &j in list.neighbors(i) {
                     let d = images.minimum_image(x[j as usize] - x[i]);
                     let r = d.length();
                     for &rule in model.pair_rules_between(model.types[i], model.types[j as usize]) {
                         let term = &model.pair_rules[rule as usize];
-                        let Law::Radial { eval, range } = term.interaction.law() else { unreachable!("pair law is radial") };
+                        let Law::Radial { eval, range, .. } = term.interaction.law() else { unreachable!("pair law is radial") };
                         if r < range(&term.params) {
                             push_pair(&mut blocks, i as u32, j, radial_block(&eval(&term.params, r), d, r));
                         }

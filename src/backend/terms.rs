@@ -77,10 +77,8 @@ impl CpuBackend {
             let geometry = PairGeometry { x, types: &model.types, list, images };
             for (i, &xi) in x.iter().enumerate() {
                 self.pair_table().for_each_term(i, &geometry, |_, d, r, radial, j| {
-                    if j as usize > i {
-                        let segment = Segment { from: xi, d, force: -radial.force_along(d, r) };
-                        visit(&Term { kind: TermKind::Pair, particles: &[i as u32, j], segments: &[segment], bond: usize::MAX });
-                    }
+                    let segment = Segment { from: xi, d, force: -radial.force_along(d, r) };
+                    visit(&Term { kind: TermKind::Pair, particles: &[i as u32, j], segments: &[segment], bond: usize::MAX });
                 });
             }
         }

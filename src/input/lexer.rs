@@ -121,51 +121,80 @@ fn physical_line(input: Span) -> IResult<Span, Vec<(Span, bool)>> {
 
 /// Splits a file into statements.
 pub fn lex(file: &Arc<SourceFile>) -> Result<Vec<Statement>, InputError> {
-    let mut statements = Vec::new();
-    let mut pending: Vec<Token> = Vec::new();
-    let mut input = Span::new(file.text.as_str());
-    while !input.fragment().is_empty() {
-        let (after, words) = physical_line(input)
-            .map_err(|_| InputError::at_offset(file, input.location_offset(), "unreadable line; expected blank-separated words"))?;
-        let (after, _) = alt((line_ending, eof)).parse(after).map_err(|_: nom::Err<nom::error::Error<Span>>| {
-            let found = after.fragment().chars().next().unwrap_or(' ');
-            let message = if found == '"' {
-                "unterminated quoted string; expected a closing `\"` on the same line".to_string()
-            } else {
-                format!("unexpected `{}`; expected a blank-separated word", found.escape_debug())
-            };
-            InputError::at_offset(file, after.location_offset(), message)
-        })?;
-        input = after;
-        let mut tokens: Vec<Token> = words
-            .into_iter()
-            .map(|(span, quoted)| {
-                let token_offset = span.location_offset() - usize::from(quoted);
-                // The span knows its line; its column is counted from the line
-                // start only (`line_col` would rescan the file: O(N²) in all).
-                Token {
-                    text: span.fragment().to_string(),
-                    line: span.location_line(),
-                    col: (span.get_utf8_column() - usize::from(quoted)) as u32,
-                    offset: token_offset,
-                    text_len: span.fragment().len() + 2 * usize::from(quoted),
-                    file: file.clone(),
+    statements(file).collect()
+}
+
+/// The statements of a file, lexed one at a time as the caller asks for
+/// them: a large topology is parsed without ever holding all its tokens
+/// (about 14 per bead of a network, ~90 bytes each).
+pub fn statements(file: &Arc<SourceFile>) -> Statements<'_> {
+    Statements { file, input: Span::new(file.text.as_str()), failed: false }
+}
+
+/// Iterator of [`statements`]; it stops after the first error.
+pub struct Statements<'a> {
+    file: &'a Arc<SourceFile>,
+    input: Span<'a>,
+    failed: bool,
+}
+
+impl Iterator for Statements<'_> {
+    type Item = Result<Statement, InputError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        let file = self.file;
+        let mut pending: Vec<Token> = Vec::new();
+        while !self.failed && !self.input.fragment().is_empty() {
+            let input = self.input;
+            let line = physical_line(input)
+                .map_err(|_| InputError::at_offset(file, input.location_offset(), "unreadable line; expected blank-separated words"))
+                .and_then(|(after, words)| {
+                    let (after, _) = alt((line_ending, eof)).parse(after).map_err(|_: nom::Err<nom::error::Error<Span>>| {
+                        let found = after.fragment().chars().next().unwrap_or(' ');
+                        let message = if found == '"' {
+                            "unterminated quoted string; expected a closing `\"` on the same line".to_string()
+                        } else {
+                            format!("unexpected `{}`; expected a blank-separated word", found.escape_debug())
+                        };
+                        InputError::at_offset(file, after.location_offset(), message)
+                    })?;
+                    Ok((after, words))
+                });
+            let (after, words) = match line {
+                Ok(line) => line,
+                Err(e) => {
+                    self.failed = true;
+                    return Some(Err(e));
                 }
-            })
-            .collect();
-        let continues = tokens.last().is_some_and(|t| t.text == "&");
-        if continues {
-            tokens.pop();
+            };
+            self.input = after;
+            let mut tokens: Vec<Token> = words
+                .into_iter()
+                .map(|(span, quoted)| {
+                    let token_offset = span.location_offset() - usize::from(quoted);
+                    // The span knows its line; its column is counted from the line
+                    // start only (`line_col` would rescan the file: O(N²) in all).
+                    Token {
+                        text: span.fragment().to_string(),
+                        line: span.location_line(),
+                        col: (span.get_utf8_column() - usize::from(quoted)) as u32,
+                        offset: token_offset,
+                        text_len: span.fragment().len() + 2 * usize::from(quoted),
+                        file: file.clone(),
+                    }
+                })
+                .collect();
+            let continues = tokens.last().is_some_and(|t| t.text == "&");
+            if continues {
+                tokens.pop();
+            }
+            pending.extend(tokens);
+            if !continues && !pending.is_empty() {
+                return Some(Ok(Statement { tokens: pending }));
+            }
         }
-        pending.extend(tokens);
-        if !continues && !pending.is_empty() {
-            statements.push(Statement { tokens: std::mem::take(&mut pending) });
-        }
+        (!pending.is_empty()).then_some(Ok(Statement { tokens: pending }))
     }
-    if !pending.is_empty() {
-        statements.push(Statement { tokens: pending });
-    }
-    Ok(statements)
 }
 
 #[cfg(test)]

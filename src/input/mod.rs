@@ -12,5 +12,5 @@ mod lexer;
 mod number;
 
 pub use self::error::InputError;
-pub use self::lexer::{lex, SourceFile, Statement, Token};
+pub use self::lexer::{lex, statements, SourceFile, Statement, Statements, Token};
 pub use self::number::{evaluate_expression, parse_f64, parse_u64};

@@ -80,7 +80,11 @@ pub fn clamp_fraction(moves: &[DVec3], limits: &[f64]) -> f64 {
 /// to s·dt when a particle would move farther than its entry of `limits`
 /// (see the module docs). Returns s (1 for a full step).
 ///
-/// `scratch` (drift, noise) is reused between calls. On a blow-up `state` is unchanged.
+/// `scratch` (the displacements) is reused between calls. On a blow-up
+/// `state` is unchanged. Two passes over the particles: the displacements
+/// with the refusal check, then the commit; with `limits`, one more before
+/// them for s, which draws the noise again rather than storing it (the
+/// stream is counter-based, so the draw is the same).
 #[allow(clippy::too_many_arguments)]
 pub fn overdamped_step(
     model: &Model,
@@ -92,48 +96,51 @@ pub fn overdamped_step(
     seed: u64,
     settings: &OverdampedSettings,
     limits: Option<&[f64]>,
-    scratch: &mut (Vec<DVec3>, Vec<DVec3>),
+    scratch: &mut Vec<DVec3>,
 ) -> Result<f64, Blowup> {
     let step = state.step;
     let refused = |d: &DVec3| !d.is_finite() || d.length() > settings.max_displacement;
-    let (drift, noise) = scratch;
-    drift.resize(state.len(), DVec3::ZERO);
-    noise.resize(state.len(), DVec3::ZERO);
-    drift.par_iter_mut().zip(noise.par_iter_mut()).enumerate().with_min_len(1024).for_each(|(i, (a, b))| {
+    // Drift a = dt·F/γ and noise b = √(2kT·dt/γ)·ξ of particle i; a `fixed`
+    // particle never moves (and draws no noise).
+    let drift_and_noise = |i: usize| {
         let gamma = model.type_drag[model.types[i] as usize];
-        (*a, *b) = (DVec3::ZERO, DVec3::ZERO);
         if gamma.is_infinite() {
-            // A `fixed` particle never moves (and draws no noise).
-            return;
+            return (DVec3::ZERO, DVec3::ZERO);
         }
-        *a = forces[i] * (dt / gamma);
-        if kt > 0.0 {
-            let amplitude = (2.0 * kt * dt / gamma).sqrt();
-            *b = amplitude * DVec3::from_array(noise3(seed, step, i as u32, settings.noise));
-        }
-    });
+        let noise = if kt > 0.0 {
+            (2.0 * kt * dt / gamma).sqrt() * DVec3::from_array(noise3(seed, step, i as u32, settings.noise))
+        } else {
+            DVec3::ZERO
+        };
+        (forces[i] * (dt / gamma), noise)
+    };
     // The minimum is exact, so s does not depend on the thread count.
     let fraction = limits.map_or(1.0, |limits| {
         (0..state.len())
             .into_par_iter()
             .with_min_len(1024)
-            .map(|i| step_fraction(drift[i].length(), noise[i].length(), limits[i]))
+            .map(|i| {
+                let (a, b) = drift_and_noise(i);
+                step_fraction(a.length(), b.length(), limits[i])
+            })
             .reduce(|| 1.0, f64::min)
     });
     let root = fraction.sqrt();
-    let any_refused = drift
+    scratch.resize(state.len(), DVec3::ZERO);
+    let any_refused = scratch
         .par_iter_mut()
-        .zip(noise.par_iter())
+        .enumerate()
         .with_min_len(1024)
         .fold(
             || false,
-            |bad, (a, b)| {
-                *a = if fraction == 1.0 { *a + *b } else { fraction * *a + root * *b };
-                bad | refused(a)
+            |bad, (i, d)| {
+                let (a, b) = drift_and_noise(i);
+                *d = if fraction == 1.0 { a + b } else { fraction * a + root * b };
+                bad | refused(d)
             },
         )
         .reduce(|| false, |a, b| a | b);
-    let scratch = &*drift;
+    let scratch = &*scratch;
     if any_refused {
         let particle = scratch.iter().position(refused).expect("a refused displacement");
         return Err(Blowup { particle, displacement: scratch[particle].length() });

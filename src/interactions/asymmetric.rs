@@ -24,7 +24,7 @@ interaction!(
     "asymmetric",
     Kind::Bond,
     "Bilinear bond, stiffer in tension than compression: E = ½k_t(r − r0)² or ½k_c(r − r0)²",
-    Law::Radial { eval, range: |_| f64::INFINITY }
+    Law::Radial { eval, force: radial_force!(eval), range: |_| f64::INFINITY }
 );
 
 #[cfg(test)]

@@ -29,7 +29,7 @@ interaction!(
     "cable",
     Kind::Bond,
     "Tension-only cable with pre-strain, F = k·⟨(r − r0)/r0 + τ⟩₊",
-    Law::Radial { eval, range: |_| f64::INFINITY }
+    Law::Radial { eval, force: radial_force!(eval), range: |_| f64::INFINITY }
 );
 
 #[cfg(test)]

@@ -44,7 +44,7 @@ interaction!(
     "fene",
     Kind::Bond,
     "FENE bond with WCA core, E = −½K·R0²·ln(1 − (r/R0)²) + WCA (LAMMPS bond_style fene)",
-    Law::Radial { eval, range: |_| f64::INFINITY }
+    Law::Radial { eval, force: radial_force!(eval), range: |_| f64::INFINITY }
 );
 
 #[cfg(test)]

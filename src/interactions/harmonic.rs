@@ -16,7 +16,13 @@ fn eval(p: &[f64], r: f64) -> Radial {
     Radial { energy: 0.5 * p[K] * stretch * stretch, de_dr: p[K] * stretch, d2e_dr2: p[K] }
 }
 
-interaction!(Harmonic, "harmonic", Kind::Bond, "Hookean bond E = ½k(r − r0)²", Law::Radial { eval, range: |_| f64::INFINITY });
+interaction!(
+    Harmonic,
+    "harmonic",
+    Kind::Bond,
+    "Hookean bond E = ½k(r − r0)²",
+    Law::Radial { eval, force: radial_force!(eval), range: |_| f64::INFINITY }
+);
 
 #[cfg(test)]
 mod tests {

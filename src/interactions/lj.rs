@@ -13,6 +13,16 @@ static PARAMS: [ParamSpec; 3] = [
     ParamSpec::new("rc", Dim::Length, "cutoff (E = 0 beyond; not shifted)").positive(),
 ];
 
+/// (dE/dr)/r = 4ε[6(σ/r)⁶ − 12(σ/r)¹²]/r² of the Lennard-Jones energy,
+/// from r² alone (no square root; shared with `wca`).
+#[inline(always)]
+pub(crate) fn lennard_jones_over_r(epsilon: f64, sigma: f64, r2: f64) -> f64 {
+    let s2 = sigma * sigma / r2;
+    let s6 = s2 * s2 * s2;
+    let s12 = s6 * s6;
+    4.0 * epsilon * (6.0 * s6 - 12.0 * s12) / r2
+}
+
 /// 4ε[(σ/r)¹² − (σ/r)⁶] and its first two derivatives (shared with `wca`).
 pub(crate) fn lennard_jones(epsilon: f64, sigma: f64, r: f64) -> Radial {
     let s2 = sigma * sigma / (r * r);
@@ -20,7 +30,7 @@ pub(crate) fn lennard_jones(epsilon: f64, sigma: f64, r: f64) -> Radial {
     let s12 = s6 * s6;
     Radial {
         energy: 4.0 * epsilon * (s12 - s6),
-        de_dr: 4.0 * epsilon * (6.0 * s6 - 12.0 * s12) / r,
+        de_dr: lennard_jones_over_r(epsilon, sigma, r * r) * r,
         d2e_dr2: 4.0 * epsilon * (156.0 * s12 - 42.0 * s6) / (r * r),
     }
 }
@@ -33,7 +43,21 @@ fn eval(p: &[f64], r: f64) -> Radial {
     }
 }
 
-interaction!(Lj, "lj", Kind::Pair, "Lennard-Jones 12-6, cut at rc and not shifted (LAMMPS lj/cut)", Law::Radial { eval, range: |p| p[RC] });
+fn force(p: &[f64], r2: f64) -> f64 {
+    if r2 < p[RC] * p[RC] {
+        lennard_jones_over_r(p[EPSILON], p[SIGMA], r2)
+    } else {
+        0.0
+    }
+}
+
+interaction!(
+    Lj,
+    "lj",
+    Kind::Pair,
+    "Lennard-Jones 12-6, cut at rc and not shifted (LAMMPS lj/cut)",
+    Law::Radial { eval, force, range: |p| p[RC] }
+);
 
 #[cfg(test)]
 mod tests {

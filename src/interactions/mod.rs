@@ -67,6 +67,18 @@ macro_rules! interaction {
     };
 }
 
+/// The `force` of a [`Law::Radial`] from its `eval` (for laws that need r
+/// anyway): `over_r(eval(p, √r²).de_dr, √r²)`. `eval` is inlined into the
+/// closure, so the energy and d²E/dr² it would compute are dropped.
+macro_rules! radial_force {
+    ($eval:ident) => {
+        |p: &[f64], r2: f64| {
+            let r = r2.sqrt();
+            $crate::interactions::over_r($eval(p, r).de_dr, r)
+        }
+    };
+}
+
 pub mod testing;
 
 mod area_conservation;
@@ -193,6 +205,16 @@ impl Radial {
     }
 }
 
+/// (dE/dr)/r, exactly 0 when dE/dr = 0 (even at r = 0; see [`Radial::force_along`]).
+#[inline(always)]
+pub fn over_r(de_dr: f64, r: f64) -> f64 {
+    if de_dr == 0.0 {
+        0.0
+    } else {
+        de_dr / r
+    }
+}
+
 /// Energy and the force on each of three particles.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ThreeBody {
@@ -212,7 +234,14 @@ pub struct OneBody {
 pub enum Law {
     /// E(r) for bonds and pairs. `range` is the cutoff beyond which E ≡ 0
     /// (used for pair neighbour lists; `f64::INFINITY` for bonds).
-    Radial { eval: fn(&[f64], f64) -> Radial, range: fn(&[f64]) -> f64 },
+    ///
+    /// `force(p, r²)` is (dE/dr)/r, the force on particle i being
+    /// (x_j − x_i)·force: what the step loop calls. It is the same
+    /// derivative as `eval`'s without the energy and d²E/dr², so it skips
+    /// their work (`soft` takes a sine, no cosine), and it takes r² so a law
+    /// that needs no r skips the square root (`wca`, `lj`). [`radial_force!`]
+    /// derives it from `eval`: inlined, the unused energy terms are dropped.
+    Radial { eval: fn(&[f64], f64) -> Radial, force: fn(&[f64], f64) -> f64, range: fn(&[f64]) -> f64 },
     /// E(r_i, r_j, r_k) for angles; positions are made image-consistent
     /// (r_i and r_k are placed at their minimum image around r_j).
     ThreeBody(fn(&[f64], [DVec3; 3]) -> ThreeBody),

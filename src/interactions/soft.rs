@@ -29,7 +29,7 @@ interaction!(
     "soft",
     Kind::Pair,
     "Cosine soft repulsion E = A[1 + cos(πr/rc)] (LAMMPS pair_style soft)",
-    Law::Radial { eval, range: |p| p[RC] }
+    Law::Radial { eval, force: radial_force!(eval), range: |p| p[RC] }
 );
 
 #[cfg(test)]

@@ -25,7 +25,7 @@ interaction!(
     "soft_repulsion",
     Kind::Pair,
     "One-sided harmonic excluded volume E = ½k(σ − r)² for r < σ",
-    Law::Radial { eval, range: |p| p[SIGMA] }
+    Law::Radial { eval, force: radial_force!(eval), range: |p| p[SIGMA] }
 );
 
 #[cfg(test)]

@@ -24,7 +24,7 @@ interaction!(
     "spring",
     Kind::Bond,
     "Strain spring with pre-strain, F = k·((r − r0)/r0 + τ) in tension and compression",
-    Law::Radial { eval, range: |_| f64::INFINITY }
+    Law::Radial { eval, force: radial_force!(eval), range: |_| f64::INFINITY }
 );
 
 #[cfg(test)]

@@ -6,7 +6,9 @@
 //! - Σf = 0 and Σ r×f = 0 (momentum and angular momentum) when the law is internal;
 //! - translation and rotation invariance of the energy (internal laws);
 //! - zero force at the rest configuration the caller names;
-//! - for [`Law::Radial`], d²E/dr² against a central difference of dE/dr.
+//! - for [`Law::Radial`], d²E/dr² against a central difference of dE/dr, and
+//!   the force-only evaluator (the step loop's) against `eval`'s dE/dr
+//!   (forces in these checks come from `force`, energies from `eval`).
 //!
 //! A [`Law::Contact`] law is viewed as a function of four positions: the
 //! node, then the three corners of the face.
@@ -28,12 +30,11 @@ use faer::{Col, Mat};
 /// particles; 4 for a contact law: node, then the face's corners).
 pub fn evaluate(law: Law, params: &[f64], positions: &[DVec3]) -> (f64, Vec<DVec3>) {
     match law {
-        Law::Radial { eval, .. } => {
+        Law::Radial { eval, force, .. } => {
+            // Energy from `eval`, forces from `force`: what the step loop uses.
             let d = positions[1] - positions[0];
-            let r = d.length();
-            let out = eval(params, r);
-            let f_j = -out.de_dr * d / r;
-            (out.energy, vec![-f_j, f_j])
+            let f_i = d * force(params, d.length_squared());
+            (eval(params, d.length()).energy, vec![f_i, -f_i])
         }
         Law::ThreeBody(eval) => {
             let out = eval(params, [positions[0], positions[1], positions[2]]);
@@ -346,6 +347,17 @@ pub fn assert_all_checks(interaction: &dyn Interaction, params: &[f64], position
         assert_invariant_under_rigid_motion(interaction, params, positions);
     }
     if matches!(interaction.law(), Law::Radial { .. }) {
-        assert_radial_curvature(interaction, params, (positions[1] - positions[0]).length(), h);
+        let r = (positions[1] - positions[0]).length();
+        assert_radial_curvature(interaction, params, r, h);
+        assert_force_matches_eval(interaction, params, r);
     }
+}
+
+/// For a radial law, `force(p, r²)·r` (the step loop's force) equals
+/// `eval(p, r).de_dr` to rounding (the same derivative, computed without the energy).
+pub fn assert_force_matches_eval(interaction: &dyn Interaction, params: &[f64], r: f64) {
+    let Law::Radial { eval, force, .. } = interaction.law() else { panic!("{} is not radial", interaction.name()) };
+    let (de_dr, fast) = (eval(params, r).de_dr, force(params, r * r) * r);
+    let scale = de_dr.abs().max(fast.abs()).max(1e-300);
+    assert!((de_dr - fast).abs() / scale < 1e-12, "{}: at r = {r}: force·r = {fast}, eval dE/dr = {de_dr}", interaction.name());
 }

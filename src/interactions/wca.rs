@@ -1,6 +1,6 @@
 #![doc = include_str!("wca.md")]
 
-use super::lj::lennard_jones;
+use super::lj::{lennard_jones, lennard_jones_over_r};
 use super::{Kind, Law, ParamSpec, Radial};
 use crate::units::Dim;
 
@@ -29,12 +29,21 @@ fn eval(p: &[f64], r: f64) -> Radial {
     }
 }
 
+fn force(p: &[f64], r2: f64) -> f64 {
+    let rc = cutoff(p);
+    if r2 < rc * rc {
+        lennard_jones_over_r(p[EPSILON], p[SIGMA], r2)
+    } else {
+        0.0
+    }
+}
+
 interaction!(
     Wca,
     "wca",
     Kind::Pair,
     "Weeks–Chandler–Andersen repulsion: LJ cut at 2^(1/6)σ and shifted up by ε",
-    Law::Radial { eval, range: cutoff }
+    Law::Radial { eval, force, range: cutoff }
 );
 
 #[cfg(test)]

@@ -9,13 +9,19 @@
 //! |d_ij|² < r_list²,   d_ij = minimum_image(x_j − x_i),   r_list = cutoff + skin
 //! ```
 //!
-//! and stores a **full** list in CSR form: `j` appears in `i`'s list and `i`
-//! in `j`'s, particle `i`'s neighbours are `neighbors[offsets[i]..offsets[i+1]]`,
-//! **sorted ascending by `j`**. Sorting makes the order of every per-particle
-//! force sum a function of the pair set alone, not of the cell layout or of
-//! when the list happened to be rebuilt, which is what bit-reproducible runs
-//! need (a full list also lets each particle gather its own force without
-//! atomics — convention 4).
+//! and stores it in CSR form, particle `i`'s neighbours being
+//! `neighbors[offsets[i]..offsets[i+1]]`, **sorted ascending by `j`**:
+//!
+//! - a **full** list ([`NeighborList::new`]): `j` appears in `i`'s list and
+//!   `i` in `j`'s, so each particle can gather its own terms (the contact
+//!   search and bond formation use it);
+//! - a **half** list ([`NeighborList::half`]): only `j > i`, each pair once,
+//!   for Newton's-third-law force passes (the CPU pair forces: half the
+//!   memory and half the distance tests).
+//!
+//! Sorting makes the order of every per-particle force sum a function of the
+//! pair set alone, not of the cell layout or of when the list happened to be
+//! rebuilt, which is what bit-reproducible runs need.
 //!
 //! # Skin and rebuild criterion
 //!

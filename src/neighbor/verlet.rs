@@ -8,11 +8,14 @@ use crate::system::{Images, SimBox};
 
 const AXES: [char; 3] = ['x', 'y', 'z'];
 
-/// A full, per-particle sorted Verlet list (CSR) with a skin.
+/// A per-particle sorted Verlet list (CSR) with a skin: full, or half
+/// (each pair once, in the row of its lower index).
 #[derive(Clone, Debug)]
 pub struct NeighborList {
     cutoff: f64,
     skin: f64,
+    /// Keep only partners `j > i` (see the module docs).
+    half: bool,
     offsets: Vec<u32>,
     neighbors: Vec<u32>,
     /// Positions at the last build (for the skin/2 criterion).
@@ -24,11 +27,32 @@ pub struct NeighborList {
 }
 
 impl NeighborList {
-    /// An empty list for pairs within `cutoff`, searched out to `cutoff + skin`.
+    /// An empty full list for pairs within `cutoff`, searched out to `cutoff + skin`.
     ///
     /// Invalid values (negative or non-finite) are reported by [`Self::build`].
     pub fn new(cutoff: f64, skin: f64) -> Self {
-        Self { cutoff, skin, offsets: vec![0], neighbors: Vec::new(), reference: Vec::new(), reference_box: None, builds: 0, grid: [0; 3] }
+        Self {
+            cutoff,
+            skin,
+            half: false,
+            offsets: vec![0],
+            neighbors: Vec::new(),
+            reference: Vec::new(),
+            reference_box: None,
+            builds: 0,
+            grid: [0; 3],
+        }
+    }
+
+    /// An empty half list: like [`Self::new`], but particle `i` lists only
+    /// its partners `j > i`, so each pair is stored once.
+    pub fn half(cutoff: f64, skin: f64) -> Self {
+        Self { half: true, ..Self::new(cutoff, skin) }
+    }
+
+    /// Whether each pair is stored once (in the row of its lower index).
+    pub fn is_half(&self) -> bool {
+        self.half
     }
 
     /// The interaction cutoff.
@@ -66,9 +90,13 @@ impl NeighborList {
         self.len() == 0
     }
 
-    /// Number of unordered pairs (each is stored twice in the full list).
+    /// Number of unordered pairs (each is stored twice in a full list, once in a half list).
     pub fn num_pairs(&self) -> usize {
-        self.neighbors.len() / 2
+        if self.half {
+            self.neighbors.len()
+        } else {
+            self.neighbors.len() / 2
+        }
     }
 
     /// CSR offsets: particle `i`'s neighbours are `flat()[offsets()[i]..offsets()[i + 1]]`.
@@ -81,10 +109,21 @@ impl NeighborList {
         &self.neighbors
     }
 
-    /// The neighbours of particle `i`, sorted ascending.
+    /// The neighbours of particle `i`, sorted ascending (only those above `i`
+    /// in a half list).
     #[inline]
     pub fn neighbors(&self, i: usize) -> &[u32] {
         &self.neighbors[self.offsets[i] as usize..self.offsets[i + 1] as usize]
+    }
+
+    /// Every partner of particle `i`, ascending, from either kind of list
+    /// (a half list is searched row by row: for diagnostics, not loops).
+    pub fn partners(&self, i: usize) -> Vec<u32> {
+        if !self.half {
+            return self.neighbors(i).to_vec();
+        }
+        let below = (0..i).filter(|&k| self.neighbors(k).binary_search(&(i as u32)).is_ok());
+        below.map(|k| k as u32).chain(self.neighbors(i).iter().copied()).collect()
     }
 
     /// True when the list must be rebuilt before computing forces at `positions`:
@@ -164,7 +203,7 @@ impl NeighborList {
             self.grid = [0; 3];
         } else {
             let grid = CellGrid::new(range, sim_box, positions);
-            let chunks = grid.gather(positions, sim_box, exclusions, range * range);
+            let chunks = grid.gather(positions, sim_box, exclusions, range * range, self.half);
             let total: usize = chunks.iter().map(|(_, entries)| entries.len()).sum();
             if total > u32::MAX as usize {
                 return Err(format!("neighbour list: {total} entries exceed the u32 index range"));
@@ -327,7 +366,7 @@ impl CellGrid {
     /// The sorted neighbour lists of particles `0..n`, gathered in parallel
     /// by chunks of 1024 particles: per chunk, each particle's list length
     /// and the lists concatenated (one buffer per chunk, not per particle).
-    fn gather(&self, positions: &[DVec3], sim_box: &SimBox, exclusions: &Exclusions, range2: f64) -> Vec<(Vec<u32>, Vec<u32>)> {
+    fn gather(&self, positions: &[DVec3], sim_box: &SimBox, exclusions: &Exclusions, range2: f64, half: bool) -> Vec<(Vec<u32>, Vec<u32>)> {
         const CHUNK: usize = 1024;
         let images = sim_box.images();
         let n = positions.len();
@@ -339,7 +378,7 @@ impl CellGrid {
                 let mut entries = Vec::new();
                 for i in particles {
                     let start = entries.len();
-                    self.partners_of(i, positions, &images, exclusions, range2, &mut entries);
+                    self.partners_of(i, positions, &images, exclusions, range2, half, &mut entries);
                     entries[start..].sort_unstable();
                     lengths.push((entries.len() - start) as u32);
                 }
@@ -348,9 +387,20 @@ impl CellGrid {
             .collect()
     }
 
-    /// Appends the partners of particle `i` within the list radius, in cell order.
+    /// Appends the partners of particle `i` within the list radius (only
+    /// those above `i` when `half`), in cell order.
     #[inline]
-    fn partners_of(&self, i: usize, positions: &[DVec3], images: &Images, exclusions: &Exclusions, range2: f64, out: &mut Vec<u32>) {
+    #[allow(clippy::too_many_arguments)]
+    fn partners_of(
+        &self,
+        i: usize,
+        positions: &[DVec3],
+        images: &Images,
+        exclusions: &Exclusions,
+        range2: f64,
+        half: bool,
+        out: &mut Vec<u32>,
+    ) {
         let xi = positions[i];
         let c = self.coords(xi);
         let (nx, kx) = self.axis_neighbours(0, c[0]);
@@ -361,7 +411,7 @@ impl CellGrid {
                 for &cx in &nx[..kx] {
                     let cell = self.flat([cx, cy, cz]) as usize;
                     for &j in &self.members[self.start[cell] as usize..self.start[cell + 1] as usize] {
-                        if j as usize == i {
+                        if j as usize == i || (half && (j as usize) < i) {
                             continue;
                         }
                         let d = images.minimum_image(positions[j as usize] - xi);
@@ -425,6 +475,21 @@ mod tests {
         }
         let total: usize = expected.iter().map(Vec::len).sum();
         assert_eq!(list.num_pairs() * 2, total);
+        for (i, want) in expected.iter().enumerate().step_by(7) {
+            assert_eq!(list.partners(i), *want);
+        }
+        // The half list is the upper triangle of the same pair set.
+        let mut half = NeighborList::half(cutoff, skin);
+        half.build(x, b, ex).unwrap();
+        assert!(half.is_half() && !list.is_half());
+        for (i, want) in expected.iter().enumerate() {
+            let upper: Vec<u32> = want.iter().copied().filter(|&j| j as usize > i).collect();
+            assert_eq!(half.neighbors(i), &upper[..], "half list, particle {i}");
+        }
+        assert_eq!(half.num_pairs(), list.num_pairs());
+        for (i, want) in expected.iter().enumerate().step_by(7) {
+            assert_eq!(half.partners(i), *want, "all partners from the half list");
+        }
         list
     }
 

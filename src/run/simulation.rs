@@ -77,7 +77,7 @@ pub struct Simulation {
     lifetime_file: Option<PathBuf>,
     options: RunOptions,
     deck_stem: String,
-    scratch: (Vec<DVec3>, Vec<DVec3>),
+    scratch: Vec<DVec3>,
     /// Per-particle displacement limits of the contact step clamp.
     step_limits: Vec<f64>,
     /// Explicit steps shortened by the contact step clamp.
@@ -129,7 +129,7 @@ impl Simulation {
             lifetime_file: None,
             options,
             deck_stem,
-            scratch: (Vec::new(), Vec::new()),
+            scratch: Vec::new(),
             step_limits: Vec::new(),
             contact_clamps: 0,
             last_minimize: None,
@@ -415,7 +415,7 @@ impl Simulation {
         }
         self.forces_current = true;
         self.energies_current = energies;
-        if let Some(i) = self.forces.forces.par_iter().position_first(|f| !f.is_finite()) {
+        if let Some(i) = self.forces.forces.par_iter().with_min_len(4096).position_first(|f| !f.is_finite()) {
             return Err(self.blowup(i, "non-finite force".into()));
         }
         Ok(())

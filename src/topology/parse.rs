@@ -5,7 +5,7 @@ use std::sync::Arc;
 
 use glam::DVec3;
 
-use crate::input::{lex, parse_f64, parse_u64, InputError, SourceFile, Statement, Token};
+use crate::input::{parse_f64, parse_u64, statements, InputError, SourceFile, Statement, Token};
 
 /// One axis of a `[ box ]` section or deck `box` command.
 #[derive(Clone, Debug)]
@@ -86,7 +86,9 @@ fn expect_fields(statement: &Statement, allowed: &[usize], layout: &str) -> Resu
 
 struct Parser {
     topology: Topology,
-    index_of_id: HashMap<u64, (u32, Token)>,
+    /// Index and byte offset (for errors) of each particle id: no token per
+    /// particle is kept, so a large topology parses in little memory.
+    index_of_id: HashMap<u64, (u32, usize)>,
     body_ids: HashMap<u64, Token>,
     /// The id token of each body and the first token of each triangle line (for errors).
     body_tokens: Vec<Token>,
@@ -120,15 +122,16 @@ impl Parser {
         if id == 0 {
             return Err(t[0].error("found particle id 0, expected a positive integer"));
         }
-        if let Some((_, first)) = self.index_of_id.get(&id) {
-            return Err(t[0].error(format!("particle id {id} is already used at line {}; expected unique ids", first.line)));
+        if let Some(&(_, first)) = self.index_of_id.get(&id) {
+            let line = t[0].file.line_col(first).0;
+            return Err(t[0].error(format!("particle id {id} is already used at line {line}; expected unique ids")));
         }
         let x = parse_f64(&t[2], "the x coordinate")?;
         let y = parse_f64(&t[3], "the y coordinate")?;
         let z = parse_f64(&t[4], "the z coordinate")?;
         let body = t.get(5).map(|b| parse_u64(b, "a body id")).transpose()?;
         let index = self.topology.ids.len() as u32;
-        self.index_of_id.insert(id, (index, t[0].clone()));
+        self.index_of_id.insert(id, (index, t[0].offset));
         self.topology.ids.push(id);
         self.topology.type_names.push(t[1].clone());
         self.topology.positions.push(DVec3::new(x, y, z));
@@ -221,9 +224,8 @@ pub fn parse_box_axis(t: &[Token], axes: &mut [BoxAxis]) -> Result<usize, InputE
     Ok(index)
 }
 
-/// Reads and parses a topology file.
+/// Reads and parses a topology file, one statement at a time.
 pub fn parse_topology(file: &Arc<SourceFile>) -> Result<Topology, InputError> {
-    let statements = lex(file)?;
     let mut parser = Parser {
         topology: Topology { path: file.path.clone(), ..Default::default() },
         index_of_id: HashMap::new(),
@@ -234,7 +236,8 @@ pub fn parse_topology(file: &Arc<SourceFile>) -> Result<Topology, InputError> {
     let mut section: Option<Section> = None;
     let mut seen_sections: Vec<Section> = Vec::new();
     let mut seen_axes = [false; 3];
-    for s in &statements {
+    for s in statements(file) {
+        let s = &s?;
         if let Some(next) = section_of(s) {
             let next = next?;
             if seen_sections.contains(&next) {
@@ -274,8 +277,12 @@ pub fn parse_topology(file: &Arc<SourceFile>) -> Result<Topology, InputError> {
         if let Some(body) = body {
             if !parser.body_ids.contains_key(body) && !parser.topology.bodies.is_empty() {
                 let id = parser.topology.ids[index];
-                let (_, token) = &parser.index_of_id[&id];
-                return Err(token.error(format!("particle {id} names body {body}, expected a body listed in [ bodies ]")));
+                let (_, offset) = parser.index_of_id[&id];
+                return Err(InputError::at_offset(
+                    file,
+                    offset,
+                    format!("particle {id} names body {body}, expected a body listed in [ bodies ]"),
+                ));
             }
         }
     }
