@@ -22,9 +22,9 @@
 //!    s, s′ there. Pairs beyond the candidate list are farther than every
 //!    contact range, so s = 0 for them.
 //! 3. **Face weights** (parallel): Φ_t = Σ_rules ε·P_t.
-//! 4. **Node pulls** (parallel): ε·s′_k·B_k per rule, from the node's faces.
-//! 5. **Distance part** (node order): each pull is added to the forces of
-//!    the node's nearest pair, gathered with the node–face terms.
+//! 4. **Node weights** (parallel): B_k per rule, from the node's faces.
+//! 5. **Distance part** (node order): each pull ε·s′_k·B_k is added to the
+//!    forces of the node's nearest pair, gathered with the node–face terms.
 //! 6. **Gather**: particle i adds −Φ_t·∂A_t/∂x_i over its faces, in face order.
 //!
 //! Every sum has a fixed order: bit-identical on any thread count.
@@ -32,7 +32,8 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::contact::{csr, face_corners, Candidates, ContactMesh};
+use super::contact::{csr, face_corners, push_pair_blocks, Candidates, ContactMesh};
+use super::stiffness::StiffnessBlock;
 use super::virial::{add6, outer};
 use crate::interactions::{node_face_forces, Law, Radial};
 use crate::mesh::triangle_area_gradient;
@@ -58,11 +59,11 @@ pub(super) struct Adhesion {
     area: Vec<f64>,
     gradient: Vec<[DVec3; 3]>,
     weight: Vec<f64>,
-    /// Per compact node k and rule j, at `k·rules + j`: s, s′ and the
-    /// nearest pair (`u32::MAX`: no candidate face), then its pull ε·s′·B.
+    /// Per compact node k and rule j, at `k·rules + j`: s, s′, s″ and the
+    /// nearest pair (`u32::MAX`: no candidate face), then B_k (0 where s′ = 0).
     switch: Vec<Radial>,
     nearest: Vec<u32>,
-    pull: Vec<f64>,
+    shared: Vec<f64>,
 }
 
 /// Switch s(d) (in `energy`, with s′ in `de_dr`) and density ε of contact
@@ -119,7 +120,7 @@ impl Adhesion {
             weight: vec![0.0; faces],
             switch: vec![Radial::ZERO; slots],
             nearest: vec![u32::MAX; slots],
-            pull: vec![0.0; slots],
+            shared: vec![0.0; slots],
             rules,
         }
     }
@@ -132,7 +133,7 @@ impl Adhesion {
         }
         let count = self.rules.len();
         let densities: Vec<f64> = self.rules.iter().map(|&r| density_of(model, r)).collect();
-        let Self { rules, between, body_types, face_nodes, offsets, corner_of, area, gradient, weight, switch, nearest, pull } = self;
+        let Self { rules, between, body_types, face_nodes, offsets, corner_of, area, gradient, weight, switch, nearest, shared } = self;
         area.par_iter_mut().zip(gradient.par_iter_mut()).zip(&mesh.faces).with_min_len(256).for_each(|((a, g), (corners, _))| {
             (*a, *g) = triangle_area_gradient(face_corners(x, images, *corners));
         });
@@ -162,24 +163,35 @@ impl Adhesion {
             *w = densities.iter().enumerate().map(|(j, eps)| eps * s(a, j) * s(b, j) * s(c, j)).sum();
         });
         let area = &*area;
-        pull.par_chunks_mut(count).enumerate().with_min_len(64).for_each(|(k, pull)| {
+        shared.par_chunks_mut(count).enumerate().with_min_len(64).for_each(|(k, shared)| {
             let p = mesh.nodes[k] as usize;
-            for (j, pull) in pull.iter_mut().enumerate() {
-                let slope = switch[k * count + j].de_dr;
-                *pull = if slope == 0.0 {
+            for (j, shared) in shared.iter_mut().enumerate() {
+                *shared = if switch[k * count + j].de_dr == 0.0 {
                     0.0
                 } else {
                     let others = |&[f, role]: &[u32; 2]| {
                         let corners = face_nodes[f as usize];
                         area[f as usize] * s(corners[(role as usize + 1) % 3], j) * s(corners[(role as usize + 2) % 3], j)
                     };
-                    densities[j] * slope * corner_of[offsets[p] as usize..offsets[p + 1] as usize].iter().map(others).sum::<f64>()
+                    corner_of[offsets[p] as usize..offsets[p + 1] as usize].iter().map(others).sum::<f64>()
                 };
             }
         });
-        for (&pair, &de_dd) in nearest.iter().zip(pull.iter()).filter(|(_, de_dd)| **de_dd != 0.0) {
+        for (slot, (&pair, &b)) in nearest.iter().zip(shared.iter()).enumerate().filter(|(_, (_, b))| **b != 0.0) {
+            let de_dd = densities[slot % count] * switch[slot].de_dr * b;
             let f = node_face_forces(&Radial { energy: 0.0, de_dr: de_dd, d2e_dr2: 0.0 }, &candidates.points[pair as usize]);
             candidates.forces[pair as usize].iter_mut().zip(f).for_each(|(a, b)| *a += b);
+        }
+    }
+
+    /// Appends each node's Gauss–Newton blocks per rule, max(ε·s″_k·B_k, 0)·g gᵀ
+    /// at its nearest pair ([`push_pair_blocks`]), in node and rule order, at
+    /// the last evaluation (the area part is left out: `src/backend/stiffness.rs`).
+    pub(super) fn stiffness(&self, model: &Model, mesh: &ContactMesh, candidates: &Candidates, blocks: &mut Vec<StiffnessBlock>) {
+        let densities: Vec<f64> = self.rules.iter().map(|&r| density_of(model, r)).collect();
+        for (slot, (&pair, &b)) in self.nearest.iter().zip(&self.shared).enumerate().filter(|(_, (_, b))| **b != 0.0) {
+            let curvature = densities[slot % self.rules.len()] * self.switch[slot].d2e_dr2 * b;
+            push_pair_blocks(mesh, candidates, pair as usize, curvature, blocks);
         }
     }
 

@@ -321,27 +321,17 @@ impl Contacts {
     }
 
     /// Appends each candidate pair's Gauss–Newton stiffness blocks
-    /// max(b″, 0)·g_a g_bᵀ, g = (n̂, −w_0 n̂, −w_1 n̂, −w_2 n̂) over (node, corners),
-    /// in pair order, at the positions of the last [`Self::prepare`] (see
-    /// `src/backend/stiffness.rs`). Area-weighted terms (adhesion) add none.
+    /// max(b″, 0)·g_a g_bᵀ ([`push_pair_blocks`]) in pair order, then the
+    /// area-weighted terms' (adhesion: per node and rule at its nearest pair),
+    /// at the positions of the last [`Self::prepare`] (see
+    /// `src/backend/stiffness.rs`).
     pub(super) fn stiffness(&self, model: &Model, blocks: &mut Vec<StiffnessBlock>) {
         for (k, pt) in self.candidates.points.iter().enumerate() {
             let curvature: f64 =
                 self.barriers_of(k, model).iter().map(|&r| radial(&model.contact_rules[r as usize], pt.distance).d2e_dr2).sum();
-            if curvature <= 0.0 {
-                continue;
-            }
-            let [node, face] = self.candidates.pairs[k];
-            let corners = self.mesh.faces[face as usize].0;
-            let nn = DMat3::from_cols(pt.normal * pt.normal.x, pt.normal * pt.normal.y, pt.normal * pt.normal.z) * curvature;
-            let particles = [self.mesh.nodes[node as usize], corners[0], corners[1], corners[2]];
-            let g = [1.0, -pt.weights[0], -pt.weights[1], -pt.weights[2]];
-            for a in 0..4 {
-                for b in 0..4 {
-                    blocks.push(StiffnessBlock { i: particles[a], j: particles[b], block: nn * (g[a] * g[b]) });
-                }
-            }
+            push_pair_blocks(&self.mesh, &self.candidates, k, curvature, blocks);
         }
+        self.adhesion.stiffness(model, &self.mesh, &self.candidates, blocks);
     }
 
     /// Energies per registry entry and the virial, pair by pair (d·n̂ ⊗ f_node)
@@ -355,6 +345,25 @@ impl Contacts {
             add6(virial, outer(pt.distance * pt.normal, self.candidates.forces[k][0]));
         }
         self.adhesion.energy(model, &self.mesh, x, images, energy, virial);
+    }
+}
+
+/// Appends the Gauss–Newton blocks c·g_a g_bᵀ of candidate pair `k` for a
+/// curvature c = ∂²E/∂d² > 0 (nothing for c ≤ 0), g = (n̂, −w_0 n̂, −w_1 n̂,
+/// −w_2 n̂) over (node, corner 0, corner 1, corner 2) at its closest point.
+pub(super) fn push_pair_blocks(mesh: &ContactMesh, candidates: &Candidates, k: usize, curvature: f64, blocks: &mut Vec<StiffnessBlock>) {
+    if curvature <= 0.0 {
+        return;
+    }
+    let (pt, [node, face]) = (&candidates.points[k], candidates.pairs[k]);
+    let corners = mesh.faces[face as usize].0;
+    let nn = DMat3::from_cols(pt.normal * pt.normal.x, pt.normal * pt.normal.y, pt.normal * pt.normal.z) * curvature;
+    let particles = [mesh.nodes[node as usize], corners[0], corners[1], corners[2]];
+    let g = [1.0, -pt.weights[0], -pt.weights[1], -pt.weights[2]];
+    for a in 0..4 {
+        for b in 0..4 {
+            blocks.push(StiffnessBlock { i: particles[a], j: particles[b], block: nn * (g[a] * g[b]) });
+        }
     }
 }
 

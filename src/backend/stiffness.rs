@@ -36,9 +36,7 @@
 //!     generalised Gauss–Newton term (4κ/A_i)·g gᵀ, g = ∇u_i − (u_i/A_i)·∇A_i
 //!     on node i's one-ring (analytic, PSD as it stands). Left out:
 //!     ∂E/∂M_i·∇²M_i + ∂E/∂A_i·∇²A_i, O(ℓ/R) of what is kept.
-//!
-//!   `contact_adhesion` adds no blocks: its area part and switch distances
-//!   enter the step through F only.
+
 //! - **Contact pairs between bodies** (node p, face corners x_k, distance d
 //!   to the closest point q = Σ w_k x_k): the Gauss–Newton block
 //!   max(b″, 0)·g gᵀ with g = ∂d/∂(p, x_0, x_1, x_2) = (n̂, −w_0 n̂, −w_1 n̂,
@@ -46,10 +44,26 @@
 //!   The dropped part b′·∂²d is negative semi-definite for a repulsive
 //!   barrier (b′ < 0): the projection would remove it anyway. The implicit
 //!   step also applies the contact step clamp.
+//! - **Adhesion** (`contact_adhesion`, E = ε·Σ_t A_t·s_a s_b s_c with
+//!   ε = −w): per node k and rule, the Gauss–Newton block of its distance,
+//!   max(∂²E/∂d_k², 0)·g_k g_kᵀ, ∂²E/∂d_k² = ε·s″(d_k)·B_k,
+//!   B_k = Σ_{t ∋ k} A_t·Π_{c ≠ k} s_c, g_k as for a contact pair at node
+//!   k's nearest pair. It is stiff (−w·s″ > 0) on the near half of the
+//!   switch zone, where s is concave, and clamped to 0 on the far half.
+//!   Left out: the area part ε·P_t·∇²A_t of each face (P_t = s_a s_b s_c),
+//!   a negative tension −w·P_t that lowers the stiffness γ·∇²A_t the face's
+//!   `surface_tension` blocks carry; alone it is indefinite like ∇²A_t, and
+//!   its projection would keep exactly the pieces that are the opposite of
+//!   what it does, so a contact face keeps its full tension's stiffness
+//!   (γ/(γ − w) of the exact one: stiffer, still ⪰ 0). Also left out: the
+//!   cross terms ε·s′_k s′_l·(…)·∇d_k∇d_lᵀ between corners of a face and the
+//!   area–distance terms ε·s′_k·(…)·∇A_t∇d_kᵀ (indefinite), and the pull
+//!   ε·s′_k·B_k·∇²d_k.
 //!
 //! Blocks come in term order (bonds, angles, pairs by particle and ascending
-//! neighbour, contact pairs, externals, then bodies by body, term and
-//! stencil), so the assembled matrix is the same on any thread count.
+//! neighbour, contact pairs, adhesion by node and rule, externals, then
+//! bodies by body, term and stencil), so the assembled matrix is the same on
+//! any thread count.
 
 use faer::Mat;
 use glam::{DMat3, DVec3};
