@@ -572,15 +572,19 @@ impl GpuBackend {
         match over {
             Over::Groups(groups) => direct(pass, groups),
             Over::Particles => direct(pass, self.params.n.div_ceil(WORKGROUP)),
-            Over::Chunks => {
-                for c in 0..self.nlist.chunks {
-                    pass.set_bind_group(0, &self.main_group, &self.nlist.offsets(c));
-                    direct(pass, self.nlist.per_chunk.div_ceil(WORKGROUP));
-                }
-                if self.nlist.chunks > 1 {
-                    pass.set_bind_group(0, &self.main_group, &self.nlist.offsets(0));
-                }
-            }
+            Over::Chunks => self.per_chunk(pass, |pass| direct(pass, self.nlist.per_chunk.div_ceil(WORKGROUP))),
+        }
+    }
+
+    /// Runs `dispatch` once per neighbour-list chunk with that chunk bound,
+    /// then binds chunk 0 again (what every other kernel sees).
+    fn per_chunk(&self, pass: &mut wgpu::ComputePass, mut dispatch: impl FnMut(&mut wgpu::ComputePass)) {
+        for c in 0..self.nlist.chunks {
+            pass.set_bind_group(0, &self.main_group, &self.nlist.offsets(c));
+            dispatch(pass);
+        }
+        if self.nlist.chunks > 1 {
+            pass.set_bind_group(0, &self.main_group, &self.nlist.offsets(0));
         }
     }
 
@@ -605,10 +609,7 @@ impl GpuBackend {
             indirect(pass, &k.scan_add, 1);
             indirect(pass, &k.scatter, 0);
             indirect(pass, &k.sort, 1);
-            for c in 0..self.nlist.chunks {
-                pass.set_bind_group(0, &self.main_group, &self.nlist.offsets(c));
-                indirect(pass, &k.build, 3);
-            }
+            self.per_chunk(pass, |pass| indirect(pass, &k.build, 3));
         }
         self.dispatch(pass, &k.forces, Over::Chunks);
         if integrate {

@@ -73,7 +73,7 @@ impl NeighbourStorage {
             let first = c * per_chunk;
             let slot = (c * CHUNK_UNIFORM_STRIDE / 4) as usize;
             info[slot] = first as u32;
-            info[slot + 1] = (per_chunk.min(n as u64 - first.min(n as u64))) as u32;
+            info[slot + 1] = per_chunk.min((n as u64).saturating_sub(first)) as u32;
         }
         let list = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("nlist"),
