@@ -44,6 +44,7 @@ PARAMS = {
     "turgor_log": {"cell": dict(k=40.0, dp0=2.0, v0=1.15), "nucleus": dict(k=60.0, dp0=0.0, v0=0.85)},
     "surface_tension": {"cell": dict(gamma=2.0), "nucleus": dict(gamma=3.5)},
     "area_conservation": {"cell": dict(ka=20.0, kl=10.0, a0=0.9), "nucleus": dict(ka=10.0, kl=15.0, a0=1.05)},
+    "surface_shear": {"cell": dict(k=0.8), "nucleus": dict(k=1.3)},
     "helfrich_bending": {"cell": dict(kappa=1.5, c0=0.4), "nucleus": dict(kappa=0.8, c0=-0.7)},
 }
 DRAG = {"a": 1.0, "b": 2.5}
@@ -183,6 +184,11 @@ def energy_numpy(name, p, x, faces):
     if name == "area_conservation":
         at0 = p["a0"] / len(faces)
         return 0.5 * p["ka"] * (areas.sum() - p["a0"]) ** 2 / p["a0"] + 0.5 * p["kl"] * ((areas - at0) ** 2 / at0).sum()
+    if name == "surface_shear":
+        f = np.array(faces)
+        a, b, c = x[f[:, 0]], x[f[:, 1]], x[f[:, 2]]
+        squares = ((b - a) ** 2).sum(axis=1) + ((c - b) ** 2).sum(axis=1) + ((a - c) ** 2).sum(axis=1)
+        return p["k"] * (squares / (4.0 * math.sqrt(3.0) * areas) - 1.0).sum()
     if name == "helfrich_bending":
         m = np.zeros(len(x))
         a = np.zeros(len(x))
@@ -261,6 +267,15 @@ def add_terms(system, name, bodies, group):
         for _, _, faces, nodes, p in bodies:
             for a, b, c in faces:
                 f.addBond([nodes[a], nodes[b], nodes[c]], [p["gamma"]])
+        f.setForceGroup(group)
+        system.addForce(f)
+        return
+    if name == "surface_shear":
+        shape = "(distance(p1,p2)^2+distance(p2,p3)^2+distance(p3,p1)^2)"
+        f = face_force(f"k*({shape}/(4*sqrt(3)*{area_expr(1, 2, 3)})-1)", ["k"])
+        for _, _, faces, nodes, p in bodies:
+            for a, b, c in faces:
+                f.addBond([nodes[a], nodes[b], nodes[c]], [p["k"]])
         f.setForceGroup(group)
         system.addForce(f)
         return
@@ -467,7 +482,7 @@ def main():
                 ("generator", f"OpenMM {mm.__version__} (Reference platform, double precision) via reference/openmm_surfaces.py"),
                 ("date", args.date), ("case", case), ("deck", f"{name}/{case}.in"),
                 ("epsilon", "1e-10"), ("run_epsilon", "1e-9"),
-                ("epsilon_reason", "OpenMM differentiates the same f64 formulas symbolically (Lepton; CustomCVForce by the chain rule) and sums in another order: measured <= 9.4e-15 relative on every case (tests/golden.rs); 1e-10 leaves margin for other compilers and libm versions"),
+                ("epsilon_reason", "OpenMM differentiates the same f64 formulas symbolically (Lepton; CustomCVForce by the chain rule) and sums in another order: measured <= 1.1e-14 relative on every case (tests/golden.rs); 1e-10 leaves margin for other compilers and libm versions"),
                 ("run_epsilon_reason", "after 100 overdamped Euler steps (OpenMM CustomIntegrator x <- x + dt*f/gamma) round-off has accumulated over every step (positions relative to the largest displacement, forces and energies to the largest value met): measured <= 1.1e-12; 1e-9 leaves margin for chaotic growth of round-off"),
             ]
             docs.append(document(header, [("init", init), ("run", last)]))

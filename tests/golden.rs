@@ -199,7 +199,7 @@ fn surface_golden_files_tell_a_perturbed_term_apart() {
             checked += 1;
         }
     }
-    assert_eq!(checked, 10);
+    assert_eq!(checked, 12);
 }
 
 /// The LAMMPS inputs committed beside each case are what `cellmd
@@ -237,7 +237,7 @@ fn committed_lammps_inputs_are_current_exports() {
             }
         }
     }
-    assert_eq!(openmm, 10, "expected two OpenMM cases for each of the five surface types");
+    assert_eq!(openmm, 12, "expected two OpenMM cases for each of the six surface types");
 }
 
 /// Each name has `reference/NAME.yaml` or a row `| `NAME` | reason | `test` |`

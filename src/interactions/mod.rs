@@ -96,6 +96,7 @@ mod lj;
 mod soft;
 mod soft_repulsion;
 mod spring;
+mod surface_shear;
 mod surface_tension;
 mod turgor;
 mod turgor_log;
@@ -124,6 +125,7 @@ pub static REGISTRY: &[&dyn Interaction] = &[
     &turgor_log::TurgorLog,
     &surface_tension::SurfaceTension,
     &area_conservation::AreaConservation,
+    &surface_shear::SurfaceShear,
     &helfrich_bending::HelfrichBending,
     &contact_barrier::ContactBarrier,
     &contact_adhesion::ContactAdhesion,
