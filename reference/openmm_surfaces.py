@@ -262,20 +262,16 @@ def helfrich_expr(n):
 
 def add_terms(system, name, bodies, group):
     """Adds the OpenMM forces of interaction `name` on `bodies` [(type, x, faces, nodes, params)]."""
-    if name == "surface_tension":
-        f = face_force(f"gamma*{area_expr(1, 2, 3)}", ["gamma"])
+    # Energies that are a sum over faces of one expression with one parameter.
+    shape = "(distance(p1,p2)^2+distance(p2,p3)^2+distance(p3,p1)^2)"
+    per_face = {"surface_tension": (f"gamma*{area_expr(1, 2, 3)}", "gamma"),
+                "surface_shear": (f"k*({shape}/(4*sqrt(3)*{area_expr(1, 2, 3)})-1)", "k")}
+    if name in per_face:
+        expression, key = per_face[name]
+        f = face_force(expression, [key])
         for _, _, faces, nodes, p in bodies:
             for a, b, c in faces:
-                f.addBond([nodes[a], nodes[b], nodes[c]], [p["gamma"]])
-        f.setForceGroup(group)
-        system.addForce(f)
-        return
-    if name == "surface_shear":
-        shape = "(distance(p1,p2)^2+distance(p2,p3)^2+distance(p3,p1)^2)"
-        f = face_force(f"k*({shape}/(4*sqrt(3)*{area_expr(1, 2, 3)})-1)", ["k"])
-        for _, _, faces, nodes, p in bodies:
-            for a, b, c in faces:
-                f.addBond([nodes[a], nodes[b], nodes[c]], [p["k"]])
+                f.addBond([nodes[a], nodes[b], nodes[c]], [p[key]])
         f.setForceGroup(group)
         system.addForce(f)
         return

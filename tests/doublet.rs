@@ -4,9 +4,9 @@
 //!
 //! **Setup.** Two icosphere meshes of level L (R = 2 µm: a sphere's volume),
 //! γ = 100 pN/µm, turgor K = 2000 Pa with ΔP0 = 2γA/(3V) (each cell alone is
-//! in equilibrium at its initial volume), `area_conservation kl 100` (keeps
-//! the fluid surface's triangulation even; a uniform stretch ε adds
-//! 100·ε pN/µm to every face, contact or free). The discretisation lengths
+//! in equilibrium at its initial volume), `surface_shear` with shear
+//! modulus μ = 2γ (k = μ·a, a the mean face area: keeps the fluid surface's
+//! triangulation even without adding tension). The discretisation lengths
 //! follow the mesh edge ℓ: barrier d̂ = ℓ/6 with κ such that the barrier
 //! carries the pressure load of a node at d ≈ d̂/2, switch d_on = d̂,
 //! d_off = d̂ + ℓ. Each doublet starts as two truncated spheres (mapped
@@ -23,29 +23,34 @@
 //! hemispheres). θ is the mean of the two cells.
 //!
 //! **Discretisation.** The rim of the contact moves only as nodes zip into
-//! or out of contact, and the face-area regulariser remembers the mesh's
-//! history, so the contact line pins: the advancing and receding angles
-//! differ by up to 10° (contact-angle hysteresis of the mesh), while their
-//! midpoint converges to Young–Dupré as the mesh is refined (measured
-//! |midpoint − θ_YD| ≤ 2.2° at level 2, ≤ 0.75° at level 3).
-//! `cargo test --release --test doublet -- --ignored --nocapture` prints the
-//! table for levels 2 and 3 (in the README). At w/γ = 0.75 the mesh degrades
-//! (faces collapse at the rim) and the angle is wrong: that row is reported,
-//! not asserted.
+//! or out of contact, so it can pin: the advancing and receding angles
+//! differ (contact-angle hysteresis of the mesh) and their midpoint is the
+//! estimate. Across the adhesion switch the tension falls from γ to γ − w
+//! within one edge, which pulls nodes along the surface; the shear
+//! regulariser carries that pull (at some cost in angle: it resists the
+//! spreading), where `area_conservation kl 100`, used before, let faces
+//! collapse at w/γ = 0.75. Measured (README table): |midpoint − θ_YD| ≤ 2.6°
+//! at level 2 and ≤ 1.5° at level 3, bands ≤ 2.8°, smallest face ≥ 0.40 of
+//! the mean. `cargo test --release --test doublet -- --ignored --nocapture`
+//! prints the table for levels 2 and 3.
 //!
-//! The CI test runs level 2 for w/γ = 0.1, 0.25, 0.5: the midpoint is within
-//! 2.5° of θ_YD (the level-2 error measured, ≤ 2.2°), each band is at most 8°
-//! wide (measured ≤ 7.2°), the midpoints rise with w, and the mesh stays
-//! healthy (smallest face ≥ ¼ of the mean; measured ≥ 0.51). Seed 000's
-//! factor-2 reading (cos θ = 1 − w/(2γ): 18.2°, 29.0°, 41.4°) fails it.
+//! The CI test runs level 2 for w/γ = 0.1, 0.25, 0.5, 0.75: the midpoint is
+//! within 3° of θ_YD (the level-2 error measured, ≤ 2.63°), each band is at
+//! most 4° wide (measured ≤ 2.8°), the midpoints rise with w, and the mesh
+//! stays healthy (smallest face ≥ 0.4 of the mean; measured ≥ 0.48). Seed
+//! 000's factor-2 reading (cos θ = 1 − w/(2γ): 18.2°, 29.0°, 41.4°, 51.3°)
+//! fails it.
 //!
 //! **Implicit step** (issue #6: `contact_adhesion`'s stiffness blocks). The
-//! advancing doublet at w/γ = 0.25 relaxed by `integrator implicit` at 10×
-//! the explicit dt settles within 0.5° of the explicit angle (measured
-//! 38.944° vs 38.835°; 38.948° before the blocks), and at 1000× (0.27 s)
-//! within 5° (measured +4.61°; before the blocks it did not settle within
-//! 100 steps). `-- --ignored implicit_doublet_time_step_table` prints the
-//! sweep from 1× to 30000× (in the README).
+//! advancing doublet at w/γ = 0.25, regularised by `area_conservation kl
+//! 100` as when the README's table was measured, relaxed by `integrator
+//! implicit` at 10× the explicit dt settles within 0.5° of the explicit
+//! angle (measured 38.944° vs 38.835°; 38.948° before the blocks), and at
+//! 1000× (0.27 s) within 5° (measured +4.61°; before the blocks it did not
+//! settle within 100 steps). With `surface_shear` instead, the 10× run
+//! settles at 37.50° against the explicit 38.83° (−1.3°: the shear-held rim
+//! pins on the path the larger steps take). `-- --ignored
+//! implicit_doublet_time_step_table` prints the sweep from 1× to 30000×.
 
 mod common;
 
@@ -59,7 +64,30 @@ use glam::{DMat4, DVec3, DVec4};
 const RADIUS: f64 = 2.0;
 const GAMMA: f64 = 100.0;
 const TURGOR_K: f64 = 2000.0;
+/// Shear modulus of the `surface_shear` mesh regulariser, pN/µm (2γ).
+const MU: f64 = 200.0;
+/// Per-face area modulus of the `area_conservation` regulariser that the
+/// implicit-step tests keep (their README table was measured with it), pN/µm.
 const KL: f64 = 100.0;
+
+/// How the fluid surface's triangulation is kept even.
+#[derive(Clone, Copy, Debug)]
+enum Regulariser {
+    /// `surface_shear` with μ = [`MU`]: the Young–Dupré sweep.
+    Shear,
+    /// `area_conservation kl` [`KL`]: the implicit-step tests.
+    FaceArea,
+}
+
+impl Regulariser {
+    /// The force-field line for a body of area `a0` with `faces` faces.
+    fn line(self, a0: f64, faces: f64) -> String {
+        match self {
+            Regulariser::Shear => format!("body cell surface_shear k {:?}\n", MU * a0 / faces),
+            Regulariser::FaceArea => format!("body cell area_conservation kl {KL} a0 {a0:?}\n"),
+        }
+    }
+}
 
 /// The discretisation lengths and the time step of a level.
 #[derive(Clone, Copy, Debug)]
@@ -203,12 +231,12 @@ struct Relaxed {
 
 /// Relaxes the doublet of `level` with w = `w_over_gamma`·γ from contact angle `theta0` (degrees).
 fn relax(level: u32, w_over_gamma: f64, theta0: f64) -> Relaxed {
-    relax_with(level, w_over_gamma, theta0, "", Lengths::of(level).dt).unwrap_or_else(|e| panic!("{e}"))
+    relax_with(level, w_over_gamma, theta0, Regulariser::Shear, "", Lengths::of(level).dt).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// [`relax`] with deck lines `integrator` (e.g. `integrator implicit`) at time step `dt`: an error
 /// where the run fails or does not settle.
-fn relax_with(level: u32, w_over_gamma: f64, theta0: f64, integrator: &str, dt: f64) -> Result<Relaxed, String> {
+fn relax_with(level: u32, w_over_gamma: f64, theta0: f64, regulariser: Regulariser, integrator: &str, dt: f64) -> Result<Relaxed, String> {
     let l = Lengths::of(level);
     let (on, off) = (l.dhat, l.dhat + l.edge);
     let top = doublet_topology(level, theta0.to_radians(), 0.5 * l.dhat);
@@ -224,10 +252,10 @@ fn relax_with(level: u32, w_over_gamma: f64, theta0: f64, integrator: &str, dt: 
     let (v0, a0) = sim.model.body_volume_and_area(0, &sim.state.positions, &sim.sim_box.images());
     let ff = format!(
         "particle node drag 1\nbody cell turgor k {TURGOR_K} dp0 {:?} v0 {v0:?}\nbody cell surface_tension gamma {GAMMA}\n\
-         body cell area_conservation kl {} a0 {a0:?}\ncontact cell cell contact_barrier dhat {:?} kappa {:?}\n\
+         {}contact cell cell contact_barrier dhat {:?} kappa {:?}\n\
          contact cell cell contact_adhesion w {:?} d_on {on:?} d_off {off:?}\n",
         2.0 * GAMMA * a0 / (3.0 * v0),
-        KL,
+        regulariser.line(a0, 20.0 * 4f64.powi(level as i32)),
         l.dhat,
         l.kappa,
         w_over_gamma * GAMMA,
@@ -292,31 +320,38 @@ fn young_dupre_sweep_table() {
 #[test]
 fn doublet_contact_angles_follow_young_dupre() {
     let mut last = 0.0;
-    for w in [0.1, 0.25, 0.5] {
+    for w in [0.1, 0.25, 0.5, 0.75] {
         let (oracle, advancing, receding) = sweep_row(2, w);
         let midpoint = 0.5 * (advancing.theta + receding.theta);
         for (start, r) in [("advancing", advancing), ("receding", receding)] {
-            assert!(r.smallest_face > 0.25, "w/γ = {w}, {start}: a face shrank to {:.3} of the mean", r.smallest_face);
+            assert!(r.smallest_face > 0.4, "w/γ = {w}, {start}: a face shrank to {:.3} of the mean", r.smallest_face);
             assert!(r.asymmetry < 1.0, "w/γ = {w}, {start}: the two cells differ by {:.2}°", r.asymmetry);
         }
-        assert!((midpoint - oracle).abs() < 2.5, "w/γ = {w}: midpoint {midpoint:.2}° vs Young–Dupré {oracle:.2}°");
-        assert!(receding.theta - advancing.theta < 8.0, "w/γ = {w}: band {:.2}°–{:.2}°", advancing.theta, receding.theta);
+        assert!((midpoint - oracle).abs() < 3.0, "w/γ = {w}: midpoint {midpoint:.2}° vs Young–Dupré {oracle:.2}°");
+        assert!((receding.theta - advancing.theta).abs() < 4.0, "w/γ = {w}: band {:.2}°–{:.2}°", advancing.theta, receding.theta);
         assert!(midpoint > last, "w/γ = {w}: the angle did not grow with adhesion ({midpoint:.2}° after {last:.2}°)");
         last = midpoint;
     }
+}
+
+/// The explicit reference of the implicit-step tests: w/γ = 0.25 from
+/// θ_YD − 10° at level 2 with the face-area regulariser.
+fn explicit_doublet() -> Relaxed {
+    let (w, dt) = (0.25, Lengths::of(2).dt);
+    relax_with(2, w, young_dupre(w) - 10.0, Regulariser::FaceArea, "", dt).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// The implicit step at `factor` × the explicit time step, w/γ = 0.25 from
 /// θ_YD − 10° at level 2 (the advancing case), or why it failed.
 fn implicit_doublet(factor: f64) -> Result<Relaxed, String> {
     let (w, dt) = (0.25, Lengths::of(2).dt);
-    relax_with(2, w, young_dupre(w) - 10.0, "integrator implicit", factor * dt)
+    relax_with(2, w, young_dupre(w) - 10.0, Regulariser::FaceArea, "integrator implicit", factor * dt)
 }
 
 #[test]
 #[ignore]
 fn implicit_doublet_time_step_table() {
-    let explicit = relax(2, 0.25, young_dupre(0.25) - 10.0);
+    let explicit = explicit_doublet();
     println!("explicit dt {:.3e} s: θ = {:.3}°, {} steps", Lengths::of(2).dt, explicit.theta, explicit.steps);
     for factor in [1.0, 3.0, 10.0, 30.0, 100.0, 300.0, 1000.0, 3000.0, 10000.0, 30000.0] {
         match implicit_doublet(factor) {
@@ -338,7 +373,7 @@ fn implicit_doublet_time_step_table() {
 /// step after 100 steps.
 #[test]
 fn the_implicit_step_settles_the_doublet_at_the_explicit_angle() {
-    let explicit = relax(2, 0.25, young_dupre(0.25) - 10.0);
+    let explicit = explicit_doublet();
     for (factor, tolerance) in [(10.0, 0.5), (1000.0, 5.0)] {
         let r = implicit_doublet(factor).unwrap_or_else(|e| panic!("{factor}× the explicit dt: {e}"));
         println!("{factor}× dt: θ = {:.3}° vs explicit {:.3}°, {} steps", r.theta, explicit.theta, r.steps);
