@@ -248,7 +248,7 @@ fn main() -> ExitCode {
                 rayon::current_num_threads()
             );
             let started = std::time::Instant::now();
-            match Simulation::execute(&plan, options) {
+            match Simulation::execute(plan, options) {
                 Ok(sim) => {
                     println!("done: {} steps in {:.2} s", sim.state.step, started.elapsed().as_secs_f64());
                     ExitCode::SUCCESS

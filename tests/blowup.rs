@@ -9,7 +9,7 @@ use common::Case;
 
 fn run_to_error(case: &Case) -> RunError {
     let plan = validate_file(&case.path("deck.in"), &[]).unwrap();
-    match Simulation::execute(&plan, RunOptions { output_dir: case.output_dir().to_path_buf(), ..Default::default() }) {
+    match Simulation::execute(plan, RunOptions { output_dir: case.output_dir().to_path_buf(), ..Default::default() }) {
         Ok(_) => panic!("the run should blow up"),
         Err(e) => e,
     }
@@ -84,7 +84,7 @@ fn coincident_particles_on_a_slack_bond_are_not_a_blowup() {
     let stretched = Case::new(&[("t.top", top), ("f.ff", "particle a drag 1\nbond s harmonic k 10 r0 1\n"), ("deck.in", deck)]);
     let plan = stretched.plan();
     let options = RunOptions { output_dir: stretched.output_dir().to_path_buf(), ..Default::default() };
-    let error = Simulation::execute(&plan, options).err().expect("a blow-up").to_string();
+    let error = Simulation::execute(plan, options).err().expect("a blow-up").to_string();
     assert!(error.contains("non-finite force") && error.contains("harmonic"), "{error}");
 }
 

@@ -325,7 +325,7 @@ fn restarts_keep_per_bond_rest_lengths() {
     assert_eq!(rest[1], Some(0.6), "the unchanging bond keeps its own r0");
     assert!(rest[0].unwrap() > 0.5 * 1.1, "the plastic bond reset from its own r0 0.5: {:?}", rest[0]);
     let plan = validate_file(&case.path("again.in"), &[]).unwrap();
-    let again = Simulation::execute(&plan, RunOptions { output_dir: case.path(""), ..Default::default() }).unwrap();
+    let again = Simulation::execute(plan, RunOptions { output_dir: case.path(""), ..Default::default() }).unwrap();
     assert_eq!(bits(&again), bits(&whole));
     assert_eq!(again.state.bonds, whole.state.bonds);
 }

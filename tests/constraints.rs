@@ -35,7 +35,7 @@ fn chain(n: usize, anchors: usize, integrator: &str, dt: f64, steps: u64, load: 
 }
 
 fn run(case: &Case) -> Simulation {
-    Simulation::execute(&case.plan(), RunOptions { output_dir: case.output_dir().to_path_buf(), ..Default::default() }).unwrap()
+    Simulation::execute(case.plan(), RunOptions { output_dir: case.output_dir().to_path_buf(), ..Default::default() }).unwrap()
 }
 
 fn worst_length_error(sim: &Simulation) -> f64 {

@@ -127,7 +127,7 @@ fn the_same_deck_twice_writes_identical_files() {
     let (one, two) = (deck(body), deck(body));
     for case in [&one, &two] {
         let plan = case.plan();
-        Simulation::execute(&plan, RunOptions { output_dir: case.output_dir().to_path_buf(), ..Default::default() }).unwrap();
+        Simulation::execute(plan, RunOptions { output_dir: case.output_dir().to_path_buf(), ..Default::default() }).unwrap();
     }
     for file in ["a.mcap", "t.csv"] {
         assert_eq!(std::fs::read(one.path(file)).unwrap(), std::fs::read(two.path(file)).unwrap(), "{file} differs");

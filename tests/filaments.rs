@@ -211,7 +211,7 @@ fn thermal_filaments_keep_the_worm_like_chain_statistics() {
                 temperature 1\nseed 11\ntimestep 0.0005\nrun 8000\n";
     let case = Case::new(&[("t.top", &(top + &bonds + &angles)), ("f.ff", &ff), ("deck.in", deck)]);
     let options = cellmd::run::RunOptions { output_dir: case.output_dir().to_path_buf(), ..Default::default() };
-    let sim = cellmd::run::Simulation::execute(&case.plan(), options).unwrap();
+    let sim = cellmd::run::Simulation::execute(case.plan(), options).unwrap();
     let x = &sim.state.positions;
     let per = segments + 1;
     let (mut cos_sum, mut joints, mut r2, mut l1, mut l2) = (0.0, 0.0, 0.0, 0.0, 0.0);

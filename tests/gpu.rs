@@ -320,7 +320,7 @@ fn every_input_deck_runs_on_the_gpu_like_on_the_cpu() {
             // A CPU-only feature: the GPU must refuse the deck with the reason.
             let dir = tempfile::tempdir().unwrap();
             let options = RunOptions { output_dir: dir.path().to_path_buf(), device: Some(DevicePreference::Gpu), ..Default::default() };
-            let refusal = Simulation::execute(&plan, options).err().map(|e| e.to_string()).unwrap_or_default();
+            let refusal = Simulation::execute(plan.clone(), options).err().map(|e| e.to_string()).unwrap_or_default();
             assert!(refusal.contains(why), "{}: expected the GPU to refuse with {why:?}, got {refusal:?}", deck.display());
             refused += 1;
             continue;
@@ -566,7 +566,7 @@ fn kinetics_decks_give_the_same_events_on_the_gpu() {
         let run = |device: DevicePreference| {
             let dir = tempfile::tempdir().unwrap();
             let options = RunOptions { output_dir: dir.path().to_path_buf(), device: Some(device), ..Default::default() };
-            let sim = Simulation::execute(&plan, options).unwrap_or_else(|e| panic!("{} on {device:?}: {e}", deck.display()));
+            let sim = Simulation::execute(plan.clone(), options).unwrap_or_else(|e| panic!("{} on {device:?}: {e}", deck.display()));
             let events: Vec<String> = std::fs::read_dir(dir.path())
                 .unwrap()
                 .map(|e| e.unwrap().path())
@@ -636,7 +636,7 @@ fn evolving_bonds_follow_the_cpu_on_the_gpu() {
     let plan = case.plan();
     let run = |device: DevicePreference| {
         let options = RunOptions { output_dir: case.output_dir().to_path_buf(), device: Some(device), ..Default::default() };
-        Simulation::execute(&plan, options).unwrap().state
+        Simulation::execute(plan.clone(), options).unwrap().state
     };
     let (start, cpu, gpu) = (Simulation::new(&plan, RunOptions::default()).state, run(DevicePreference::Cpu), run(DevicePreference::Gpu));
     let travelled = (0..start.len()).map(|i| (cpu.positions[i] - start.positions[i]).length()).fold(0.0, f64::max);

@@ -35,7 +35,7 @@ fn cantilever(integrator: &str, dt: f64, steps: u64) -> Case {
 }
 
 fn run(case: &Case) -> Result<Simulation, RunError> {
-    Simulation::execute(&case.plan(), RunOptions { output_dir: case.output_dir().to_path_buf(), ..Default::default() })
+    Simulation::execute(case.plan(), RunOptions { output_dir: case.output_dir().to_path_buf(), ..Default::default() })
 }
 
 /// The explicit stability limit of the bending stencil, γℓ³/(8κ).

@@ -21,7 +21,7 @@ fn every_input_deck_runs_shortened() {
         }
         let out = tempfile::tempdir().unwrap();
         let plan = validate_file(&path, &shortened()).unwrap_or_else(|e| panic!("{e}"));
-        Simulation::execute(&plan, RunOptions { output_dir: out.path().to_path_buf(), ..Default::default() })
+        Simulation::execute(plan, RunOptions { output_dir: out.path().to_path_buf(), ..Default::default() })
             .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         decks += 1;
     }
@@ -32,7 +32,7 @@ fn every_input_deck_runs_shortened() {
 fn quickstart_writes_thermo_and_a_foxglove_mcap() {
     let out = tempfile::tempdir().unwrap();
     let plan = validate_file(Path::new("inputs/quickstart.in"), &shortened()).unwrap();
-    let sim = Simulation::execute(&plan, RunOptions { output_dir: out.path().to_path_buf(), ..Default::default() }).unwrap();
+    let sim = Simulation::execute(plan, RunOptions { output_dir: out.path().to_path_buf(), ..Default::default() }).unwrap();
     assert_eq!(sim.state.step, 400);
 
     let thermo = std::fs::read_to_string(out.path().join("quickstart.thermo.csv")).unwrap();

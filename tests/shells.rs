@@ -213,7 +213,7 @@ fn body_terms_are_deterministic_and_refused_on_the_gpu() {
     assert_eq!(position_bits(&one), position_bits(&two));
     assert!(one.state.positions.iter().zip(&plan.positions).any(|(a, b)| (*a - *b).length() > 1e-3));
     let gpu = Simulation::execute(
-        &plan,
+        plan,
         RunOptions { output_dir: case.output_dir().to_path_buf(), device: Some(DevicePreference::Gpu), ..Default::default() },
     );
     let refusal = gpu.err().map(|e| e.to_string()).unwrap_or_default();
@@ -281,7 +281,7 @@ fn cellmd_build_icosphere_writes_a_runnable_cell() {
 fn single_cell_deck_writes_a_foxglove_scene_of_its_surface() {
     let out = tempfile::tempdir().unwrap();
     let plan = validate_file(std::path::Path::new("inputs/single_cell.in"), &[("steps".into(), "1000".into())]).unwrap();
-    Simulation::execute(&plan, RunOptions { output_dir: out.path().to_path_buf(), ..Default::default() }).unwrap();
+    Simulation::execute(plan, RunOptions { output_dir: out.path().to_path_buf(), ..Default::default() }).unwrap();
     let bytes = std::fs::read(out.path().join("single_cell.mcap")).unwrap();
     let scenes: Vec<serde_json::Value> = mcap::MessageStream::new(&bytes)
         .unwrap()

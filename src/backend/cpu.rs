@@ -36,9 +36,10 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::bonded::Bonded;
+use super::candidates::Near;
 use super::contact::Contacts;
 use super::newton::{Newton, Scatter, BLOCK};
-use super::pair_table::{Near, PairGeometry, PairTable};
+use super::pair_table::{PairGeometry, PairTable};
 use super::surface::Surfaces;
 use super::virial::add6;
 use crate::interactions::{Law, REGISTRY};
@@ -391,7 +392,7 @@ impl ScatterTerms<'_> {
     fn scatter<const ENERGY: bool>(&self, newton: &mut Newton, forces: &mut [DVec3], columns: usize) -> Option<(Vec<f64>, [f64; 6])> {
         let PairGeometry { x, images, .. } = self.geometry;
         let rows = |range: std::ops::Range<usize>, scatter: &mut Scatter, energy: &mut [f64], virial: &mut [f64; 6]| {
-            let mut near = Near::default();
+            let mut near = Near::new();
             for i in range {
                 if let Some(pairs) = self.pairs {
                     pairs.row_forces::<ENERGY>(i, self.geometry, &mut near, energy, virial, |j, f| scatter.pair(i, j, f));

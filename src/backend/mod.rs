@@ -3,6 +3,7 @@
 
 mod adhesion;
 mod bonded;
+mod candidates;
 mod contact;
 pub mod cpu;
 mod newton;

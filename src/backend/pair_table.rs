@@ -19,6 +19,7 @@
 
 use glam::DVec3;
 
+use super::candidates::{Near, BATCH};
 use super::virial::{add6, outer};
 use crate::interactions::{Law, Radial};
 use crate::neighbor::NeighborList;
@@ -35,41 +36,6 @@ struct Kernel {
     cutoff: f64,
     /// Column of this rule's interaction among the pair interactions in use.
     column: u32,
-}
-
-/// Candidates per batch of [`PairTable::row_forces`].
-const BATCH: usize = 64;
-
-/// Scratch of [`PairTable::row_forces`]: one batch's candidates within
-/// reach (partner, separation, r²). One per block of rows, on the stack.
-pub(super) struct Near {
-    j: [u32; BATCH],
-    d: [DVec3; BATCH],
-    r2: [f64; BATCH],
-}
-
-impl Near {
-    /// Keeps the candidates of `batch` within reach of x_i (r² < `reach2(j)`),
-    /// in order, without a branch; returns how many.
-    #[inline(always)]
-    fn keep(&mut self, batch: &[u32], xi: DVec3, x: &[DVec3], images: &Images, reach2: impl Fn(u32) -> f64) -> usize {
-        let mut kept = 0;
-        for &j in batch {
-            let d = images.minimum_image(x[j as usize] - xi);
-            let r2 = d.length_squared();
-            self.j[kept] = j;
-            self.d[kept] = d;
-            self.r2[kept] = r2;
-            kept += usize::from(r2 < reach2(j));
-        }
-        kept
-    }
-}
-
-impl Default for Near {
-    fn default() -> Self {
-        Self { j: [0; BATCH], d: [DVec3::ZERO; BATCH], r2: [0.0; BATCH] }
-    }
 }
 
 /// What the pair loop reads: positions, types, the neighbour list, the box.
@@ -159,10 +125,8 @@ impl PairTable {
     /// column of `energy` and r_ij ⊗ f_ij to `virial`; the forces are the
     /// same bits either way.
     ///
-    /// The row is walked in batches: first every candidate's separation and
-    /// r², keeping those within reach without a branch (most candidates of
-    /// a list with a skin are out of reach, in no predictable pattern), then
-    /// the laws on the kept ones.
+    /// The row is walked in batches: first the candidates within reach
+    /// ([`Near::keep`], see [`super::candidates`]), then the laws on those.
     #[inline(always)]
     pub(super) fn row_forces<const ENERGY: bool>(
         &self,
@@ -182,8 +146,8 @@ impl PairTable {
                 [reach2] => near.keep(batch, xi, x, images, |_| reach2),
                 _ => near.keep(batch, xi, x, images, |j| self.skip2[row + types[j as usize] as usize]),
             };
-            for k in 0..kept {
-                let (j, d, r2) = (near.j[k] as usize, near.d[k], near.r2[k]);
+            for &k in near.kept(kept) {
+                let (j, (d, r2)) = (batch[k as usize] as usize, near.separation(k as usize));
                 let mut over_r = 0.0;
                 for kernel in self.kernels_of(row + types[j] as usize) {
                     over_r += (kernel.force)(self.params_of(kernel), r2);

@@ -99,19 +99,27 @@ pub struct Simulation {
 }
 
 impl Simulation {
-    /// A simulation at the plan's initial state (positions wrapped into the box).
+    /// A simulation at the plan's initial state (positions wrapped into the
+    /// box), on copies of the plan's model and positions; [`Self::execute`]
+    /// takes them instead.
     pub fn new(plan: &Plan, options: RunOptions) -> Self {
-        let mut state = State::new(plan.positions.clone());
+        Self::start(plan.model.clone(), plan.sim_box, plan.positions.clone(), &plan.deck_path, options)
+    }
+
+    fn start(model: Model, sim_box: SimBox, positions: Vec<DVec3>, deck_path: &Path, options: RunOptions) -> Self {
+        let mut state = State::new(positions);
         for (x, image) in state.positions.iter_mut().zip(state.images.iter_mut()) {
-            plan.sim_box.wrap(x, image);
+            sim_box.wrap(x, image);
         }
-        state.bonds = initial_bond_state(&plan.model);
-        let deck_stem = plan.deck_path.file_stem().map_or("cellmd".into(), |s| s.to_string_lossy().into_owned());
+        state.bonds = initial_bond_state(&model);
+        let deck_stem = deck_path.file_stem().map_or("cellmd".into(), |s| s.to_string_lossy().into_owned());
         Self {
-            thermo: Thermo::new(&plan.model),
-            model: plan.model.clone(),
+            thermo: Thermo::new(&model),
+            formation: (!model.bind_rules.is_empty()).then(|| Formation::new(&model, &sim_box)),
+            bond_type_names: model.bond_types.iter().map(|t| t.label.text.clone()).collect(),
+            model,
             state,
-            sim_box: plan.sim_box,
+            sim_box,
             forces: Forces::default(),
             kt: 0.0,
             dt: 0.0,
@@ -123,7 +131,6 @@ impl Simulation {
             energies_current: false,
             dumps: Vec::new(),
             kinetics: Kinetics::default(),
-            formation: (!plan.model.bind_rules.is_empty()).then(|| Formation::new(&plan.model, &plan.sim_box)),
             event_log: None,
             lifetimes: LifetimeTable::default(),
             lifetime_file: None,
@@ -138,14 +145,16 @@ impl Simulation {
             constraints: Constraints::default(),
             implicit_tension: Vec::new(),
             gpu: None,
-            bond_type_names: plan.model.bond_types.iter().map(|t| t.label.text.clone()).collect(),
         }
     }
 
-    /// Runs every action of the plan; output files are closed cleanly even on error.
-    pub fn execute(plan: &Plan, options: RunOptions) -> Result<Simulation, RunError> {
-        let mut sim = Simulation::new(plan, options);
-        let result = plan.actions.iter().try_for_each(|a| sim.apply(a));
+    /// Runs every action of the plan; output files are closed cleanly even on
+    /// error. The simulation takes the plan's model and initial positions
+    /// (no second copy of the system stays resident during the run).
+    pub fn execute(plan: Plan, options: RunOptions) -> Result<Simulation, RunError> {
+        let Plan { deck_path, model, sim_box, positions, actions } = plan;
+        let mut sim = Simulation::start(model, sim_box, positions, &deck_path, options);
+        let result = actions.iter().try_for_each(|a| sim.apply(a));
         let closed = sim.close_outputs();
         result?;
         closed?;

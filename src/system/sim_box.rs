@@ -98,12 +98,21 @@ pub struct Images {
 }
 
 impl Images {
+    /// 1.5·2⁵²: `(q + SHIFT) − SHIFT` is q rounded to the nearest integer.
+    pub const SHIFT: f64 = 6_755_399_441_055_744.0;
+
     #[inline(always)]
     pub fn minimum_image(&self, d: DVec3) -> DVec3 {
-        const SHIFT: f64 = 6_755_399_441_055_744.0; // 1.5·2⁵²
         let q = d * self.inverse;
-        let nearest = (q + DVec3::splat(SHIFT)) - DVec3::splat(SHIFT);
+        let nearest = (q + DVec3::splat(Self::SHIFT)) - DVec3::splat(Self::SHIFT);
         d - self.lengths * nearest
+    }
+
+    /// The periodic lengths L and their inverses 1/L (0 on non-periodic
+    /// axes), for vector code that repeats [`Self::minimum_image`]'s arithmetic.
+    #[inline(always)]
+    pub fn lengths_and_inverses(&self) -> (DVec3, DVec3) {
+        (self.lengths, self.inverse)
     }
 }
 

@@ -17,7 +17,7 @@ impl Case {
     pub fn run_with_threads(&self, threads: usize) -> Simulation {
         let plan = self.plan();
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-        pool.install(|| Simulation::execute(&plan, RunOptions { output_dir: self.dir.path().to_path_buf(), ..Default::default() }).unwrap())
+        pool.install(|| Simulation::execute(plan, RunOptions { output_dir: self.dir.path().to_path_buf(), ..Default::default() }).unwrap())
     }
 
     /// Files as (name, contents); the deck is `deck.in`.
@@ -39,7 +39,7 @@ impl Case {
 
     pub fn run(&self) -> Simulation {
         let plan = self.plan();
-        Simulation::execute(&plan, RunOptions { output_dir: self.dir.path().to_path_buf(), ..Default::default() })
+        Simulation::execute(plan, RunOptions { output_dir: self.dir.path().to_path_buf(), ..Default::default() })
             .unwrap_or_else(|e| panic!("{e}"))
     }
 
