@@ -91,8 +91,7 @@ mod tests {
 
     #[test]
     fn shared_checks() {
-        for level in [0, 1, 2] {
-            let (mesh, x) = deformed_icosphere(level, 1.5, 0.05);
+        for (_, mesh, x) in deformed_icospheres(&[0, 1, 2]) {
             let area = mesh.area(&x);
             for (ka, kl, a0) in [(100.0, 0.0, 0.9 * area), (0.0, 50.0, 1.1 * area), (80.0, 30.0, area)] {
                 let p = params_of(&AreaConservation, &[("ka", ka), ("kl", kl), ("a0", a0)]);

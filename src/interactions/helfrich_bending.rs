@@ -166,8 +166,7 @@ mod tests {
 
     #[test]
     fn shared_checks() {
-        for level in [0, 1, 2] {
-            let (mesh, x) = deformed_icosphere(level, 1.5, 0.05);
+        for (_, mesh, x) in deformed_icospheres(&[0, 1, 2]) {
             for (kappa, c0) in [(0.08, 0.0), (0.08, 1.2), (1.0, -0.7)] {
                 let p = params_of(&HelfrichBending, &[("kappa", kappa), ("c0", c0)]);
                 assert_surface_checks(&HelfrichBending, &p, &mesh, &x, 1e-6, 1e-3);
@@ -193,8 +192,7 @@ mod tests {
 
     #[test]
     fn stiffness_is_the_gauss_newton_model_of_each_node() {
-        for level in [0, 1] {
-            let (mesh, x) = deformed_icosphere(level, 1.5, 0.05);
+        for (level, mesh, x) in deformed_icospheres(&[0, 1]) {
             let rings = |y: &[DVec3]| -> Vec<(f64, f64)> {
                 (0..mesh.nodes() as u32)
                     .map(|i| {

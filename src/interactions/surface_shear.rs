@@ -49,14 +49,10 @@ fn hessian(p: &[f64], mesh: &SurfaceMesh, x: &[DVec3], out: &mut SurfaceHessian)
         let second_a = triangle_area_hessian(corners);
         let matrix = Mat::from_fn(9, 9, |r, col| {
             let (k, l, i, j) = (r / 3, col / 3, r % 3, col % 3);
-            let laplacian = if i == j {
-                if k == l {
-                    4.0
-                } else {
-                    -2.0
-                }
-            } else {
-                0.0
+            let laplacian = match (i == j, k == l) {
+                (false, _) => 0.0,
+                (true, true) => 4.0,
+                (true, false) => -2.0,
             };
             c * (laplacian / a - (gs[k][i] * ga[l][j] + ga[k][i] * gs[l][j]) / (a * a)
                 + s * (2.0 * ga[k][i] * ga[l][j] / (a * a * a) - second_a[k][l].col(j)[i] / (a * a)))
@@ -80,8 +76,7 @@ mod tests {
 
     #[test]
     fn shared_checks() {
-        for level in [0, 1, 2] {
-            let (mesh, x) = deformed_icosphere(level, 1.5, 0.05);
+        for (_, mesh, x) in deformed_icospheres(&[0, 1, 2]) {
             let p = params_of(&SurfaceShear, &[("k", 0.7)]);
             assert_surface_checks(&SurfaceShear, &p, &mesh, &x, 1e-6, 1e-3);
         }
@@ -132,8 +127,7 @@ mod tests {
 
     #[test]
     fn stiffness_is_the_exact_hessian_per_face_projected() {
-        for level in [0, 1] {
-            let (mesh, x) = deformed_icosphere(level, 1.5, 0.05);
+        for (_, mesh, x) in deformed_icospheres(&[0, 1]) {
             let p = params_of(&SurfaceShear, &[("k", 0.7)]);
             assert_surface_hessian(&SurfaceShear, &p, &mesh, &x, |_| 0.0, 1e-4, 1e-5);
         }

@@ -39,8 +39,7 @@ mod tests {
 
     #[test]
     fn shared_checks() {
-        for level in [0, 1, 2] {
-            let (mesh, x) = deformed_icosphere(level, 1.5, 0.05);
+        for (_, mesh, x) in deformed_icospheres(&[0, 1, 2]) {
             let p = params_of(&SurfaceTension, &[("gamma", 665.0)]);
             assert_surface_checks(&SurfaceTension, &p, &mesh, &x, 1e-6, 1e-3);
         }
@@ -62,8 +61,7 @@ mod tests {
 
     #[test]
     fn stiffness_is_the_exact_hessian_per_face_projected() {
-        for level in [0, 1] {
-            let (mesh, x) = deformed_icosphere(level, 1.5, 0.05);
+        for (level, mesh, x) in deformed_icospheres(&[0, 1]) {
             let p = params_of(&SurfaceTension, &[("gamma", 300.0)]);
             let lowest = assert_surface_hessian(&SurfaceTension, &p, &mesh, &x, |_| 0.0, 1e-4, 1e-5);
             // Area is concave in some directions: the projection has work to do.

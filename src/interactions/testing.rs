@@ -305,6 +305,15 @@ pub fn assert_surface_hessian(
     spectrum[0] / spectrum[dim - 1]
 }
 
+/// The surface-law test meshes: [`deformed_icosphere`] of radius 1.5 and
+/// jitter 0.05 at each of `levels`, with its level.
+pub fn deformed_icospheres(levels: &[u32]) -> impl Iterator<Item = (u32, SurfaceMesh, Vec<DVec3>)> + '_ {
+    levels.iter().map(|&level| {
+        let (mesh, x) = deformed_icosphere(level, 1.5, 0.05);
+        (level, mesh, x)
+    })
+}
+
 /// A deformed icosphere for surface-law tests: the icosphere of `level` and
 /// `radius`, stretched into an ellipsoid (1.3, 1, 0.8) and each node moved
 /// by a deterministic pseudo-random offset of up to `jitter` × radius.

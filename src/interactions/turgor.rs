@@ -59,8 +59,7 @@ mod tests {
 
     #[test]
     fn shared_checks() {
-        for level in [0, 1, 2] {
-            let (mesh, x) = deformed_icosphere(level, 1.5, 0.05);
+        for (_, mesh, x) in deformed_icospheres(&[0, 1, 2]) {
             let v = mesh.volume(&x);
             for (k, dp0, v0) in [(1000.0, 0.0, 1.1 * v), (500.0, 40.0, 0.9 * v), (0.0, 133.0, v)] {
                 let p = params_of(&Turgor, &[("k", k), ("dp0", dp0), ("v0", v0)]);
