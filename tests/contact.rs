@@ -140,6 +140,53 @@ fn the_step_clamp_keeps_a_too_large_step_from_jumping_through() {
     assert!(sim.state.time < 200.0 * 1e-2, "clamped steps advance time by less than dt");
 }
 
+/// Steps the clamp shortens advance bond ages and stamp kinetic events by
+/// their actual length: a tethered pair beside the pressed cells carries
+/// bonds that never break (their age must equal the run's time, the sum of
+/// the actual step lengths) and bonds that break fast (each event's time must
+/// be the thermo time of its step).
+#[test]
+fn clamped_steps_age_bonds_and_stamp_events_by_their_actual_length() {
+    let tether = "[ particles ]\n1001 anchor 8 8 8\n1002 anchor 8 8 9\n[ bonds ]\n";
+    let bonds = "slow 1001 1002\n".repeat(20) + &"fast 1001 1002\n".repeat(200);
+    let top = merge_topologies(&[&two_cells(2, 2.0, 0.1), &format!("{tether}{bonds}")]);
+    let ff = format!(
+        "{SHELLS}{BARRIER}particle anchor fixed\nbond slow harmonic k 1 r0 1 kinetics slip k0 1e-9 x_beta 1e-3\n\
+         bond fast harmonic k 1 r0 1 kinetics slip k0 20 x_beta 1e-3\n"
+    );
+    let settings = "temperature 0.0041\nseed 7\ntimestep 1e-2\nevents events.csv\nthermo 1 step time\nthermo_file thermo.csv\nrun 200\n";
+    let case = case_on(&top, &ff, 50.0, settings);
+    let sim = case.run();
+    assert!(sim.contact_clamps > 0, "the clamp never acted");
+    assert!(sim.state.time < 200.0 * 1e-2, "clamped steps advance time by less than dt");
+    let bonds = sim.state.bonds.as_ref().unwrap();
+    let is_slow = |b: usize| sim.model.bond_types[sim.model.bond_type[b] as usize].label.text == "slow";
+    let slow: Vec<usize> = (0..sim.model.bonds.len()).filter(|&b| is_slow(b)).collect();
+    assert_eq!(slow.len(), 20);
+    for b in slow {
+        assert!(bonds.bound[b]);
+        assert_eq!(bonds.age[b], sim.state.time, "bond {b}: age {} after {} s of partly clamped steps", bonds.age[b], sim.state.time);
+    }
+    let thermo: std::collections::HashMap<u64, f64> = std::fs::read_to_string(case.path("thermo.csv"))
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            (f[0].parse().unwrap(), f[1].parse().unwrap())
+        })
+        .collect();
+    let mut events = 0;
+    for row in std::fs::read_to_string(case.path("events.csv")).unwrap().lines().skip(1) {
+        let f: Vec<&str> = row.split(',').collect();
+        let (step, time): (u64, f64) = (f[0].parse().unwrap(), f[1].parse().unwrap());
+        assert_eq!(time, thermo[&step], "event at step {step}: time {time}, thermo time {}", thermo[&step]);
+        events += 1;
+    }
+    println!("{} of 200 steps clamped, {events} events", sim.contact_clamps);
+    assert!(events > 50, "too few events to test: {events}");
+}
+
 #[test]
 fn contact_runs_are_bit_identical_on_one_and_two_threads() {
     let case = pressed_case(5.0, "temperature 0.0041\nseed 3\ntimestep 1e-3\nthermo 100 step pe mindist nclamp\nrun 300\n");

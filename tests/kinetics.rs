@@ -700,3 +700,45 @@ fn coarse_steps_are_warned_about_once_per_bond_type() {
     assert_eq!(warnings.len(), 1, "{stderr}");
     assert!(warnings[0].contains("bond type `f0` has k_off·dt = 0.500"), "{}", warnings[0]);
 }
+
+/// (step, time) of every row of a thermo CSV whose first two columns are
+/// `step` and `time`.
+fn thermo_times(case: &Case, file: &str) -> std::collections::HashMap<u64, f64> {
+    let text = std::fs::read_to_string(case.path(file)).unwrap();
+    text.lines()
+        .skip(1)
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            (f[0].parse().unwrap(), f[1].parse().unwrap())
+        })
+        .collect()
+}
+
+/// Event times come from the run's clock, not from step × dt: after a deck
+/// changes `timestep` between runs, each event's time is the thermo time of
+/// its step (before the fix, the second run's events were stamped up to
+/// 0.1 s late).
+#[test]
+fn event_times_equal_thermo_times_when_the_timestep_changes() {
+    let c = case(
+        &fixed_pairs(400, &[1.0]),
+        "bond b harmonic k 10 r0 1 kinetics slip k0 5 x_beta 0.5",
+        "temperature 1\nseed 5\nevents events.csv\nthermo 1 step time\nthermo_file thermo.csv\n\
+         timestep 5e-4\nrun 200\ntimestep 1e-3\nrun 200\n",
+    );
+    c.run();
+    let thermo = thermo_times(&c, "thermo.csv");
+    let log = std::fs::read_to_string(c.path("events.csv")).unwrap();
+    let (mut first, mut second) = (0, 0);
+    for row in log.lines().skip(1) {
+        let f: Vec<&str> = row.split(',').collect();
+        let (step, time): (u64, f64) = (f[0].parse().unwrap(), f[1].parse().unwrap());
+        if step < 200 {
+            first += 1;
+        } else {
+            second += 1;
+        }
+        assert_eq!(time, thermo[&step], "event at step {step}: time {time}, thermo time {}", thermo[&step]);
+    }
+    assert!(first > 20 && second > 20, "too few events to test: {first} in the first run, {second} in the second");
+}

@@ -6,7 +6,9 @@
 //! 2. the integrator moves x_s → x_{s+1};
 //! 3. [`Kinetics::step`] decides, from the tensions of pass 1 and random
 //!    numbers keyed by (seed, s, bond index), every break, rebind and reset,
-//!    advances ages, rest lengths (motor, ratchet) and maturation scales, and
+//!    advances ages, rest lengths (motor, ratchet) and maturation scales by
+//!    the step's actual length Δt (a [`StepClock`], shorter than dt where the
+//!    contact clamp shortened the step), and
 //!    applies them together: S_s → S_{s+1};
 //! 4. the next force pass sees S_{s+1}.
 //!
@@ -20,7 +22,7 @@ use super::formation::Binding;
 use super::state::{BondState, FormedBond};
 use super::Effect;
 use crate::integrate::rng::block;
-use crate::system::{Model, SimBox, State};
+use crate::system::{Model, SimBox, State, StepClock};
 
 /// Philox stream of per-step kinetic decisions.
 const STREAM_KINETICS: u32 = 2;
@@ -100,24 +102,25 @@ impl Kinetics {
     }
 
     /// Decides and applies the state changes of step `state.step − 1` (the
-    /// step whose forces produced `tension` and `length`).
-    #[allow(clippy::too_many_arguments)]
+    /// step whose forces produced `tension` and `length`), which `clock`
+    /// describes: rates act over its actual length and events are stamped
+    /// with its start time.
     pub fn step(
         &mut self,
         model: &Model,
         state: &mut State,
         tension: &[f64],
         length: &[f64],
-        step: u64,
-        dt: f64,
+        clock: StepClock,
         kt: f64,
         seed: u64,
     ) -> KineticsReport {
+        let step = clock.step;
         let mut report = KineticsReport::default();
         let Some(bonds) = state.bonds.as_mut() else { return report };
         self.warned.resize(model.bond_types.len(), false);
         let outcomes: Vec<Outcome> =
-            (0..bonds.len()).into_par_iter().map(|b| decide(model, bonds, b, tension[b], length[b], step, dt, kt, seed)).collect();
+            (0..bonds.len()).into_par_iter().map(|b| decide(model, bonds, b, tension[b], length[b], clock, kt, seed)).collect();
         for (b, o) in outcomes.iter().enumerate() {
             let t = model.bond_type[b] as usize;
             if o.rate_dt > COARSE_RATE_DT && !self.warned[t] {
@@ -147,7 +150,7 @@ impl Kinetics {
             let [i, j] = model.bonds[b];
             report.events.push(Event {
                 step,
-                time: step as f64 * dt,
+                time: clock.start,
                 kind,
                 bond: b,
                 bond_type: model.bond_types[t].label.text.clone(),
@@ -172,8 +175,7 @@ impl Kinetics {
         state: &mut State,
         sim_box: &SimBox,
         bindings: Vec<Binding>,
-        step: u64,
-        dt: f64,
+        clock: StepClock,
     ) -> Vec<Event> {
         let bonds = state.bonds.as_mut().expect("bond state exists with bind rules");
         let mut events = Vec::with_capacity(bindings.len());
@@ -197,8 +199,8 @@ impl Kinetics {
             };
             let [i, j] = model.bonds[b];
             events.push(Event {
-                step,
-                time: step as f64 * dt,
+                step: clock.step,
+                time: clock.start,
                 kind,
                 bond: b,
                 bond_type: model.bond_types[model.bond_type[b] as usize].label.text.clone(),
@@ -214,7 +216,8 @@ impl Kinetics {
 
 /// One bond's decision: a pure function of its state, force and random numbers.
 #[allow(clippy::too_many_arguments)]
-fn decide(model: &Model, bonds: &BondState, b: usize, force: f64, length: f64, step: u64, dt: f64, kt: f64, seed: u64) -> Outcome {
+fn decide(model: &Model, bonds: &BondState, b: usize, force: f64, length: f64, clock: StepClock, kt: f64, seed: u64) -> Outcome {
+    let (step, dt) = (clock.step, clock.length);
     let t = model.bond_type[b] as usize;
     let mut out = Outcome { event: None, rest: bonds.rest[b], scale: bonds.scale[b], age: bonds.age[b], rate_dt: 0.0 };
     let rules = &model.bond_kinetics[t].rules;

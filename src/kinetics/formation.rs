@@ -40,7 +40,7 @@ use crate::input::{parse_u64, InputError, Token};
 use crate::integrate::rng::philox4x32_10;
 use crate::interactions::ParamSpec;
 use crate::neighbor::{Exclusions, NeighborList};
-use crate::system::{Model, SimBox, State};
+use crate::system::{Model, SimBox, State, StepClock};
 use crate::units::{Dim, UnitSystem};
 
 /// Philox key salt separating formation decisions from every other stream.
@@ -174,16 +174,10 @@ impl Formation {
         Self { neighbors: NeighborList::new(capture, skin), none: Exclusions::none(), body }
     }
 
-    /// The bindings decided at `step` from the positions of `state`.
-    pub fn decide(
-        &mut self,
-        model: &Model,
-        state: &State,
-        sim_box: &SimBox,
-        step: u64,
-        dt: f64,
-        seed: u64,
-    ) -> Result<Vec<Binding>, String> {
+    /// The bindings decided at the step `clock` describes, over its actual
+    /// length, from the positions of `state`.
+    pub fn decide(&mut self, model: &Model, state: &State, sim_box: &SimBox, clock: StepClock, seed: u64) -> Result<Vec<Binding>, String> {
+        let (step, dt) = (clock.step, clock.length);
         if model.bind_rules.is_empty() {
             return Ok(Vec::new());
         }

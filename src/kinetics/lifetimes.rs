@@ -45,7 +45,7 @@ pub struct LifetimeTable {
 }
 
 impl LifetimeTable {
-    /// Adds the breaks among `events`, decided with time step `dt`.
+    /// Adds the breaks among `events`, decided over a step of length `dt`.
     pub fn record(&mut self, model: &Model, events: &[Event], dt: f64) {
         self.per_type.resize(model.bond_types.len(), TypeSums::default());
         for e in events.iter().filter(|e| e.kind == EventKind::Break) {

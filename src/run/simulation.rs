@@ -19,7 +19,7 @@ use crate::integrate::overdamped::{overdamped_step, Blowup, OverdampedSettings};
 use crate::kinetics::{initial_bond_state, Binding, EventLog, Formation, Kinetics, LifetimeTable};
 use crate::output::restart::{read_state, write_state, RestartData};
 use crate::output::{open_writer_with_columns, FrameView, Measures, TopologyView, TrajectoryWriter};
-use crate::system::{Model, SimBox, State};
+use crate::system::{Model, SimBox, State, StepClock};
 
 /// The longest GPU segment between read-backs when no output is due.
 const GPU_SYNC_STEPS: u64 = 1000;
@@ -544,6 +544,7 @@ impl Simulation {
     fn run_cpu(&mut self, last: u64, bar: &Option<ProgressBar>) -> Result<(), RunError> {
         let mut before = Vec::new();
         while self.state.step < last {
+            let (step, start) = (self.state.step, self.state.time);
             if !self.constraints.list.is_empty() {
                 before.clone_from(&self.state.positions);
             }
@@ -564,12 +565,13 @@ impl Simulation {
                         limited.then_some(self.step_limits.as_slice()),
                         &mut self.scratch,
                     )
-                    .map(|fraction| self.contact_clamps += u64::from(fraction < 1.0))
+                    .inspect(|&fraction| self.contact_clamps += u64::from(fraction < 1.0))
                 }
             };
-            if let Err(Blowup { particle, displacement }) = moved {
-                return Err(self.blowup(particle, self.displacement_message(displacement)));
-            }
+            let fraction = match moved {
+                Ok(fraction) => fraction,
+                Err(Blowup { particle, displacement }) => return Err(self.blowup(particle, self.displacement_message(displacement))),
+            };
             if !self.constraints.list.is_empty() {
                 let projected = self.constraints.project(&self.model, &before, &mut self.state, &self.sim_box, self.dt);
                 if self.implicit_tension.len() == self.constraints.tension.len() {
@@ -589,7 +591,7 @@ impl Simulation {
                 }
             }
             if self.model.has_kinetics() {
-                self.kinetics_step()?;
+                self.kinetics_step(StepClock { step, start, length: fraction * self.dt })?;
             }
             let final_step = self.state.step == last;
             let thermo_due = self.thermo.every > 0 && self.state.step.is_multiple_of(self.thermo.every);
@@ -613,7 +615,9 @@ impl Simulation {
 
     /// One linearly implicit step from the current forces; a failed solve
     /// stops the run, a refused displacement is returned like the explicit one.
-    fn implicit_step(&mut self, implicit: &ImplicitSettings) -> Result<Result<(), Blowup>, RunError> {
+    /// One implicit step; returns the fraction of dt it took (below 1 where
+    /// the contact clamp shortened it).
+    fn implicit_step(&mut self, implicit: &ImplicitSettings) -> Result<Result<f64, Blowup>, RunError> {
         let backend = self.backend.as_ref().expect("backend built");
         let stiffness = backend.stiffness(&self.model, &self.state, &self.sim_box);
         let limited = backend.contact_step_limits(self.model.len(), &mut self.step_limits);
@@ -637,9 +641,10 @@ impl Simulation {
         self.implicit_tension = constrained.tension;
         match outcome {
             Ok(report) => {
-                self.contact_clamps += u64::from(report.step_fraction < 1.0);
+                let fraction = report.step_fraction;
+                self.contact_clamps += u64::from(fraction < 1.0);
                 self.last_solve = report;
-                Ok(Ok(()))
+                Ok(Ok(fraction))
             }
             Err(ImplicitError::Blowup(blowup)) => Ok(Err(blowup)),
             Err(ImplicitError::Solve(why)) => Err(RunError::Setup(format!("integrator implicit at step {}: {why}", self.state.step))),
@@ -721,6 +726,7 @@ impl Simulation {
         let kinetics = self.model.has_kinetics();
         let evolving = self.model.bond_kinetics.iter().flat_map(|k| &k.rules).any(|r| r.rule.evolves_every_step());
         while self.state.step < last {
+            let (step, start) = (self.state.step, self.state.time);
             let next_output = self.next_output_step(last).min(self.state.step + GPU_SYNC_STEPS);
             let steps = if kinetics { 1 } else { next_output - self.state.step };
             let outcome = gpu.run(self.state.step, steps);
@@ -758,7 +764,8 @@ impl Simulation {
                 // (measured at the end of the previous one), then measured
                 // again at the new positions with the new bond state.
                 let resets = self.kinetics.resets;
-                let changed = self.kinetics_step()?;
+                // One step per segment with kinetics, never clamped on the GPU.
+                let changed = self.kinetics_step(StepClock { step, start, length: self.dt })?;
                 if self.backend.is_none() {
                     // Bonds formed: both backends are rebuilt for the new bond list.
                     self.ensure_forces()?;
@@ -803,23 +810,22 @@ impl Simulation {
     /// Bond kinetics of the step just integrated, decided from the tensions of
     /// its force pass; a break or rebind updates the pair exclusions.
     /// Returns whether a bond broke, bound or formed.
-    fn kinetics_step(&mut self) -> Result<bool, RunError> {
-        let step = self.state.step - 1;
+    fn kinetics_step(&mut self, clock: StepClock) -> Result<bool, RunError> {
         let backend = self.backend.as_ref().expect("backend built");
         let (tension, length) = backend.bond_tension_and_length();
-        let mut report = self.kinetics.step(&self.model, &mut self.state, tension, length, step, self.dt, self.kt, self.seed);
+        let mut report = self.kinetics.step(&self.model, &mut self.state, tension, length, clock, self.kt, self.seed);
         for warning in &report.warnings {
             eprintln!("{warning}");
         }
         let mut formed_any = false;
         if let Some(formation) = &mut self.formation {
-            let bindings = formation.decide(&self.model, &self.state, &self.sim_box, step, self.dt, self.seed).map_err(RunError::Setup)?;
+            let bindings = formation.decide(&self.model, &self.state, &self.sim_box, clock, self.seed).map_err(RunError::Setup)?;
             formed_any = bindings.iter().any(|b| matches!(b, Binding::New(..)));
             report.bonds_changed |= !bindings.is_empty();
-            report.events.extend(self.kinetics.apply_bindings(&mut self.model, &mut self.state, &self.sim_box, bindings, step, self.dt));
+            report.events.extend(self.kinetics.apply_bindings(&mut self.model, &mut self.state, &self.sim_box, bindings, clock));
         }
         if !report.events.is_empty() {
-            self.lifetimes.record(&self.model, &report.events, self.dt);
+            self.lifetimes.record(&self.model, &report.events, clock.length);
             if let Some(log) = &mut self.event_log {
                 log.write(&report.events)?;
             }

@@ -1,9 +1,11 @@
 //! Simulation state: the box and the per-particle arrays (f64, structure of arrays).
 
+mod clock;
 mod model;
 mod sim_box;
 mod state;
 
+pub use self::clock::StepClock;
 pub use self::model::{registry_index, Body, External, Model, SpecialBonds};
 pub use self::sim_box::{Images, SimBox};
 pub use self::state::State;
