@@ -105,6 +105,7 @@ impl Kinetics {
     /// step whose forces produced `tension` and `length`), which `clock`
     /// describes: rates act over its actual length and events are stamped
     /// with its start time.
+    #[allow(clippy::too_many_arguments)]
     pub fn step(
         &mut self,
         model: &Model,
