@@ -23,12 +23,7 @@ struct Outcome {
 /// `cellmd ARGS` with a time limit (a hang fails the test instead of blocking it).
 fn cellmd(args: &[&str]) -> Outcome {
     let started = Instant::now();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_cellmd"))
-        .args(args)
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_cellmd")).args(args).stdout(Stdio::null()).stderr(Stdio::piped()).spawn().unwrap();
     let stderr = child.stderr.take().unwrap();
     let reader = std::thread::spawn(move || std::io::read_to_string(stderr).unwrap_or_default());
     loop {
@@ -97,7 +92,11 @@ fn generated_crashers_are_diagnosed_quickly() {
         (write("latin1.in", b"units lj\nprint caf\xe9\n"), ":2:10: found byte 0xE9, which is not UTF-8".into(), 1),
         // A password file named as a topology: one clipped word, no other line.
         (
-            write("topology.in", format!("units lj\ntopology {}\n", write("passwd", format!("root:x:0:0:{}\n{secret}", "r".repeat(300)).as_bytes())).as_bytes()),
+            write(
+                "topology.in",
+                format!("units lj\ntopology {}\n", write("passwd", format!("root:x:0:0:{}\n{secret}", "r".repeat(300)).as_bytes()))
+                    .as_bytes(),
+            ),
             "passwd:1:1: found `root:x:0:0:rrrr".into(),
             1,
         ),

@@ -60,9 +60,9 @@ impl Variables {
         if !self.from_command_line.contains_key(&name.text) {
             let total = self.total + value.len() - self.values.get(&name.text).map_or(0, String::len);
             if total > MAX_VARIABLES_BYTES {
-                return Err(name.error(format!(
-                    "found {total} bytes in all variables' values, expected at most {MAX_VARIABLES_BYTES} (64 MiB)"
-                )));
+                return Err(
+                    name.error(format!("found {total} bytes in all variables' values, expected at most {MAX_VARIABLES_BYTES} (64 MiB)"))
+                );
             }
             self.total = total;
             self.values.insert(name.text.clone(), value);

@@ -52,7 +52,7 @@ impl Snippet {
         let line_end = text[offset..].find(['\n', '\r']).map_or(text.len(), |i| offset + i);
         let lead = text[line_start..offset].char_indices().rev().nth(LEAD_CHARS - 1).map_or(line_start, |(i, _)| line_start + i);
         let end = text[lead..line_end].char_indices().nth(SNIPPET_CHARS).map_or(line_end, |(i, _)| lead + i);
-                let label_end = (offset + len).min(end).max(offset);
+        let label_end = (offset + len).min(end).max(offset);
         let skipped = text[line_start..lead].chars().count();
         Self {
             path: file.path.clone(),
@@ -152,9 +152,7 @@ mod tests {
     /// The error rendered as the CLI prints it (miette's graphical report, no colours).
     fn rendered(error: InputError) -> String {
         let mut out = String::new();
-        miette::GraphicalReportHandler::new_themed(miette::GraphicalTheme::unicode_nocolor())
-            .render_report(&mut out, &error)
-            .unwrap();
+        miette::GraphicalReportHandler::new_themed(miette::GraphicalTheme::unicode_nocolor()).render_report(&mut out, &error).unwrap();
         out
     }
 

@@ -56,7 +56,11 @@ impl SourceFile {
                 let valid = e.utf8_error().valid_up_to();
                 let byte = e.as_bytes()[valid];
                 let prefix = Self::new(shown, String::from_utf8_lossy(&e.as_bytes()[..valid]).into_owned());
-                Err(InputError::at_offset(&prefix, valid, format!("found byte 0x{byte:02X}, which is not UTF-8; expected a UTF-8 text file")))
+                Err(InputError::at_offset(
+                    &prefix,
+                    valid,
+                    format!("found byte 0x{byte:02X}, which is not UTF-8; expected a UTF-8 text file"),
+                ))
             }
         }
     }

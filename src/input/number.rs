@@ -150,7 +150,8 @@ mod tests {
         let deep = format!("{}1{}", "(".repeat(MAX_NESTING - 1), ")".repeat(MAX_NESTING - 1));
         assert_eq!(evaluate_expression(&deep).unwrap(), 1.0);
         assert_eq!(evaluate_expression(&format!("{}1", "-".repeat(MAX_NESTING - 1))).unwrap(), -1.0);
-        let too_deep = "found an expression nested more than 64 deep (parentheses, unary `-` and `^` together); expected a flatter expression";
+        let too_deep =
+            "found an expression nested more than 64 deep (parentheses, unary `-` and `^` together); expected a flatter expression";
         for text in [
             format!("{}1{}", "(".repeat(40_000), ")".repeat(40_000)),
             format!("{}1", "-".repeat(60_000)),

@@ -379,7 +379,10 @@ mod tests {
             assert_eq!(parse(&format!("{two}{line}\n")).unwrap_err(), expected, "{line}");
         }
         // A term listed twice, in either direction, would be counted twice.
-        assert_eq!(parse(&format!("{two}s 1 2\ns 2 1\n")).unwrap_err(), "t.top:7:1: bond `s` 2–1 is already listed at line 6; expected each bond once");
+        assert_eq!(
+            parse(&format!("{two}s 1 2\ns 2 1\n")).unwrap_err(),
+            "t.top:7:1: bond `s` 2–1 is already listed at line 6; expected each bond once"
+        );
         assert!(parse(&format!("{two}s 1 2\nt 2 1\n")).is_ok(), "two bond types on one pair");
         assert_eq!(
             parse(&format!("{two}[ angles ]\nb 1 2 3\nb 3 2 1\n")).unwrap_err(),
