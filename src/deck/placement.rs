@@ -4,8 +4,10 @@
 //! * every particle is inside a fixed axis' bounds, and close enough to a
 //!   periodic box to be wrapped into it ([`SimBox::misplaced_axis`]; LAMMPS
 //!   refuses atoms outside a fixed box too);
-//! * no bond, and no arm of an angle, joins two coincident particles (its
-//!   direction, and so its force, is undefined);
+//! * no bond whose law exerts a force at zero length (a harmonic spring with
+//!   r0 > 0), and no arm of an angle, joins two coincident particles: the
+//!   force's direction is undefined (a slack `cable` or a FENE bond exerts
+//!   none there, and its coincident ends are harmless);
 //! * no face of a body has zero area (corners coincident or collinear: its
 //!   normal is undefined), to a relative [`FLAT`].
 //!
@@ -14,15 +16,30 @@
 use glam::DVec3;
 
 use crate::input::InputError;
-use crate::system::SimBox;
+use crate::interactions::Law;
+use crate::system::{Model, SimBox};
 use crate::topology::Topology;
 
 /// A face is degenerate when |e₁ × e₂| ≤ FLAT · |e₁| · |e₂| (the sine of its
 /// angle between two edges).
 pub const FLAT: f64 = 1e-12;
 
-/// Checks the topology's initial positions in `sim_box`.
-pub(super) fn check_placement(topology: &Topology, sim_box: &SimBox) -> Result<(), InputError> {
+/// Whether bond `b` (a topology bond, with its own r0 if it has one) pulls
+/// or pushes its ends at zero length.
+fn pulls_at_zero_length(model: &Model, b: usize) -> bool {
+    let t = model.bond_type[b] as usize;
+    let mut params = model.bond_types[t].params.clone();
+    if let (Some(k), Some(rest)) = (model.bond_kinetics[t].rest_index, model.initial_rest_length(b)) {
+        params[k] = rest;
+    }
+    match model.bond_types[t].interaction.law() {
+        Law::Radial { eval, .. } => eval(&params, 0.0).de_dr != 0.0,
+        _ => true,
+    }
+}
+
+/// Checks the topology's initial positions in `sim_box` (`model` built from it).
+pub(super) fn check_placement(topology: &Topology, model: &Model, sim_box: &SimBox) -> Result<(), InputError> {
     let x = &topology.positions;
     let id = |p: u32| topology.ids[p as usize];
     for (i, &at) in x.iter().enumerate() {
@@ -36,14 +53,16 @@ pub(super) fn check_placement(topology: &Topology, sim_box: &SimBox) -> Result<(
     }
     let images = sim_box.images();
     let separation = |i: u32, j: u32| images.minimum_image(x[j as usize] - x[i as usize]);
-    for bond in &topology.bonds {
+    for (b, bond) in topology.bonds.iter().enumerate() {
         let [i, j] = bond.particles;
-        if separation(i, j) == DVec3::ZERO {
+        if separation(i, j) == DVec3::ZERO && pulls_at_zero_length(model, b) {
             return Err(bond.type_name.error(format!(
-                "bond `{}` joins particles {} and {} at the same position; expected bonded particles apart (the bond's direction is undefined)",
+                "bond `{}` joins particles {} and {} at the same position, where its law `{}` exerts a force of undefined direction; \
+                 expected bonded particles apart",
                 bond.type_name.text,
                 id(i),
-                id(j)
+                id(j),
+                model.bond_types[model.bond_type[b] as usize].interaction.name()
             )));
         }
     }

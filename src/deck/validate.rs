@@ -153,7 +153,7 @@ impl Validator {
                 [axes[0].periodic, axes[1].periodic, axes[2].periodic],
             );
             let model = Model::build(topology, &self.forcefield, self.units, self.special_bonds)?;
-            check_placement(topology, &sim_box)?;
+            check_placement(topology, &model, &sim_box)?;
             check_outward(&model, topology, &sim_box)?;
             self.positions = topology.positions.clone();
             self.sim_box = Some(sim_box);

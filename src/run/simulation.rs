@@ -443,7 +443,7 @@ impl Simulation {
         self.forces_current = true;
         self.energies_current = energies;
         if let Some(i) = self.forces.forces.par_iter().with_min_len(4096).position_first(|f| !finite_force(*f)) {
-            return Err(self.blowup(i, "non-finite force (or one whose |F|² overflows)".into()));
+            return Err(self.blowup(i, "non-finite force".into()));
         }
         Ok(())
     }
@@ -897,7 +897,7 @@ impl Simulation {
         self.forces_current = true;
         self.energies_current = true;
         if let Some(i) = self.forces.forces.iter().position(|f| !finite_force(*f)) {
-            return Err(self.blowup(i, "non-finite force (or one whose |F|² overflows) during minimisation".into()));
+            return Err(self.blowup(i, "non-finite force during minimisation".into()));
         }
         self.check_in_box()?;
         let verdict = if report.converged { "converged" } else { "stopped at maxiter without converging" };
