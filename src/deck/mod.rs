@@ -11,6 +11,7 @@
 //! relative to the output directory (the working directory unless `cellmd run
 //! -o DIR`). See README.md for the command reference.
 
+mod placement;
 mod plan;
 mod validate;
 mod variables;

@@ -5,11 +5,12 @@ use std::path::{Path, PathBuf};
 
 use glam::DVec3;
 
+use super::placement::check_placement;
 use super::plan::{Action, CoeffTarget, DumpSpec, Group, NeighborSettings, Plan, ThermoColumn};
 use super::variables::Variables;
 use crate::forcefield::{load_forcefield, parse_params, ForceField};
 use crate::gpu::DevicePreference;
-use crate::input::{lex, parse_f64, parse_u64, InputError, SourceFile, Statement, Token};
+use crate::input::{check_input_file, lex, parse_f64, parse_u64, InputError, SourceFile, Statement, Token};
 use crate::integrate::fire::FireSettings;
 use crate::integrate::implicit::{ImplicitSettings, LinearSolver};
 use crate::integrate::overdamped::OverdampedSettings;
@@ -152,6 +153,7 @@ impl Validator {
                 [axes[0].periodic, axes[1].periodic, axes[2].periodic],
             );
             let model = Model::build(topology, &self.forcefield, self.units, self.special_bonds)?;
+            check_placement(topology, &model, &sim_box)?;
             check_outward(&model, topology, &sim_box)?;
             self.positions = topology.positions.clone();
             self.sim_box = Some(sim_box);
@@ -360,6 +362,8 @@ impl Validator {
                 if s.len() < 4 {
                     return Err(s[2].error("expected at least one id or id range A:B after `id`"));
                 }
+                let mut by_id: Vec<(u64, u32)> = model.ids.iter().enumerate().map(|(i, &id)| (id, i as u32)).collect();
+                by_id.sort_unstable();
                 for t in &s[3..] {
                     let (lo, hi) = match t.text.split_once(':') {
                         Some((a, b)) => {
@@ -375,13 +379,13 @@ impl Validator {
                     if hi < lo {
                         return Err(t.error(format!("found range {lo}:{hi}, expected A <= B")));
                     }
-                    let before = member.iter().filter(|m| **m).count();
-                    for (i, m) in member.iter_mut().enumerate() {
-                        *m |= (lo..=hi).contains(&model.ids[i]);
-                    }
-                    if member.iter().filter(|m| **m).count() == before && !(lo..=hi).any(|id| model.ids.contains(&id)) {
+                    // By lookup in the sorted ids: the cost is the matches', not the range's.
+                    let first = by_id.partition_point(|&(id, _)| id < lo);
+                    let matched = by_id[first..].iter().take_while(|&&(id, _)| id <= hi);
+                    if matched.clone().next().is_none() {
                         return Err(t.error(format!("`{}` matches no particle; expected ids present in the topology", t.text)));
                     }
+                    matched.for_each(|&(_, i)| member[i as usize] = true);
                 }
             }
             other => return Err(s[2].error(format!("found `{other}`, expected `type`, `id` or `all`"))),
@@ -739,11 +743,14 @@ impl Validator {
                 self.model(kw)?;
                 let written = PathBuf::from(&s[1].text);
                 let path = if self.states_written.contains(&written) { written } else { self.input_path(&s[1]) };
-                if !self.states_written.contains(&path) && !path.exists() {
-                    return Err(s[1].error(format!(
-                        "cannot read `{}`: no such file; expected a restart file written by `write_state`",
-                        path.display()
-                    )));
+                if !self.states_written.contains(&path) {
+                    if !path.exists() {
+                        return Err(s[1].error(format!(
+                            "cannot read `{}`: no such file; expected a restart file written by `write_state`",
+                            path.display()
+                        )));
+                    }
+                    check_input_file(&path).map_err(|why| s[1].error(format!("cannot read `{}`: {why}", path.display())))?;
                 }
                 self.actions.push(Action::ReadState(path));
             }
@@ -781,11 +788,11 @@ pub fn validate(file: &std::sync::Arc<SourceFile>, deck_dir: &Path, overrides: &
     for statement in &statements {
         let kw = statement.keyword();
         if kw.text == "variable" {
-            let rest: Vec<Token> = statement.tokens[1..].iter().map(|t| v.vars.substitute(t)).collect::<Result<_, _>>()?;
+            let rest = v.vars.substitute_all(&statement.tokens[1..])?;
             v.vars.define(kw, &rest)?;
             continue;
         }
-        let tokens: Vec<Token> = statement.tokens.iter().map(|t| v.vars.substitute(t)).collect::<Result<_, _>>()?;
+        let tokens = v.vars.substitute_all(&statement.tokens)?;
         v.command(&tokens)?;
         last = Some(kw.clone());
     }

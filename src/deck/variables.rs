@@ -1,22 +1,39 @@
 //! Deck variables: `variable NAME equal EXPR` / `variable NAME string TEXT`,
 //! used as `${NAME}` anywhere in a later token. Values given on the command
 //! line (`--var NAME=VALUE`) take precedence over the deck's definitions.
+//!
+//! Memory is bounded: a value, and the substituted words of one statement
+//! together, hold at most [`MAX_VARIABLE_BYTES`], and all values together at
+//! most [`MAX_VARIABLES_BYTES`] (28 string variables that each doubled the
+//! last took 3.1 GB before these caps).
 
 use std::collections::HashMap;
 
 use crate::input::{evaluate_expression, InputError, Token};
 
+/// The longest value of a variable, and of the substituted words of one statement: 1 MiB.
+pub const MAX_VARIABLE_BYTES: usize = 1 << 20;
+/// The most bytes all variables' values hold together: 64 MiB.
+pub const MAX_VARIABLES_BYTES: usize = 64 << 20;
+
+fn too_long(at: &Token, len: usize) -> InputError {
+    at.error(format!("found {len} bytes after substituting variables, expected at most {MAX_VARIABLE_BYTES} (1 MiB)"))
+}
+
 #[derive(Clone, Debug, Default)]
 pub struct Variables {
     values: HashMap<String, String>,
     from_command_line: HashMap<String, String>,
+    /// Bytes of all values together.
+    total: usize,
 }
 
 impl Variables {
     /// Variables fixed on the command line.
     pub fn with_overrides(overrides: &[(String, String)]) -> Self {
         let from_command_line: HashMap<String, String> = overrides.iter().cloned().collect();
-        Self { values: from_command_line.clone(), from_command_line }
+        let total = from_command_line.values().map(String::len).sum();
+        Self { values: from_command_line.clone(), from_command_line, total }
     }
 
     /// Handles `variable NAME equal|string VALUE...` (tokens after `variable`).
@@ -37,14 +54,41 @@ impl Variables {
             "string" => rest.join(" "),
             other => return Err(tokens[1].error(format!("found `{other}`, expected `equal` or `string`"))),
         };
+        if value.len() > MAX_VARIABLE_BYTES {
+            return Err(too_long(&tokens[2], value.len()));
+        }
         if !self.from_command_line.contains_key(&name.text) {
+            let total = self.total + value.len() - self.values.get(&name.text).map_or(0, String::len);
+            if total > MAX_VARIABLES_BYTES {
+                return Err(
+                    name.error(format!("found {total} bytes in all variables' values, expected at most {MAX_VARIABLES_BYTES} (64 MiB)"))
+                );
+            }
+            self.total = total;
             self.values.insert(name.text.clone(), value);
         }
         Ok(())
     }
 
-    /// Replaces every `${NAME}` in a token.
-    pub fn substitute(&self, token: &Token) -> Result<Token, InputError> {
+    /// Substitutes every token of a statement; the substituted ones may hold
+    /// [`MAX_VARIABLE_BYTES`] together.
+    pub fn substitute_all(&self, tokens: &[Token]) -> Result<Vec<Token>, InputError> {
+        let mut grown = 0;
+        tokens
+            .iter()
+            .map(|t| {
+                let out = self.substitute(t, grown)?;
+                if t.text.contains("${") {
+                    grown += out.text.len();
+                }
+                Ok(out)
+            })
+            .collect()
+    }
+
+    /// Replaces every `${NAME}` in a token, after `before` substituted bytes
+    /// of the same statement.
+    fn substitute(&self, token: &Token, before: usize) -> Result<Token, InputError> {
         if !token.text.contains("${") {
             return Ok(token.clone());
         }
@@ -60,8 +104,14 @@ impl Variables {
                     "found undefined variable `{name}`, expected a `variable {name} ...` line before this one or `--var {name}=VALUE`"
                 ))
             })?;
+            if before + out.len() + value.len() > MAX_VARIABLE_BYTES {
+                return Err(too_long(token, before + out.len() + value.len()));
+            }
             out.push_str(value);
             rest = &after[end + 1..];
+        }
+        if before + out.len() + rest.len() > MAX_VARIABLE_BYTES {
+            return Err(too_long(token, before + out.len() + rest.len()));
         }
         out.push_str(rest);
         Ok(token.with_text(out))

@@ -451,7 +451,11 @@ impl GpuBackend {
             let mut x = DVec3::ZERO;
             for a in 0..3 {
                 x[a] = self.sim_box.lo[a] + self.fixed.decode(data[i][a], data[n + i][a]);
-                state.images[i][a] = data[2 * n + i][a] as i32;
+                // The GPU counts images in i32: the i64 counter moves by the
+                // wrapping difference (exact while a particle crosses fewer
+                // than 2³¹ boxes between read-backs).
+                let moved = (data[2 * n + i][a] as i32).wrapping_sub(state.images[i][a] as i32);
+                state.images[i][a] += i64::from(moved);
             }
             state.positions[i] = x;
         }

@@ -5,12 +5,15 @@
 //! by blanks, and `"double quoted"` tokens may contain blanks and `#`. The nom
 //! grammar in [`lexer`] turns a file into [`Statement`]s of [`Token`]s that
 //! remember their `line:col`, and every later error is an [`InputError`]
-//! pointing at the offending token (`file:line:col: message`).
+//! pointing at the offending token (`file:line:col: message`). Files are read
+//! by [`read_input_file`]: regular files of at most [`MAX_INPUT_BYTES`].
 
 mod error;
+mod file;
 mod lexer;
 mod number;
 
 pub use self::error::InputError;
+pub use self::file::{check_input_file, read_input_file, MAX_INPUT_BYTES};
 pub use self::lexer::{lex, statements, SourceFile, Statement, Statements, Token};
 pub use self::number::{evaluate_expression, parse_f64, parse_u64};

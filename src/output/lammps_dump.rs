@@ -259,7 +259,7 @@ mod tests {
                 for a in 0..3 {
                     let x: f64 = cols[2 + a].parse().unwrap();
                     assert_eq!(x.to_bits(), s.frames[f][i][a].to_bits(), "{line}");
-                    assert_eq!(cols[5 + a].parse::<i32>().unwrap(), s.images[i][a]);
+                    assert_eq!(cols[5 + a].parse::<i64>().unwrap(), s.images[i][a]);
                 }
             }
         }

@@ -564,7 +564,7 @@ impl Serialize for FlatPositions<'_> {
 
 /// Serializes image counters flat, zeros when none are given.
 struct FlatImages<'a> {
-    images: &'a [[i32; 3]],
+    images: &'a [[i64; 3]],
     n: usize,
 }
 

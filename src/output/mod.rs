@@ -81,7 +81,7 @@ pub struct FrameView<'a> {
     /// Positions by internal index (wrapped on periodic axes).
     pub positions: &'a [DVec3],
     /// Image counters by internal index, or empty for all zeros.
-    pub images: &'a [[i32; 3]],
+    pub images: &'a [[i64; 3]],
     /// What the writer asked for in [`TrajectoryWriter::needs`]; empty otherwise.
     pub measures: Measures<'a>,
 }
@@ -116,7 +116,7 @@ impl Needs {
 impl FrameView<'_> {
     /// The image counter of particle `i` (zeros when `images` is empty).
     #[inline]
-    pub fn image(&self, i: usize) -> [i32; 3] {
+    pub fn image(&self, i: usize) -> [i64; 3] {
         self.images.get(i).copied().unwrap_or([0; 3])
     }
 }
@@ -300,7 +300,7 @@ pub(crate) mod test_support {
         pub sim_box: SimBox,
         /// Positions per frame.
         pub frames: Vec<Vec<DVec3>>,
-        pub images: Vec<[i32; 3]>,
+        pub images: Vec<[i64; 3]>,
     }
 
     impl Sample {

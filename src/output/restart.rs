@@ -69,7 +69,7 @@ pub struct RestartData {
     /// User id of each particle, by internal index.
     pub ids: Vec<u64>,
     pub positions: Vec<DVec3>,
-    pub images: Vec<[i32; 3]>,
+    pub images: Vec<[i64; 3]>,
     /// Bond state (bound, age, rest length, scale) when bonds have kinetics.
     #[serde(default)]
     pub bonds: Option<crate::kinetics::BondState>,
@@ -216,7 +216,7 @@ mod tests {
                 DVec3::new(5e-324, f64::MAX, -f64::MIN_POSITIVE),
                 DVec3::new(std::f64::consts::PI, 1e22, 9007199254740993.0),
             ],
-            images: vec![[0, 0, 0], [-1, 2, 0], [i32::MIN, i32::MAX, 3]],
+            images: vec![[0, 0, 0], [-1, 2, 0], [i64::MIN, i64::MAX, 3]],
             bonds: Some(crate::kinetics::BondState {
                 bound: vec![true, false],
                 age: vec![0.1 + 0.2, 5e-324],

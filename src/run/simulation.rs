@@ -291,6 +291,7 @@ impl Simulation {
             self.state.positions[i] += delta;
             self.sim_box.wrap(&mut self.state.positions[i], &mut self.state.images[i]);
         }
+        self.check_in_box()?;
         if let Some(backend) = self.backend.as_mut() {
             backend.update_neighbors(&self.state, &self.sim_box, true).map_err(RunError::Setup)?;
         }
@@ -338,7 +339,24 @@ impl Simulation {
         }
         self.backend = None;
         self.forces_current = false;
-        Ok(())
+        self.check_in_box()
+    }
+
+    /// Stops the run, as a blow-up (step, particle id, last good frame), if a
+    /// particle left a fixed box or cannot be wrapped into a periodic one:
+    /// LAMMPS' "Lost atoms". Checked after every CPU step and at every GPU
+    /// read-back.
+    fn check_in_box(&mut self) -> Result<(), RunError> {
+        let sim_box = self.sim_box;
+        let lost = self.state.positions.par_iter().with_min_len(4096).position_first(|&x| sim_box.misplaced_axis(x).is_some());
+        match lost {
+            Some(i) => {
+                let x = self.state.positions[i];
+                let axis = sim_box.misplaced_axis(x).expect("found above");
+                Err(self.blowup(i, format!("lost: {} (LAMMPS: lost atoms)", sim_box.misplacement(x, axis))))
+            }
+            None => Ok(()),
+        }
     }
 
     /// The smallest node–face distance between different bodies at the last
@@ -424,7 +442,7 @@ impl Simulation {
         }
         self.forces_current = true;
         self.energies_current = energies;
-        if let Some(i) = self.forces.forces.par_iter().with_min_len(4096).position_first(|f| !f.is_finite()) {
+        if let Some(i) = self.forces.forces.par_iter().with_min_len(4096).position_first(|f| !finite_force(*f)) {
             return Err(self.blowup(i, "non-finite force".into()));
         }
         Ok(())
@@ -590,6 +608,7 @@ impl Simulation {
                     )));
                 }
             }
+            self.check_in_box()?;
             if self.model.has_kinetics() {
                 self.kinetics_step(StepClock { step, start, length: fraction * self.dt })?;
             }
@@ -744,7 +763,8 @@ impl Simulation {
             let dump_due = self.dumps.iter().any(|d| self.state.step.is_multiple_of(d.spec.every));
             // Positions come back only when something reads them; between
             // outputs the sync only reads the GPU's status words.
-            if final_step || thermo_due || dump_due || outcome.is_err() || kinetics {
+            let read_back = final_step || thermo_due || dump_due || outcome.is_err() || kinetics;
+            if read_back {
                 gpu.download(&mut self.state);
             }
             if let Err(GpuHalt::Capacity { message, .. }) = outcome {
@@ -758,6 +778,9 @@ impl Simulation {
                     self.forces.forces[particle].length()
                 );
                 return Err(self.blowup(particle, what));
+            }
+            if read_back {
+                self.check_in_box()?;
             }
             if kinetics {
                 // As on the CPU: decided from the tensions before the step
@@ -879,9 +902,10 @@ impl Simulation {
         self.state = state;
         self.forces_current = true;
         self.energies_current = true;
-        if let Some(i) = self.forces.forces.iter().position(|f| !f.is_finite()) {
+        if let Some(i) = self.forces.forces.iter().position(|f| !finite_force(*f)) {
             return Err(self.blowup(i, "non-finite force during minimisation".into()));
         }
+        self.check_in_box()?;
         let verdict = if report.converged { "converged" } else { "stopped at maxiter without converging" };
         self.say(&format!(
             "minimize (FIRE): {verdict} after {} iterations: max |F| = {:e} (ftol {:e}), pe = {:e}{}",
@@ -914,4 +938,11 @@ impl Simulation {
         }
         first_error.map_or(Ok(()), Err)
     }
+}
+
+/// Whether a force and its squared magnitude are finite: `turgor dp0 1e308`
+/// gave finite components whose |F| overflowed, and every later step was
+/// clamped to nothing instead of stopping.
+fn finite_force(f: DVec3) -> bool {
+    f.length_squared().is_finite()
 }

@@ -8,6 +8,10 @@
 
 use glam::DVec3;
 
+/// Image counters stay below 2⁶² in magnitude (i64, with room to add): a
+/// coordinate further from a periodic box cannot be wrapped into it.
+pub const MAX_IMAGE: f64 = 4_611_686_018_427_387_904.0;
+
 /// An axis-aligned box `[lo, hi)` with a periodic flag per axis.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SimBox {
@@ -49,28 +53,67 @@ impl SimBox {
         }
     }
 
-    /// Wraps a position into the box on periodic axes, updating its image counter.
+    /// Wraps a position into the box on periodic axes, updating its image
+    /// counter: one box length is added or subtracted (the usual case, as a
+    /// step crosses at most one box), more by floor arithmetic, never by a loop
+    /// (1e300 in a 10 µm box, or 1 in a 1e-12 one, never ended). A coordinate
+    /// that cannot be wrapped — not finite, or [`MAX_IMAGE`] box lengths or
+    /// more away — is left as it is, for [`Self::misplaced_axis`] to report.
     #[inline]
-    pub fn wrap(&self, x: &mut DVec3, image: &mut [i32; 3]) {
-        let l = self.lengths();
+    pub fn wrap(&self, x: &mut DVec3, image: &mut [i64; 3]) {
         for axis in 0..3 {
-            if !self.periodic[axis] {
+            let (lo, hi) = (self.lo[axis], self.hi[axis]);
+            let v = &mut x[axis];
+            if !self.periodic[axis] || (*v >= lo && *v < hi) {
                 continue;
             }
-            while x[axis] >= self.hi[axis] {
-                x[axis] -= l[axis];
-                image[axis] += 1;
+            let l = hi - lo;
+            let crossed = if *v >= hi { 1 } else { -1 };
+            let once = *v - crossed as f64 * l;
+            if once >= lo && once < hi {
+                *v = once;
+                image[axis] += crossed;
+                continue;
             }
-            while x[axis] < self.lo[axis] {
-                x[axis] += l[axis];
-                image[axis] -= 1;
+            let t = *v - lo;
+            let r = t.rem_euclid(l);
+            let n = ((t - r) / l).round();
+            if !(n.abs() < MAX_IMAGE) {
+                continue;
             }
+            let inside = lo + r;
+            (*v, image[axis]) = if inside < hi { (inside, image[axis] + n as i64) } else { (lo, image[axis] + n as i64 + 1) };
+        }
+    }
+
+    /// The first axis on which a position cannot be in this box: outside
+    /// `[lo, hi]` on a fixed axis, or not wrappable on a periodic one (see
+    /// [`Self::wrap`]); `None` if it is in the box.
+    #[inline]
+    pub fn misplaced_axis(&self, x: DVec3) -> Option<usize> {
+        (0..3).find(|&a| {
+            let (lo, hi, v) = (self.lo[a], self.hi[a], x[a]);
+            if self.periodic[a] {
+                !((v - lo).abs() < MAX_IMAGE * (hi - lo))
+            } else {
+                !(v >= lo && v <= hi)
+            }
+        })
+    }
+
+    /// What is wrong with a position [`Self::misplaced_axis`] refuses.
+    pub fn misplacement(&self, x: DVec3, axis: usize) -> String {
+        let (name, lo, hi, v) = (["x", "y", "z"][axis], self.lo[axis], self.hi[axis], x[axis]);
+        if self.periodic[axis] {
+            format!("{name} = {v:e} cannot be wrapped into the periodic box [{lo:e}, {hi:e}) (2⁶² box lengths or more away, or not finite)")
+        } else {
+            format!("{name} = {v:e} is outside the fixed box [{lo:e}, {hi:e}]")
         }
     }
 
     /// Unwrapped position from a wrapped one and its image counter.
     #[inline]
-    pub fn unwrap(&self, x: DVec3, image: [i32; 3]) -> DVec3 {
+    pub fn unwrap(&self, x: DVec3, image: [i64; 3]) -> DVec3 {
         let l = self.lengths();
         x + DVec3::new(image[0] as f64 * l.x, image[1] as f64 * l.y, image[2] as f64 * l.z)
     }
@@ -145,5 +188,37 @@ mod tests {
         assert_eq!(image, [2, -1, 0]);
         assert!(x.x >= 0.0 && x.x < 10.0 && x.y >= 0.0 && x.y < 10.0);
         assert!((b.unwrap(x, image) - original).length() < 1e-12);
+    }
+
+    #[test]
+    fn far_coordinates_wrap_by_floor_or_are_refused() {
+        let b = periodic_box();
+        let mut x = DVec3::new(2.2e10 + 3.0, -1e15 - 2.5, 0.0);
+        let mut image = [0; 3];
+        b.wrap(&mut x, &mut image);
+        assert_eq!((x, image), (DVec3::new(3.0, 7.5, 0.0), [2_200_000_000, -100_000_000_000_001, 0]));
+        assert_eq!(b.misplaced_axis(x), None);
+        // A 1e-12 edge: 10¹² images, at once.
+        let tiny = SimBox::new(DVec3::ZERO, DVec3::splat(1e-12), [true; 3]);
+        let (mut x, mut image) = (DVec3::new(1.0, -1.0, 0.5e-12), [0; 3]);
+        tiny.wrap(&mut x, &mut image);
+        assert!((0..3).all(|a| x[a] >= 0.0 && x[a] < 1e-12), "{x}");
+        assert_eq!(image[2], 0);
+        assert!((image[0] - 1_000_000_000_000).abs() <= 1 && (image[1] + 1_000_000_000_000).abs() <= 1, "{image:?}");
+        // Beyond 2⁶² box lengths, or not finite: left as it is, and reported.
+        for far in [1e300, f64::INFINITY, f64::NAN] {
+            let (mut x, mut image) = (DVec3::new(1.0, far, 1.0), [0; 3]);
+            b.wrap(&mut x, &mut image);
+            assert_eq!((x.y.to_bits(), image), (far.to_bits(), [0; 3]));
+            assert_eq!(b.misplaced_axis(x), Some(1));
+        }
+        assert_eq!(
+            b.misplacement(DVec3::new(1.0, 1e300, 1.0), 1),
+            "y = 1e300 cannot be wrapped into the periodic box [0e0, 1e1) (2⁶² box lengths or more away, or not finite)"
+        );
+        // A fixed axis holds [lo, hi], ends included.
+        assert_eq!(b.misplaced_axis(DVec3::new(0.0, 0.0, 10.0)), None);
+        assert_eq!(b.misplaced_axis(DVec3::new(0.0, 0.0, 10.000001)), Some(2));
+        assert_eq!(b.misplacement(DVec3::new(0.0, 0.0, -1.0), 2), "z = -1e0 is outside the fixed box [0e0, 1e1]");
     }
 }

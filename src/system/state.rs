@@ -13,7 +13,7 @@ pub struct State {
     /// Simulated time (time units).
     pub time: f64,
     pub positions: Vec<DVec3>,
-    pub images: Vec<[i32; 3]>,
+    pub images: Vec<[i64; 3]>,
     /// Bond state, when some bond type has kinetic rules.
     #[serde(default)]
     pub bonds: Option<crate::kinetics::BondState>,

@@ -40,6 +40,8 @@ pub struct Topology {
     pub bodies: Vec<(u64, Token)>,
     /// (body id, three particle indices).
     pub triangles: Vec<(u64, [u32; 3])>,
+    /// The first token of each triangle's line (for errors).
+    pub face_tokens: Vec<Token>,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
@@ -90,9 +92,12 @@ struct Parser {
     /// particle is kept, so a large topology parses in little memory.
     index_of_id: HashMap<u64, (u32, usize)>,
     body_ids: HashMap<u64, Token>,
-    /// The id token of each body and the first token of each triangle line (for errors).
+    /// The id token of each body (for errors).
     body_tokens: Vec<Token>,
-    face_tokens: Vec<Token>,
+    /// Line of each bonded term by (type, particles in canonical order): a
+    /// term listed twice would be counted twice. Type names are interned.
+    term_lines: HashMap<(u32, [u32; 3]), u32>,
+    term_types: HashMap<String, u32>,
 }
 
 impl Parser {
@@ -141,7 +146,7 @@ impl Parser {
 
     /// A bonded term of `N` particles; `extra` more fields are allowed after
     /// them (read by the caller).
-    fn term<const N: usize>(&self, s: &Statement, extra: usize, layout: &str) -> Result<TypedTerm<N>, InputError> {
+    fn term<const N: usize>(&mut self, s: &Statement, extra: usize, layout: &str) -> Result<TypedTerm<N>, InputError> {
         let allowed: Vec<usize> = (N + 1..=N + 1 + extra).collect();
         expect_fields(s, &allowed, layout)?;
         let mut particles = [0u32; N];
@@ -158,7 +163,32 @@ impl Parser {
                 }
             }
         }
+        self.refuse_duplicate(s, particles)?;
         Ok(TypedTerm { type_name: s.tokens[0].clone(), particles })
+    }
+
+    /// A bond `i j` is `j i`, an angle `i j k` is `k j i`; one listed twice is an error.
+    fn refuse_duplicate<const N: usize>(&mut self, s: &Statement, particles: [u32; N]) -> Result<(), InputError> {
+        let mut key = [u32::MAX; 3];
+        key[..N].copy_from_slice(&particles);
+        if key[0] > key[N - 1] {
+            key[..N].reverse();
+        }
+        let types = self.term_types.len() as u32;
+        let ty = *self.term_types.entry(s.tokens[0].text.clone()).or_insert(types);
+        let line = s.tokens[0].line;
+        match self.term_lines.insert((ty, key), line) {
+            Some(first) => {
+                let ids: Vec<&str> = s.tokens[1..=N].iter().map(|t| t.text.as_str()).collect();
+                let what = if N == 2 { "bond" } else { "angle" };
+                Err(s.tokens[0].error(format!(
+                    "{what} `{}` {} is already listed at line {first}; expected each {what} once",
+                    s.tokens[0].text,
+                    ids.join("–")
+                )))
+            }
+            None => Ok(()),
+        }
     }
 
     fn body(&mut self, s: &Statement) -> Result<(), InputError> {
@@ -187,7 +217,7 @@ impl Parser {
             return Err(s.tokens[1].error("a triangle repeats a particle; expected three distinct particles"));
         }
         self.topology.triangles.push((body, particles));
-        self.face_tokens.push(s.tokens[0].clone());
+        self.topology.face_tokens.push(s.tokens[0].clone());
         Ok(())
     }
 }
@@ -215,6 +245,10 @@ pub fn parse_box_axis(t: &[Token], axes: &mut [BoxAxis]) -> Result<usize, InputE
     if hi <= lo {
         return Err(t[2].error(format!("upper bound {hi} is not above lower bound {lo}; expected hi > lo")));
     }
+    let edge = hi - lo;
+    if !edge.is_finite() || !(1.0 / edge).is_finite() {
+        return Err(t[2].error(format!("found box edge hi − lo = {edge:e}, expected a finite length whose inverse is finite")));
+    }
     let periodic = match t[3].text.as_str() {
         "p" => true,
         "f" => false,
@@ -231,7 +265,8 @@ pub fn parse_topology(file: &Arc<SourceFile>) -> Result<Topology, InputError> {
         index_of_id: HashMap::new(),
         body_ids: HashMap::new(),
         body_tokens: Vec::new(),
-        face_tokens: Vec::new(),
+        term_lines: HashMap::new(),
+        term_types: HashMap::new(),
     };
     let mut section: Option<Section> = None;
     let mut seen_sections: Vec<Section> = Vec::new();
@@ -286,7 +321,7 @@ pub fn parse_topology(file: &Arc<SourceFile>) -> Result<Topology, InputError> {
             }
         }
     }
-    super::surface::check_bodies(&parser.topology, &parser.face_tokens, &parser.body_tokens)?;
+    super::surface::check_bodies(&parser.topology, &parser.topology.face_tokens, &parser.body_tokens)?;
     Ok(parser.topology)
 }
 
@@ -343,6 +378,17 @@ mod tests {
         ] {
             assert_eq!(parse(&format!("{two}{line}\n")).unwrap_err(), expected, "{line}");
         }
+        // A term listed twice, in either direction, would be counted twice.
+        assert_eq!(
+            parse(&format!("{two}s 1 2\ns 2 1\n")).unwrap_err(),
+            "t.top:7:1: bond `s` 2–1 is already listed at line 6; expected each bond once"
+        );
+        assert!(parse(&format!("{two}s 1 2\nt 2 1\n")).is_ok(), "two bond types on one pair");
+        assert_eq!(
+            parse(&format!("{two}[ angles ]\nb 1 2 3\nb 3 2 1\n")).unwrap_err(),
+            "t.top:8:1: angle `b` 3–2–1 is already listed at line 7; expected each angle once"
+        );
+        assert!(parse(&format!("{two}[ angles ]\nb 1 2 3\nb 2 1 3\n")).is_ok(), "another vertex");
         // Angles take no extra field.
         assert_eq!(parse(&format!("{two}[ angles ]\nb 1 2 3 1.0\n")).unwrap_err(), "t.top:7:9: found 5 fields, expected `type i j k`");
     }

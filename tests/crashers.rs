@@ -1,0 +1,124 @@
+//! Every input that ever crashed, hung or passed silently (issue 21's fuzz
+//! findings) now ends quickly with its diagnosis and the right exit status.
+//!
+//! Committed cases are `tests/decks/crashers/*.in`, each starting with
+//! `# expect: TEXT` (in stderr; empty for a run that must succeed) and
+//! `# exit: STATUS`; inputs too large to commit (a 1 MB line, 40 000 nested
+//! parentheses, a FIFO) are generated here. Parse-time findings with exact
+//! messages (duplicate bonds, box overflow, coincident particles, `/dev/zero`
+//! as a topology, doubling variables) are bad decks in `tests/decks/bad/`.
+
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// Generous: every case takes well under a second in the test profile.
+const LIMIT: Duration = Duration::from_secs(60);
+
+struct Outcome {
+    status: i32,
+    stderr: String,
+    seconds: f64,
+}
+
+/// `cellmd ARGS` with a time limit (a hang fails the test instead of blocking it).
+fn cellmd(args: &[&str]) -> Outcome {
+    let started = Instant::now();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_cellmd")).args(args).stdout(Stdio::null()).stderr(Stdio::piped()).spawn().unwrap();
+    let stderr = child.stderr.take().unwrap();
+    let reader = std::thread::spawn(move || std::io::read_to_string(stderr).unwrap_or_default());
+    loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            let stderr = reader.join().unwrap();
+            assert!(!stderr.contains("panicked"), "cellmd {args:?} panicked:\n{stderr}");
+            return Outcome { status: status.code().unwrap_or(-1), stderr, seconds: started.elapsed().as_secs_f64() };
+        }
+        if started.elapsed() > LIMIT {
+            child.kill().unwrap();
+            panic!("cellmd {args:?} hung (killed after {LIMIT:?})");
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+}
+
+fn header<'a>(text: &'a str, key: &str) -> &'a str {
+    text.lines().find_map(|l| l.strip_prefix(key)).unwrap_or_else(|| panic!("no `{key}` line"))
+}
+
+#[test]
+fn committed_crashers_are_diagnosed() {
+    let mut decks: Vec<_> = std::fs::read_dir("tests/decks/crashers")
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "in"))
+        .collect();
+    decks.sort();
+    assert!(decks.len() >= 5, "{decks:?}");
+    let out = tempfile::tempdir().unwrap();
+    for deck in decks {
+        let text = std::fs::read_to_string(&deck).unwrap();
+        let (expected, status) = (header(&text, "# expect: "), header(&text, "# exit: ").parse::<i32>().unwrap());
+        let got = cellmd(&["run", "--quiet", deck.to_str().unwrap(), "-o", out.path().to_str().unwrap()]);
+        assert_eq!(got.status, status, "{}:\n{}", deck.display(), got.stderr);
+        assert!(got.stderr.contains(expected), "{}: stderr lacks `{expected}`:\n{}", deck.display(), got.stderr);
+    }
+    // The image counter beyond i32, in the dump and the restart.
+    let dump = std::fs::read_to_string(out.path().join("image_overflow.dump")).unwrap();
+    assert!(dump.lines().any(|l| l == "1 3 2200000000"), "{dump}");
+    let restart = std::fs::read_to_string(out.path().join("image_overflow.restart")).unwrap();
+    assert!(restart.contains("2200000000"), "{restart}");
+}
+
+/// Inputs too large (or too strange) to commit, each with the start of its
+/// expected message and exit status.
+#[test]
+fn generated_crashers_are_diagnosed_quickly() {
+    let dir = tempfile::tempdir().unwrap();
+    let write = |name: &str, bytes: &[u8]| {
+        let path = dir.path().join(name);
+        std::fs::write(&path, bytes).unwrap();
+        path.to_str().unwrap().to_string()
+    };
+    let nested = |open: &str, close: &str, n: usize| format!("variable v equal {}1{}\n", open.repeat(n), close.repeat(n));
+    let too_deep = "found an expression nested more than 64 deep";
+    let secret: String = (0..50).map(|i| format!("secret{i} line\n")).collect();
+    let cases: Vec<(String, String, i32)> = vec![
+        // The renderer panicked on a column beyond 65 536.
+        (write("wide.in", format!("{}x\n", " ".repeat(65_536)).as_bytes()), ":1:65537: found unknown command `x`".into(), 1),
+        (write("parens.in", nested("(", ")", 40_000).as_bytes()), too_deep.into(), 1),
+        (write("minus.in", nested("-", "", 60_000).as_bytes()), too_deep.into(), 1),
+        (write("powers.in", format!("variable v equal 1{}\n", "^1".repeat(60_000)).as_bytes()), too_deep.into(), 1),
+        // Quadratic lexing: 26 s for a 1 MB line.
+        (write("long.in", format!("units lj\nprint {}\n", "x ".repeat(500_000)).as_bytes()), ":2:1: `print` needs a system".into(), 1),
+        (write("latin1.in", b"units lj\nprint caf\xe9\n"), ":2:10: found byte 0xE9, which is not UTF-8".into(), 1),
+        // A password file named as a topology: one clipped word, no other line.
+        (
+            write(
+                "topology.in",
+                format!("units lj\ntopology {}\n", write("passwd", format!("root:x:0:0:{}\n{secret}", "r".repeat(300)).as_bytes()))
+                    .as_bytes(),
+            ),
+            "passwd:1:1: found `root:x:0:0:rrrr".into(),
+            1,
+        ),
+    ];
+    for (deck, expected, status) in &cases {
+        let got = cellmd(&["check", deck]);
+        assert_eq!(got.status, *status, "{deck}:\n{}", got.stderr);
+        assert!(got.stderr.contains(expected.as_str()), "{deck}: stderr lacks `{expected}`:\n{}", got.stderr);
+        assert!(!got.stderr.contains("secret"), "{deck} echoed more of a file:\n{}", got.stderr);
+        assert!(got.stderr.lines().all(|l| l.chars().count() < 400), "{deck}: a long line in\n{}", got.stderr);
+        assert!(got.seconds < 20.0, "{deck}: {} s", got.seconds);
+    }
+    // A FIFO blocked forever.
+    #[cfg(unix)]
+    {
+        let fifo = dir.path().join("fifo.top");
+        assert!(Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+        let deck = write("fifo.in", format!("units lj\ntopology {}\n", fifo.display()).as_bytes());
+        let got = cellmd(&["check", &deck]);
+        assert_eq!(got.status, 1, "{}", got.stderr);
+        assert!(got.stderr.contains("it is a FIFO (named pipe); expected a regular file"), "{}", got.stderr);
+        let got = cellmd(&["check", fifo.to_str().unwrap()]);
+        assert!(got.stderr.contains("it is a FIFO (named pipe); expected a regular file"), "{}", got.stderr);
+    }
+}

@@ -1,0 +1,258 @@
+//! A fast, deterministic mutation fuzzer over the input corpus, inside the
+//! test suite (the coverage-guided fuzz targets in `fuzz/` run separately,
+//! `scripts/fuzz`).
+//!
+//! Every deck, topology and force field of `tests/decks/bad/` and the example
+//! decks of `inputs/` (with their force fields, and their topologies up to
+//! [`MAX_TOPOLOGY_BYTES`]) is mutated with a seeded generator — words
+//! replaced by extreme or syntactic values, lines deleted, duplicated or
+//! swapped, control and multi-byte characters inserted, the file truncated —
+//! and parsed (decks validated in their own directory). No mutant may panic
+//! or hang, and every error must be `file:line:col: message` with its line and
+//! column inside the file it names, rendered as the CLI renders it. A
+//! failure names the file and the seed.
+
+use std::path::{Path, PathBuf};
+use std::sync::mpsc;
+use std::time::Duration;
+
+use cellmd::deck::validate;
+use cellmd::forcefield::{check_pair_types, load_forcefield, ForceField};
+use cellmd::input::{InputError, SourceFile};
+use cellmd::topology::parse_topology;
+use cellmd::units::UnitSystem;
+
+/// Mutants per file: fewer of the example decks, whose validation reads
+/// their (large) topologies.
+fn mutants(path: &Path) -> u64 {
+    if path.starts_with("inputs") {
+        12
+    } else {
+        24
+    }
+}
+/// Larger topologies are left out (their parse time, not their grammar, would dominate).
+const MAX_TOPOLOGY_BYTES: u64 = 100_000;
+/// The longest any one mutant may take before it counts as a hang.
+const HANG: Duration = Duration::from_secs(30);
+
+/// SplitMix64: small, seedable, the same on every platform.
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    fn below(&mut self, n: usize) -> usize {
+        (self.next() % n.max(1) as u64) as usize
+    }
+}
+
+/// Values that have broken parsers before, or might.
+const WORDS: &[&str] = &[
+    "0",
+    "-0",
+    "-1",
+    "1e308",
+    "-1e308",
+    "1e-320",
+    "1e300",
+    "nan",
+    "inf",
+    "-inf",
+    "18446744073709551616",
+    "4294967297",
+    "9223372036854775808",
+    "1:1000000000000",
+    "3:2",
+    "${x}",
+    "${",
+    "}",
+    "&",
+    "#",
+    "\"",
+    "(",
+    ")",
+    "((((1",
+    "-----1",
+    "2^2^2^2",
+    "[",
+    "]",
+    "[ bonds ]",
+    "[ particles ]",
+    "[ box ]",
+    "include",
+    "run",
+    "all",
+    "p",
+    "f",
+    "é",
+    "\u{202e}",
+    "x y z",
+];
+const CHARS: &[char] = &['\0', '\r', '\t', '"', '#', '&', '\u{7f}', 'é', '€', '\u{feff}', ' ', '\n', '$', '{', '}', ':'];
+
+fn mutate(text: &str, rng: &mut Rng) -> String {
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    for _ in 0..1 + rng.below(3) {
+        if lines.is_empty() {
+            lines.push(String::new());
+        }
+        let l = rng.below(lines.len());
+        match rng.below(8) {
+            0 | 1 => {
+                let mut words: Vec<String> = lines[l].split(' ').map(str::to_string).collect();
+                let w = rng.below(words.len());
+                words[w] = WORDS[rng.below(WORDS.len())].to_string();
+                lines[l] = words.join(" ");
+            }
+            2 => {
+                lines.remove(l);
+            }
+            3 => {
+                let copy = lines[l].clone();
+                lines.insert(rng.below(lines.len() + 1), copy);
+            }
+            4 => {
+                let m = rng.below(lines.len());
+                lines.swap(l, m);
+            }
+            5 => {
+                let chars: Vec<char> = lines[l].chars().collect();
+                let at = rng.below(chars.len() + 1);
+                let c = CHARS[rng.below(CHARS.len())];
+                lines[l] = chars[..at].iter().chain(std::iter::once(&c)).chain(&chars[at..]).collect();
+            }
+            6 => {
+                let words: Vec<&str> = text.split_whitespace().collect();
+                if let Some(word) = words.get(rng.below(words.len())) {
+                    let n = 1 + rng.below(40);
+                    lines[l] = format!("{} {}", lines[l], vec![*word; n].join(" "));
+                }
+            }
+            _ => {
+                let chars: Vec<char> = lines[l].chars().collect();
+                lines[l] = chars[..rng.below(chars.len() + 1)].iter().collect();
+                lines.truncate(l + 1);
+            }
+        }
+    }
+    let mut out = lines.join("\n");
+    if rng.below(4) > 0 {
+        out.push('\n');
+    }
+    out
+}
+
+#[derive(Clone, Copy)]
+enum Language {
+    Deck,
+    Topology,
+    ForceField,
+}
+
+/// Parses a mutant: whether it failed (cleanly); `Err` describes what is
+/// wrong with how it failed.
+fn check(language: Language, path: &Path, text: &str, scratch: &Path) -> Result<bool, String> {
+    let shown = path.display().to_string();
+    let result: Result<(), InputError> = match language {
+        Language::Deck => validate(&SourceFile::new(shown.clone(), text), path.parent().unwrap(), &[]).map(|_| ()),
+        Language::Topology => parse_topology(&SourceFile::new(shown.clone(), text)).map(|_| ()),
+        Language::ForceField => {
+            // Written to a scratch file: the force-field reader takes a path.
+            let file = scratch.join(path.file_name().unwrap());
+            std::fs::write(&file, text).unwrap();
+            let mut ff = ForceField::default();
+            load_forcefield(&file, None, UnitSystem::Cell, &mut ff, &mut Vec::new()).and_then(|()| check_pair_types(&ff))
+        }
+    };
+    let Err(e) = result else { return Ok(false) };
+    let message = e.to_string();
+    // Rendered as the CLI renders it (this panicked past column 65 536).
+    let mut report = String::new();
+    miette::GraphicalReportHandler::new().render_report(&mut report, &e).map_err(|_| format!("not rendered: {message}"))?;
+    if !message.starts_with(&format!("{}:{}:{}: ", e.path, e.line, e.col)) || e.message.is_empty() || e.line == 0 || e.col == 0 {
+        return Err(format!("not `file:line:col: message`: {message}"));
+    }
+    // An error in the mutant itself points inside it.
+    let named = Path::new(&e.path);
+    if named == path || named.file_name() == path.file_name() && named.starts_with(scratch) {
+        let lines: Vec<&str> = text.split('\n').collect();
+        let line = lines.get(e.line as usize - 1).ok_or_else(|| format!("line {} of {} lines: {message}", e.line, lines.len()))?;
+        if e.col as usize > line.chars().count() + 1 {
+            return Err(format!("column {} of a {}-character line: {message}", e.col, line.chars().count()));
+        }
+    }
+    Ok(true)
+}
+
+fn corpus() -> Vec<(Language, PathBuf)> {
+    let mut files = Vec::new();
+    for dir in ["tests/decks/bad", "inputs", "forcefields", "topologies"] {
+        for entry in std::fs::read_dir(dir).unwrap() {
+            let path = entry.unwrap().path();
+            let language = match path.extension().and_then(|e| e.to_str()) {
+                Some("in") => Language::Deck,
+                Some("ff") => Language::ForceField,
+                Some("top") if std::fs::metadata(&path).unwrap().len() <= MAX_TOPOLOGY_BYTES => Language::Topology,
+                _ => continue,
+            };
+            files.push((language, path));
+        }
+    }
+    files.sort_by(|a, b| a.1.cmp(&b.1));
+    files
+}
+
+#[test]
+fn mutants_of_every_input_fail_cleanly_or_parse() {
+    let files = corpus();
+    assert!(files.len() > 100, "{} files", files.len());
+    let (progress, done) = mpsc::channel::<Option<String>>();
+    let worker = std::thread::Builder::new()
+        .stack_size(8 << 20)
+        .spawn(move || {
+            let scratch = tempfile::tempdir().unwrap();
+            let (mut failures, mut refused, mut seconds) = (Vec::new(), 0, std::collections::BTreeMap::new());
+            for (n, (language, path)) in files.iter().enumerate() {
+                let text = std::fs::read_to_string(path).unwrap();
+                let started = std::time::Instant::now();
+                for seed in 0..mutants(path) {
+                    let mut rng = Rng(seed ^ ((n as u64) << 32));
+                    let mutant = mutate(&text, &mut rng);
+                    let what = format!("{} seed {seed}", path.display());
+                    progress.send(Some(what.clone())).unwrap();
+                    let outcome = std::panic::catch_unwind(|| check(*language, path, &mutant, scratch.path())).unwrap_or_else(|panic| {
+                        let text = panic.downcast_ref::<String>().cloned().or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()));
+                        Err(format!("panicked: {}", text.unwrap_or_default()))
+                    });
+                    match outcome {
+                        Ok(failed) => refused += usize::from(failed),
+                        Err(why) => failures.push(format!("{what}: {why}")),
+                    }
+                }
+                *seconds.entry(path.parent().unwrap().display().to_string()).or_insert(0.0) += started.elapsed().as_secs_f64();
+            }
+            progress.send(None).unwrap();
+            (failures, refused, files.iter().map(|(_, p)| mutants(p) as usize).sum::<usize>(), seconds)
+        })
+        .unwrap();
+    let mut current = String::from("the start");
+    loop {
+        match done.recv_timeout(HANG) {
+            Ok(Some(what)) => current = what,
+            Ok(None) => break,
+            Err(_) => panic!("{current}: no result after {HANG:?} (a hang?)"),
+        }
+    }
+    let (failures, refused, total, seconds) = worker.join().unwrap();
+    eprintln!("{refused} of {total} mutants refused, the others parsed; seconds by folder: {seconds:?}");
+    assert!(failures.is_empty(), "{} mutants failed badly:\n{}", failures.len(), failures.join("\n"));
+    // The mutants reach both the error paths and the parsers' ends.
+    assert!(refused > total / 3 && refused < total, "{refused} of {total} mutants refused");
+}
