@@ -11,10 +11,12 @@
 //! relative to the output directory (the working directory unless `cellmd run
 //! -o DIR`). See README.md for the command reference.
 
+mod open;
 mod plan;
 mod validate;
 mod variables;
 
+pub use self::open::OpenDeck;
 pub use self::plan::{Action, CoeffTarget, DumpSpec, Group, NeighborSettings, Plan, ThermoColumn};
 pub use self::validate::{validate, validate_file};
 pub use self::variables::Variables;
