@@ -22,9 +22,11 @@
 //! | [`compare`] | cellmd vs LAMMPS probes, agreement table, golden reference files (`cellmd compare`) |
 //! | [`build`] | topology generators (`cellmd build`: icosphere, filament, network, aster, cortex, branched, filopodium, cells, sheet, tensegrity) |
 //! | [`run`] | executes a plan: run loop, thermo, blow-up diagnosis, minimise |
+//! | [`cli`] | the `cellmd` command line (the binary and the Python package's console script call [`cli::main`]) |
 
 pub mod backend;
 pub mod build;
+pub mod cli;
 pub mod compare;
 pub mod deck;
 pub mod export;

@@ -12,10 +12,12 @@
 //! -o DIR`). See README.md for the command reference.
 
 mod placement;
+mod open;
 mod plan;
 mod validate;
 mod variables;
 
+pub use self::open::OpenDeck;
 pub use self::plan::{Action, CoeffTarget, DumpSpec, Group, NeighborSettings, Plan, ThermoColumn};
 pub use self::validate::{validate, validate_file};
 pub use self::variables::Variables;

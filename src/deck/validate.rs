@@ -28,7 +28,8 @@ const COMMANDS: &str = "units, variable, topology, forcefield, box, special_bond
 /// Commands that define the system and must come before it is first used.
 const SETUP: [&str; 5] = ["units", "topology", "forcefield", "box", "special_bonds"];
 
-struct Validator {
+/// The state of a deck being validated: what its commands so far defined.
+pub(super) struct Validator {
     deck_dir: PathBuf,
     vars: Variables,
     units: UnitSystem,
@@ -49,7 +50,7 @@ struct Validator {
     externals: HashSet<String>,
     states_written: HashSet<PathBuf>,
     timestep_set: bool,
-    actions: Vec<Action>,
+    pub(super) actions: Vec<Action>,
 }
 
 fn expect_len(s: &[Token], range: std::ops::RangeInclusive<usize>, usage: &str) -> Result<(), InputError> {
@@ -226,7 +227,7 @@ impl Validator {
         Ok(())
     }
 
-    fn thermo_columns(&self, tokens: &[Token]) -> Result<Vec<ThermoColumn>, InputError> {
+    pub(super) fn thermo_columns(&self, tokens: &[Token]) -> Result<Vec<ThermoColumn>, InputError> {
         const FIXED: &str =
             "step, time, pe, pe/NAME, fmax, fnorm, press, pxx, pyy, pzz, pxy, pxz, pyz, nbuild, solver_iterations, solver_residual, ctension/BONDTYPE, breaks, rebinds, forms, resets, nbound/BONDTYPE, tension/BONDTYPE, volume/BODYTYPE, area/BODYTYPE, planetension/AXIS/POS, gamma/BODYTYPE, e2e/BONDTYPE, tcorr/BONDTYPE/LAG, fx/GROUP, fy/GROUP, fz/GROUP, xu/GROUP, yu/GROUP, zu/GROUP, mindist, nclamp";
         let bond_type = |t: &Token, name: &str| {
@@ -500,7 +501,7 @@ impl Validator {
         Ok(())
     }
 
-    fn command(&mut self, s: &[Token]) -> Result<(), InputError> {
+    pub(super) fn command(&mut self, s: &[Token]) -> Result<(), InputError> {
         let kw = &s[0];
         match kw.text.as_str() {
             k if SETUP.contains(&k) => self.setup_command(s)?,
@@ -763,50 +764,67 @@ impl Validator {
 
 /// Validates a deck given as source text.
 pub fn validate(file: &std::sync::Arc<SourceFile>, deck_dir: &Path, overrides: &[(String, String)]) -> Result<Plan, InputError> {
-    let statements: Vec<Statement> = lex(file)?;
-    let mut v = Validator {
-        deck_dir: deck_dir.to_path_buf(),
-        vars: Variables::with_overrides(overrides),
-        units: UnitSystem::Cell,
-        topology: None,
-        forcefield: ForceField::default(),
-        forcefield_seen: false,
-        box_axes: None,
-        special_bonds: SpecialBonds::default(),
-        initial_model: None,
-        model: None,
-        positions: Vec::new(),
-        sim_box: None,
-        groups: HashMap::new(),
-        dumps: HashMap::new(),
-        externals: HashSet::new(),
-        states_written: HashSet::new(),
-        timestep_set: false,
-        actions: Vec::new(),
-    };
-    let mut last: Option<Token> = None;
-    for statement in &statements {
-        let kw = statement.keyword();
-        if kw.text == "variable" {
-            let rest = v.vars.substitute_all(&statement.tokens[1..])?;
-            v.vars.define(kw, &rest)?;
-            continue;
-        }
-        let tokens = v.vars.substitute_all(&statement.tokens)?;
-        v.command(&tokens)?;
-        last = Some(kw.clone());
-    }
+    validate_with(&mut Validator::new(deck_dir, overrides), file)
+}
+
+/// Validates a deck with a fresh `v`, which then holds the deck's context.
+pub(super) fn validate_with(v: &mut Validator, file: &std::sync::Arc<SourceFile>) -> Result<Plan, InputError> {
+    let last = v.statements(file)?;
     let Some(last) = last else {
         return Err(InputError::in_file(&file.path, "the deck is empty; expected at least `topology`, `forcefield`, `timestep` and `run`"));
     };
     v.model(&last)?;
     Ok(Plan {
         deck_path: PathBuf::from(&file.path),
-        model: v.initial_model.unwrap(),
-        sim_box: v.sim_box.unwrap(),
-        positions: v.positions,
-        actions: v.actions,
+        model: v.initial_model.take().expect("built above"),
+        sim_box: v.sim_box.expect("built with the model"),
+        positions: std::mem::take(&mut v.positions),
+        actions: std::mem::take(&mut v.actions),
     })
+}
+
+impl Validator {
+    pub(super) fn new(deck_dir: &Path, overrides: &[(String, String)]) -> Self {
+        Validator {
+            deck_dir: deck_dir.to_path_buf(),
+            vars: Variables::with_overrides(overrides),
+            units: UnitSystem::Cell,
+            topology: None,
+            forcefield: ForceField::default(),
+            forcefield_seen: false,
+            box_axes: None,
+            special_bonds: SpecialBonds::default(),
+            initial_model: None,
+            model: None,
+            positions: Vec::new(),
+            sim_box: None,
+            groups: HashMap::new(),
+            dumps: HashMap::new(),
+            externals: HashSet::new(),
+            states_written: HashSet::new(),
+            timestep_set: false,
+            actions: Vec::new(),
+        }
+    }
+
+    /// Validates every statement of `file` in order, appending to the
+    /// actions; returns the keyword of the last command (None: no command).
+    pub(super) fn statements(&mut self, file: &std::sync::Arc<SourceFile>) -> Result<Option<Token>, InputError> {
+        let statements: Vec<Statement> = lex(file)?;
+        let mut last = None;
+        for statement in &statements {
+            let kw = statement.keyword();
+            if kw.text == "variable" {
+                let rest = self.vars.substitute_all(&statement.tokens[1..])?;
+                self.vars.define(kw, &rest)?;
+                continue;
+            }
+            let tokens = self.vars.substitute_all(&statement.tokens)?;
+            self.command(&tokens)?;
+            last = Some(kw.clone());
+        }
+        Ok(last)
+    }
 }
 
 /// Reads and validates a deck file.

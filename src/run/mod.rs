@@ -5,4 +5,4 @@ mod simulation;
 pub mod thermo;
 
 pub use self::blowup::RunError;
-pub use self::simulation::{RunOptions, Simulation};
+pub use self::simulation::{ActiveRun, BondTable, RunOptions, Simulation};

@@ -21,6 +21,10 @@ use crate::output::restart::{read_state, write_state, RestartData};
 use crate::output::{open_writer_with_columns, FrameView, Measures, TopologyView, TrajectoryWriter};
 use crate::system::{Model, SimBox, State, StepClock};
 
+mod stepping;
+
+pub use self::stepping::{ActiveRun, BondTable};
+
 /// The longest GPU segment between read-backs when no output is due.
 const GPU_SYNC_STEPS: u64 = 1000;
 
@@ -521,6 +525,14 @@ impl Simulation {
 
     /// `run N`: N overdamped steps, on the CPU backend or the GPU.
     pub fn run(&mut self, steps: u64) -> Result<(), RunError> {
+        let run = self.begin_run(steps)?;
+        self.advance(&run, run.last)?;
+        self.end_run(run)
+    }
+
+    /// The start of a `run N`: checks, forces, the backend, the thermo
+    /// header and the outputs of the first step.
+    pub fn begin_run(&mut self, steps: u64) -> Result<ActiveRun, RunError> {
         self.check_kinetics_temperature()?;
         self.ensure_forces()?;
         let gpu = self.gpu_for_run()?;
@@ -535,13 +547,27 @@ impl Simulation {
             None => self.say(&header),
         }
         self.outputs_at_step(&bar, true)?;
-        let started = std::time::Instant::now();
-        let last = self.state.step + steps;
-        match gpu {
-            Some(context) => self.run_gpu(&context, last, &bar)?,
-            None => self.run_cpu(last, &bar)?,
+        Ok(ActiveRun { steps, last: self.state.step + steps, gpu, bar, started: std::time::Instant::now() })
+    }
+
+    /// Steps of `run` up to step `until` (at most the run's last): on the
+    /// CPU the same steps, bit for bit, however the run is cut into
+    /// segments; forces are recomputed first if the system changed since.
+    pub fn advance(&mut self, run: &ActiveRun, until: u64) -> Result<(), RunError> {
+        let until = until.min(run.last);
+        if self.backend.is_none() || !self.forces_current {
+            self.ensure_forces()?;
         }
-        if let Some(b) = bar {
+        match &run.gpu {
+            Some(context) => self.run_gpu(context, until, run.last, &run.bar),
+            None => self.run_cpu(until, run.last, &run.bar),
+        }
+    }
+
+    /// The end of a run: flushes thermo, writes the lifetime table and
+    /// reports the loop time.
+    pub fn end_run(&mut self, run: ActiveRun) -> Result<(), RunError> {
+        if let Some(b) = run.bar {
             b.finish_and_clear();
         }
         self.thermo.flush()?;
@@ -550,18 +576,20 @@ impl Simulation {
                 .write(path, &self.model, self.state.bonds.as_ref())
                 .map_err(|e| RunError::Io(format!("{}: {e}", path.display())))?;
         }
-        let seconds = started.elapsed().as_secs_f64();
+        let seconds = run.started.elapsed().as_secs_f64();
         self.say(&format!(
-            "loop time {seconds:.6} s for {steps} steps with {} particles: {:.6e} particle-steps/s",
+            "loop time {seconds:.6} s for {} steps with {} particles: {:.6e} particle-steps/s",
+            run.steps,
             self.model.len(),
-            (steps as f64 * self.model.len() as f64) / seconds
+            (run.steps as f64 * self.model.len() as f64) / seconds
         ));
         Ok(())
     }
 
-    fn run_cpu(&mut self, last: u64, bar: &Option<ProgressBar>) -> Result<(), RunError> {
+    /// CPU steps up to `until` of a run that ends at `last`.
+    fn run_cpu(&mut self, until: u64, last: u64, bar: &Option<ProgressBar>) -> Result<(), RunError> {
         let mut before = Vec::new();
-        while self.state.step < last {
+        while self.state.step < until {
             let (step, start) = (self.state.step, self.state.time);
             if !self.constraints.list.is_empty() {
                 before.clone_from(&self.state.positions);
@@ -730,8 +758,10 @@ impl Simulation {
     /// kinetics the host synchronises every step: it reads the positions back,
     /// measures every bond's tension and length in f64, decides the step's
     /// events exactly as on the CPU, and uploads the changed bond state as one
-    /// batch (a new GPU backend when bonds formed).
-    fn run_gpu(&mut self, context: &GpuContext, last: u64, bar: &Option<ProgressBar>) -> Result<(), RunError> {
+    /// batch (a new GPU backend when bonds formed). A segment that ends at
+    /// `until` before `last` reads the positions back and leaves the CPU
+    /// forces current there.
+    fn run_gpu(&mut self, context: &GpuContext, until: u64, last: u64, bar: &Option<ProgressBar>) -> Result<(), RunError> {
         let settings = StepSettings {
             dt: self.dt,
             kt: self.kt,
@@ -744,9 +774,9 @@ impl Simulation {
         let mut gpu = GpuBackend::new(context, &self.model, &self.state, &self.sim_box, &settings).map_err(RunError::Setup)?;
         let kinetics = self.model.has_kinetics();
         let evolving = self.model.bond_kinetics.iter().flat_map(|k| &k.rules).any(|r| r.rule.evolves_every_step());
-        while self.state.step < last {
+        while self.state.step < until {
             let (step, start) = (self.state.step, self.state.time);
-            let next_output = self.next_output_step(last).min(self.state.step + GPU_SYNC_STEPS);
+            let next_output = self.next_output_step(last).min(self.state.step + GPU_SYNC_STEPS).min(until);
             let steps = if kinetics { 1 } else { next_output - self.state.step };
             let outcome = gpu.run(self.state.step, steps);
             let done = match &outcome {
@@ -759,11 +789,12 @@ impl Simulation {
             }
             self.forces_current = false;
             let final_step = self.state.step == last;
+            let segment_end = self.state.step == until;
             let thermo_due = self.thermo.every > 0 && self.state.step.is_multiple_of(self.thermo.every);
             let dump_due = self.dumps.iter().any(|d| self.state.step.is_multiple_of(d.spec.every));
             // Positions come back only when something reads them; between
             // outputs the sync only reads the GPU's status words.
-            let read_back = final_step || thermo_due || dump_due || outcome.is_err() || kinetics;
+            let read_back = segment_end || thermo_due || dump_due || outcome.is_err() || kinetics;
             if read_back {
                 gpu.download(&mut self.state);
             }
@@ -799,8 +830,8 @@ impl Simulation {
                 let backend = self.backend.as_mut().expect("backend built");
                 backend.measure_bonds(&self.model, &self.state, &self.sim_box);
             }
-            if thermo_due || final_step {
-                self.refresh_cpu_forces(true)?;
+            if thermo_due || segment_end {
+                self.refresh_cpu_forces(thermo_due || final_step)?;
             }
             self.outputs_at_step(bar, final_step && !thermo_due)?;
             if let Some(b) = bar {

@@ -203,10 +203,14 @@ pub struct Thermo {
     pub every: u64,
     columns: Vec<ThermoColumn>,
     /// Header name of each column.
-    labels: Vec<String>,
+    pub(crate) labels: Vec<String>,
     pub units: UnitSystem,
     file: Option<BufWriter<File>>,
     file_header_written: bool,
+    /// Whether rows are kept in `log` (the Python API's `thermo()`).
+    pub(crate) record: bool,
+    /// The rows since recording began or the columns last changed.
+    pub(crate) log: Vec<Vec<f64>>,
 }
 
 /// Minimum column width on stdout; longer names widen their column.
@@ -214,8 +218,16 @@ const WIDTH: usize = 14;
 
 impl Thermo {
     pub fn new(model: &crate::system::Model) -> Self {
-        let mut thermo =
-            Self { every: 0, columns: Vec::new(), labels: Vec::new(), units: model.units, file: None, file_header_written: false };
+        let mut thermo = Self {
+            every: 0,
+            columns: Vec::new(),
+            labels: Vec::new(),
+            units: model.units,
+            file: None,
+            file_header_written: false,
+            record: false,
+            log: Vec::new(),
+        };
         thermo.set_columns(vec![ThermoColumn::Step, ThermoColumn::Time, ThermoColumn::Pe, ThermoColumn::Fmax, ThermoColumn::Press], model);
         thermo
     }
@@ -224,6 +236,7 @@ impl Thermo {
     pub fn set_columns(&mut self, columns: Vec<ThermoColumn>, model: &crate::system::Model) {
         if columns != self.columns {
             self.file_header_written = false;
+            self.log.clear();
         }
         self.labels = columns.iter().map(|c| column_label(c, model)).collect();
         self.columns = columns;
@@ -255,8 +268,11 @@ impl Thermo {
     }
 
     /// A row of [`values`](Self::values) for stdout; also appended to the
-    /// CSV file when one is set.
+    /// CSV file when one is set, and kept when recording.
     pub fn row(&mut self, values: &[f64]) -> std::io::Result<String> {
+        if self.record {
+            self.log.push(values.to_vec());
+        }
         let line: String = (0..self.columns.len())
             .map(|k| {
                 let w = self.width(k);

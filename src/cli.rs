@@ -1,0 +1,364 @@
+//! The `cellmd` command line: run | check | list | export-lammps | compare |
+//! build | profile-gpu. The `cellmd` binary (src/main.rs) and the Python
+//! package's `cellmd` console script both call [`main`].
+
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+use crate::compare::{cellmd_probes, golden, run_lammps, Agreement, Lmp, Tolerance};
+use crate::deck::validate_file;
+use crate::export::{self, ExportOptions};
+use crate::gpu::backend::StepSettings;
+use crate::gpu::{DevicePreference, GpuBackend, GpuContext};
+use crate::interactions::{documentation, lookup, REGISTRY};
+use crate::kinetics::{lookup_rule, rule_documentation, RULES};
+use crate::run::{RunOptions, Simulation};
+use crate::units::UnitSystem;
+
+#[derive(Parser)]
+#[command(name = "cellmd", version, about = "Overdamped molecular dynamics whose force fields are cell mechanics")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Validate and run a deck.
+    Run {
+        deck: PathBuf,
+        /// Directory for output files (default: the working directory).
+        #[arg(short, long, default_value = ".")]
+        output_dir: PathBuf,
+        /// Set a deck variable, overriding the deck's own definition (repeatable).
+        #[arg(long = "var", value_name = "NAME=VALUE", value_parser = parse_var)]
+        vars: Vec<(String, String)>,
+        /// Worker threads (default: all cores). Results are identical for any count.
+        #[arg(long)]
+        threads: Option<usize>,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+        /// Backend for the steps, overriding the deck's `device`: cpu, gpu or auto.
+        #[arg(long, value_parser = parse_device)]
+        device: Option<DevicePreference>,
+    },
+    /// Time each phase of a GPU step on a deck's initial system (neighbour
+    /// check, rebuild, forces, integration, read-back) and print the shares.
+    ProfileGpu {
+        deck: PathBuf,
+        #[arg(long = "var", value_name = "NAME=VALUE", value_parser = parse_var)]
+        vars: Vec<(String, String)>,
+        /// Calls of each phase to average over.
+        #[arg(long, default_value_t = 20)]
+        repetitions: u32,
+        /// Neighbour-list rebuilds per step to weight the rebuild cost by
+        /// (default: from 200 GPU steps of the deck).
+        #[arg(long)]
+        rebuild_rate: Option<f64>,
+    },
+    /// Validate a deck (and its topology and force fields) without running it.
+    Check {
+        deck: PathBuf,
+        #[arg(long = "var", value_name = "NAME=VALUE", value_parser = parse_var)]
+        vars: Vec<(String, String)>,
+    },
+    /// Write a LAMMPS data file and input script equivalent to the deck.
+    ExportLammps {
+        deck: PathBuf,
+        /// Directory for `data.lammps` and `in.lammps`.
+        outdir: PathBuf,
+        #[arg(long = "var", value_name = "NAME=VALUE", value_parser = parse_var)]
+        vars: Vec<(String, String)>,
+        /// Also write the probe files `cellmd compare` reads.
+        #[arg(long)]
+        probes: bool,
+    },
+    /// Run the deck in cellmd and in LAMMPS and compare energies, forces and positions.
+    Compare {
+        deck: PathBuf,
+        #[arg(long = "var", value_name = "NAME=VALUE", value_parser = parse_var)]
+        vars: Vec<(String, String)>,
+        /// The lmp executable (default: $CELLMD_LMP, lmp on PATH, or scripts/reference-venv --lmp).
+        #[arg(long)]
+        lmp: Option<PathBuf>,
+        /// Keep LAMMPS' files in this directory (default: a temporary one).
+        #[arg(long)]
+        workdir: Option<PathBuf>,
+        /// Tolerance of energies, forces and virial at one configuration (relative).
+        #[arg(long, default_value_t = 1e-10)]
+        tol: f64,
+        /// Tolerance of positions, forces and energies after the run (relative).
+        #[arg(long, default_value_t = 1e-9)]
+        run_tol: f64,
+        /// Also write LAMMPS' results as a golden document (reference/*.yaml) to this file.
+        #[arg(long, value_name = "FILE")]
+        write_golden: Option<PathBuf>,
+        /// `key=value` header entries of the golden document (repeatable).
+        #[arg(long = "golden-header", value_name = "KEY=VALUE", value_parser = parse_var)]
+        golden_header: Vec<(String, String)>,
+    },
+    /// Write a topology file of a generated system (deterministic).
+    Build {
+        // Boxed: the generators' options dwarf every other command's.
+        #[command(subcommand)]
+        what: Box<crate::build::Generator>,
+    },
+    /// List interaction types and kinetic rules, or print one's documentation.
+    List {
+        name: Option<String>,
+        /// Show units of the `lj` system instead of `cell`.
+        #[arg(long)]
+        lj: bool,
+    },
+}
+
+fn parse_device(s: &str) -> Result<DevicePreference, String> {
+    DevicePreference::from_keyword(s).ok_or_else(|| format!("found `{s}`, expected cpu, gpu or auto"))
+}
+
+fn parse_var(s: &str) -> Result<(String, String), String> {
+    s.split_once('=').map(|(a, b)| (a.to_string(), b.to_string())).ok_or_else(|| format!("expected NAME=VALUE, found `{s}`"))
+}
+
+fn report(error: impl miette::Diagnostic + Send + Sync + 'static) -> ExitCode {
+    eprintln!("{:?}", miette::Report::new(error));
+    ExitCode::from(1)
+}
+
+/// Runs the command line `args` (the program name first, as
+/// [`std::env::args_os`] gives it) and returns the process's exit status.
+/// `--help`, `--version` and malformed arguments print clap's text and exit
+/// the process, as a command line does.
+pub fn main<I, T>(args: I) -> ExitCode
+where
+    I: IntoIterator<Item = T>,
+    T: Into<std::ffi::OsString> + Clone,
+{
+    // One unwrapped `file:line:col: message` line, then the source snippet.
+    let _ = miette::set_hook(Box::new(|_| Box::new(miette::MietteHandlerOpts::new().wrap_lines(false).build())));
+    let cli = Cli::parse_from(args);
+    match cli.command {
+        Command::Build { what } => build(what),
+        Command::List { name, lj } => {
+            let units = if lj { UnitSystem::Lj } else { UnitSystem::Cell };
+            match name {
+                None => {
+                    println!("{:<16} {:<9} summary", "name", "kind");
+                    for i in REGISTRY {
+                        println!("{:<16} {:<9} {}", i.name(), i.kind().keyword(), i.summary());
+                    }
+                    for r in RULES {
+                        println!("{:<16} {:<9} {}", r.name(), "kinetics", r.summary());
+                    }
+                }
+                Some(name) => match (lookup(&name), lookup_rule(&name)) {
+                    (Some(i), _) => println!("{}", documentation(i, units)),
+                    (None, Some(r)) => println!("{}", rule_documentation(r, units)),
+                    (None, None) => {
+                        let names: Vec<&str> = REGISTRY.iter().map(|i| i.name()).chain(RULES.iter().map(|r| r.name())).collect();
+                        eprintln!("error: unknown interaction or kinetic rule `{name}`; expected one of: {}", names.join(", "));
+                        return ExitCode::from(2);
+                    }
+                },
+            }
+            ExitCode::SUCCESS
+        }
+        Command::ProfileGpu { deck, vars, repetitions, rebuild_rate } => {
+            let plan = match validate_file(&deck, &vars) {
+                Ok(plan) => plan,
+                Err(e) => return report(e),
+            };
+            match profile_gpu(&plan, repetitions, rebuild_rate) {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::from(3)
+                }
+            }
+        }
+        Command::Check { deck, vars } => match validate_file(&deck, &vars) {
+            Ok(plan) => {
+                println!(
+                    "{}: ok ({} particles, {} bonds, {} angles, {} actions)",
+                    deck.display(),
+                    plan.model.len(),
+                    plan.model.bonds.len(),
+                    plan.model.angles.len(),
+                    plan.actions.len()
+                );
+                ExitCode::SUCCESS
+            }
+            Err(e) => report(e),
+        },
+        Command::ExportLammps { deck, outdir, vars, probes } => {
+            let plan = match validate_file(&deck, &vars) {
+                Ok(plan) => plan,
+                Err(e) => return report(e),
+            };
+            match export::export(&plan, ExportOptions { probes }) {
+                Ok(lammps) => match export::lammps::write(&lammps, &outdir) {
+                    Ok(()) => {
+                        println!("wrote {0}/data.lammps and {0}/in.lammps", outdir.display());
+                        ExitCode::SUCCESS
+                    }
+                    Err(e) => {
+                        eprintln!("error: {}: {e}", outdir.display());
+                        ExitCode::from(1)
+                    }
+                },
+                Err(e) => {
+                    eprintln!("error: cannot export {} to LAMMPS: {e}", deck.display());
+                    ExitCode::from(2)
+                }
+            }
+        }
+        Command::Compare { deck, vars, lmp, workdir, tol, run_tol, write_golden, golden_header } => {
+            let plan = match validate_file(&deck, &vars) {
+                Ok(plan) => plan,
+                Err(e) => return report(e),
+            };
+            match compare(&plan, lmp, workdir, Tolerance { single_point: tol, run: run_tol }, write_golden, golden_header) {
+                Ok(true) => ExitCode::SUCCESS,
+                Ok(false) => ExitCode::from(4),
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::from(2)
+                }
+            }
+        }
+        Command::Run { deck, output_dir, vars, threads, quiet, device } => {
+            if let Some(n) = threads {
+                if let Err(e) = rayon::ThreadPoolBuilder::new().num_threads(n).build_global() {
+                    eprintln!("error: cannot start {n} threads: {e}");
+                    return ExitCode::from(2);
+                }
+            }
+            let plan = match validate_file(&deck, &vars) {
+                Ok(plan) => plan,
+                Err(e) => return report(e),
+            };
+            if let Err(e) = std::fs::create_dir_all(&output_dir) {
+                eprintln!("error: cannot create output directory {}: {e}", output_dir.display());
+                return ExitCode::from(1);
+            }
+            let interactive = std::io::stderr().is_terminal() && std::env::var_os("CI").is_none();
+            let options = RunOptions { output_dir, progress: interactive && !quiet, echo: true, device };
+            println!(
+                "cellmd {}: {} — {} particles, {} bonds, {} angles, {} pair rules; {} CPU threads",
+                env!("CARGO_PKG_VERSION"),
+                deck.display(),
+                plan.model.len(),
+                plan.model.bonds.len(),
+                plan.model.angles.len(),
+                plan.model.pair_rules.len(),
+                rayon::current_num_threads()
+            );
+            let started = std::time::Instant::now();
+            match Simulation::execute(plan, options) {
+                Ok(sim) => {
+                    println!("done: {} steps in {:.2} s", sim.state.step, started.elapsed().as_secs_f64());
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::from(3)
+                }
+            }
+        }
+    }
+}
+
+/// `cellmd build ...`: writes the topology and prints its summary; bad
+/// options exit with status 2 and what was expected.
+fn build(what: Box<crate::build::Generator>) -> ExitCode {
+    let built = match what.build() {
+        Ok(built) => built,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let output = what.output();
+    if let Err(e) = std::fs::write(output, &built.text) {
+        eprintln!("error: cannot write {}: {e}", output.display());
+        return ExitCode::from(1);
+    }
+    println!("wrote {}: {}", output.display(), built.summary());
+    ExitCode::SUCCESS
+}
+
+/// `cellmd profile-gpu`: the GPU phase times on the deck's initial system.
+fn profile_gpu(plan: &crate::deck::Plan, repetitions: u32, rebuild_rate: Option<f64>) -> Result<(), String> {
+    let sim = Simulation::before_first_run(plan, RunOptions::default()).map_err(|e| e.to_string())?;
+    let context = GpuContext::open(false)?;
+    let settings = StepSettings {
+        dt: sim.dt,
+        kt: sim.kt,
+        seed: sim.seed,
+        skin: sim.neighbor.skin,
+        neighbor_every: sim.neighbor.every,
+        neighbor_check: sim.neighbor.check,
+        integrator: sim.integrator,
+    };
+    let mut gpu = GpuBackend::new(&context, &sim.model, &sim.state, &sim.sim_box, &settings)?;
+    let rate = match rebuild_rate {
+        Some(rate) => rate,
+        None => {
+            let mut probe = GpuBackend::new(&context, &sim.model, &sim.state, &sim.sim_box, &settings)?;
+            let before = probe.neighbor_builds();
+            let done = probe.run(0, 200).map_err(|e| format!("{e:?}"))?;
+            (probe.neighbor_builds() - before).saturating_sub(1) as f64 / done.max(1) as f64
+        }
+    };
+    let t = gpu.profile(repetitions)?;
+    let step = t.check + rate * t.neighbor_build + t.forces + t.integrate;
+    let n = sim.model.len() as f64;
+    println!("device: {}", context.describe());
+    println!("{} particles; {rate:.4} neighbour rebuilds per step", sim.model.len());
+    println!("{:<26} {:>14} {:>12}", "phase", "µs per call", "share/step");
+    let rows = [
+        ("neighbour check", t.check, t.check),
+        ("neighbour rebuild", t.neighbor_build, rate * t.neighbor_build),
+        ("forces", t.forces, t.forces),
+        ("integration", t.integrate, t.integrate),
+    ];
+    for (name, per_call, per_step) in rows {
+        println!("{name:<26} {:>14.1} {:>11.1}%", per_call * 1e6, 100.0 * per_step / step);
+    }
+    println!("{:<26} {:>14.1} {:>12}", "read-back of positions", t.readback * 1e6, "per output");
+    println!("GPU step: {:.1} µs = {:.3e} particle-steps/s (kernels only, no read-back)", step * 1e6, n / step);
+    Ok(())
+}
+
+/// `cellmd compare`: prints the table; returns whether the engines agree.
+fn compare(
+    plan: &crate::deck::Plan,
+    lmp: Option<PathBuf>,
+    workdir: Option<PathBuf>,
+    tol: Tolerance,
+    write_golden: Option<PathBuf>,
+    header: Vec<(String, String)>,
+) -> Result<bool, String> {
+    let lmp = match lmp {
+        Some(p) => Lmp::at(p),
+        None => Lmp::find()?,
+    };
+    let scratch = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let dir = workdir.unwrap_or_else(|| scratch.path().to_path_buf());
+    let (reference, version) = run_lammps(plan, &lmp, &dir)?;
+    let ours = cellmd_probes(plan)?;
+    let agreement = Agreement::new(&ours, &reference)?;
+    println!("cellmd {} vs {version} on {}", env!("CARGO_PKG_VERSION"), plan.deck_path.display());
+    print!("{}", agreement.table("LAMMPS", tol));
+    if let Some(path) = write_golden {
+        let mut entries = vec![("generator", format!("{version} via cellmd export-lammps"))];
+        entries.extend(header.iter().map(|(k, v)| (k.as_str(), v.clone())));
+        let doc = golden::document_of(&entries, &reference);
+        std::fs::write(&path, golden::write(&[doc])).map_err(|e| format!("{}: {e}", path.display()))?;
+    }
+    Ok(agreement.agrees(tol))
+}
