@@ -15,6 +15,6 @@ mod plan;
 mod validate;
 mod variables;
 
-pub use self::plan::{Action, CoeffTarget, DumpSpec, Group, NeighborSettings, Plan, ThermoColumn};
-pub use self::validate::{validate, validate_file};
+pub use self::plan::{Action, CheckpointSpec, CoeffTarget, DumpSpec, Group, NeighborSettings, Plan, ThermoColumn};
+pub use self::validate::{validate, validate_file, validate_file_with, validate_with, ValidateOptions};
 pub use self::variables::Variables;

@@ -45,8 +45,12 @@ impl SourceFile {
     /// Reads a file; a missing or unreadable file is an error at `requested_by`.
     pub fn read(path: &std::path::Path, requested_by: Option<&Token>) -> Result<Arc<Self>, InputError> {
         let shown = path.display().to_string();
-        match std::fs::read_to_string(path) {
-            Ok(text) => Ok(Self::new(shown, text)),
+        let read = super::sources::replayed(&shown).unwrap_or_else(|| std::fs::read_to_string(path).map_err(|e| e.to_string()));
+        match read {
+            Ok(text) => {
+                super::sources::note(&shown, &text);
+                Ok(Self::new(shown, text))
+            }
             Err(e) => {
                 let message = format!("cannot read `{shown}`: {e}; expected an existing, readable text file");
                 Err(match requested_by {

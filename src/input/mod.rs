@@ -5,12 +5,16 @@
 //! by blanks, and `"double quoted"` tokens may contain blanks and `#`. The nom
 //! grammar in [`lexer`] turns a file into [`Statement`]s of [`Token`]s that
 //! remember their `line:col`, and every later error is an [`InputError`]
-//! pointing at the offending token (`file:line:col: message`).
+//! pointing at the offending token (`file:line:col: message`). Every file read
+//! can be recorded, and later served from the record instead of the disk
+//! ([`recording`], [`replaying`]): restarts carry a deck's inputs this way.
 
 mod error;
 mod lexer;
 mod number;
+mod sources;
 
 pub use self::error::InputError;
 pub use self::lexer::{lex, statements, SourceFile, Statement, Statements, Token};
 pub use self::number::{evaluate_expression, parse_f64, parse_u64};
+pub use self::sources::{recording, replaying, DeckInputs, InputFile};
