@@ -3,19 +3,22 @@
 //! package's `cellmd` console script both call [`main`].
 
 use std::io::IsTerminal;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
 use crate::compare::{cellmd_probes, golden, run_lammps, Agreement, Lmp, Tolerance};
-use crate::deck::validate_file;
+use crate::deck::{validate_file, validate_file_with, ValidateOptions};
 use crate::export::{self, ExportOptions};
 use crate::gpu::backend::StepSettings;
 use crate::gpu::{DevicePreference, GpuBackend, GpuContext};
+use crate::input::replaying;
 use crate::interactions::{documentation, lookup, REGISTRY};
 use crate::kinetics::{lookup_rule, rule_documentation, RULES};
-use crate::run::{RunOptions, Simulation};
+use crate::output::read_state;
+use crate::output::run_log::LogHeader;
+use crate::run::{RunOptions, Simulation, StopReason, StopSignal, OUTPUT_ERROR_STATUS};
 use crate::units::UnitSystem;
 
 #[derive(Parser)]
@@ -27,12 +30,20 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Validate and run a deck.
+    /// Validate and run a deck, or continue a stopped run from its restart.
     Run {
-        deck: PathBuf,
+        #[arg(required_unless_present = "resume")]
+        deck: Option<PathBuf>,
+        /// Continue the run a restart file comes from (it carries the deck,
+        /// topology and force fields as read): no deck needed.
+        #[arg(long = "continue", value_name = "RESTART", conflicts_with_all = ["deck", "vars"])]
+        resume: Option<PathBuf>,
         /// Directory for output files (default: the working directory).
         #[arg(short, long, default_value = ".")]
         output_dir: PathBuf,
+        /// Accept output paths outside the output directory (absolute or with `..`).
+        #[arg(long)]
+        allow_outside: bool,
         /// Set a deck variable, overriding the deck's own definition (repeatable).
         #[arg(long = "var", value_name = "NAME=VALUE", value_parser = parse_var)]
         vars: Vec<(String, String)>,
@@ -65,6 +76,9 @@ enum Command {
         deck: PathBuf,
         #[arg(long = "var", value_name = "NAME=VALUE", value_parser = parse_var)]
         vars: Vec<(String, String)>,
+        /// Accept output paths outside the output directory (absolute or with `..`).
+        #[arg(long)]
+        allow_outside: bool,
     },
     /// Write a LAMMPS data file and input script equivalent to the deck.
     ExportLammps {
@@ -168,6 +182,7 @@ where
             ExitCode::SUCCESS
         }
         Command::ProfileGpu { deck, vars, repetitions, rebuild_rate } => {
+            let _runtime_dir = headless_runtime_dir();
             let plan = match validate_file(&deck, &vars) {
                 Ok(plan) => plan,
                 Err(e) => return report(e),
@@ -180,7 +195,7 @@ where
                 }
             }
         }
-        Command::Check { deck, vars } => match validate_file(&deck, &vars) {
+        Command::Check { deck, vars, allow_outside } => match validate_file_with(&deck, &vars, ValidateOptions { allow_outside }) {
             Ok(plan) => {
                 println!(
                     "{}: ok ({} particles, {} bonds, {} angles, {} actions)",
@@ -230,46 +245,101 @@ where
                 }
             }
         }
-        Command::Run { deck, output_dir, vars, threads, quiet, device } => {
+        Command::Run { deck, resume, output_dir, allow_outside, vars, threads, quiet, device } => {
+            let _runtime_dir = headless_runtime_dir();
             if let Some(n) = threads {
                 if let Err(e) = rayon::ThreadPoolBuilder::new().num_threads(n).build_global() {
                     eprintln!("error: cannot start {n} threads: {e}");
                     return ExitCode::from(2);
                 }
             }
-            let plan = match validate_file(&deck, &vars) {
+            let restart = match resume.as_deref().map(read_state).transpose() {
+                Ok(restart) => restart,
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    return ExitCode::from(1);
+                }
+            };
+            let options = ValidateOptions { allow_outside };
+            let plan = match (&restart, &deck) {
+                (Some(data), _) => match &data.resume {
+                    Some(r) => replaying(&r.inputs.files, || validate_file_with(Path::new(&r.inputs.deck), &r.inputs.vars, options)),
+                    None => {
+                        eprintln!(
+                            "error: {}: this restart carries no deck (written by an older cellmd); continue it with a deck's `read_state`",
+                            resume.as_ref().expect("restart read").display()
+                        );
+                        return ExitCode::from(1);
+                    }
+                },
+                (None, Some(deck)) => validate_file_with(deck, &vars, options),
+                (None, None) => unreachable!("clap requires a deck or --continue"),
+            };
+            let plan = match plan {
                 Ok(plan) => plan,
                 Err(e) => return report(e),
             };
             if let Err(e) = std::fs::create_dir_all(&output_dir) {
                 eprintln!("error: cannot create output directory {}: {e}", output_dir.display());
-                return ExitCode::from(1);
+                return ExitCode::from(OUTPUT_ERROR_STATUS);
             }
+            let stop = match StopSignal::on_signals() {
+                Ok(stop) => stop,
+                Err(e) => {
+                    eprintln!("error: cannot install the SIGTERM/SIGINT handlers: {e}");
+                    return ExitCode::from(2);
+                }
+            };
             let interactive = std::io::stderr().is_terminal() && std::env::var_os("CI").is_none();
-            let options = RunOptions { output_dir, progress: interactive && !quiet, echo: true, device };
-            println!(
+            let log = LogHeader {
+                version: format!("cellmd {} (git {})", env!("CARGO_PKG_VERSION"), env!("CELLMD_GIT_HASH")),
+                command_line: std::env::args().collect::<Vec<_>>().join(" "),
+            };
+            let options =
+                RunOptions { output_dir, progress: interactive && !quiet, echo: true, device, stop: stop.clone(), log: Some(log) };
+            stop.say(&format!(
                 "cellmd {}: {} — {} particles, {} bonds, {} angles, {} pair rules; {} CPU threads",
                 env!("CARGO_PKG_VERSION"),
-                deck.display(),
+                plan.inputs.deck,
                 plan.model.len(),
                 plan.model.bonds.len(),
                 plan.model.angles.len(),
                 plan.model.pair_rules.len(),
                 rayon::current_num_threads()
-            );
+            ));
             let started = std::time::Instant::now();
-            match Simulation::execute(plan, options) {
+            let outcome = match (restart, resume) {
+                (Some(data), Some(path)) => Simulation::resume(plan, data, &path, options),
+                _ => Simulation::execute(plan, options),
+            };
+            match outcome {
                 Ok(sim) => {
-                    println!("done: {} steps in {:.2} s", sim.state.step, started.elapsed().as_secs_f64());
+                    stop.say(&format!("done: {} steps in {:.2} s", sim.state.step, started.elapsed().as_secs_f64()));
                     ExitCode::SUCCESS
                 }
                 Err(e) => {
-                    eprintln!("error: {e}");
-                    ExitCode::from(3)
+                    // A closed stdout is an ordinary end for a pipe (`| head`): no message.
+                    if stop.requested() != Some(StopReason::StdoutClosed) {
+                        eprintln!("error: {e}");
+                    }
+                    ExitCode::from(e.exit_status())
                 }
             }
         }
     }
+}
+
+/// Mesa's Vulkan loader complains ("error: XDG_RUNTIME_DIR is invalid")
+/// when the variable is unset, as in batch jobs and containers: a private
+/// directory (mode 0700, removed at exit) stands in for it. Called before
+/// any thread starts and before the Vulkan instance exists.
+fn headless_runtime_dir() -> Option<tempfile::TempDir> {
+    if std::env::var_os("XDG_RUNTIME_DIR").is_some() {
+        return None;
+    }
+    let dir = tempfile::Builder::new().prefix("cellmd-runtime-").tempdir().ok()?;
+    std::env::set_var("XDG_RUNTIME_DIR", dir.path());
+    Some(dir)
 }
 
 /// `cellmd build ...`: writes the topology and prints its summary; bad

@@ -18,6 +18,6 @@ mod validate;
 mod variables;
 
 pub use self::open::OpenDeck;
-pub use self::plan::{Action, CoeffTarget, DumpSpec, Group, NeighborSettings, Plan, ThermoColumn};
-pub use self::validate::{validate, validate_file};
+pub use self::plan::{Action, CheckpointSpec, CoeffTarget, DumpSpec, Group, NeighborSettings, Plan, ThermoColumn};
+pub use self::validate::{validate, validate_file, validate_file_with, validate_with, ValidateOptions};
 pub use self::variables::Variables;

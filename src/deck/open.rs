@@ -19,7 +19,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 use super::plan::{Action, Plan, ThermoColumn};
-use super::validate::{validate_with, Validator};
+use super::validate::{validate_in, ValidateOptions, Validator};
 use crate::input::{lex, InputError, SourceFile};
 
 /// A validated deck whose context later commands are validated in.
@@ -31,8 +31,8 @@ impl OpenDeck {
     /// Validates a deck given as text (inputs relative to `deck_dir`), as
     /// [`super::validate`] does, and keeps its context.
     pub fn open(file: &Arc<SourceFile>, deck_dir: &Path, overrides: &[(String, String)]) -> Result<(OpenDeck, Plan), InputError> {
-        let mut validator = Validator::new(deck_dir, overrides);
-        let plan = validate_with(&mut validator, file)?;
+        let mut validator = Validator::new(deck_dir, overrides, ValidateOptions::default());
+        let plan = validate_in(&mut validator, file)?;
         Ok((OpenDeck { validator }, plan))
     }
 

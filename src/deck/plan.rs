@@ -104,6 +104,17 @@ pub struct DumpSpec {
     pub columns: Vec<crate::output::AtomColumn>,
 }
 
+/// Periodic restart files (`write_state FILE every N [keep K]`): written at
+/// every step that is a multiple of `every` during a run, each atomically.
+/// A `*` in the file name stands for the step; then only the last `keep`
+/// files (when given) are kept.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CheckpointSpec {
+    pub path: PathBuf,
+    pub every: u64,
+    pub keep: Option<usize>,
+}
+
 /// A named particle group (deck `group`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Group {
@@ -158,6 +169,8 @@ pub enum Action {
     Minimize(FireSettings),
     Run(u64),
     WriteState(PathBuf),
+    /// Periodic checkpoints from now on (replacing earlier ones).
+    Checkpoint(CheckpointSpec),
     ReadState(PathBuf),
     Print(String),
 }
@@ -175,6 +188,24 @@ impl Action {
                 | Action::Dump(_)
                 | Action::Undump(_)
                 | Action::WriteState(_)
+                | Action::Checkpoint(_)
+                | Action::Print(_)
+        )
+    }
+
+    /// Whether `cellmd run --continue` applies the action again, before the
+    /// restart's state, when it came before the point the run stopped at:
+    /// settings, model edits and opened outputs are; what moved particles
+    /// or wrote files (runs, minimisations, displacements, state files,
+    /// prints) is not, the restart holds its outcome.
+    pub fn replays_on_continue(&self) -> bool {
+        !matches!(
+            self,
+            Action::Run(_)
+                | Action::Minimize(_)
+                | Action::Displace { .. }
+                | Action::WriteState(_)
+                | Action::ReadState(_)
                 | Action::Print(_)
         )
     }
@@ -196,4 +227,6 @@ pub struct Plan {
     pub sim_box: SimBox,
     pub positions: Vec<glam::DVec3>,
     pub actions: Vec<Action>,
+    /// The deck's path, `--var` overrides and input files as read.
+    pub inputs: crate::input::DeckInputs,
 }

@@ -6,11 +6,11 @@ use std::path::{Path, PathBuf};
 use glam::DVec3;
 
 use super::placement::check_placement;
-use super::plan::{Action, CoeffTarget, DumpSpec, Group, NeighborSettings, Plan, ThermoColumn};
+use super::plan::{Action, CheckpointSpec, CoeffTarget, DumpSpec, Group, NeighborSettings, Plan, ThermoColumn};
 use super::variables::Variables;
 use crate::forcefield::{load_forcefield, parse_params, ForceField};
 use crate::gpu::DevicePreference;
-use crate::input::{check_input_file, lex, parse_f64, parse_u64, InputError, SourceFile, Statement, Token};
+use crate::input::{check_input_file, lex, parse_f64, parse_u64, recording, DeckInputs, InputError, InputFile, SourceFile, Statement, Token};
 use crate::integrate::fire::FireSettings;
 use crate::integrate::implicit::{ImplicitSettings, LinearSolver};
 use crate::integrate::overdamped::OverdampedSettings;
@@ -51,6 +51,15 @@ pub(super) struct Validator {
     states_written: HashSet<PathBuf>,
     timestep_set: bool,
     pub(super) actions: Vec<Action>,
+    allow_outside: bool,
+}
+
+/// How a deck is validated.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct ValidateOptions {
+    /// Accept output paths outside the output directory (absolute, or with
+    /// a `..` component): `cellmd run --allow-outside`.
+    pub allow_outside: bool,
 }
 
 fn expect_len(s: &[Token], range: std::ops::RangeInclusive<usize>, usage: &str) -> Result<(), InputError> {
@@ -123,6 +132,21 @@ impl Validator {
         } else {
             self.deck_dir.join(p)
         }
+    }
+
+    /// An output path (relative to the output directory): refused when it
+    /// would leave that directory, unless outside paths are allowed.
+    fn output_file(&self, token: &Token) -> Result<PathBuf, InputError> {
+        let path = PathBuf::from(&token.text);
+        let escapes = path.is_absolute() || path.components().any(|c| matches!(c, std::path::Component::ParentDir));
+        if escapes && !self.allow_outside {
+            return Err(token.error(format!(
+                "found output path `{}` outside the output directory; expected a relative path without `..` \
+                 (or `cellmd run --allow-outside`)",
+                token.text
+            )));
+        }
+        Ok(path)
     }
 
     /// The group a token names (`all` or one a `group` command defined before).
@@ -399,6 +423,50 @@ impl Validator {
         Ok(())
     }
 
+    /// `write_state FILE [every N [keep K]]`: once now, or periodically
+    /// during runs; `*` in FILE stands for the step.
+    fn write_state(&mut self, s: &[Token]) -> Result<(), InputError> {
+        const USAGE: &str = "write_state FILE [every N [keep K]]";
+        expect_len(s, 1..=5, USAGE)?;
+        self.model(&s[0])?;
+        let path = self.output_file(&s[1])?;
+        if s.len() == 2 {
+            self.states_written.insert(path.clone());
+            self.actions.push(Action::WriteState(path));
+            return Ok(());
+        }
+        if s[2].text != "every" {
+            return Err(s[2].error(format!("found `{}`, expected `every` or the end of the line (`{USAGE}`)", s[2].text)));
+        }
+        let n = s.get(3).ok_or_else(|| s[2].error(format!("`every` has no value; expected `{USAGE}`")))?;
+        let every = parse_u64(n, "a checkpoint interval in steps")?;
+        if every == 0 {
+            return Err(n.error("found 0, expected a checkpoint interval >= 1"));
+        }
+        let keep = match s.get(4) {
+            None => None,
+            Some(k) if k.text != "keep" => {
+                return Err(k.error(format!("found `{}`, expected `keep` or the end of the line (`{USAGE}`)", k.text)))
+            }
+            Some(k) => {
+                let count = s.get(5).ok_or_else(|| k.error(format!("`keep` has no value; expected `{USAGE}`")))?;
+                let keep = parse_u64(count, "a number of checkpoint files to keep")?;
+                if keep == 0 {
+                    return Err(count.error("found 0, expected keep >= 1"));
+                }
+                if !s[1].text.contains('*') {
+                    return Err(count.error(format!(
+                        "`keep` needs a `*` (the step) in the file name; `{}` is one file, overwritten at each checkpoint",
+                        s[1].text
+                    )));
+                }
+                Some(keep as usize)
+            }
+        };
+        self.actions.push(Action::Checkpoint(CheckpointSpec { path, every, keep }));
+        Ok(())
+    }
+
     /// `displace_atoms GROUP move DX DY DZ` (LAMMPS' syntax, lengths in box units).
     fn displace_atoms(&mut self, s: &[Token]) -> Result<(), InputError> {
         const USAGE: &str = "displace_atoms GROUP move DX DY DZ";
@@ -605,15 +673,15 @@ impl Validator {
             }
             "thermo_file" => {
                 expect_len(s, 1..=1, "thermo_file FILE.csv")?;
-                self.actions.push(Action::ThermoFile(PathBuf::from(&s[1].text)));
+                self.actions.push(Action::ThermoFile(self.output_file(&s[1])?));
             }
             "events" => {
                 expect_len(s, 1..=1, "events FILE.csv")?;
-                self.actions.push(Action::EventFile(PathBuf::from(&s[1].text)));
+                self.actions.push(Action::EventFile(self.output_file(&s[1])?));
             }
             "lifetimes" => {
                 expect_len(s, 1..=1, "lifetimes FILE.csv")?;
-                self.actions.push(Action::LifetimeFile(PathBuf::from(&s[1].text)));
+                self.actions.push(Action::LifetimeFile(self.output_file(&s[1])?));
             }
             "dump" => {
                 const USAGE: &str = "dump NAME every N mcap|xyz|lammps|bonds FILE [columns COLUMN...]";
@@ -627,7 +695,7 @@ impl Validator {
                 }
                 let format = DumpFormat::from_keyword(&s[4].text)
                     .ok_or_else(|| s[4].error(format!("found format `{}`, expected `mcap`, `xyz`, `lammps` or `bonds`", s[4].text)))?;
-                let path = PathBuf::from(&s[5].text);
+                let path = self.output_file(&s[5])?;
                 let columns = self.dump_columns(format, &s[6..], USAGE)?;
                 if self.dumps.contains_key(&s[1].text) {
                     return Err(
@@ -732,13 +800,7 @@ impl Validator {
                 }
                 self.actions.push(Action::Run(n));
             }
-            "write_state" => {
-                expect_len(s, 1..=1, "write_state FILE")?;
-                self.model(kw)?;
-                let path = PathBuf::from(&s[1].text);
-                self.states_written.insert(path.clone());
-                self.actions.push(Action::WriteState(path));
-            }
+            "write_state" => self.write_state(s)?,
             "read_state" => {
                 expect_len(s, 1..=1, "read_state FILE")?;
                 self.model(kw)?;
@@ -762,13 +824,32 @@ impl Validator {
     }
 }
 
-/// Validates a deck given as source text.
+/// Validates a deck given as source text. The plan keeps every input file
+/// read (the deck first), so that a restart can carry them.
 pub fn validate(file: &std::sync::Arc<SourceFile>, deck_dir: &Path, overrides: &[(String, String)]) -> Result<Plan, InputError> {
-    validate_with(&mut Validator::new(deck_dir, overrides), file)
+    validate_with(file, deck_dir, overrides, ValidateOptions::default())
+}
+
+/// [`validate`] with options; the plan records every input file read.
+pub fn validate_with(
+    file: &std::sync::Arc<SourceFile>,
+    deck_dir: &Path,
+    overrides: &[(String, String)],
+    options: ValidateOptions,
+) -> Result<Plan, InputError> {
+    let (plan, read) = recording(|| validate_in(&mut Validator::new(deck_dir, overrides, options), file));
+    let mut plan = plan?;
+    let deck = InputFile { path: file.path.clone(), text: file.text.clone() };
+    plan.inputs = DeckInputs {
+        deck: file.path.clone(),
+        vars: overrides.to_vec(),
+        files: std::iter::once(deck.clone()).chain(read.into_iter().filter(|f| *f != deck)).collect(),
+    };
+    Ok(plan)
 }
 
 /// Validates a deck with a fresh `v`, which then holds the deck's context.
-pub(super) fn validate_with(v: &mut Validator, file: &std::sync::Arc<SourceFile>) -> Result<Plan, InputError> {
+pub(super) fn validate_in(v: &mut Validator, file: &std::sync::Arc<SourceFile>) -> Result<Plan, InputError> {
     let last = v.statements(file)?;
     let Some(last) = last else {
         return Err(InputError::in_file(&file.path, "the deck is empty; expected at least `topology`, `forcefield`, `timestep` and `run`"));
@@ -780,11 +861,12 @@ pub(super) fn validate_with(v: &mut Validator, file: &std::sync::Arc<SourceFile>
         sim_box: v.sim_box.expect("built with the model"),
         positions: std::mem::take(&mut v.positions),
         actions: std::mem::take(&mut v.actions),
+        inputs: DeckInputs::default(),
     })
 }
 
 impl Validator {
-    pub(super) fn new(deck_dir: &Path, overrides: &[(String, String)]) -> Self {
+    pub(super) fn new(deck_dir: &Path, overrides: &[(String, String)], options: ValidateOptions) -> Self {
         Validator {
             deck_dir: deck_dir.to_path_buf(),
             vars: Variables::with_overrides(overrides),
@@ -804,6 +886,7 @@ impl Validator {
             states_written: HashSet::new(),
             timestep_set: false,
             actions: Vec::new(),
+            allow_outside: options.allow_outside,
         }
     }
 
@@ -829,9 +912,14 @@ impl Validator {
 
 /// Reads and validates a deck file.
 pub fn validate_file(path: &Path, overrides: &[(String, String)]) -> Result<Plan, InputError> {
+    validate_file_with(path, overrides, ValidateOptions::default())
+}
+
+/// [`validate_file`] with options.
+pub fn validate_file_with(path: &Path, overrides: &[(String, String)], options: ValidateOptions) -> Result<Plan, InputError> {
     let file = SourceFile::read(path, None)?;
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    validate(&file, &dir, overrides)
+    validate_with(&file, &dir, overrides, options)
 }
 
 /// Every body must enclose a positive volume at its initial positions (in the

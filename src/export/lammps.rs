@@ -675,6 +675,7 @@ impl Writer<'_> {
                 }
                 Action::ReadState(_) => return Err("`read_state` cannot be exported: LAMMPS cannot read cellmd restart files".into()),
                 Action::WriteState(path) => self.line(format!("# write_state {}: not exported", path.display())),
+                Action::Checkpoint(spec) => self.line(format!("# write_state {} every {}: not exported", spec.path.display(), spec.every)),
                 Action::Print(text) => self.line(format!("print \"{}\"", text.replace('"', "'"))),
                 Action::Run(steps) => {
                     self.brownian();

@@ -43,26 +43,32 @@ impl SourceFile {
     /// that is not UTF-8 an error at its own line and column.
     pub fn read(path: &std::path::Path, requested_by: Option<&Token>) -> Result<Arc<Self>, InputError> {
         let shown = path.display().to_string();
-        let bytes = read_input_file(path).map_err(|why| {
+        let fail = |why: String| {
             let message = format!("cannot read `{shown}`: {why}");
             match requested_by {
                 Some(token) => InputError::at(token, message),
                 None => InputError::in_file(&shown, message),
             }
-        })?;
-        match String::from_utf8(bytes) {
-            Ok(text) => Ok(Self::new(shown, text)),
-            Err(e) => {
-                let valid = e.utf8_error().valid_up_to();
-                let byte = e.as_bytes()[valid];
-                let prefix = Self::new(shown, String::from_utf8_lossy(&e.as_bytes()[..valid]).into_owned());
-                Err(InputError::at_offset(
-                    &prefix,
-                    valid,
-                    format!("found byte 0x{byte:02X}, which is not UTF-8; expected a UTF-8 text file"),
-                ))
-            }
-        }
+        };
+        // A restart's recorded copy stands in for the disk when replaying.
+        let text = match super::sources::replayed(&shown) {
+            Some(replayed) => replayed.map_err(fail)?,
+            None => match String::from_utf8(read_input_file(path).map_err(fail)?) {
+                Ok(text) => text,
+                Err(e) => {
+                    let valid = e.utf8_error().valid_up_to();
+                    let byte = e.as_bytes()[valid];
+                    let prefix = Self::new(shown, String::from_utf8_lossy(&e.as_bytes()[..valid]).into_owned());
+                    return Err(InputError::at_offset(
+                        &prefix,
+                        valid,
+                        format!("found byte 0x{byte:02X}, which is not UTF-8; expected a UTF-8 text file"),
+                    ));
+                }
+            },
+        };
+        super::sources::note(&shown, &text);
+        Ok(Self::new(shown, text))
     }
 
     /// 1-based line and column (in characters) of a byte offset.

@@ -6,14 +6,18 @@
 //! grammar in [`lexer`] turns a file into [`Statement`]s of [`Token`]s that
 //! remember their `line:col`, and every later error is an [`InputError`]
 //! pointing at the offending token (`file:line:col: message`). Files are read
-//! by [`read_input_file`]: regular files of at most [`MAX_INPUT_BYTES`].
+//! by [`read_input_file`]: regular files of at most [`MAX_INPUT_BYTES`]. Every
+//! file read can be recorded, and later served from the record instead of the
+//! disk ([`recording`], [`replaying`]): restarts carry a deck's inputs this way.
 
 mod error;
 mod file;
 mod lexer;
 mod number;
+mod sources;
 
 pub use self::error::InputError;
 pub use self::file::{check_input_file, read_input_file, MAX_INPUT_BYTES};
 pub use self::lexer::{lex, statements, SourceFile, Statement, Statements, Token};
 pub use self::number::{evaluate_expression, parse_f64, parse_u64};
+pub use self::sources::{recording, replaying, DeckInputs, InputFile};

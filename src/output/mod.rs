@@ -11,7 +11,8 @@
 //! | extended XYZ (OVITO, ASE) | `xyz` | [`xyz`] | species, position, id; box and pbc per frame |
 //! | LAMMPS text dump | `lammps` | [`lammps_dump`] | id, type, position, image flags, sorted by id; or the columns the deck names (forces, per-particle stress, von Mises) |
 //! | per-bond tension (CSV) | `bonds` | [`bond_csv`] | per frame and bond: ids, type, length, tension dE/dr, midpoint |
-//! | restart (JSON) | — | [`restart`] | step, time, box, ids, positions, images, bond state |
+//! | restart (JSON) | — | [`restart`] | step, time, box, ids, positions, images, bond state, counters, the deck's inputs |
+//! | run log (text) | — | [`run_log`] | version, git hash, command line, inputs as read, parameters of each run, time by phase |
 //!
 //! Conventions shared by all writers:
 //!
@@ -42,6 +43,7 @@ pub mod bond_csv;
 pub mod lammps_dump;
 pub mod mcap_writer;
 pub mod restart;
+pub mod run_log;
 pub mod xyz;
 
 pub use self::bond_csv::BondCsvWriter;

@@ -13,7 +13,10 @@
 //!   "ids": [40, 7, 12, 3],
 //!   "positions": [[0.30000000000000004, 1e-300, -0.0], ...],
 //!   "images": [[0, 0, 0], [-1, 2, 0], ...],
-//!   "bonds": {"bound": [true, ...], "age": [0.2, ...], "rest": [0.95, null, ...], "scale": [1.0, ...], "formed": []}
+//!   "bonds": {"bound": [true, ...], "age": [0.2, ...], "rest": [0.95, null, ...], "scale": [1.0, ...], "formed": []},
+//!   "counters": {"breaks": 12, "rebinds": 3, "forms": 0, "resets": 0, "contact_clamps": 0},
+//!   "resume": {"inputs": {"deck": "inputs/a.in", "vars": [["n", "3"]], "files": [{"path": "inputs/a.in", "text": "..."}, ...]},
+//!              "action": 9, "run_end": 5000}
 //! }
 //! ```
 //!
@@ -27,7 +30,16 @@
 //!   length (`null`: its type's `r0`) and stiffness scale, then the bonds
 //!   formed during the run. A restart thus keeps per-bond rest lengths,
 //!   including those that kinetic rules have moved.
-//! * Unknown keys are ignored, so later versions may add fields.
+//! * `counters` are the cumulative thermo counts (`breaks`, `rebinds`,
+//!   `forms`, `resets`, `nclamp`), restored by `read_state` and `--continue`.
+//! * `resume` carries the model and force field as their sources: the deck's
+//!   path, its `--var` overrides and the text of every input file read (deck,
+//!   topology, force fields, includes), plus the index of the deck action to
+//!   continue with and the last step of the `run` in progress.
+//!   `cellmd run --continue FILE` rebuilds the system from these texts alone
+//!   (no file of the original needs to exist) and finishes the deck.
+//! * Unknown keys are ignored and `counters`/`resume` are optional, so files
+//!   of earlier builds still read, and later versions may add fields.
 //!
 //! Every f64 round-trips bit-exactly: serde_json prints the shortest string
 //! that parses back to the same value, and this crate enables serde_json's
@@ -49,6 +61,7 @@ use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
 use super::atomic::write_atomically;
+use crate::input::DeckInputs;
 use crate::system::{SimBox, State};
 use crate::units::UnitSystem;
 
@@ -73,6 +86,36 @@ pub struct RestartData {
     /// Bond state (bound, age, rest length, scale) when bonds have kinetics.
     #[serde(default)]
     pub bonds: Option<crate::kinetics::BondState>,
+    /// Cumulative thermo counters, so they go on counting after a restart.
+    #[serde(default)]
+    pub counters: Counters,
+    /// The deck, its inputs and where the run was in it (absent in restarts
+    /// of older versions: those continue only through a deck's `read_state`).
+    #[serde(default)]
+    pub resume: Option<Resume>,
+}
+
+/// Cumulative counts that thermo columns report (`breaks`, `rebinds`,
+/// `forms`, `resets`, `nclamp`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Counters {
+    pub breaks: u64,
+    pub rebinds: u64,
+    pub forms: u64,
+    pub resets: u64,
+    pub contact_clamps: u64,
+}
+
+/// Where a run stood in its deck: what `cellmd run --continue` needs.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Resume {
+    /// The deck's path, `--var` overrides and every input file as read.
+    pub inputs: DeckInputs,
+    /// Index of the deck action to continue with (the `run` in progress, or
+    /// the next action when the state was saved between actions).
+    pub action: usize,
+    /// The step at which the `run` in progress ends (None: between actions).
+    pub run_end: Option<u64>,
 }
 
 impl RestartData {
@@ -87,6 +130,8 @@ impl RestartData {
             positions: state.positions.clone(),
             images: state.images.clone(),
             bonds: state.bonds.clone(),
+            counters: Counters::default(),
+            resume: None,
         }
     }
 
@@ -223,6 +268,16 @@ mod tests {
                 rest: vec![Some(0.8), None],
                 scale: vec![1e-17, 1.0],
                 formed: Vec::new(),
+            }),
+            counters: Counters { breaks: 3, rebinds: 2, forms: 1, resets: 0, contact_clamps: u64::MAX },
+            resume: Some(Resume {
+                inputs: DeckInputs {
+                    deck: "d/deck.in".into(),
+                    vars: vec![("n".into(), "3".into())],
+                    files: vec![crate::input::InputFile { path: "d/deck.in".into(), text: "run ${n}\n\"é\"".into() }],
+                },
+                action: 4,
+                run_end: Some(200),
             }),
         }
     }

@@ -17,10 +17,31 @@ pub enum RunError {
         /// Where the last good frame was written.
         last_good: Vec<String>,
     },
+    /// An output file could not be created or written (its path and the
+    /// step are in the message).
     Io(String),
     /// Anything else (e.g. a box too small for the neighbour cutoff).
     Setup(String),
+    /// Stopped early on request (a signal, a closed stdout), outputs
+    /// finalised and a restart written.
+    Stopped { step: u64, reason: String, restart: String },
 }
+
+impl RunError {
+    /// The exit status of `cellmd run` ending with this error: 3 for a
+    /// blow-up or another failure of the run, [`OUTPUT_ERROR_STATUS`] for an
+    /// output error, [`STOPPED_STATUS`](super::stop::STOPPED_STATUS) when stopped.
+    pub fn exit_status(&self) -> u8 {
+        match self {
+            RunError::Blowup { .. } | RunError::Setup(_) => 3,
+            RunError::Io(_) => OUTPUT_ERROR_STATUS,
+            RunError::Stopped { .. } => super::stop::STOPPED_STATUS,
+        }
+    }
+}
+
+/// Exit status of a run that could not create or write an output file.
+pub const OUTPUT_ERROR_STATUS: u8 = 6;
 
 impl fmt::Display for RunError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -40,17 +61,14 @@ impl fmt::Display for RunError {
             }
             RunError::Io(e) => write!(f, "output error: {e}"),
             RunError::Setup(e) => write!(f, "{e}"),
+            RunError::Stopped { step, reason, restart } => {
+                write!(f, "stopped after step {step} ({reason}); outputs closed, restart written to {restart}")
+            }
         }
     }
 }
 
 impl std::error::Error for RunError {}
-
-impl From<std::io::Error> for RunError {
-    fn from(e: std::io::Error) -> Self {
-        RunError::Io(e.to_string())
-    }
-}
 
 /// The entry with the largest (or a non-finite) force among `parts`.
 pub fn culprit(parts: Vec<ForceBreakdown>) -> Option<Box<ForceBreakdown>> {

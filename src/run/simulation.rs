@@ -7,17 +7,20 @@ use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 
 use super::blowup::{culprit, RunError};
+use super::stop::StopSignal;
 use super::thermo::{column_value, Thermo, ThermoInputs};
 use crate::backend::{CpuBackend, Forces};
-use crate::deck::{Action, CoeffTarget, DumpSpec, NeighborSettings, Plan, ThermoColumn};
+use crate::deck::{Action, CheckpointSpec, CoeffTarget, DumpSpec, NeighborSettings, Plan, ThermoColumn};
 use crate::gpu::backend::StepSettings;
 use crate::gpu::{DevicePreference, GpuBackend, GpuContext, GpuHalt};
+use crate::input::DeckInputs;
 use crate::integrate::constraints::{Constraint, Constraints};
 use crate::integrate::fire::{fire_minimize, FireReport, FireSettings};
 use crate::integrate::implicit::{implicit_step, ConstrainedBonds, ImplicitError, ImplicitSettings, SolveReport};
 use crate::integrate::overdamped::{overdamped_step, Blowup, OverdampedSettings};
 use crate::kinetics::{initial_bond_state, Binding, EventLog, Formation, Kinetics, LifetimeTable};
-use crate::output::restart::{read_state, write_state, RestartData};
+use crate::output::restart::{read_state, write_state, Counters, RestartData, Resume};
+use crate::output::run_log::{model_parameters, LogHeader, Phase, PhaseTimes, RunLog};
 use crate::output::{open_writer_with_columns, FrameView, Measures, TopologyView, TrajectoryWriter};
 use crate::system::{Model, SimBox, State, StepClock};
 
@@ -39,11 +42,32 @@ pub struct RunOptions {
     pub echo: bool,
     /// Overrides the deck's `device` (the CLI's `--device`).
     pub device: Option<DevicePreference>,
+    /// Set by SIGTERM/SIGINT or a closed stdout: the run stops after the
+    /// current step, finalises its outputs and writes a restart.
+    pub stop: StopSignal,
+    /// Write the run log `NAME.log` in the output directory, with this head.
+    pub log: Option<LogHeader>,
 }
 
 impl Default for RunOptions {
     fn default() -> Self {
-        Self { output_dir: PathBuf::from("."), progress: false, echo: false, device: None }
+        Self { output_dir: PathBuf::from("."), progress: false, echo: false, device: None, stop: StopSignal::new(), log: None }
+    }
+}
+
+/// Periodic checkpoints in force, the step of the last one and the files
+/// written with a `*` name (oldest first).
+struct Checkpoints {
+    spec: CheckpointSpec,
+    last_step: Option<u64>,
+    written: std::collections::VecDeque<PathBuf>,
+}
+
+/// `path` with a `*` in its file name replaced by the step (LAMMPS' `write_restart file.*`).
+fn with_step(path: &Path, step: u64) -> PathBuf {
+    match path.file_name().map(|n| n.to_string_lossy()) {
+        Some(name) if name.contains('*') => path.with_file_name(name.replace('*', &step.to_string())),
+        _ => path.to_path_buf(),
     }
 }
 
@@ -75,7 +99,7 @@ pub struct Simulation {
     pub kinetics: Kinetics,
     /// Bond formation (when the force field has `bind` rules).
     formation: Option<Formation>,
-    event_log: Option<EventLog>,
+    event_log: Option<(EventLog, PathBuf)>,
     /// Lifetimes of broken bonds and where the deck wants their table.
     lifetimes: LifetimeTable,
     lifetime_file: Option<PathBuf>,
@@ -100,6 +124,16 @@ pub struct Simulation {
     gpu: Option<Result<GpuContext, String>>,
     /// Bond type labels, for outputs.
     bond_type_names: Vec<String>,
+    /// The deck and its inputs as read, carried by every restart written.
+    inputs: DeckInputs,
+    /// Index of the deck action being applied.
+    action: usize,
+    /// The last step of the `run` in progress.
+    run_end: Option<u64>,
+    checkpoints: Option<Checkpoints>,
+    /// Wall time by phase of the step loop (for the run log).
+    pub times: PhaseTimes,
+    log: Option<RunLog>,
 }
 
 impl Simulation {
@@ -107,10 +141,10 @@ impl Simulation {
     /// box), on copies of the plan's model and positions; [`Self::execute`]
     /// takes them instead.
     pub fn new(plan: &Plan, options: RunOptions) -> Self {
-        Self::start(plan.model.clone(), plan.sim_box, plan.positions.clone(), &plan.deck_path, options)
+        Self::start(plan.model.clone(), plan.sim_box, plan.positions.clone(), &plan.deck_path, plan.inputs.clone(), options)
     }
 
-    fn start(model: Model, sim_box: SimBox, positions: Vec<DVec3>, deck_path: &Path, options: RunOptions) -> Self {
+    fn start(model: Model, sim_box: SimBox, positions: Vec<DVec3>, deck_path: &Path, inputs: DeckInputs, options: RunOptions) -> Self {
         let mut state = State::new(positions);
         for (x, image) in state.positions.iter_mut().zip(state.images.iter_mut()) {
             sim_box.wrap(x, image);
@@ -149,6 +183,12 @@ impl Simulation {
             constraints: Constraints::default(),
             implicit_tension: Vec::new(),
             gpu: None,
+            inputs,
+            action: 0,
+            run_end: None,
+            checkpoints: None,
+            times: PhaseTimes::default(),
+            log: None,
         }
     }
 
@@ -156,13 +196,132 @@ impl Simulation {
     /// error. The simulation takes the plan's model and initial positions
     /// (no second copy of the system stays resident during the run).
     pub fn execute(plan: Plan, options: RunOptions) -> Result<Simulation, RunError> {
-        let Plan { deck_path, model, sim_box, positions, actions } = plan;
-        let mut sim = Simulation::start(model, sim_box, positions, &deck_path, options);
-        let result = actions.iter().try_for_each(|a| sim.apply(a));
-        let closed = sim.close_outputs();
+        let Plan { deck_path, model, sim_box, positions, actions, inputs } = plan;
+        let mut sim = Simulation::start(model, sim_box, positions, &deck_path, inputs, options);
+        let result = sim.open_log().and_then(|()| sim.perform(&actions, 0));
+        sim.finish(result)
+    }
+
+    /// Continues a run from a restart that carries its deck (`cellmd run
+    /// --continue`): `plan` is the deck rebuilt from the restart's inputs.
+    /// The actions before the stopping point that set things up are applied
+    /// again (settings, model edits, outputs, opened anew in the output
+    /// directory), then the restart's state and counters are loaded, the
+    /// `run` in progress is finished and the rest of the deck is applied.
+    /// The final state is the uninterrupted run's, bit for bit (on the CPU).
+    pub fn resume(plan: Plan, data: RestartData, restart: &Path, options: RunOptions) -> Result<Simulation, RunError> {
+        let Some(resume) = data.resume.clone() else {
+            return Err(RunError::Setup(format!("{}: the restart carries no deck to continue", restart.display())));
+        };
+        let Plan { deck_path, model, sim_box, positions, actions, inputs } = plan;
+        let mut sim = Simulation::start(model, sim_box, positions, &deck_path, inputs, options);
+        let result = (|| {
+            sim.open_log()?;
+            let before = actions.get(..resume.action).ok_or_else(|| {
+                RunError::Setup(format!("{}: action {} is beyond the deck's {}", restart.display(), resume.action, actions.len()))
+            })?;
+            for (k, action) in before.iter().enumerate().filter(|(_, a)| a.replays_on_continue()) {
+                sim.action = k;
+                sim.apply(action)?;
+            }
+            sim.load_restart(data, restart)?;
+            sim.say(&format!("continuing {} from step {} ({})", sim.inputs.deck, sim.state.step, restart.display()));
+            let next = match resume.run_end {
+                Some(end) if end > sim.state.step => {
+                    sim.action = resume.action;
+                    sim.run(end - sim.state.step)?;
+                    resume.action + 1
+                }
+                Some(_) => resume.action + 1,
+                None => resume.action,
+            };
+            sim.perform(&actions, next)
+        })();
+        sim.finish(result)
+    }
+
+    /// Applies `actions[from..]`, checking for a stop request before each.
+    fn perform(&mut self, actions: &[Action], from: usize) -> Result<(), RunError> {
+        for (k, action) in actions.iter().enumerate().skip(from) {
+            self.action = k;
+            self.stop_if_requested()?;
+            self.apply(action)?;
+        }
+        Ok(())
+    }
+
+    /// Closes every output after the actions (also after an error); the
+    /// run log ends with the outcome and the time by phase.
+    fn finish(mut self, result: Result<(), RunError>) -> Result<Simulation, RunError> {
+        let mut closed = self.close_outputs();
+        if let Some(mut log) = self.log.take() {
+            let outcome = match &result {
+                Ok(()) => format!("finished at step {}", self.state.step),
+                Err(e) => format!("ended at step {}: {e}", self.state.step),
+            };
+            let text = format!(
+                "\n{outcome}\nloop time {:.3} s by section (CPU step loop):\n{}",
+                self.times.total.as_secs_f64(),
+                self.times.table()
+            );
+            if let Err(e) = log.section(&text) {
+                closed = closed.and(Err(self.output_error(&log.path, e)));
+            }
+        }
         result?;
         closed?;
-        Ok(sim)
+        Ok(self)
+    }
+
+    /// Creates the run log when the options ask for one.
+    fn open_log(&mut self) -> Result<(), RunError> {
+        let Some(header) = &self.options.log else { return Ok(()) };
+        let path = self.output_path(Path::new(&format!("{}.log", self.deck_stem)));
+        let log = RunLog::create(&path, header, &self.inputs).map_err(|e| self.output_error(&path, e))?;
+        self.log = Some(log);
+        Ok(())
+    }
+
+    /// Logs the resolved settings and parameters a `run` starts with.
+    fn log_run(&mut self, steps: u64, device: &str) -> Result<(), RunError> {
+        let Some(log) = &mut self.log else { return Ok(()) };
+        let text = format!(
+            "\nrun {steps} from step {} on {device}: units {:?}, {} particles, box {:?} to {:?} periodic {:?}\n\
+             timestep {:e}, temperature (kT) {:e}, seed {}, integrator {:?}, neighbor {:?}\n{}",
+            self.state.step,
+            self.model.units,
+            self.model.len(),
+            self.sim_box.lo.to_array(),
+            self.sim_box.hi.to_array(),
+            self.sim_box.periodic,
+            self.dt,
+            self.kt,
+            self.seed,
+            self.integrator,
+            self.neighbor,
+            model_parameters(&self.model)
+        );
+        if let Err(e) = log.section(&text) {
+            let path = log.path.clone();
+            return Err(self.output_error(&path, e));
+        }
+        Ok(())
+    }
+
+    /// When a stop was requested: writes `NAME.restart` (with the deck and
+    /// where the run stands in it) and the lifetime table, and returns
+    /// [`RunError::Stopped`]; the caller's error path closes the outputs.
+    fn stop_if_requested(&mut self) -> Result<(), RunError> {
+        let Some(reason) = self.options.stop.requested() else { return Ok(()) };
+        let restart = self.output_path(Path::new(&format!("{}.restart", self.deck_stem)));
+        self.write_lifetimes()?;
+        write_state(&restart, &self.restart_data()).map_err(|e| self.output_error(&restart, e))?;
+        Err(RunError::Stopped { step: self.state.step, reason: reason.to_string(), restart: restart.display().to_string() })
+    }
+
+    /// An output that could not be written, with the step it happened at.
+    fn output_error(&self, path: &Path, e: impl std::fmt::Display) -> RunError {
+        RunError::Io(format!("{}: {e} (at step {})", path.display(), self.state.step))
     }
 
     /// The simulation as the deck sets it up before its first `run` or
@@ -181,7 +340,7 @@ impl Simulation {
 
     fn say(&self, message: &str) {
         if self.options.echo {
-            println!("{message}");
+            self.options.stop.say(message);
         }
     }
 
@@ -211,25 +370,28 @@ impl Simulation {
             }
             Action::EventFile(path) => {
                 let path = self.output_path(path);
-                let file = std::fs::File::create(&path).map_err(|e| RunError::Io(format!("{}: {e}", path.display())))?;
-                if let Some(old) = self.event_log.replace(EventLog::create(file, self.model.units)?) {
-                    old.finish()?;
+                let file = std::fs::File::create(&path).map_err(|e| self.output_error(&path, e))?;
+                let log = EventLog::create(file, self.model.units).map_err(|e| self.output_error(&path, e))?;
+                if let Some((old, old_path)) = self.event_log.replace((log, path)) {
+                    old.finish().map_err(|e| self.output_error(&old_path, e))?;
                 }
             }
             Action::LifetimeFile(path) => self.lifetime_file = Some(self.output_path(path)),
             Action::ThermoFile(path) => {
                 let path = self.output_path(path);
-                self.thermo.set_file(std::fs::File::create(&path).map_err(|e| RunError::Io(format!("{}: {e}", path.display())))?)?;
+                let file = std::fs::File::create(&path).map_err(|e| self.output_error(&path, e))?;
+                self.thermo.set_file(file, path).map_err(|(path, e)| self.output_error(&path, e))?;
             }
             Action::Dump(spec) => {
                 let path = self.output_path(&spec.path);
                 let writer = open_writer_with_columns(spec.format, &path, &self.topology_view(), &spec.columns)
-                    .map_err(|e| RunError::Io(format!("{}: {e}", path.display())))?;
+                    .map_err(|e| self.output_error(&path, e))?;
                 self.dumps.push(ActiveDump { spec: spec.clone(), path, writer, last_step: None });
             }
             Action::Undump(name) => {
                 if let Some(k) = self.dumps.iter().position(|d| d.spec.name == *name) {
-                    self.dumps.remove(k).writer.finish()?;
+                    let dump = self.dumps.remove(k);
+                    dump.writer.finish().map_err(|e| self.output_error(&dump.path, e))?;
                 }
             }
             Action::External(external) => {
@@ -272,9 +434,12 @@ impl Simulation {
             Action::Minimize(settings) => self.minimize(settings)?,
             Action::Run(steps) => self.run(*steps)?,
             Action::WriteState(path) => {
-                let path = self.output_path(path);
-                write_state(&path, &self.restart_data()).map_err(|e| RunError::Io(format!("{}: {e}", path.display())))?;
+                let path = self.output_path(&with_step(path, self.state.step));
+                write_state(&path, &self.restart_data()).map_err(|e| self.output_error(&path, e))?;
                 self.say(&format!("wrote state at step {} to {}", self.state.step, path.display()));
+            }
+            Action::Checkpoint(spec) => {
+                self.checkpoints = Some(Checkpoints { spec: spec.clone(), last_step: None, written: Default::default() })
             }
             Action::ReadState(path) => {
                 let path = if path.exists() { path.clone() } else { self.output_path(path) };
@@ -318,8 +483,42 @@ impl Simulation {
         }
     }
 
+    /// The restart of the current state: with the counters, the deck and
+    /// where the run stands in it.
     fn restart_data(&self) -> RestartData {
-        RestartData::from_state(self.model.units, &self.state, &self.sim_box, &self.model.ids)
+        let mut data = RestartData::from_state(self.model.units, &self.state, &self.sim_box, &self.model.ids);
+        data.counters = Counters {
+            breaks: self.kinetics.breaks,
+            rebinds: self.kinetics.rebinds,
+            forms: self.kinetics.forms,
+            resets: self.kinetics.resets,
+            contact_clamps: self.contact_clamps,
+        };
+        data.resume = Some(Resume { inputs: self.inputs.clone(), action: self.action, run_end: self.run_end });
+        data
+    }
+
+    /// A periodic checkpoint when one is due at this step.
+    fn checkpoint(&mut self) -> Result<(), RunError> {
+        let step = self.state.step;
+        let Some(due) = self.checkpoints.as_ref().filter(|c| step.is_multiple_of(c.spec.every) && c.last_step != Some(step)) else {
+            return Ok(());
+        };
+        let path = self.output_path(&with_step(&due.spec.path, step));
+        write_state(&path, &self.restart_data()).map_err(|e| self.output_error(&path, e))?;
+        let checkpoints = self.checkpoints.as_mut().expect("due above");
+        checkpoints.last_step = Some(step);
+        let mut stale = Vec::new();
+        if let Some(keep) = checkpoints.spec.keep {
+            checkpoints.written.push_back(path);
+            while checkpoints.written.len() > keep {
+                stale.extend(checkpoints.written.pop_front());
+            }
+        }
+        for old in stale {
+            std::fs::remove_file(&old).map_err(|e| self.output_error(&old, e))?;
+        }
+        Ok(())
     }
 
     fn load_restart(&mut self, data: RestartData, path: &Path) -> Result<(), RunError> {
@@ -332,6 +531,12 @@ impl Simulation {
                 self.model.units
             )));
         }
+        let counters = data.counters;
+        self.kinetics.breaks = counters.breaks;
+        self.kinetics.rebinds = counters.rebinds;
+        self.kinetics.forms = counters.forms;
+        self.kinetics.resets = counters.resets;
+        self.contact_clamps = counters.contact_clamps;
         self.sim_box = data.sim_box;
         if self.formation.is_some() {
             self.formation = Some(Formation::new(&self.model, &self.sim_box));
@@ -499,7 +704,9 @@ impl Simulation {
             images: &self.state.images,
             measures: Measures { forces, virial: &virial, bond_tension: &tension, bond_length: &length },
         };
-        self.dumps[i].writer.write_frame(&frame)?;
+        if let Err(e) = self.dumps[i].writer.write_frame(&frame) {
+            return Err(self.output_error(&self.dumps[i].path, e));
+        }
         self.dumps[i].last_step = Some(self.state.step);
         Ok(())
     }
@@ -514,13 +721,21 @@ impl Simulation {
         let due = self.thermo.every > 0 && step.is_multiple_of(self.thermo.every);
         if due || force_thermo {
             let values = self.thermo.values(&self.thermo_inputs());
-            let line = self.thermo.row(&values)?;
+            let line = self.thermo.row(&values).map_err(|(path, e)| self.output_error(&path, e))?;
             match bar {
                 Some(bar) => bar.println(line),
                 None => self.say(&line),
             }
         }
-        Ok(())
+        self.checkpoint()
+    }
+
+    /// The lifetime table, rewritten after every `run` (and when stopped).
+    fn write_lifetimes(&self) -> Result<(), RunError> {
+        match &self.lifetime_file {
+            Some(path) => self.lifetimes.write(path, &self.model, self.state.bonds.as_ref()).map_err(|e| self.output_error(path, e)),
+            None => Ok(()),
+        }
     }
 
     /// `run N`: N overdamped steps, on the CPU backend or the GPU.
@@ -546,8 +761,11 @@ impl Simulation {
             Some(b) => b.println(header),
             None => self.say(&header),
         }
+        let last = self.state.step + steps;
+        self.run_end = Some(last);
+        self.log_run(steps, if gpu.is_some() { "the GPU" } else { "the CPU" })?;
         self.outputs_at_step(&bar, true)?;
-        Ok(ActiveRun { steps, last: self.state.step + steps, gpu, bar, started: std::time::Instant::now() })
+        Ok(ActiveRun { steps, last, gpu, bar, started: std::time::Instant::now() })
     }
 
     /// Steps of `run` up to step `until` (at most the run's last): on the
@@ -558,24 +776,22 @@ impl Simulation {
         if self.backend.is_none() || !self.forces_current {
             self.ensure_forces()?;
         }
-        match &run.gpu {
+        let started = std::time::Instant::now();
+        let looped = match &run.gpu {
             Some(context) => self.run_gpu(context, until, run.last, &run.bar),
             None => self.run_cpu(until, run.last, &run.bar),
-        }
+        };
+        self.times.total += started.elapsed();
+        looped
     }
 
-    /// The end of a run: flushes thermo, writes the lifetime table and
-    /// reports the loop time.
+    /// The end of a run: writes the lifetime table and reports the loop time.
     pub fn end_run(&mut self, run: ActiveRun) -> Result<(), RunError> {
         if let Some(b) = run.bar {
             b.finish_and_clear();
         }
-        self.thermo.flush()?;
-        if let Some(path) = &self.lifetime_file {
-            self.lifetimes
-                .write(path, &self.model, self.state.bonds.as_ref())
-                .map_err(|e| RunError::Io(format!("{}: {e}", path.display())))?;
-        }
+        self.run_end = None;
+        self.write_lifetimes()?;
         let seconds = run.started.elapsed().as_secs_f64();
         self.say(&format!(
             "loop time {seconds:.6} s for {} steps with {} particles: {:.6e} particle-steps/s",
@@ -590,6 +806,8 @@ impl Simulation {
     fn run_cpu(&mut self, until: u64, last: u64, bar: &Option<ProgressBar>) -> Result<(), RunError> {
         let mut before = Vec::new();
         while self.state.step < until {
+            self.stop_if_requested()?;
+            let mut clock = self.times.clock();
             let (step, start) = (self.state.step, self.state.time);
             if !self.constraints.list.is_empty() {
                 before.clone_from(&self.state.positions);
@@ -636,9 +854,11 @@ impl Simulation {
                     )));
                 }
             }
+            clock.lap(&mut self.times, Phase::Integrate);
             self.check_in_box()?;
             if self.model.has_kinetics() {
                 self.kinetics_step(StepClock { step, start, length: fraction * self.dt })?;
+                clock.lap(&mut self.times, Phase::Kinetics);
             }
             let final_step = self.state.step == last;
             let thermo_due = self.thermo.every > 0 && self.state.step.is_multiple_of(self.thermo.every);
@@ -646,13 +866,16 @@ impl Simulation {
                 Some(backend) => {
                     if self.state.step.is_multiple_of(self.neighbor.every) {
                         backend.update_neighbors(&self.state, &self.sim_box, self.neighbor.check).map_err(RunError::Setup)?;
+                        clock.lap(&mut self.times, Phase::Neighbor);
                     }
                     self.compute_forces(thermo_due || final_step)?;
                 }
                 // Bonds formed: the backend is rebuilt for the new bond list.
                 None => self.ensure_forces()?,
             }
+            clock.lap(&mut self.times, Phase::Force);
             self.outputs_at_step(bar, final_step && !thermo_due)?;
+            clock.lap(&mut self.times, Phase::Output);
             if let Some(b) = bar {
                 b.inc(1);
             }
@@ -794,7 +1017,9 @@ impl Simulation {
             let dump_due = self.dumps.iter().any(|d| self.state.step.is_multiple_of(d.spec.every));
             // Positions come back only when something reads them; between
             // outputs the sync only reads the GPU's status words.
-            let read_back = segment_end || thermo_due || dump_due || outcome.is_err() || kinetics;
+            let checkpoint_due = self.checkpoints.as_ref().is_some_and(|c| self.state.step.is_multiple_of(c.spec.every));
+            let stopping = self.options.stop.requested().is_some();
+            let read_back = segment_end || thermo_due || dump_due || checkpoint_due || stopping || outcome.is_err() || kinetics;
             if read_back {
                 gpu.download(&mut self.state);
             }
@@ -837,6 +1062,10 @@ impl Simulation {
             if let Some(b) = bar {
                 b.inc(done);
             }
+            if stopping {
+                // The positions of this sync were read back above.
+                self.stop_if_requested()?;
+            }
         }
         Ok(())
     }
@@ -850,6 +1079,9 @@ impl Simulation {
         }
         for dump in &self.dumps {
             next = next.min(after(dump.spec.every));
+        }
+        if let Some(c) = &self.checkpoints {
+            next = next.min(after(c.spec.every));
         }
         next
     }
@@ -880,12 +1112,17 @@ impl Simulation {
         }
         if !report.events.is_empty() {
             self.lifetimes.record(&self.model, &report.events, clock.length);
-            if let Some(log) = &mut self.event_log {
-                log.write(&report.events)?;
+            if let Some((log, path)) = &mut self.event_log {
+                if let Err(e) = log.write(&report.events) {
+                    let path = path.clone();
+                    return Err(self.output_error(&path, e));
+                }
             }
             let bound = &self.state.bonds.as_ref().expect("kinetics has bond state").bound;
-            for dump in &mut self.dumps {
-                dump.writer.write_bond_events(&report.events, bound)?;
+            let failed =
+                self.dumps.iter_mut().find_map(|d| d.writer.write_bond_events(&report.events, bound).err().map(|e| (d.path.clone(), e)));
+            if let Some((path, e)) = failed {
+                return Err(self.output_error(&path, e));
             }
         }
         if formed_any {
@@ -954,17 +1191,17 @@ impl Simulation {
     /// Finishes every output file (called at the end and on errors).
     pub fn close_outputs(&mut self) -> Result<(), RunError> {
         let mut first_error = None;
-        for dump in self.dumps.drain(..) {
+        for dump in std::mem::take(&mut self.dumps) {
             if let Err(e) = dump.writer.finish() {
-                first_error.get_or_insert(RunError::Io(format!("{}: {e}", dump.path.display())));
+                first_error.get_or_insert(self.output_error(&dump.path, e));
             }
         }
-        if let Err(e) = self.thermo.close() {
-            first_error.get_or_insert(RunError::Io(e.to_string()));
+        if let Err((path, e)) = self.thermo.close() {
+            first_error.get_or_insert(self.output_error(&path, e));
         }
-        if let Some(log) = self.event_log.take() {
+        if let Some((log, path)) = self.event_log.take() {
             if let Err(e) = log.finish() {
-                first_error.get_or_insert(RunError::Io(e.to_string()));
+                first_error.get_or_insert(self.output_error(&path, e));
             }
         }
         first_error.map_or(Ok(()), Err)

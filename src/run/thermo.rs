@@ -30,6 +30,7 @@
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
+use std::path::PathBuf;
 
 use crate::backend::Forces;
 use crate::deck::ThermoColumn;
@@ -205,13 +206,17 @@ pub struct Thermo {
     /// Header name of each column.
     pub(crate) labels: Vec<String>,
     pub units: UnitSystem,
-    file: Option<BufWriter<File>>,
+    /// The CSV file and its path (for error messages).
+    file: Option<(BufWriter<File>, PathBuf)>,
     file_header_written: bool,
     /// Whether rows are kept in `log` (the Python API's `thermo()`).
     pub(crate) record: bool,
     /// The rows since recording began or the columns last changed.
     pub(crate) log: Vec<Vec<f64>>,
 }
+
+/// An error writing the thermo CSV: its path and the cause.
+pub type FileError = (PathBuf, std::io::Error);
 
 /// Minimum column width on stdout; longer names widen their column.
 const WIDTH: usize = 14;
@@ -246,9 +251,9 @@ impl Thermo {
         WIDTH.max(self.labels[k].chars().count() + 2)
     }
 
-    pub fn set_file(&mut self, file: File) -> std::io::Result<()> {
+    pub fn set_file(&mut self, file: File, path: PathBuf) -> Result<(), FileError> {
         self.close()?;
-        self.file = Some(BufWriter::new(file));
+        self.file = Some((BufWriter::new(file), path));
         self.file_header_written = false;
         Ok(())
     }
@@ -268,8 +273,10 @@ impl Thermo {
     }
 
     /// A row of [`values`](Self::values) for stdout; also appended to the
-    /// CSV file when one is set, and kept when recording.
-    pub fn row(&mut self, values: &[f64]) -> std::io::Result<String> {
+    /// CSV file when one is set, and flushed: the file holds every row
+    /// printed so far, each whole, whenever the run is killed. Rows are also
+    /// kept in memory when recording.
+    pub fn row(&mut self, values: &[f64]) -> Result<String, FileError> {
         if self.record {
             self.log.push(values.to_vec());
         }
@@ -283,34 +290,32 @@ impl Thermo {
                 }
             })
             .collect();
-        if let Some(file) = &mut self.file {
-            if !self.file_header_written {
-                let header: Vec<String> =
-                    self.columns.iter().zip(&self.labels).map(|(c, l)| format!("{l}[{}]", column_unit(c, self.units))).collect();
-                writeln!(file, "{}", header.join(","))?;
-                self.file_header_written = true;
-            }
-            let fields: Vec<String> = self
-                .columns
-                .iter()
-                .zip(values)
-                .map(|(c, v)| if is_integer(c) { format!("{}", *v as u64) } else { format!("{v:e}") })
-                .collect();
-            writeln!(file, "{}", fields.join(","))?;
+        if let Some((file, path)) = &mut self.file {
+            let mut write = || -> std::io::Result<()> {
+                if !self.file_header_written {
+                    let header: Vec<String> =
+                        self.columns.iter().zip(&self.labels).map(|(c, l)| format!("{l}[{}]", column_unit(c, self.units))).collect();
+                    writeln!(file, "{}", header.join(","))?;
+                    self.file_header_written = true;
+                }
+                let fields: Vec<String> = self
+                    .columns
+                    .iter()
+                    .zip(values)
+                    .map(|(c, v)| if is_integer(c) { format!("{}", *v as u64) } else { format!("{v:e}") })
+                    .collect();
+                writeln!(file, "{}", fields.join(","))?;
+                file.flush()
+            };
+            write().map_err(|e| (path.clone(), e))?;
         }
         Ok(line)
     }
 
-    pub fn flush(&mut self) -> std::io::Result<()> {
-        if let Some(f) = &mut self.file {
-            f.flush()?;
+    pub fn close(&mut self) -> Result<(), FileError> {
+        if let Some((mut file, path)) = self.file.take() {
+            file.flush().map_err(|e| (path, e))?;
         }
-        Ok(())
-    }
-
-    pub fn close(&mut self) -> std::io::Result<()> {
-        self.flush()?;
-        self.file = None;
         Ok(())
     }
 }
