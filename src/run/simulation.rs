@@ -18,7 +18,7 @@ use crate::integrate::implicit::{implicit_step, ConstrainedBonds, ImplicitError,
 use crate::integrate::overdamped::{overdamped_step, Blowup, OverdampedSettings};
 use crate::kinetics::{initial_bond_state, Binding, EventLog, Formation, Kinetics, LifetimeTable};
 use crate::output::restart::{read_state, write_state, RestartData};
-use crate::output::{open_writer_with_columns, FrameView, Measures, TopologyView, TrajectoryWriter};
+use crate::output::{open_writer_with, FrameView, Measures, TopologyView, TrajectoryWriter, WallPlane};
 use crate::system::{Model, SimBox, State};
 
 /// The longest GPU segment between read-backs when no output is due.
@@ -219,7 +219,7 @@ impl Simulation {
             }
             Action::Dump(spec) => {
                 let path = self.output_path(&spec.path);
-                let writer = open_writer_with_columns(spec.format, &path, &self.topology_view(), &spec.columns)
+                let writer = open_writer_with(spec.format, &path, &self.topology_view(), &spec.options)
                     .map_err(|e| RunError::Io(format!("{}: {e}", path.display())))?;
                 self.dumps.push(ActiveDump { spec: spec.clone(), path, writer, last_step: None });
             }
@@ -469,6 +469,11 @@ impl Simulation {
             }
         }
         let forces: &[DVec3] = if needs.forces { &self.forces.forces } else { &[] };
+        let walls: Vec<WallPlane> = (self.model.externals.iter())
+            .filter(|e| e.term.interaction.name() == "wall")
+            .filter_map(|e| crate::interactions::wall_plane(&e.term.params))
+            .map(|(normal, offset)| WallPlane { normal, offset })
+            .collect();
         let frame = FrameView {
             step: self.state.step,
             time: self.state.time,
@@ -476,6 +481,8 @@ impl Simulation {
             positions: &self.state.positions,
             images: &self.state.images,
             measures: Measures { forces, virial: &virial, bond_tension: &tension, bond_length: &length },
+            bound: self.state.bonds.as_ref().map_or(&[], |b| &b.bound),
+            walls: &walls,
         };
         self.dumps[i].writer.write_frame(&frame)?;
         self.dumps[i].last_step = Some(self.state.step);
