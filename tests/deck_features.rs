@@ -71,7 +71,7 @@ fn lammps_and_xyz_dumps_through_the_deck() {
     let lammps = std::fs::read_to_string(case.path("a.dump")).unwrap();
     // Frames at 0, 10, 20 (closed before the second run).
     assert_eq!(lammps.matches("ITEM: TIMESTEP").count(), 3);
-    assert!(lammps.contains("ITEM: ATOMS id type x y z ix iy iz"));
+    assert!(lammps.contains("ITEM: ATOMS id type element x y z ix iy iz"));
     let xyz = std::fs::read_to_string(case.path("b.xyz")).unwrap();
     // Frames at 0, 5, 10, 15, 20, 25, 30: 7 frames of 4 + 2 lines.
     assert_eq!(xyz.lines().count(), 7 * 6);

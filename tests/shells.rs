@@ -283,15 +283,14 @@ fn single_cell_deck_writes_a_foxglove_scene_of_its_surface() {
     let plan = validate_file(std::path::Path::new("inputs/single_cell.in"), &[("steps".into(), "1000".into())]).unwrap();
     Simulation::execute(plan, RunOptions { output_dir: out.path().to_path_buf(), ..Default::default() }).unwrap();
     let bytes = std::fs::read(out.path().join("single_cell.mcap")).unwrap();
-    let scenes: Vec<serde_json::Value> = mcap::MessageStream::new(&bytes)
+    let scenes: Vec<foxglove::schemas::SceneUpdate> = mcap::MessageStream::new(&bytes)
         .unwrap()
         .map(|m| m.unwrap())
         .filter(|m| m.channel.topic == "/scene")
-        .map(|m| serde_json::from_slice(&m.data).unwrap())
+        .map(|m| prost::Message::decode(&m.data[..]).unwrap())
         .collect();
     assert_eq!(scenes.len(), 2);
-    let triangles = scenes[1]["entities"][0]["triangles"].as_array().unwrap();
-    assert_eq!(triangles[0]["points"].as_array().unwrap().len(), 3 * 1280);
+    assert_eq!(scenes[1].entities[0].triangles[0].points.len(), 3 * 1280);
     let csv = std::fs::read_to_string(out.path().join("single_cell.thermo.csv")).unwrap();
     let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
     let column = header.iter().position(|h| h.starts_with("volume/cell")).unwrap();

@@ -100,8 +100,8 @@ pub struct DumpSpec {
     pub every: u64,
     pub format: DumpFormat,
     pub path: PathBuf,
-    /// LAMMPS dump atom columns (`columns ...`); empty: the format's default.
-    pub columns: Vec<crate::output::AtomColumn>,
+    /// LAMMPS dump atom columns (`columns ...`) and the MCAP scene's `encoding`.
+    pub options: crate::output::WriterOptions,
 }
 
 /// Periodic restart files (`write_state FILE every N [keep K]`): written at

@@ -17,7 +17,7 @@ use crate::integrate::overdamped::OverdampedSettings;
 use crate::integrate::rng::Noise;
 use crate::interactions::{param_index, Kind, REGISTRY};
 use crate::kinetics::EventKind;
-use crate::output::{AtomColumn, DumpFormat};
+use crate::output::{AtomColumn, DumpFormat, Encoding, WriterOptions};
 use crate::system::{External, Model, SimBox, SpecialBonds};
 use crate::topology::{parse_box_axis, parse_topology, BoxAxis, Topology};
 use crate::units::UnitSystem;
@@ -339,27 +339,42 @@ impl Validator {
             .collect()
     }
 
-    /// The optional `columns C...` of a `dump` (LAMMPS dumps only).
-    fn dump_columns(&self, format: DumpFormat, rest: &[Token], usage: &str) -> Result<Vec<AtomColumn>, InputError> {
-        let Some(first) = rest.first() else { return Ok(Vec::new()) };
-        if first.text != "columns" {
-            return Err(first.error(format!("found `{}`, expected `columns` or the end of the line (`{usage}`)", first.text)));
+    /// The options after a `dump`'s file: `columns C...` (LAMMPS dumps) or
+    /// `encoding protobuf|json` (MCAP).
+    fn dump_options(&self, format: DumpFormat, rest: &[Token], usage: &str) -> Result<WriterOptions, InputError> {
+        let mut options = WriterOptions::default();
+        let Some(first) = rest.first() else { return Ok(options) };
+        match (first.text.as_str(), format) {
+            ("columns", DumpFormat::Lammps) => {
+                if rest.len() < 2 {
+                    return Err(first.error("expected at least one column name after `columns`"));
+                }
+                options.columns = rest[1..]
+                    .iter()
+                    .map(|t| {
+                        AtomColumn::from_name(&t.text).ok_or_else(|| {
+                            let names: Vec<String> = AtomColumn::all().iter().map(|c| c.name()).collect();
+                            t.error(format!("found dump column `{}`, expected one of: {}", t.text, names.join(" ")))
+                        })
+                    })
+                    .collect::<Result<_, _>>()?;
+            }
+            ("encoding", DumpFormat::Mcap) => {
+                expect_len(rest, 1..=1, usage)?;
+                options.encoding = Encoding::from_keyword(&rest[1].text)
+                    .ok_or_else(|| rest[1].error(format!("found encoding `{}`, expected `protobuf` or `json`", rest[1].text)))?;
+            }
+            ("columns", _) => {
+                return Err(first.error(format!("`{}` dumps have fixed fields; expected `columns` only after `lammps`", format.keyword())))
+            }
+            ("encoding", _) => {
+                return Err(first.error(format!("`{}` dumps have one encoding; expected `encoding` only after `mcap`", format.keyword())))
+            }
+            (other, _) => {
+                return Err(first.error(format!("found `{other}`, expected `columns`, `encoding` or the end of the line (`{usage}`)")))
+            }
         }
-        if format != DumpFormat::Lammps {
-            return Err(first.error(format!("`{}` dumps have fixed fields; expected `columns` only after `lammps`", format.keyword())));
-        }
-        if rest.len() < 2 {
-            return Err(first.error("expected at least one column name after `columns`"));
-        }
-        rest[1..]
-            .iter()
-            .map(|t| {
-                AtomColumn::from_name(&t.text).ok_or_else(|| {
-                    let names: Vec<String> = AtomColumn::all().iter().map(|c| c.name()).collect();
-                    t.error(format!("found dump column `{}`, expected one of: {}", t.text, names.join(" ")))
-                })
-            })
-            .collect()
+        Ok(options)
     }
 
     fn group(&mut self, s: &[Token]) -> Result<(), InputError> {
@@ -684,7 +699,7 @@ impl Validator {
                 self.actions.push(Action::LifetimeFile(self.output_file(&s[1])?));
             }
             "dump" => {
-                const USAGE: &str = "dump NAME every N mcap|xyz|lammps|bonds FILE [columns COLUMN...]";
+                const USAGE: &str = "dump NAME every N mcap|xyz|lammps|bonds|dcd FILE [columns COLUMN...] [encoding protobuf|json]";
                 expect_len(s, 5..=usize::MAX, USAGE)?;
                 if s[2].text != "every" {
                     return Err(s[2].error(format!("found `{}`, expected `every`", s[2].text)));
@@ -693,10 +708,12 @@ impl Validator {
                 if every == 0 {
                     return Err(s[3].error("found 0, expected a dump interval >= 1"));
                 }
-                let format = DumpFormat::from_keyword(&s[4].text)
-                    .ok_or_else(|| s[4].error(format!("found format `{}`, expected `mcap`, `xyz`, `lammps` or `bonds`", s[4].text)))?;
+                let format = DumpFormat::from_keyword(&s[4].text).ok_or_else(|| {
+                    let names: Vec<String> = DumpFormat::ALL.iter().map(|f| format!("`{}`", f.keyword())).collect();
+                    s[4].error(format!("found format `{}`, expected one of {}", s[4].text, names.join(", ")))
+                })?;
                 let path = self.output_file(&s[5])?;
-                let columns = self.dump_columns(format, &s[6..], USAGE)?;
+                let options = self.dump_options(format, &s[6..], USAGE)?;
                 if self.dumps.contains_key(&s[1].text) {
                     return Err(
                         s[1].error(format!("dump `{}` is already active; expected a new name or `undump {}` first", s[1].text, s[1].text))
@@ -706,7 +723,7 @@ impl Validator {
                     return Err(s[5].error(format!("`{}` is already written by another dump; expected a different file", s[5].text)));
                 }
                 self.dumps.insert(s[1].text.clone(), path.clone());
-                self.actions.push(Action::Dump(DumpSpec { name: s[1].text.clone(), every, format, path, columns }));
+                self.actions.push(Action::Dump(DumpSpec { name: s[1].text.clone(), every, format, path, options }));
             }
             "undump" => {
                 expect_len(s, 1..=1, "undump NAME")?;

@@ -30,6 +30,7 @@
 
 use glam::DVec3;
 
+pub use self::wall::plane as wall_plane;
 pub use crate::hessian::SurfaceHessian;
 pub use crate::mesh::SurfaceMesh;
 use crate::units::Dim;

@@ -30,6 +30,11 @@ fn unit_normal(p: &[f64]) -> Option<DVec3> {
     Some((n / scale).normalize())
 }
 
+/// The wall's plane `n̂·x = d` as (unit normal, d), or `None` for a zero normal.
+pub fn plane(p: &[f64]) -> Option<(DVec3, f64)> {
+    unit_normal(p).map(|n| (n, p[D]))
+}
+
 fn eval(p: &[f64], x: DVec3) -> OneBody {
     let Some(n) = unit_normal(p) else {
         return OneBody { energy: 0.0, force: DVec3::ZERO };

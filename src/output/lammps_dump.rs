@@ -13,17 +13,20 @@
 //! 0 10
 //! 0 10
 //! -5 5
-//! ITEM: ATOMS id type x y z ix iy iz
-//! 3 1 3 7.25 -1.5 0 0 0
+//! ITEM: ATOMS id type element x y z ix iy iz
+//! 3 1 cortex 3 7.25 -1.5 0 0 0
 //! ...
 //! ```
 //!
 //! * Boundary letters come from [`SimBox::boundary_letter`](crate::system::SimBox::boundary_letter)
 //!   (`p` periodic, `f` fixed).
 //! * Atom lines are sorted by user id; `type` is the 1-based type number
-//!   (type index + 1, the order of the force field's type names); positions
-//!   are the stored (wrapped) ones with image flags `ix iy iz`, so the
-//!   unwrapped position is `x + ix·Lx`. Reals use shortest round-trip form.
+//!   (type index + 1, the order of the force field's type names) and
+//!   `element` its name (whitespace replaced by `_`) — the column OVITO and
+//!   VMD take particle type names from (LAMMPS writes it with
+//!   `dump_modify element`); positions are the stored (wrapped) ones with
+//!   image flags `ix iy iz`, so the unwrapped position is `x + ix·Lx`. Reals
+//!   use shortest round-trip form.
 //! * `dump … lammps FILE columns C...` selects the atom columns instead
 //!   (LAMMPS `dump custom` style; the header line names them). Without
 //!   `columns` the output is the default above, unchanged. See [`AtomColumn`]
@@ -37,13 +40,14 @@ use std::fs::File;
 use std::io::{self, BufWriter, Write};
 use std::path::Path;
 
-use super::{check_frame, check_topology, invalid_input, FrameView, Needs, Real, TopologyView, TrajectoryWriter};
+use super::{check_frame, check_topology, invalid_input, token, FrameView, Needs, Real, TopologyView, TrajectoryWriter};
 
 /// A per-atom column of a LAMMPS dump (`dump … lammps FILE columns ...`).
 ///
 /// | name | meaning | unit (`cell`) |
 /// |---|---|---|
 /// | `id`, `type` | user id, 1-based type number | – |
+/// | `element` | type name (OVITO and VMD read it as the particle type) | – |
 /// | `x y z` | stored (wrapped) position | µm |
 /// | `ix iy iz` | image flags | – |
 /// | `xu yu zu` | unwrapped position x + ix·Lx | µm |
@@ -55,6 +59,8 @@ use super::{check_frame, check_topology, invalid_input, FrameView, Needs, Real, 
 pub enum AtomColumn {
     Id,
     Type,
+    /// The type's name.
+    Element,
     /// Wrapped position component.
     X(usize),
     Image(usize),
@@ -74,7 +80,7 @@ const AXES: [&str; 3] = ["x", "y", "z"];
 impl AtomColumn {
     /// Every column, in the order `cellmd` lists them.
     pub fn all() -> Vec<AtomColumn> {
-        let mut v = vec![AtomColumn::Id, AtomColumn::Type];
+        let mut v = vec![AtomColumn::Id, AtomColumn::Type, AtomColumn::Element];
         v.extend((0..3).map(AtomColumn::X));
         v.extend((0..3).map(AtomColumn::Image));
         v.extend((0..3).map(AtomColumn::Unwrapped));
@@ -85,9 +91,9 @@ impl AtomColumn {
         v
     }
 
-    /// The default columns: `id type x y z ix iy iz`.
+    /// The default columns: `id type element x y z ix iy iz`.
     pub fn defaults() -> Vec<AtomColumn> {
-        let mut v = vec![AtomColumn::Id, AtomColumn::Type];
+        let mut v = vec![AtomColumn::Id, AtomColumn::Type, AtomColumn::Element];
         v.extend((0..3).map(AtomColumn::X));
         v.extend((0..3).map(AtomColumn::Image));
         v
@@ -98,6 +104,7 @@ impl AtomColumn {
         match self {
             AtomColumn::Id => "id".into(),
             AtomColumn::Type => "type".into(),
+            AtomColumn::Element => "element".into(),
             AtomColumn::X(a) => AXES[a].into(),
             AtomColumn::Image(a) => format!("i{}", AXES[a]),
             AtomColumn::Unwrapped(a) => format!("{}u", AXES[a]),
@@ -127,6 +134,8 @@ pub struct LammpsDumpWriter {
     out: BufWriter<File>,
     ids: Vec<u64>,
     types: Vec<u32>,
+    /// Type-name token per type.
+    type_names: Vec<String>,
     /// Internal indices sorted by user id.
     order: Vec<usize>,
     columns: Vec<AtomColumn>,
@@ -154,6 +163,7 @@ impl LammpsDumpWriter {
             out: BufWriter::new(File::create(path)?),
             ids: topology.ids.to_vec(),
             types: topology.types.to_vec(),
+            type_names: topology.type_names.iter().map(|n| token(n)).collect(),
             order,
             columns,
             needs,
@@ -195,6 +205,7 @@ impl TrajectoryWriter for LammpsDumpWriter {
                 let _ = match *c {
                     AtomColumn::Id => write!(line, "{}", self.ids[i]),
                     AtomColumn::Type => write!(line, "{}", self.types[i] + 1),
+                    AtomColumn::Element => line.write_str(&self.type_names[self.types[i] as usize]),
                     AtomColumn::X(a) => write!(line, "{}", Real(frame.positions[i][a])),
                     AtomColumn::Image(a) => write!(line, "{}", frame.image(i)[a]),
                     AtomColumn::Unwrapped(a) => write!(line, "{}", Real(b.unwrap(frame.positions[i], frame.image(i))[a])),
@@ -246,25 +257,26 @@ mod tests {
             assert_eq!(fr[3], "4");
             assert_eq!(fr[4], "ITEM: BOX BOUNDS pp pp ff");
             assert_eq!(&fr[5..8], &["0 10", "0 10", "-5 5"]);
-            assert_eq!(fr[8], "ITEM: ATOMS id type x y z ix iy iz");
+            assert_eq!(fr[8], "ITEM: ATOMS id type element x y z ix iy iz");
             let mut last_id = 0;
             for line in &fr[9..] {
                 let cols: Vec<&str> = line.split(' ').collect();
-                assert_eq!(cols.len(), 8, "{line}");
+                assert_eq!(cols.len(), 9, "{line}");
                 let id: u64 = cols[0].parse().unwrap();
                 assert!(id > last_id, "sorted by id");
                 last_id = id;
                 let i = s.ids.iter().position(|&x| x == id).unwrap();
                 assert_eq!(cols[1].parse::<u32>().unwrap(), s.types[i] + 1);
+                assert_eq!(cols[2], ["cortex", "adhesion_site"][s.types[i] as usize]);
                 for a in 0..3 {
-                    let x: f64 = cols[2 + a].parse().unwrap();
+                    let x: f64 = cols[3 + a].parse().unwrap();
                     assert_eq!(x.to_bits(), s.frames[f][i][a].to_bits(), "{line}");
-                    assert_eq!(cols[5 + a].parse::<i64>().unwrap(), s.images[i][a]);
+                    assert_eq!(cols[6 + a].parse::<i64>().unwrap(), s.images[i][a]);
                 }
             }
         }
-        assert_eq!(lines[9], "3 1 3 7.25 -1.5 0 0 0");
-        assert_eq!(lines[10], "7 2 9.95 5 2.5 -1 2 0");
+        assert_eq!(lines[9], "3 1 cortex 3 7.25 -1.5 0 0 0");
+        assert_eq!(lines[10], "7 2 adhesion_site 9.95 5 2.5 -1 2 0");
     }
 
     #[test]
@@ -300,12 +312,12 @@ mod tests {
     }
 
     #[test]
-    fn column_names_round_trip_and_defaults_are_the_classic_header() {
+    fn column_names_round_trip_and_defaults_name_the_element() {
         for c in AtomColumn::all() {
             assert_eq!(AtomColumn::from_name(&c.name()), Some(c));
         }
         let names: Vec<String> = AtomColumn::defaults().iter().map(|c| c.name()).collect();
-        assert_eq!(names.join(" "), "id type x y z ix iy iz");
+        assert_eq!(names.join(" "), "id type element x y z ix iy iz");
         assert_eq!(AtomColumn::from_name("c_stress[1]"), None);
     }
 }

@@ -1,38 +1,35 @@
-//! MCAP trajectories with JSON messages, viewable in Foxglove.
+//! MCAP trajectories, viewable in Foxglove: zstd-compressed chunks, cellmd's
+//! own channels as JSON with a JSON Schema, and the 3D scene as Foxglove's
+//! protobuf `foxglove.SceneUpdate` (or JSON, when the deck asks).
 //!
 //! # Channels
 //!
-//! Every channel uses `json` message encoding with a `jsonschema` schema (the
-//! schema texts are the `*_SCHEMA` constants below).
+//! | topic | schema | encoding | when | contents |
+//! |---|---|---|---|---|
+//! | `/cellmd/topology` | `cellmd.Topology` | json | once, with the first frame | units, ids, type names, per-particle types and radii, bonds/angles/triangles as user ids |
+//! | `/cellmd/frame` | `cellmd.Frame` | json | every frame | step, time, box, flat positions and image counters |
+//! | `/cellmd/bond_state` | `cellmd.BondState` | json | with the first frame, then after each step with bond events | per-bond `bound` flags |
+//! | `/cellmd/events` | `cellmd.BondEvents` | json | each step with bond events | break / rebind / form / reset events |
+//! | `/scene` | `foxglove.SceneUpdate` | protobuf (schema: its `FileDescriptorSet`), or json with `encoding json` | every frame | see [`scene`](super::scene): particles, bound bonds, surfaces, box, walls |
 //!
-//! | topic | schema | when | contents |
-//! |---|---|---|---|
-//! | `/cellmd/topology` | `cellmd.Topology` | once, with the first frame | units, ids, type names, per-particle types and radii, bonds/angles/triangles as user ids |
-//! | `/cellmd/frame` | `cellmd.Frame` | every frame | step, time, box, flat positions and image counters |
-//! | `/cellmd/bond_state` | `cellmd.BondState` | with the first frame, then on [`McapWriter::write_bond_state`] | per-bond `bound` flags |
-//! | `/scene` | `foxglove.SceneUpdate` | every frame | spheres per particle + bond lines for the 3D panel |
-//!
+//! cellmd's own schemas are the `*_SCHEMA` constants below (JSON Schema, the
+//! form Foxglove's Raw Messages and Plot panels and `mcap cat --json` read).
 //! `cellmd.Frame` positions are one flat array `[x0, y0, z0, x1, …]` in
 //! internal particle order — the order of `ids` in `cellmd.Topology` — and
 //! `images` likewise `[ix0, iy0, iz0, …]`; the unwrapped position is
 //! `x + image·(hi − lo)`. JSON numbers are written in shortest round-trip
 //! form, so positions decode bit-exactly (non-finite values become `null`).
+//! Bond `k` of `cellmd.BondState.bound` is bond `k` of `cellmd.Topology`;
+//! the first state is the one at the first frame (a run continued from a
+//! restart starts with its broken bonds). Once `bind` rules have formed new
+//! bonds the state is no longer written (it would not match the topology):
+//! `/cellmd/events` carries every change.
 //!
-//! In this version bonds do not change during a run, so the bond state is
-//! written once (all bound) with the first frame. Bond kinetics will call
-//! [`McapWriter::write_bond_state`] whenever bonds break or form.
+//! # Compression
 //!
-//! # Foxglove scene
-//!
-//! `/scene` carries one `SceneEntity` (frame `world`, id `particles`) that
-//! replaces the previous one each frame: a `SpherePrimitive` per particle
-//! (diameter `2·radius` of its type, or `2·DEFAULT_RADIUS` when the
-//! radius is 0; colour by type from a fixed ten-colour palette) and one
-//! `LinePrimitive` of type `LINE_LIST` (2) with a segment per bond. A bond
-//! segment runs from particle `a` to `a + minimum_image(x_b − x_a)`, so bonds
-//! across a periodic face do not span the box. Lines are 2 px wide
-//! (`scale_invariant`). The scene costs ~250 bytes per particle and frame; it
-//! can be turned off with [`McapWriter::set_scene`].
+//! Chunks are compressed with zstd (the MCAP default chunk size, 768 KiB):
+//! ~10× smaller than uncompressed JSON. Every MCAP reader (the `mcap` CLI,
+//! Foxglove, the Python and Rust libraries) decompresses them.
 //!
 //! # Time stamps
 //!
@@ -48,12 +45,14 @@ use std::fs::File;
 use std::io::{self, BufWriter, Write};
 use std::path::Path;
 
+use foxglove::Encode;
 use glam::DVec3;
 use mcap::records::MessageHeader;
 use serde::ser::{SerializeSeq, Serializer};
 use serde::Serialize;
 
-use super::{check_frame, check_topology, invalid_input, units_keyword, FrameView, TopologyView, TrajectoryWriter};
+use super::scene::{self, Scene, SCENE_UPDATE_SCHEMA};
+use super::{check_frame, check_topology, invalid_input, units_keyword, Encoding, FrameView, TopologyView, TrajectoryWriter};
 use crate::system::SimBox;
 
 /// Topic of the topology channel.
@@ -66,23 +65,6 @@ pub const TOPIC_BOND_STATE: &str = "/cellmd/bond_state";
 pub const TOPIC_SCENE: &str = "/scene";
 /// Bond kinetics events (`cellmd.BondEvents`), one message per step that has any.
 pub const TOPIC_EVENTS: &str = "/cellmd/events";
-
-/// Sphere radius drawn for types whose radius is 0 (length units).
-pub const DEFAULT_RADIUS: f64 = 0.05;
-
-/// Type colours (matplotlib's tab10), cycled by type index.
-pub const PALETTE: [[u8; 3]; 10] = [
-    [31, 119, 180],
-    [255, 127, 14],
-    [44, 160, 44],
-    [214, 39, 40],
-    [148, 103, 189],
-    [140, 86, 75],
-    [227, 119, 194],
-    [127, 127, 127],
-    [188, 189, 34],
-    [23, 190, 207],
-];
 
 /// JSON Schema of `cellmd.Topology`.
 pub const TOPOLOGY_SCHEMA: &str = r#"{
@@ -158,86 +140,6 @@ pub const BOND_STATE_SCHEMA: &str = r#"{
   "required": ["step", "time", "bound"]
 }"#;
 
-macro_rules! fox_vector3 {
-    () => {
-        r#"{"title": "foxglove.Vector3", "type": "object", "properties": {"x": {"type": "number"}, "y": {"type": "number"}, "z": {"type": "number"}}, "required": ["x", "y", "z"]}"#
-    };
-}
-macro_rules! fox_point3 {
-    () => {
-        r#"{"title": "foxglove.Point3", "type": "object", "properties": {"x": {"type": "number"}, "y": {"type": "number"}, "z": {"type": "number"}}, "required": ["x", "y", "z"]}"#
-    };
-}
-macro_rules! fox_pose {
-    () => {
-        concat!(
-            r#"{"title": "foxglove.Pose", "type": "object", "properties": {"position": "#,
-            fox_vector3!(),
-            r#", "orientation": {"title": "foxglove.Quaternion", "type": "object", "properties": {"x": {"type": "number"}, "y": {"type": "number"}, "z": {"type": "number"}, "w": {"type": "number"}}, "required": ["x", "y", "z", "w"]}}, "required": ["position", "orientation"]}"#
-        )
-    };
-}
-macro_rules! fox_color {
-    () => {
-        r#"{"title": "foxglove.Color", "type": "object", "properties": {"r": {"type": "number"}, "g": {"type": "number"}, "b": {"type": "number"}, "a": {"type": "number"}}, "required": ["r", "g", "b", "a"]}"#
-    };
-}
-macro_rules! fox_time {
-    () => {
-        r#"{"type": "object", "title": "time", "properties": {"sec": {"type": "integer", "minimum": 0}, "nsec": {"type": "integer", "minimum": 0, "maximum": 999999999}}}"#
-    };
-}
-
-/// JSON Schema of `foxglove.SceneUpdate`: the subset of Foxglove's published
-/// schema that cellmd fills (primitive kinds it never writes are declared as
-/// arrays and always empty).
-pub const SCENE_UPDATE_SCHEMA: &str = concat!(
-    r#"{"title": "foxglove.SceneUpdate", "description": "An update to the entities displayed in a 3D scene (subset used by cellmd)", "type": "object", "properties": {"#,
-    r#""deletions": {"type": "array", "items": {"title": "foxglove.SceneEntityDeletion", "type": "object", "properties": {"timestamp": "#,
-    fox_time!(),
-    r#", "type": {"type": "integer", "description": "0 = MATCHING_ID, 1 = ALL"}, "id": {"type": "string"}}, "required": ["timestamp", "type", "id"]}}, "#,
-    r#""entities": {"type": "array", "items": {"title": "foxglove.SceneEntity", "type": "object", "properties": {"#,
-    r#""timestamp": "#,
-    fox_time!(),
-    r#", "frame_id": {"type": "string"}, "id": {"type": "string"}, "#,
-    r#""lifetime": {"type": "object", "title": "duration", "properties": {"sec": {"type": "integer"}, "nsec": {"type": "integer", "minimum": 0, "maximum": 999999999}}}, "#,
-    r#""frame_locked": {"type": "boolean"}, "#,
-    r#""metadata": {"type": "array", "items": {"title": "foxglove.KeyValuePair", "type": "object", "properties": {"key": {"type": "string"}, "value": {"type": "string"}}, "required": ["key", "value"]}}, "#,
-    r#""arrows": {"type": "array", "description": "unused (always empty)"}, "#,
-    r#""cubes": {"type": "array", "description": "unused (always empty)"}, "#,
-    r#""spheres": {"type": "array", "items": {"title": "foxglove.SpherePrimitive", "type": "object", "properties": {"pose": "#,
-    fox_pose!(),
-    r#", "size": "#,
-    fox_vector3!(),
-    r#", "color": "#,
-    fox_color!(),
-    r#"}, "required": ["pose", "size", "color"]}}, "#,
-    r#""cylinders": {"type": "array", "description": "unused (always empty)"}, "#,
-    r#""lines": {"type": "array", "items": {"title": "foxglove.LinePrimitive", "type": "object", "properties": {"#,
-    r#""type": {"title": "foxglove.LineType", "type": "integer", "description": "0 = LINE_STRIP, 1 = LINE_LOOP, 2 = LINE_LIST"}, "pose": "#,
-    fox_pose!(),
-    r#", "thickness": {"type": "number"}, "scale_invariant": {"type": "boolean"}, "points": {"type": "array", "items": "#,
-    fox_point3!(),
-    r#"}, "color": "#,
-    fox_color!(),
-    r#", "colors": {"type": "array", "items": "#,
-    fox_color!(),
-    r#"}, "indices": {"type": "array", "items": {"type": "integer", "minimum": 0}}}, "required": ["type", "pose", "thickness", "scale_invariant", "points", "color", "colors", "indices"]}}, "#,
-    r#""triangles": {"type": "array", "items": {"title": "foxglove.TriangleListPrimitive", "type": "object", "properties": {"pose": "#,
-    fox_pose!(),
-    r#", "points": {"type": "array", "items": "#,
-    fox_point3!(),
-    r#"}, "color": "#,
-    fox_color!(),
-    r#", "colors": {"type": "array", "items": "#,
-    fox_color!(),
-    r#"}, "indices": {"type": "array", "items": {"type": "integer", "minimum": 0}}}, "required": ["pose", "points", "color", "colors", "indices"]}}, "#,
-    r#""texts": {"type": "array", "description": "unused (always empty)"}, "#,
-    r#""models": {"type": "array", "description": "unused (always empty)"}"#,
-    r#"}, "required": ["timestamp", "frame_id", "id", "lifetime", "frame_locked", "metadata", "arrows", "cubes", "spheres", "cylinders", "lines", "triangles", "texts", "models"]}}"#,
-    r#"}, "required": ["deletions", "entities"]}"#
-);
-
 fn mcap_err(e: mcap::McapError) -> io::Error {
     match e {
         mcap::McapError::Io(e) => e,
@@ -255,7 +157,9 @@ pub struct McapWriter {
     channel_events: u16,
     /// Stamp of the previous frame (ns).
     last_frame_ns: Option<u64>,
-    scene: bool,
+    scene: Scene,
+    scene_enabled: bool,
+    encoding: Encoding,
     units: &'static str,
     ids: Vec<u64>,
     types: Vec<u32>,
@@ -274,9 +178,15 @@ struct Sink {
 }
 
 impl Sink {
+    /// Publishes `message` as JSON.
     fn publish<T: Serialize>(&mut self, channel_id: u16, ns: u64, message: &T) -> io::Result<()> {
+        self.publish_with(channel_id, ns, |buf| serde_json::to_writer(buf, message).map_err(io::Error::other))
+    }
+
+    /// Publishes what `encode` writes into the (cleared) buffer.
+    fn publish_with(&mut self, channel_id: u16, ns: u64, encode: impl FnOnce(&mut Vec<u8>) -> io::Result<()>) -> io::Result<()> {
         self.buffer.clear();
-        serde_json::to_writer(&mut self.buffer, message).map_err(io::Error::other)?;
+        encode(&mut self.buffer)?;
         let sequence = self.sequence.entry(channel_id).or_insert(0);
         *sequence += 1;
         let header = MessageHeader { channel_id, sequence: *sequence, log_time: ns, publish_time: ns };
@@ -292,21 +202,38 @@ struct BondState<'a> {
 }
 
 impl McapWriter {
-    /// Creates (or truncates) `path` and registers the schemas and channels.
+    /// Creates (or truncates) `path` with the protobuf scene.
     pub fn create(path: &Path, topology: &TopologyView) -> io::Result<Self> {
+        Self::create_with(path, topology, Encoding::Protobuf)
+    }
+
+    /// Creates (or truncates) `path` and registers the schemas and channels;
+    /// `encoding` is the scene's.
+    pub fn create_with(path: &Path, topology: &TopologyView, encoding: Encoding) -> io::Result<Self> {
         check_topology(topology)?;
-        let options = mcap::WriteOptions::new().compression(None).profile("").library(format!("cellmd {}", env!("CARGO_PKG_VERSION")));
+        let options = mcap::WriteOptions::new()
+            .compression(Some(mcap::Compression::Zstd))
+            .profile("")
+            .library(format!("cellmd {}", env!("CARGO_PKG_VERSION")));
         let mut writer = options.create(BufWriter::new(File::create(path)?)).map_err(mcap_err)?;
         let no_metadata = BTreeMap::new();
-        let mut channel = |schema_name: &str, schema: &str, topic: &str| -> io::Result<u16> {
-            let schema_id = writer.add_schema(schema_name, "jsonschema", schema.as_bytes()).map_err(mcap_err)?;
-            writer.add_channel(schema_id, topic, "json", &no_metadata).map_err(mcap_err)
+        let mut channel =
+            |schema_name: &str, schema_encoding: &str, schema: &[u8], topic: &str, message_encoding: &str| -> io::Result<u16> {
+                let schema_id = writer.add_schema(schema_name, schema_encoding, schema).map_err(mcap_err)?;
+                writer.add_channel(schema_id, topic, message_encoding, &no_metadata).map_err(mcap_err)
+            };
+        let mut json_channel = |name: &str, schema: &str, topic: &str| channel(name, "jsonschema", schema.as_bytes(), topic, "json");
+        let channel_topology = json_channel("cellmd.Topology", TOPOLOGY_SCHEMA, TOPIC_TOPOLOGY)?;
+        let channel_frame = json_channel("cellmd.Frame", FRAME_SCHEMA, TOPIC_FRAME)?;
+        let channel_bond_state = json_channel("cellmd.BondState", BOND_STATE_SCHEMA, TOPIC_BOND_STATE)?;
+        let channel_events = json_channel("cellmd.BondEvents", BOND_EVENTS_SCHEMA, TOPIC_EVENTS)?;
+        let channel_scene = match encoding {
+            Encoding::Json => json_channel("foxglove.SceneUpdate", SCENE_UPDATE_SCHEMA, TOPIC_SCENE)?,
+            Encoding::Protobuf => {
+                let schema = foxglove::schemas::SceneUpdate::get_schema().expect("Foxglove's schemas carry their descriptors");
+                channel(&schema.name, &schema.encoding, &schema.data, TOPIC_SCENE, &foxglove::schemas::SceneUpdate::get_message_encoding())?
+            }
         };
-        let channel_topology = channel("cellmd.Topology", TOPOLOGY_SCHEMA, TOPIC_TOPOLOGY)?;
-        let channel_frame = channel("cellmd.Frame", FRAME_SCHEMA, TOPIC_FRAME)?;
-        let channel_bond_state = channel("cellmd.BondState", BOND_STATE_SCHEMA, TOPIC_BOND_STATE)?;
-        let channel_scene = channel("foxglove.SceneUpdate", SCENE_UPDATE_SCHEMA, TOPIC_SCENE)?;
-        let channel_events = channel("cellmd.BondEvents", BOND_EVENTS_SCHEMA, TOPIC_EVENTS)?;
         Ok(Self {
             sink: Sink { writer, sequence: BTreeMap::new(), buffer: Vec::new() },
             channel_topology,
@@ -315,7 +242,9 @@ impl McapWriter {
             channel_scene,
             channel_events,
             last_frame_ns: None,
-            scene: true,
+            scene: Scene::new(topology),
+            scene_enabled: true,
+            encoding,
             units: units_keyword(topology.units),
             ids: topology.ids.to_vec(),
             types: topology.types.to_vec(),
@@ -329,12 +258,12 @@ impl McapWriter {
 
     /// Turns the `/scene` channel on (the default) or off for later frames.
     pub fn set_scene(&mut self, enabled: bool) {
-        self.scene = enabled;
+        self.scene_enabled = enabled;
     }
 
     /// Records which bonds (in topology order) are bound at `step`/`time`.
     ///
-    /// Written automatically (all bound) with the first frame; bond kinetics
+    /// Written automatically with the first frame; bond kinetics
     /// calls this after each batch of binding/unbinding events. The stamp is
     /// `round(time·10⁹)` ns, not forced monotone.
     pub fn write_bond_state(&mut self, step: u64, time: f64, bound: &[bool]) -> io::Result<()> {
@@ -373,73 +302,11 @@ impl McapWriter {
     }
 
     fn write_scene(&mut self, ns: u64, frame: &FrameView) -> io::Result<()> {
-        let identity = Quaternion { x: 0.0, y: 0.0, z: 0.0, w: 1.0 };
-        let colors: Vec<Color> = (0..self.type_names.len()).map(type_color).collect();
-        let spheres = frame
-            .positions
-            .iter()
-            .zip(&self.types)
-            .map(|(x, &t)| {
-                let r = self.type_radius.get(t as usize).copied().filter(|&r| r > 0.0).unwrap_or(DEFAULT_RADIUS);
-                Sphere {
-                    pose: Pose { position: Vector3::from(*x), orientation: identity },
-                    size: Vector3 { x: 2.0 * r, y: 2.0 * r, z: 2.0 * r },
-                    color: colors[t as usize],
-                }
-            })
-            .collect();
-        let points = bond_segments(frame.sim_box, frame.positions, &self.bonds).into_iter().map(Vector3::from).collect();
-        let lines = vec![Line {
-            kind: 2,
-            pose: Pose { position: Vector3 { x: 0.0, y: 0.0, z: 0.0 }, orientation: identity },
-            thickness: 2.0,
-            scale_invariant: true,
-            points,
-            color: Color { r: 0.8, g: 0.8, b: 0.8, a: 1.0 },
-            colors: [],
-            indices: [],
-        }];
-        // Surfaces of bodies: one triangle list, each face drawn whole at its first corner's image.
-        let triangles = if self.triangles.is_empty() {
-            Vec::new()
-        } else {
-            let mut points = Vec::with_capacity(3 * self.triangles.len());
-            for &[a, b, c] in &self.triangles {
-                let xa = frame.positions[a as usize];
-                points.push(Vector3::from(xa));
-                for p in [b, c] {
-                    points.push(Vector3::from(xa + frame.sim_box.minimum_image(frame.positions[p as usize] - xa)));
-                }
-            }
-            vec![TriangleList {
-                pose: Pose { position: Vector3 { x: 0.0, y: 0.0, z: 0.0 }, orientation: identity },
-                points,
-                color: Color { r: 0.95, g: 0.55, b: 0.35, a: 0.6 },
-                colors: [],
-                indices: [],
-            }]
-        };
-        let stamp = Stamp { sec: ns / 1_000_000_000, nsec: (ns % 1_000_000_000) as u32 };
-        let update = SceneUpdate {
-            deletions: [],
-            entities: [Entity {
-                timestamp: stamp,
-                frame_id: "world",
-                id: "particles",
-                lifetime: Stamp { sec: 0, nsec: 0 },
-                frame_locked: false,
-                metadata: [],
-                arrows: [],
-                cubes: [],
-                spheres,
-                cylinders: [],
-                lines,
-                triangles,
-                texts: [],
-                models: [],
-            }],
-        };
-        self.sink.publish(self.channel_scene, ns, &update)
+        let update = self.scene.update(frame, ns);
+        match self.encoding {
+            Encoding::Protobuf => self.sink.publish_with(self.channel_scene, ns, |buf| update.encode(buf).map_err(io::Error::other)),
+            Encoding::Json => self.sink.publish(self.channel_scene, ns, &scene::to_json(&update)),
+        }
     }
 }
 
@@ -456,8 +323,8 @@ impl TrajectoryWriter for McapWriter {
         self.last_frame_ns = Some(ns);
         if first {
             self.write_topology(ns)?;
-            let all_bound = vec![true; self.bonds.len()];
-            let state = BondState { step: frame.step, time: frame.time, bound: &all_bound };
+            let bound: Vec<bool> = (0..self.bonds.len()).map(|k| frame.is_bound(k)).collect();
+            let state = BondState { step: frame.step, time: frame.time, bound: &bound };
             self.sink.publish(self.channel_bond_state, ns, &state)?;
         }
         let message = Frame {
@@ -468,7 +335,7 @@ impl TrajectoryWriter for McapWriter {
             images: FlatImages { images: frame.images, n: frame.positions.len() },
         };
         self.sink.publish(self.channel_frame, ns, &message)?;
-        if self.scene {
+        if self.scene_enabled {
             self.write_scene(ns, frame)?;
         }
         Ok(())
@@ -506,22 +373,6 @@ fn time_ns(time: f64) -> u64 {
     } else {
         0
     }
-}
-
-/// Segment end points `[a, a + minimum_image(x_b − x_a)]` for every bond.
-fn bond_segments(sim_box: &SimBox, positions: &[DVec3], bonds: &[[u32; 2]]) -> Vec<DVec3> {
-    let mut points = Vec::with_capacity(2 * bonds.len());
-    for &[a, b] in bonds {
-        let xa = positions[a as usize];
-        points.push(xa);
-        points.push(xa + sim_box.minimum_image(positions[b as usize] - xa));
-    }
-    points
-}
-
-fn type_color(t: usize) -> Color {
-    let [r, g, b] = PALETTE[t % PALETTE.len()];
-    Color { r: r as f64 / 255.0, g: g as f64 / 255.0, b: b as f64 / 255.0, a: 1.0 }
 }
 
 #[derive(Serialize)]
@@ -580,115 +431,29 @@ impl Serialize for FlatImages<'_> {
     }
 }
 
-#[derive(Serialize, Clone, Copy)]
-struct Vector3 {
-    x: f64,
-    y: f64,
-    z: f64,
-}
-
-impl From<DVec3> for Vector3 {
-    fn from(v: DVec3) -> Self {
-        Self { x: v.x, y: v.y, z: v.z }
-    }
-}
-
-#[derive(Serialize, Clone, Copy)]
-struct Quaternion {
-    x: f64,
-    y: f64,
-    z: f64,
-    w: f64,
-}
-
-#[derive(Serialize, Clone, Copy)]
-struct Pose {
-    position: Vector3,
-    orientation: Quaternion,
-}
-
-#[derive(Serialize, Clone, Copy)]
-struct Color {
-    r: f64,
-    g: f64,
-    b: f64,
-    a: f64,
-}
-
-#[derive(Serialize)]
-struct Sphere {
-    pose: Pose,
-    size: Vector3,
-    color: Color,
-}
-
-#[derive(Serialize)]
-struct Line {
-    #[serde(rename = "type")]
-    kind: u8,
-    pose: Pose,
-    thickness: f64,
-    scale_invariant: bool,
-    points: Vec<Vector3>,
-    color: Color,
-    colors: [Color; 0],
-    indices: [u32; 0],
-}
-
-#[derive(Serialize)]
-struct Stamp {
-    sec: u64,
-    nsec: u32,
-}
-
-#[derive(Serialize)]
-struct TriangleList {
-    pose: Pose,
-    /// Three points per face (outward-wound).
-    points: Vec<Vector3>,
-    color: Color,
-    colors: [Color; 0],
-    indices: [u32; 0],
-}
-
-#[derive(Serialize)]
-struct Entity {
-    timestamp: Stamp,
-    frame_id: &'static str,
-    id: &'static str,
-    lifetime: Stamp,
-    frame_locked: bool,
-    metadata: [u8; 0],
-    arrows: [u8; 0],
-    cubes: [u8; 0],
-    spheres: Vec<Sphere>,
-    cylinders: [u8; 0],
-    lines: Vec<Line>,
-    triangles: Vec<TriangleList>,
-    texts: [u8; 0],
-    models: [u8; 0],
-}
-
-#[derive(Serialize)]
-struct SceneUpdate {
-    deletions: [u8; 0],
-    entities: [Entity; 1],
-}
-
 #[cfg(test)]
 mod tests {
     use super::super::test_support::Sample;
     use super::*;
     use serde_json::Value;
 
-    fn write_sample(path: &Path, s: &Sample, times: &[f64]) {
-        let mut w = McapWriter::create(path, &s.topology()).unwrap();
+    fn write_sample(path: &Path, s: &Sample, times: &[f64], encoding: Encoding) {
+        let mut w = McapWriter::create_with(path, &s.topology(), encoding).unwrap();
         for (f, &t) in times.iter().enumerate() {
             let mut frame = s.frame(f);
             frame.time = t;
             w.write_frame(&frame).unwrap();
         }
         Box::new(w).finish().unwrap();
+    }
+
+    /// A `/scene` message as the JSON of [`SCENE_UPDATE_SCHEMA`], whichever its encoding.
+    pub(crate) fn scene_json(message: &mcap::Message) -> Value {
+        match message.channel.message_encoding.as_str() {
+            "protobuf" => scene::to_json(&<foxglove::schemas::SceneUpdate as prost::Message>::decode(&message.data[..]).unwrap()),
+            "json" => serde_json::from_slice(&message.data).unwrap(),
+            other => panic!("unexpected scene encoding {other}"),
+        }
     }
 
     #[test]
@@ -705,6 +470,40 @@ mod tests {
         }
     }
 
+    /// The file is chunked with zstd, and both scene encodings carry the
+    /// same scene: protobuf decoded equals the JSON written.
+    #[test]
+    fn chunks_are_zstd_and_both_scene_encodings_agree() {
+        let s = Sample::new(2);
+        let dir = tempfile::tempdir().unwrap();
+        let mut scenes = Vec::new();
+        for (encoding, name) in [(Encoding::Protobuf, "p.mcap"), (Encoding::Json, "j.mcap")] {
+            let path = dir.path().join(name);
+            write_sample(&path, &s, &[0.1, 0.2], encoding);
+            let bytes = std::fs::read(&path).unwrap();
+            let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
+            assert!(!summary.chunk_indexes.is_empty());
+            assert!(summary.chunk_indexes.iter().all(|c| c.compression == "zstd"), "{:?}", summary.chunk_indexes);
+            let scene = summary.channels.values().find(|c| c.topic == TOPIC_SCENE).unwrap();
+            let schema = scene.schema.as_ref().unwrap();
+            assert_eq!(schema.name, "foxglove.SceneUpdate");
+            let want = match encoding {
+                Encoding::Protobuf => ("protobuf", "protobuf"),
+                Encoding::Json => ("json", "jsonschema"),
+            };
+            assert_eq!((scene.message_encoding.as_str(), schema.encoding.as_str()), want);
+            if encoding == Encoding::Protobuf {
+                // The schema is a FileDescriptorSet that declares foxglove.SceneUpdate.
+                let set = <prost_types::FileDescriptorSet as prost::Message>::decode(&schema.data[..]).unwrap();
+                assert!(set.file.iter().any(|f| f.package() == "foxglove" && f.message_type.iter().any(|m| m.name() == "SceneUpdate")));
+            }
+            let mut stream = mcap::MessageStream::new(&bytes).unwrap().map(|m| m.unwrap());
+            scenes.push(stream.by_ref().filter(|m| m.channel.topic == TOPIC_SCENE).map(|m| scene_json(&m)).collect::<Vec<_>>());
+        }
+        assert_eq!(scenes[0].len(), 2);
+        assert_eq!(scenes[0], scenes[1]);
+    }
+
     #[test]
     fn three_frames_read_back() {
         let s = Sample::new(3);
@@ -712,7 +511,7 @@ mod tests {
         let path = dir.path().join("t.mcap");
         // The second and third times collide at ns resolution: stamps are forced up.
         let times = [0.1, 0.2, 0.2 + 1e-12];
-        write_sample(&path, &s, &times);
+        write_sample(&path, &s, &times, Encoding::Protobuf);
         let bytes = std::fs::read(&path).unwrap();
 
         let summary = mcap::Summary::read(&bytes).unwrap().expect("summary section");
@@ -731,28 +530,29 @@ mod tests {
             let message = message.unwrap();
             let channel = &message.channel;
             let schema = channel.schema.as_ref().expect("every channel has a schema");
-            assert_eq!(channel.message_encoding, "json");
-            assert_eq!(schema.encoding, "jsonschema");
             let expected_schema = match channel.topic.as_str() {
                 TOPIC_TOPOLOGY => ("cellmd.Topology", TOPOLOGY_SCHEMA),
                 TOPIC_FRAME => ("cellmd.Frame", FRAME_SCHEMA),
                 TOPIC_BOND_STATE => ("cellmd.BondState", BOND_STATE_SCHEMA),
-                TOPIC_SCENE => ("foxglove.SceneUpdate", SCENE_UPDATE_SCHEMA),
+                TOPIC_SCENE => ("foxglove.SceneUpdate", ""),
                 other => panic!("unexpected topic {other}"),
             };
             assert_eq!(schema.name, expected_schema.0);
-            assert_eq!(&schema.data[..], expected_schema.1.as_bytes());
+            if channel.topic != TOPIC_SCENE {
+                assert_eq!(channel.message_encoding, "json");
+                assert_eq!(schema.encoding, "jsonschema");
+                assert_eq!(&schema.data[..], expected_schema.1.as_bytes());
+            }
             assert_eq!(message.log_time, message.publish_time);
             *counts.entry(channel.topic.clone()).or_default() += 1;
-            let value: Value = serde_json::from_slice(&message.data).unwrap();
             match channel.topic.as_str() {
-                TOPIC_TOPOLOGY => topology = Some(value),
-                TOPIC_BOND_STATE => bond_state = Some(value),
+                TOPIC_TOPOLOGY => topology = Some(serde_json::from_slice::<Value>(&message.data).unwrap()),
+                TOPIC_BOND_STATE => bond_state = Some(serde_json::from_slice::<Value>(&message.data).unwrap()),
                 TOPIC_FRAME => {
                     frame_stamps.push(message.log_time);
-                    frames.push(value);
+                    frames.push(serde_json::from_slice::<Value>(&message.data).unwrap());
                 }
-                _ => scenes.push((message.log_time, value)),
+                _ => scenes.push((message.log_time, scene_json(&message))),
             }
         }
         assert_eq!(counts[TOPIC_TOPOLOGY], 1);
@@ -799,7 +599,7 @@ mod tests {
         let spheres = entity["spheres"].as_array().unwrap();
         assert_eq!(spheres.len(), 4);
         assert_eq!(spheres[0]["size"]["x"], 0.5);
-        assert_eq!(spheres[1]["size"]["x"], 2.0 * DEFAULT_RADIUS);
+        assert_eq!(spheres[1]["size"]["x"], 2.0 * scene::DEFAULT_RADIUS);
         assert_eq!(spheres[1]["pose"]["position"]["x"], 9.95);
         assert_ne!(spheres[0]["color"], spheres[1]["color"]);
         assert_eq!(spheres[1]["color"], spheres[2]["color"]);
@@ -821,6 +621,11 @@ mod tests {
         for key in ["arrows", "cubes", "cylinders", "texts", "models", "metadata"] {
             assert_eq!(entity[key], serde_json::json!([]), "{key}");
         }
+        // The box: its 12 edges, and no walls in this frame.
+        let frame_box = &scene["entities"][1];
+        assert_eq!(frame_box["id"], "box");
+        assert_eq!(frame_box["lines"][0]["points"].as_array().unwrap().len(), 24);
+        assert_eq!(frame_box["triangles"], serde_json::json!([]));
     }
 
     #[test]

@@ -7,9 +7,10 @@
 //!
 //! | format | keyword | module | contents |
 //! |---|---|---|---|
-//! | MCAP (Foxglove) | `mcap` | [`mcap_writer`] | topology, frames, bond state, a 3D scene |
-//! | extended XYZ (OVITO, ASE) | `xyz` | [`xyz`] | species, position, id; box and pbc per frame |
-//! | LAMMPS text dump | `lammps` | [`lammps_dump`] | id, type, position, image flags, sorted by id; or the columns the deck names (forces, per-particle stress, von Mises) |
+//! | MCAP (Foxglove), zstd chunks | `mcap` | [`mcap_writer`], [`scene`] | topology, frames, bond state, a protobuf (or JSON) 3D scene |
+//! | extended XYZ (OVITO, ASE) | `xyz` | [`xyz`] | element symbol, position, type name, id; box and pbc per frame |
+//! | LAMMPS text dump | `lammps` | [`lammps_dump`] | id, type, element (type name), position, image flags, sorted by id; or the columns the deck names (forces, per-particle stress, von Mises) |
+//! | DCD (CHARMM/NAMD binary; MDAnalysis, MDTraj, VMD) | `dcd` | [`dcd`] | f32 positions sorted by id, box lengths per frame |
 //! | per-bond tension (CSV) | `bonds` | [`bond_csv`] | per frame and bond: ids, type, length, tension dE/dr, midpoint |
 //! | restart (JSON) | — | [`restart`] | step, time, box, ids, positions, images, bond state, counters, the deck's inputs |
 //! | run log (text) | — | [`run_log`] | version, git hash, command line, inputs as read, parameters of each run, time by phase |
@@ -20,7 +21,10 @@
 //!   user id `ids[i]`. Bonds, angles and triangles in a [`TopologyView`] hold
 //!   internal indices and are written as user ids.
 //! * `types[i]` indexes `type_names` (and `type_radius`); LAMMPS dumps write
-//!   the 1-based number `types[i] + 1`.
+//!   the 1-based number `types[i] + 1`. Where a reader expects a chemical
+//!   element (ASE's extended XYZ species), type `t` is written as the element
+//!   of atomic number `t + 1` ([`element_symbol`]: H, He, Li, …) and the type
+//!   name goes in a column of its own.
 //! * Positions are the stored ones (wrapped into the box on periodic axes);
 //!   the image counters give the unwrapped position `x + image·L`.
 //! * `images` may be empty (e.g. a minimiser that does not track images): it
@@ -40,13 +44,16 @@ use crate::units::UnitSystem;
 
 pub mod atomic;
 pub mod bond_csv;
+pub mod dcd;
 pub mod lammps_dump;
 pub mod mcap_writer;
 pub mod restart;
 pub mod run_log;
+pub mod scene;
 pub mod xyz;
 
 pub use self::bond_csv::BondCsvWriter;
+pub use self::dcd::DcdWriter;
 pub use self::lammps_dump::{AtomColumn, LammpsDumpWriter};
 pub use self::mcap_writer::McapWriter;
 pub use self::restart::{read_state, write_state, RestartData};
@@ -86,6 +93,17 @@ pub struct FrameView<'a> {
     pub images: &'a [[i64; 3]],
     /// What the writer asked for in [`TrajectoryWriter::needs`]; empty otherwise.
     pub measures: Measures<'a>,
+    /// Bound flag per bond (topology order, formed bonds appended), or empty for all bound.
+    pub bound: &'a [bool],
+    /// The wall planes acting at this frame (drawn by the MCAP scene).
+    pub walls: &'a [WallPlane],
+}
+
+/// A wall's plane `normal·x = offset` (unit normal; see the `wall` interaction).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WallPlane {
+    pub normal: DVec3,
+    pub offset: f64,
 }
 
 /// Per-frame quantities beyond positions, filled when a writer needs them.
@@ -121,6 +139,12 @@ impl FrameView<'_> {
     pub fn image(&self, i: usize) -> [i64; 3] {
         self.images.get(i).copied().unwrap_or([0; 3])
     }
+
+    /// Whether bond `k` is bound (true when `bound` is empty).
+    #[inline]
+    pub fn is_bound(&self, k: usize) -> bool {
+        self.bound.get(k).copied().unwrap_or(true)
+    }
 }
 
 /// A trajectory sink: frames in, a complete file after [`finish`](Self::finish).
@@ -148,18 +172,17 @@ pub enum DumpFormat {
     Lammps,
     /// Per-bond tension and length, CSV.
     Bonds,
+    /// CHARMM/NAMD DCD (binary, f32).
+    Dcd,
 }
 
 impl DumpFormat {
-    /// Parses the deck keyword `mcap`, `xyz` or `lammps`.
+    /// Every format, in the order the deck's usage lists them.
+    pub const ALL: [DumpFormat; 5] = [Self::Mcap, Self::Xyz, Self::Lammps, Self::Bonds, Self::Dcd];
+
+    /// Parses the deck keyword (`mcap`, `xyz`, `lammps`, `bonds`, `dcd`).
     pub fn from_keyword(word: &str) -> Option<Self> {
-        match word {
-            "mcap" => Some(Self::Mcap),
-            "xyz" => Some(Self::Xyz),
-            "lammps" => Some(Self::Lammps),
-            "bonds" => Some(Self::Bonds),
-            _ => None,
-        }
+        Self::ALL.into_iter().find(|f| f.keyword() == word)
     }
 
     /// The deck keyword.
@@ -169,6 +192,7 @@ impl DumpFormat {
             Self::Xyz => "xyz",
             Self::Lammps => "lammps",
             Self::Bonds => "bonds",
+            Self::Dcd => "dcd",
         }
     }
 
@@ -179,31 +203,67 @@ impl DumpFormat {
             Self::Xyz => "xyz",
             Self::Lammps => "lammpstrj",
             Self::Bonds => "csv",
+            Self::Dcd => "dcd",
         }
     }
 }
 
-/// Opens a writer of `format` at `path` (created or truncated).
-pub fn open_writer(format: DumpFormat, path: &Path, topology: &TopologyView) -> io::Result<Box<dyn TrajectoryWriter>> {
-    open_writer_with_columns(format, path, topology, &[])
+/// How the MCAP writer encodes the Foxglove-typed `/scene` channel (deck:
+/// `dump … mcap FILE encoding protobuf|json`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Encoding {
+    /// `foxglove.SceneUpdate` as protobuf with its descriptor set (the default).
+    #[default]
+    Protobuf,
+    /// The same scene as JSON with a JSON Schema.
+    Json,
 }
 
-/// [`open_writer`] with the LAMMPS dump's atom columns (empty: the default
-/// `id type x y z ix iy iz`; other formats take none).
-pub fn open_writer_with_columns(
+impl Encoding {
+    /// Parses the deck keyword `protobuf` or `json`.
+    pub fn from_keyword(word: &str) -> Option<Self> {
+        match word {
+            "protobuf" => Some(Self::Protobuf),
+            "json" => Some(Self::Json),
+            _ => None,
+        }
+    }
+}
+
+/// Per-format options of a dump.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct WriterOptions {
+    /// LAMMPS dump atom columns (empty: the default `id type element x y z ix iy iz`).
+    pub columns: Vec<AtomColumn>,
+    /// Encoding of the MCAP scene.
+    pub encoding: Encoding,
+}
+
+/// Opens a writer of `format` at `path` (created or truncated), with default options.
+pub fn open_writer(format: DumpFormat, path: &Path, topology: &TopologyView) -> io::Result<Box<dyn TrajectoryWriter>> {
+    open_writer_with(format, path, topology, &WriterOptions::default())
+}
+
+/// [`open_writer`] with options: LAMMPS dumps take `columns`, MCAP files an
+/// `encoding`; a non-default option for another format is an error.
+pub fn open_writer_with(
     format: DumpFormat,
     path: &Path,
     topology: &TopologyView,
-    columns: &[AtomColumn],
+    options: &WriterOptions,
 ) -> io::Result<Box<dyn TrajectoryWriter>> {
-    if !columns.is_empty() && format != DumpFormat::Lammps {
+    if !options.columns.is_empty() && format != DumpFormat::Lammps {
         return Err(invalid_input(format!("only `lammps` dumps take columns, not `{}`", format.keyword())));
     }
+    if options.encoding != Encoding::default() && format != DumpFormat::Mcap {
+        return Err(invalid_input(format!("only `mcap` dumps take an encoding, not `{}`", format.keyword())));
+    }
     Ok(match format {
-        DumpFormat::Mcap => Box::new(McapWriter::create(path, topology)?),
+        DumpFormat::Mcap => Box::new(McapWriter::create_with(path, topology, options.encoding)?),
         DumpFormat::Xyz => Box::new(XyzWriter::create(path, topology)?),
-        DumpFormat::Lammps => Box::new(LammpsDumpWriter::with_columns(path, topology, columns)?),
+        DumpFormat::Lammps => Box::new(LammpsDumpWriter::with_columns(path, topology, &options.columns)?),
         DumpFormat::Bonds => Box::new(BondCsvWriter::create(path, topology)?),
+        DumpFormat::Dcd => Box::new(DcdWriter::create(path, topology)?),
     })
 }
 
@@ -276,6 +336,22 @@ impl fmt::Display for Real {
             write!(f, "{x:e}")
         }
     }
+}
+
+/// Chemical symbols by atomic number − 1.
+const ELEMENTS: [&str; 118] = [
+    "H", "He", "Li", "Be", "B", "C", "N", "O", "F", "Ne", "Na", "Mg", "Al", "Si", "P", "S", "Cl", "Ar", "K", "Ca", "Sc", "Ti", "V", "Cr",
+    "Mn", "Fe", "Co", "Ni", "Cu", "Zn", "Ga", "Ge", "As", "Se", "Br", "Kr", "Rb", "Sr", "Y", "Zr", "Nb", "Mo", "Tc", "Ru", "Rh", "Pd",
+    "Ag", "Cd", "In", "Sn", "Sb", "Te", "I", "Xe", "Cs", "Ba", "La", "Ce", "Pr", "Nd", "Pm", "Sm", "Eu", "Gd", "Tb", "Dy", "Ho", "Er",
+    "Tm", "Yb", "Lu", "Hf", "Ta", "W", "Re", "Os", "Ir", "Pt", "Au", "Hg", "Tl", "Pb", "Bi", "Po", "At", "Rn", "Fr", "Ra", "Ac", "Th",
+    "Pa", "U", "Np", "Pu", "Am", "Cm", "Bk", "Cf", "Es", "Fm", "Md", "No", "Lr", "Rf", "Db", "Sg", "Bh", "Hs", "Mt", "Ds", "Rg", "Cn",
+    "Nh", "Fl", "Mc", "Lv", "Ts", "Og",
+];
+
+/// The element symbol standing for type index `t` where a reader wants one:
+/// atomic number `t + 1` (H, He, Li, …), cycling after the 118th type.
+pub fn element_symbol(t: usize) -> &'static str {
+    ELEMENTS[t % ELEMENTS.len()]
 }
 
 /// A type name usable as one whitespace-free token (whitespace becomes `_`).
@@ -353,6 +429,8 @@ pub(crate) mod test_support {
                 positions: &self.frames[f],
                 images: &self.images,
                 measures: Measures::default(),
+                bound: &[],
+                walls: &[],
             }
         }
     }
@@ -365,10 +443,13 @@ mod tests {
 
     #[test]
     fn keywords_round_trip() {
-        for f in [DumpFormat::Mcap, DumpFormat::Xyz, DumpFormat::Lammps, DumpFormat::Bonds] {
+        for f in DumpFormat::ALL {
             assert_eq!(DumpFormat::from_keyword(f.keyword()), Some(f));
         }
-        assert_eq!(DumpFormat::from_keyword("dcd"), None);
+        assert_eq!(DumpFormat::from_keyword("h5md"), None);
+        assert_eq!(Encoding::from_keyword("json"), Some(Encoding::Json));
+        assert_eq!(Encoding::from_keyword("cbor"), None);
+        assert_eq!((element_symbol(0), element_symbol(1), element_symbol(117), element_symbol(118)), ("H", "He", "Og", "H"));
     }
 
     #[test]
@@ -410,7 +491,7 @@ mod tests {
     fn open_writer_makes_every_format() {
         let s = Sample::new(2);
         let dir = tempfile::tempdir().unwrap();
-        for format in [DumpFormat::Mcap, DumpFormat::Xyz, DumpFormat::Lammps] {
+        for format in [DumpFormat::Mcap, DumpFormat::Xyz, DumpFormat::Lammps, DumpFormat::Dcd] {
             let path = dir.path().join(format!("traj.{}", format.extension()));
             let mut w = open_writer(format, &path, &s.topology()).unwrap();
             w.write_frame(&s.frame(0)).unwrap();
@@ -418,5 +499,7 @@ mod tests {
             w.finish().unwrap();
             assert!(std::fs::metadata(&path).unwrap().len() > 0);
         }
+        let json = WriterOptions { encoding: Encoding::Json, ..Default::default() };
+        assert!(open_writer_with(DumpFormat::Xyz, &dir.path().join("x.xyz"), &s.topology(), &json).is_err());
     }
 }

@@ -21,7 +21,7 @@ use crate::integrate::overdamped::{overdamped_step, Blowup, OverdampedSettings};
 use crate::kinetics::{initial_bond_state, Binding, EventLog, Formation, Kinetics, LifetimeTable};
 use crate::output::restart::{read_state, write_state, Counters, RestartData, Resume};
 use crate::output::run_log::{model_parameters, LogHeader, Phase, PhaseTimes, RunLog};
-use crate::output::{open_writer_with_columns, FrameView, Measures, TopologyView, TrajectoryWriter};
+use crate::output::{open_writer_with, FrameView, Measures, TopologyView, TrajectoryWriter, WallPlane};
 use crate::system::{Model, SimBox, State, StepClock};
 
 mod stepping;
@@ -384,7 +384,7 @@ impl Simulation {
             }
             Action::Dump(spec) => {
                 let path = self.output_path(&spec.path);
-                let writer = open_writer_with_columns(spec.format, &path, &self.topology_view(), &spec.columns)
+                let writer = open_writer_with(spec.format, &path, &self.topology_view(), &spec.options)
                     .map_err(|e| self.output_error(&path, e))?;
                 self.dumps.push(ActiveDump { spec: spec.clone(), path, writer, last_step: None });
             }
@@ -696,6 +696,11 @@ impl Simulation {
             }
         }
         let forces: &[DVec3] = if needs.forces { &self.forces.forces } else { &[] };
+        let walls: Vec<WallPlane> = (self.model.externals.iter())
+            .filter(|e| e.term.interaction.name() == "wall")
+            .filter_map(|e| crate::interactions::wall_plane(&e.term.params))
+            .map(|(normal, offset)| WallPlane { normal, offset })
+            .collect();
         let frame = FrameView {
             step: self.state.step,
             time: self.state.time,
@@ -703,6 +708,8 @@ impl Simulation {
             positions: &self.state.positions,
             images: &self.state.images,
             measures: Measures { forces, virial: &virial, bond_tension: &tension, bond_length: &length },
+            bound: self.state.bonds.as_ref().map_or(&[], |b| &b.bound),
+            walls: &walls,
         };
         if let Err(e) = self.dumps[i].writer.write_frame(&frame) {
             return Err(self.output_error(&self.dumps[i].path, e));
