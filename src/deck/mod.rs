@@ -12,9 +12,11 @@
 //! -o DIR`). See README.md for the command reference.
 
 mod plan;
+mod protocol;
 mod validate;
 mod variables;
 
 pub use self::plan::{Action, CoeffTarget, DumpSpec, Group, NeighborSettings, Plan, ThermoColumn};
+pub use self::protocol::{Protocol, Ramp};
 pub use self::validate::{validate, validate_file};
 pub use self::variables::Variables;

@@ -1,6 +1,7 @@
 //! Executes a validated deck ([`crate::deck::Plan`]).
 
 mod blowup;
+mod protocol;
 mod simulation;
 pub mod thermo;
 
