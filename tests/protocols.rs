@@ -131,3 +131,31 @@ fn reset_rest_makes_the_current_geometry_the_rest_state() {
     let r = (sim.state.positions[1] - sim.state.positions[0]).length();
     assert!((r - 1.8).abs() < 1e-9, "{r}");
 }
+
+#[test]
+fn an_indenter_driven_to_a_load_stops_there_and_reports_load_and_depth() {
+    // A fixed particle at the origin; a sphere (R = 1, K = 10) above it at
+    // z = 1.5 comes down at 1 µm/s until it carries 0.9: depth √(0.9/10) = 0.3,
+    // i.e. the centre at z = 0.7 after 800 steps of 1 ms, where it holds.
+    let top = "[ particles ]\n1 anchor 0 0 0\n2 p 5 5 5\n";
+    let ff = "particle anchor fixed\nparticle p drag 1\n";
+    let header = "units lj\ntopology t.top\nforcefield f.ff\nbox x -20 20 f y -20 20 f z -20 20 f\ntimestep 0.001\n";
+    let body = "group a id 1\nexternal tip a indenter z 1.5 r 1 k 10\nindent tip velocity 0 0 -1 until 0.9\nrun 1000\n";
+    let case = Case::new(&[("t.top", top), ("f.ff", ff), ("deck.in", &format!("{header}{body}"))]);
+    let mut sim = case.run();
+    let centre = sim.model.externals[0].term.params[2];
+    assert!((centre - 0.7).abs() < 1.5e-3, "centre {centre}");
+    let load = sim.thermo_value(&ThermoColumn::IndenterLoad("tip".into())).unwrap();
+    let depth = sim.thermo_value(&ThermoColumn::IndenterDepth("tip".into())).unwrap();
+    assert!((depth - (1.0 - centre)).abs() < 1e-12, "depth {depth} for centre {centre}");
+    assert!((load - 10.0 * depth * depth).abs() < 1e-12, "load {load} at depth {depth}");
+    assert!((0.9..=10.0 * 0.301 * 0.301 + 1e-9).contains(&load), "load {load}: reached within one step");
+    // The anchor's reaction is the load.
+    let reaction = sim.thermo_value(&ThermoColumn::GroupForce { group: Group { name: "a".into(), members: vec![0] }, axis: 2 }).unwrap();
+    assert!((reaction + load).abs() < 1e-12, "reaction {reaction}");
+    // Without `until` it keeps going; `indent tip stop` holds it.
+    let body = "group a id 1\nexternal tip a indenter z 1.5 r 1 k 10\nindent tip velocity 0 0 -1\nrun 300\nindent tip stop\nrun 300\n";
+    let case = Case::new(&[("t.top", top), ("f.ff", ff), ("deck.in", &format!("{header}{body}"))]);
+    let sim = case.run();
+    assert!((sim.model.externals[0].term.params[2] - 1.2).abs() < 1e-12);
+}

@@ -83,7 +83,7 @@ mod tests {
     #[test]
     fn a_clashing_offset_is_refused_with_the_first_clash() {
         let mut top = parse("a.top", CELL);
-        assert_eq!(top.append(parse("b.top", CELL), 2), Err(3));
+        assert_eq!(top.append(parse("b.top", CELL), 2), Err(1), "id 1 + 2 is taken");
         assert_eq!(top.ids.len(), 4, "nothing appended");
     }
 }
