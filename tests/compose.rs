@@ -40,7 +40,11 @@ fn an_explicit_offset_places_the_ids() {
 fn bodies_of_several_topologies_get_distinct_ids() {
     let cell = std::fs::read_to_string("tests/decks/bad/body_tetrahedron.top").unwrap();
     let header = "units lj\ntopology c.top\ntopology c.top\nforcefield f.ff\nbox x -5 5 f y -5 5 f z -5 5 f\ntimestep 0.001\n";
-    let case = Case::new(&[("c.top", &cell), ("f.ff", "particle bead drag 1\nbody cell turgor k 100 v0 0.2\n"), ("deck.in", &format!("{header}run 0\n"))]);
+    let case = Case::new(&[
+        ("c.top", &cell),
+        ("f.ff", "particle bead drag 1\nbody cell turgor k 100 v0 0.2\n"),
+        ("deck.in", &format!("{header}run 0\n")),
+    ]);
     let m = case.plan().model;
     assert_eq!(m.bodies.iter().map(|b| b.id).collect::<Vec<_>>(), vec![1, 2]);
     assert_eq!(m.bodies[1].nodes, vec![4, 5, 6, 7]);

@@ -24,7 +24,8 @@ fn gamma_q() -> f64 {
 
 #[test]
 fn a_ramped_force_grows_linearly_over_the_run_and_keeps_its_end_value() {
-    let case = deck("group one id 3\nexternal pull one constant_force fx 0\nramp external pull fx 0 2\nrun 1000\nwrite_state a.state\nrun 1000\n");
+    let case =
+        deck("group one id 3\nexternal pull one constant_force fx 0\nramp external pull fx 0 2\nrun 1000\nwrite_state a.state\nrun 1000\n");
     let sim = case.run();
     let mid = cellmd::output::restart::read_state(&case.path("a.state")).unwrap().to_state();
     // Step s of N uses F = 2·s/N: x = x0 + dt/γ · Σ 2s/N = x0 + dt/γ · (N − 1).
@@ -127,7 +128,8 @@ fn reset_rest_makes_the_current_geometry_the_rest_state() {
         assert_eq!(sim.state.bonds.as_ref().unwrap().rest[0], Some(1.5));
     }
     // A reset after relaxing to r0 = 1 and pulling to 1.8 keeps 1.8.
-    let sim = deck("run 20000\ndisplace_atoms all move 0 0 0\ngroup two id 2\ndisplace_atoms two move 0.8 0 0\nreset_rest s\nrun 1000\n").run();
+    let sim =
+        deck("run 20000\ndisplace_atoms all move 0 0 0\ngroup two id 2\ndisplace_atoms two move 0.8 0 0\nreset_rest s\nrun 1000\n").run();
     let r = (sim.state.positions[1] - sim.state.positions[0]).length();
     assert!((r - 1.8).abs() < 1e-9, "{r}");
 }

@@ -2,11 +2,11 @@
 
 use std::path::PathBuf;
 
+use super::protocol::Protocol;
+use crate::forcefield::TermType;
 use crate::integrate::fire::FireSettings;
 use crate::integrate::overdamped::OverdampedSettings;
 use crate::output::DumpFormat;
-use super::protocol::Protocol;
-use crate::forcefield::TermType;
 use crate::system::{External, Model, SimBox};
 
 /// `neighbor skin S every N check yes|no`.

@@ -620,7 +620,9 @@ impl Writer<'_> {
             }
             CoeffTarget::BodyRule(_) => return Err("`coeff body` is not exported: LAMMPS has no surface terms of bodies".into()),
             CoeffTarget::External(name) => {
-                return Err(format!("`coeff external {name}` is not exported; give the external its new parameters with a new `external {name}` line"))
+                return Err(format!(
+                    "`coeff external {name}` is not exported; give the external its new parameters with a new `external {name}` line"
+                ))
             }
         }
         Ok(())

@@ -32,8 +32,8 @@
 use std::fs::File;
 use std::io::{BufWriter, Write};
 
-use crate::backend::Forces;
 use super::protocol::indenter_load;
+use crate::backend::Forces;
 use crate::deck::ThermoColumn;
 use crate::interactions::REGISTRY;
 use crate::measure::{filaments, planes};

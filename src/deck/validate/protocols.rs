@@ -84,10 +84,17 @@ impl Validator {
             "move" => self.move_group(s)?,
             "unmove" | "unfreeze" => {
                 expect_len(s, 1..=1, &format!("{} GROUP", s[0].text))?;
-                let (active, what) =
-                    if s[0].text == "unmove" { (self.protocols.moving.remove(&s[1].text).is_some(), "moved") } else { (self.protocols.frozen.remove(&s[1].text), "frozen") };
+                let (active, what) = if s[0].text == "unmove" {
+                    (self.protocols.moving.remove(&s[1].text).is_some(), "moved")
+                } else {
+                    (self.protocols.frozen.remove(&s[1].text), "frozen")
+                };
                 if !active {
-                    return Err(s[1].error(format!("found `{}`, expected a group {what} by a `{}` command before", s[1].text, &s[0].text[2..])));
+                    return Err(s[1].error(format!(
+                        "found `{}`, expected a group {what} by a `{}` command before",
+                        s[1].text,
+                        &s[0].text[2..]
+                    )));
                 }
                 if s[0].text == "unmove" {
                     Protocol::Unmove(s[1].text.clone())
@@ -135,9 +142,8 @@ impl Validator {
             }
             for k in 1..RAMP_SAMPLES {
                 let value = from + (to - from) * f64::from(k) / f64::from(RAMP_SAMPLES);
-                self.set_target_param(&target, param, value, to_token).map_err(|e| {
-                    to_token.error(format!("the ramp from {from} to {to} passes through {value}, where {}", e.message))
-                })?;
+                self.set_target_param(&target, param, value, to_token)
+                    .map_err(|e| to_token.error(format!("the ramp from {from} to {to} passes through {value}, where {}", e.message)))?;
             }
             self.set_target_param(&target, param, to, to_token)?;
             self.protocols.pending.push((target.clone(), param, s[0].clone()));
@@ -162,9 +168,12 @@ impl Validator {
         for (a, (t, name)) in s[3..].iter().zip(["VX", "VY", "VZ"]).enumerate() {
             velocity[a] = parse_f64(t, &format!("a velocity {name} in {unit}"))?;
         }
-        let clash = self.protocols.moving.iter().filter(|(other, _)| **other != group.name).find_map(|(other, members)| {
-            group.members.iter().find(|i| members.binary_search(i).is_ok()).map(|&i| (other.clone(), i))
-        });
+        let clash = self
+            .protocols
+            .moving
+            .iter()
+            .filter(|(other, _)| **other != group.name)
+            .find_map(|(other, members)| group.members.iter().find(|i| members.binary_search(i).is_ok()).map(|&i| (other.clone(), i)));
         if let Some((other, i)) = clash {
             let id = self.model(&s[0])?.ids[i as usize];
             return Err(s[1].error(format!(
@@ -199,7 +208,8 @@ impl Validator {
     fn reset_rest(&mut self, s: &[Token]) -> Result<Protocol, InputError> {
         expect_len(s, 1..=1, "reset_rest BONDTYPE|all")?;
         let model = self.model(&s[0])?;
-        let with_rest: Vec<usize> = (0..model.bond_types.len()).filter(|&t| param_index(model.bond_types[t].interaction, "r0").is_some()).collect();
+        let with_rest: Vec<usize> =
+            (0..model.bond_types.len()).filter(|&t| param_index(model.bond_types[t].interaction, "r0").is_some()).collect();
         let types = if s[1].text == "all" {
             let present: Vec<usize> = with_rest.into_iter().filter(|t| model.bond_type.iter().any(|&b| b as usize == *t)).collect();
             if present.is_empty() {
@@ -209,7 +219,11 @@ impl Validator {
         } else {
             let t = model.bond_types.iter().position(|t| t.label.text == s[1].text).ok_or_else(|| {
                 let names: Vec<&str> = model.bond_types.iter().map(|t| t.label.text.as_str()).collect();
-                s[1].error(format!("found bond type `{}`, expected `all` or one defined in the force field ({})", s[1].text, names.join(", ")))
+                s[1].error(format!(
+                    "found bond type `{}`, expected `all` or one defined in the force field ({})",
+                    s[1].text,
+                    names.join(", ")
+                ))
             })?;
             if !with_rest.contains(&t) {
                 return Err(s[1].error(format!(
@@ -252,10 +266,8 @@ impl Validator {
         self.model(&s[0])?;
         self.indenter_named(&s[1], &s[1].text)?;
         if self.protocols.pending.iter().any(|(t, _, _)| *t == CoeffTarget::External(s[1].text.clone())) {
-            return Err(s[1].error(format!(
-                "external `{}` is ramped over the next `run`; expected either a `ramp` or an `indent` of it",
-                s[1].text
-            )));
+            return Err(s[1]
+                .error(format!("external `{}` is ramped over the next `run`; expected either a `ramp` or an `indent` of it", s[1].text)));
         }
         let external = s[1].text.clone();
         match s[2].text.as_str() {
@@ -278,7 +290,9 @@ impl Validator {
                         let load = positive(&s[7], &format!("a load in {}", self.units.label(crate::units::Dim::Force)))?;
                         Some(load)
                     }
-                    Some(t) => return Err(t.error(format!("found `{}`, expected `until` or the end of the line (`{INDENT_USAGE}`)", t.text))),
+                    Some(t) => {
+                        return Err(t.error(format!("found `{}`, expected `until` or the end of the line (`{INDENT_USAGE}`)", t.text)))
+                    }
                 };
                 Ok(Protocol::Indent { external, velocity, until })
             }

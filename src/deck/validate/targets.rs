@@ -91,7 +91,12 @@ impl Validator {
         let (label, interaction) = (term.label.text.clone(), term.interaction);
         let index = param_index(interaction, &name.text).ok_or_else(|| {
             let names: Vec<&str> = interaction.params().iter().map(|p| p.name).collect();
-            name.error(format!("found parameter `{}`, expected one of `{}`'s parameters: {}", name.text, interaction.name(), names.join(", ")))
+            name.error(format!(
+                "found parameter `{}`, expected one of `{}`'s parameters: {}",
+                name.text,
+                interaction.name(),
+                names.join(", ")
+            ))
         })?;
         if rest_index == Some(index) {
             if let Some(reset) = self.protocols.reset_by(target) {
@@ -123,7 +128,9 @@ impl Validator {
         let spec = &term.interaction.params()[param];
         spec.check(value).map_err(|e| at.error(format!("expected {e}")))?;
         term.params[param] = value;
-        term.interaction.validate(&term.params).map_err(|e| at.error(format!("invalid `{}` parameters: expected {e}", term.interaction.name())))
+        term.interaction
+            .validate(&term.params)
+            .map_err(|e| at.error(format!("invalid `{}` parameters: expected {e}", term.interaction.name())))
     }
 
     /// The cutoff of a pair rule's law with its current parameters (None
