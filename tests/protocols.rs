@@ -161,3 +161,20 @@ fn an_indenter_driven_to_a_load_stops_there_and_reports_load_and_depth() {
     let sim = case.run();
     assert!((sim.model.externals[0].term.params[2] - 1.2).abs() < 1e-12);
 }
+
+#[test]
+fn coeff_and_ramp_reach_externals_and_pair_rules() {
+    // `coeff external` changes an active external between runs.
+    let sim = deck("group one id 3\nexternal pull one constant_force fx 1\nrun 100\ncoeff external pull fx 3\nrun 100\n").run();
+    let expected = 5.0 + DT / gamma_q() * (100.0 * 1.0 + 100.0 * 3.0);
+    assert!((sim.state.positions[2].x - expected).abs() < 1e-12, "{}", sim.state.positions[2].x);
+    // A pair parameter that leaves the cutoff alone ramps like any other.
+    let ff = format!("{FF}pair q q soft_repulsion k 10 sigma 2\n");
+    let header = "units lj\ntopology t.top\nforcefield f.ff\nbox x -20 20 f y -20 20 f z -20 20 f\ntimestep 0.001\n";
+    let case = Case::new(&[("t.top", TOP), ("f.ff", &ff), ("deck.in", &format!("{header}ramp pair q q k 10 40\nrun 1\n"))]);
+    let one = case.run();
+    assert_eq!(one.model.pair_rules[0].params[0], 40.0);
+    // Its only step used k = 10: the q pair 1 apart overlaps by 1 and pushes with 10.
+    let expected = 5.0 - DT * 10.0 / gamma_q();
+    assert!((one.state.positions[2].x - expected).abs() < 1e-14, "{} vs {expected}", one.state.positions[2].x);
+}
