@@ -51,11 +51,17 @@ fn exported_decks_import_back_to_the_same_forces_and_energy() {
 
 #[test]
 fn what_is_not_translated_is_listed() {
-    let data = "title\n\n2 atoms\n1 atom types\n\n0 1 xlo xhi\n0 1 ylo yhi\n0 1 zlo zhi\n\nMasses\n\n1 2.5\n\nAtoms # atomic\n\n1 1 0.1 0.2 0.3\n2 1 0.5 0.5 0.5\n";
+    let data = "title\n\n2 atoms\n1 atom types\n\n0 1 xlo xhi\n0 1 ylo yhi\n0 1 zlo zhi\n\nMasses\n\n1 2.5\n\nAtoms # atomic\n\n1 1 0.1 0.2 0.3\n2 1 0.5 0.5 0.5\n\nPair Coeffs\n\n1 1.0 1.0\n";
     let script = "units real\nboundary p f p\npair_style morse 2.0\npair_coeff 1 1 1.0 2.0 1.0\nfix 1 all nve\n";
     let imported = cellmd::export::import_lammps::import("d.data", data, Some(script)).unwrap();
     let notes = imported.notes.join("\n");
-    for expected in ["only `units lj`", "pair style `morse`", "`fix 1 all nve`: not translated", "its drag is its mass 2.5"] {
+    for expected in [
+        "only `units lj`",
+        "pair style `morse`",
+        "`fix 1 all nve`: not translated",
+        "its drag is its mass 2.5",
+        "section `Pair Coeffs` is not translated",
+    ] {
         assert!(notes.contains(expected), "notes lack {expected:?}:\n{notes}");
     }
     assert!(imported.topology.contains("y 0.0 1.0 f"), "{}", imported.topology);

@@ -231,6 +231,9 @@ pub fn import(data_name: &str, data: &str, script: Option<&str>) -> Result<Impor
             notes.push(format!("{data_name}: a triclinic box (`{line}`) is not translated; the box is orthogonal"));
         }
     }
+    for name in sections.keys().filter(|k| !["Masses", "Atoms", "Bonds", "Angles"].contains(&k.as_str())) {
+        notes.push(format!("{data_name}: section `{name}` is not translated (coefficients come from the script's *_coeff lines; velocities have no meaning in overdamped dynamics)"));
+    }
     let mut names: BTreeMap<usize, String> = BTreeMap::new();
     let mut masses: BTreeMap<usize, f64> = BTreeMap::new();
     for line in sections.get("Masses").map(|s| s.1.as_slice()).unwrap_or(&[]) {
