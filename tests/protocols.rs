@@ -178,3 +178,20 @@ fn coeff_and_ramp_reach_externals_and_pair_rules() {
     let expected = 5.0 - DT * 10.0 / gamma_q();
     assert!((one.state.positions[2].x - expected).abs() < 1e-14, "{} vs {expected}", one.state.positions[2].x);
 }
+
+#[test]
+fn a_flat_punch_driven_to_a_load_stops_at_its_depth() {
+    // The punch's face (radius 1, pushing along −z) starts 0.5 above a fixed
+    // particle and comes down at 1 µm/s until it carries 0.9 = K·δ²: δ = 0.3.
+    let top = "[ particles ]\n1 anchor 0 0 0\n2 p 5 5 5\n";
+    let ff = "particle anchor fixed\nparticle p drag 1\n";
+    let header = "units lj\ntopology t.top\nforcefield f.ff\nbox x -20 20 f y -20 20 f z -20 20 f\ntimestep 0.001\n";
+    let body = "group a id 1\nexternal punch a flat_punch x 0.3 z 0.5 nz -1 a 1 k 10\nindent punch velocity 0 0 -1 until 0.9\nrun 1000\n";
+    let case = Case::new(&[("t.top", top), ("f.ff", ff), ("deck.in", &format!("{header}{body}"))]);
+    let mut sim = case.run();
+    let face = sim.model.externals[0].term.params[2];
+    let depth = sim.thermo_value(&ThermoColumn::IndenterDepth("punch".into())).unwrap();
+    let load = sim.thermo_value(&ThermoColumn::IndenterLoad("punch".into())).unwrap();
+    assert!((depth + face).abs() < 1e-12, "depth {depth} for the face at {face}");
+    assert!((load - 10.0 * depth * depth).abs() < 1e-12 && (0.9..=10.0 * 0.301 * 0.301 + 1e-9).contains(&load), "load {load}");
+}
