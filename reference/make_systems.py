@@ -180,6 +180,26 @@ def externals():
     })
 
 
+def indenter():
+    """Spherical indenters (LAMMPS fix indent sphere) pressed into a slab."""
+    rng = random.Random(11)
+    box = 5.0
+    pts = [[rng.uniform(0, box), rng.uniform(0, box), rng.uniform(0, 3.0)] for _ in range(100)]
+    types = ["b" if k % 2 else "a" for k in range(100)]
+    tips = ("group bs type b\nexternal tip all indenter x 2.5 y 2.5 z 4.5 r 2 k 10\n"
+            "external bead bs indenter x 2.5 y 2.5 z -0.5 r 1.5 k 30\n")
+    write("indenter", {
+        "indenter.ff": TYPES,
+        "small.top": particles_block([[0.3, 0.2, 0.25], [0.1, 1.2, 1.5]], ["a", "b"]),
+        "random.top": particles_block(pts, types),
+        "small.in": deck("small.top", "indenter.ff", "x -5 5 f y -5 5 f z -5 5 f", 1e-3,
+                         extra="external tip all indenter x 0 y 0 z 2 r 2 k 20\n"),
+        # Periodic, with the spheres within half a box of every particle: LAMMPS
+        # takes the minimum image of x − c, cellmd the unwrapped x (the same here).
+        "random.in": deck("random.top", "indenter.ff", f"x 0 {box} p y 0 {box} p z 0 10 p", 1e-3, extra=tips),
+    })
+
+
 def random_points(rng, n, box, dmin):
     """n points in a periodic cube, no two closer than dmin."""
     pts = []
@@ -347,5 +367,6 @@ if __name__ == "__main__":
     for name, ff in PAIR_FF.items():
         pairs(name, ff)
     externals()
+    indenter()
     kinetics()
     per_bond_r0()

@@ -91,6 +91,14 @@ enum Command {
         #[arg(long)]
         probes: bool,
     },
+    /// Translate a LAMMPS data file (and the input script that reads it) into
+    /// DIR/system.top, system.ff and system.in, listing what it could not translate.
+    ImportLammps {
+        data: PathBuf,
+        input: Option<PathBuf>,
+        #[arg(short, long, value_name = "DIR")]
+        output: PathBuf,
+    },
     /// Run the deck in cellmd and in LAMMPS and compare energies, forces and positions.
     Compare {
         deck: PathBuf,
@@ -231,6 +239,19 @@ where
                 }
             }
         }
+        Command::ImportLammps { data, input, output } => match export::import_lammps::import_files(&data, input.as_deref(), &output) {
+            Ok(imported) => {
+                println!("wrote {0}/system.top, {0}/system.ff and {0}/system.in", output.display());
+                for note in &imported.notes {
+                    println!("not translated: {note}");
+                }
+                ExitCode::SUCCESS
+            }
+            Err(e) => {
+                eprintln!("error: {e}");
+                ExitCode::from(2)
+            }
+        },
         Command::Compare { deck, vars, lmp, workdir, tol, run_tol, write_golden, golden_header } => {
             let plan = match validate_file(&deck, &vars) {
                 Ok(plan) => plan,

@@ -14,10 +14,12 @@
 mod placement;
 mod open;
 mod plan;
+mod protocol;
 mod validate;
 mod variables;
 
 pub use self::open::OpenDeck;
 pub use self::plan::{Action, CheckpointSpec, CoeffTarget, DumpSpec, Group, NeighborSettings, Plan, ThermoColumn};
+pub use self::protocol::{Protocol, Ramp};
 pub use self::validate::{validate, validate_file, validate_file_with, validate_with, ValidateOptions};
 pub use self::variables::Variables;

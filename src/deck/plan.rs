@@ -2,6 +2,8 @@
 
 use std::path::PathBuf;
 
+use super::protocol::Protocol;
+use crate::forcefield::TermType;
 use crate::integrate::fire::FireSettings;
 use crate::integrate::overdamped::OverdampedSettings;
 use crate::output::DumpFormat;
@@ -91,6 +93,11 @@ pub enum ThermoColumn {
         group: Group,
         axis: usize,
     },
+    /// Magnitude of the summed force an indenter external exerts on its
+    /// group, its reaction (`load/NAME`).
+    IndenterLoad(String),
+    /// Deepest penetration δ of a particle into an indenter external (`depth/NAME`).
+    IndenterDepth(String),
 }
 
 /// A named trajectory output.
@@ -152,7 +159,8 @@ pub enum Action {
         group: Group,
         delta: glam::DVec3,
     },
-    /// Changes one parameter of a bond type, angle type or pair rule.
+    /// Changes one parameter of a bond type, angle type, pair rule, body
+    /// surface term or active external.
     Coeff {
         target: CoeffTarget,
         param: usize,
@@ -166,6 +174,8 @@ pub enum Action {
     },
     /// Releases a constrained bond type (`unconstrain`).
     Unconstrain(usize),
+    /// A time-dependent protocol command (`ramp`, `move`, `freeze`, `reset_rest`, …).
+    Protocol(Protocol),
     Minimize(FireSettings),
     Run(u64),
     WriteState(PathBuf),
@@ -211,12 +221,33 @@ impl Action {
     }
 }
 
-/// What a `coeff` command changes: an index into the model's tables.
+/// What a `coeff` or `ramp` command changes: an index into the model's
+/// tables, or the name of an active external.
 #[derive(Clone, Debug, PartialEq)]
 pub enum CoeffTarget {
     BondType(usize),
     AngleType(usize),
     PairRule(usize),
+    /// A surface term of a body type (index into `Model::body_rules`).
+    BodyRule(usize),
+    /// The active external of this name.
+    External(String),
+}
+
+impl CoeffTarget {
+    /// The term this target names in `model`; an external must be active
+    /// there (the deck checked it is at this point of the deck).
+    pub fn term_mut<'a>(&self, model: &'a mut Model) -> &'a mut TermType {
+        match self {
+            CoeffTarget::BondType(k) => &mut model.bond_types[*k],
+            CoeffTarget::AngleType(k) => &mut model.angle_types[*k],
+            CoeffTarget::PairRule(k) => &mut model.pair_rules[*k],
+            CoeffTarget::BodyRule(k) => &mut model.body_rules[*k],
+            CoeffTarget::External(name) => {
+                &mut model.externals.iter_mut().find(|e| e.term.label.text == *name).expect("the deck checked the external is active").term
+            }
+        }
+    }
 }
 
 /// A validated deck.

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use glam::DVec3;
 
 use super::placement::check_placement;
-use super::plan::{Action, CheckpointSpec, CoeffTarget, DumpSpec, Group, NeighborSettings, Plan, ThermoColumn};
+use super::plan::{Action, CheckpointSpec, DumpSpec, Group, NeighborSettings, Plan, ThermoColumn};
 use super::variables::Variables;
 use crate::forcefield::{load_forcefield, parse_params, ForceField};
 use crate::gpu::DevicePreference;
@@ -19,11 +19,15 @@ use crate::interactions::{param_index, Kind, REGISTRY};
 use crate::kinetics::EventKind;
 use crate::output::{AtomColumn, DumpFormat, Encoding, WriterOptions};
 use crate::system::{External, Model, SimBox, SpecialBonds};
-use crate::topology::{parse_box_axis, parse_topology, BoxAxis, Topology};
+use crate::topology::{parse_box_axis, BoxAxis, Topology};
 use crate::units::UnitSystem;
 
+mod compose;
+mod protocols;
+mod targets;
+
 /// The commands a deck understands (for "expected ..." messages).
-const COMMANDS: &str = "units, variable, topology, forcefield, box, special_bonds, temperature, timestep, seed, device, integrator, neighbor, thermo, thermo_file, events, lifetimes, dump, undump, group, external, unexternal, displace_atoms, coeff, constrain, unconstrain, minimize, run, write_state, read_state, print";
+const COMMANDS: &str = "units, variable, topology, forcefield, box, special_bonds, temperature, timestep, seed, device, integrator, neighbor, thermo, thermo_file, events, lifetimes, dump, undump, group, external, unexternal, displace_atoms, coeff, ramp, move, unmove, freeze, unfreeze, reset_rest, indent, constrain, unconstrain, minimize, run, write_state, read_state, print";
 
 /// Commands that define the system and must come before it is first used.
 const SETUP: [&str; 5] = ["units", "topology", "forcefield", "box", "special_bonds"];
@@ -52,6 +56,8 @@ pub(super) struct Validator {
     timestep_set: bool,
     pub(super) actions: Vec<Action>,
     allow_outside: bool,
+    /// Ramps waiting for a run, moving and frozen groups, reset rest lengths.
+    protocols: protocols::Protocols,
 }
 
 /// How a deck is validated.
@@ -203,14 +209,7 @@ impl Validator {
                 self.units = UnitSystem::from_keyword(&s[1].text)
                     .ok_or_else(|| s[1].error(format!("found `{}`, expected `cell` (µm, s, pN) or `lj`", s[1].text)))?;
             }
-            "topology" => {
-                expect_len(s, 1..=1, "topology FILE")?;
-                if self.topology.is_some() {
-                    return Err(kw.error("a second `topology`; expected exactly one per deck"));
-                }
-                let file = SourceFile::read(&self.input_path(&s[1]), Some(&s[1]))?;
-                self.topology = Some(parse_topology(&file)?);
-            }
+            "topology" => self.topology_command(s)?,
             "forcefield" => {
                 expect_len(s, 1..=1, "forcefield FILE")?;
                 let path = self.input_path(&s[1]);
@@ -253,7 +252,7 @@ impl Validator {
 
     pub(super) fn thermo_columns(&self, tokens: &[Token]) -> Result<Vec<ThermoColumn>, InputError> {
         const FIXED: &str =
-            "step, time, pe, pe/NAME, fmax, fnorm, press, pxx, pyy, pzz, pxy, pxz, pyz, nbuild, solver_iterations, solver_residual, ctension/BONDTYPE, breaks, rebinds, forms, resets, nbound/BONDTYPE, tension/BONDTYPE, volume/BODYTYPE, area/BODYTYPE, planetension/AXIS/POS, gamma/BODYTYPE, e2e/BONDTYPE, tcorr/BONDTYPE/LAG, fx/GROUP, fy/GROUP, fz/GROUP, xu/GROUP, yu/GROUP, zu/GROUP, mindist, nclamp";
+            "step, time, pe, pe/NAME, fmax, fnorm, press, pxx, pyy, pzz, pxy, pxz, pyz, nbuild, solver_iterations, solver_residual, ctension/BONDTYPE, breaks, rebinds, forms, resets, nbound/BONDTYPE, tension/BONDTYPE, volume/BODYTYPE, area/BODYTYPE, planetension/AXIS/POS, gamma/BODYTYPE, e2e/BONDTYPE, tcorr/BONDTYPE/LAG, fx/GROUP, fy/GROUP, fz/GROUP, xu/GROUP, yu/GROUP, zu/GROUP, load/INDENTER, depth/INDENTER, mindist, nclamp";
         let bond_type = |t: &Token, name: &str| {
             self.forcefield.bond_types.iter().position(|b| b.label.text == name).ok_or_else(|| {
                 let names: Vec<&str> = self.forcefield.bond_types.iter().map(|b| b.label.text.as_str()).collect();
@@ -319,6 +318,7 @@ impl Validator {
                                 ThermoColumn::GroupPosition { group, axis }
                             }
                         }
+                        Some((kind @ ("load" | "depth"), name)) => self.indenter_column(t, kind, name)?,
                         Some(("planetension", rest)) => {
                             let usage = format!("found `{other}`, expected planetension/AXIS/POS with AXIS x, y or z and POS a number");
                             let (axis, pos) = rest.split_once('/').ok_or_else(|| t.error(usage.clone()))?;
@@ -500,83 +500,20 @@ impl Validator {
     }
 
     fn coeff(&mut self, s: &[Token]) -> Result<(), InputError> {
-        expect_len(s, 3..=usize::MAX, "coeff bond|angle NAME PARAM VALUE ... | coeff pair A B PARAM VALUE ...")?;
+        const USAGE: &str = "coeff bond|angle NAME PARAM VALUE ... | coeff pair A B PARAM VALUE ... | coeff body TYPE LAW PARAM VALUE ... | coeff external NAME PARAM VALUE ...";
+        expect_len(s, 3..=usize::MAX, USAGE)?;
         let units = self.units;
-        let model = self.model(&s[0])?;
-        let (targets, start): (Vec<CoeffTarget>, usize) = match s[1].text.as_str() {
-            "bond" | "angle" => {
-                let table = if s[1].text == "bond" { &model.bond_types } else { &model.angle_types };
-                let index = table.iter().position(|t| t.label.text == s[2].text).ok_or_else(|| {
-                    s[2].error(format!("found {} type `{}`, expected one defined in the force field", s[1].text, s[2].text))
-                })?;
-                (vec![if s[1].text == "bond" { CoeffTarget::BondType(index) } else { CoeffTarget::AngleType(index) }], 3)
-            }
-            "pair" => {
-                expect_len(s, 5..=usize::MAX, "coeff pair A B PARAM VALUE ...")?;
-                let (a, b) = (&s[2].text, &s[3].text);
-                let rules: Vec<CoeffTarget> = model
-                    .pair_rules
-                    .iter()
-                    .enumerate()
-                    .filter(|(k, _)| {
-                        let (ta, tb) = model.pair_rule_types[*k];
-                        let (ra, rb) = (&model.type_names[ta as usize], &model.type_names[tb as usize]);
-                        (ra == a && rb == b) || (ra == b && rb == a)
-                    })
-                    .map(|(k, _)| CoeffTarget::PairRule(k))
-                    .collect();
-                if rules.is_empty() {
-                    return Err(s[2].error(format!(
-                        "no pair rule between `{a}` and `{b}`; expected a type pair with a `pair` line in the force field"
-                    )));
-                }
-                (rules, 4)
-            }
-            other => return Err(s[1].error(format!("found `{other}`, expected `bond`, `angle` or `pair`"))),
-        };
+        let (targets, start) = self.coeff_targets(s, USAGE)?;
         if !(s.len() - start).is_multiple_of(2) || s.len() == start {
             return Err(s.last().unwrap().error("expected `PARAM VALUE` pairs"));
         }
-        // Per bond type: bonds with their own r0, and the index of `r0`.
-        let mut own_rest = vec![0usize; model.bond_types.len()];
-        for (b, rest) in model.bond_rest.iter().enumerate() {
-            own_rest[model.bond_type[b] as usize] += usize::from(rest.is_some());
-        }
-        let rest_index: Vec<usize> = model.bond_kinetics.iter().map(|k| k.rest_index.unwrap_or(usize::MAX)).collect();
         let mut edits = Vec::new();
         for target in targets {
-            let term = match &target {
-                CoeffTarget::BondType(k) => &mut model.bond_types[*k],
-                CoeffTarget::AngleType(k) => &mut model.angle_types[*k],
-                CoeffTarget::PairRule(k) => &mut model.pair_rules[*k],
-            };
             for pair in s[start..].chunks(2) {
-                let index = param_index(term.interaction, &pair[0].text).ok_or_else(|| {
-                    let names: Vec<&str> = term.interaction.params().iter().map(|p| p.name).collect();
-                    pair[0].error(format!(
-                        "found parameter `{}`, expected one of `{}`'s parameters: {}",
-                        pair[0].text,
-                        term.interaction.name(),
-                        names.join(", ")
-                    ))
-                })?;
-                if let CoeffTarget::BondType(k) = target {
-                    if own_rest[k] > 0 && index == rest_index[k] {
-                        return Err(pair[0].error(format!(
-                            "bond type `{}` has {} bond{} with its own rest length in the topology, which `coeff` cannot change; expected a parameter other than `r0`",
-                            term.label.text,
-                            own_rest[k],
-                            if own_rest[k] == 1 { "" } else { "s" }
-                        )));
-                    }
-                }
-                let spec = &term.interaction.params()[index];
+                let index = self.target_param(&target, &pair[0])?;
+                let spec = &target.term_mut(self.model(&pair[0])?).interaction.params()[index];
                 let value = parse_f64(&pair[1], &format!("a value for `{}` in {}", spec.name, units.label(spec.dim)))?;
-                spec.check(value).map_err(|e| pair[1].error(format!("expected {e}")))?;
-                term.params[index] = value;
-                term.interaction
-                    .validate(&term.params)
-                    .map_err(|e| pair[1].error(format!("invalid `{}` parameters: expected {e}", term.interaction.name())))?;
+                self.set_target_param(&target, index, value, &pair[1])?;
                 edits.push(Action::Coeff { target: target.clone(), param: index, value });
             }
         }
@@ -735,23 +672,33 @@ impl Validator {
             "group" => self.group(s)?,
             "external" => {
                 expect_len(s, 3..=usize::MAX, "external NAME GROUP INTERACTION [param value]...")?;
+                self.protocols.check_external_kept(&s[1])?;
                 let units = self.units;
                 self.model(kw)?;
                 let group = self.group_named(&s[2])?;
                 let term = parse_params(&s[1], &s[3], &s[4..], Kind::External, units)?;
                 let external = External { term, group: group.name.clone(), members: group.members.clone() };
                 self.externals.insert(s[1].text.clone());
+                // The working model holds the active externals for `coeff` and `ramp`.
+                let model = self.model(kw)?;
+                model.externals.retain(|e| e.term.label.text != s[1].text);
+                model.externals.push(external.clone());
                 self.actions.push(Action::External(external));
             }
             "unexternal" => {
                 expect_len(s, 1..=1, "unexternal NAME")?;
+                self.protocols.check_external_kept(&s[1])?;
                 if !self.externals.remove(&s[1].text) {
                     return Err(s[1].error(format!("found `{}`, expected the name of an active external", s[1].text)));
+                }
+                if let Some(model) = self.model.as_mut() {
+                    model.externals.retain(|e| e.term.label.text != s[1].text);
                 }
                 self.actions.push(Action::Unexternal(s[1].text.clone()));
             }
             "displace_atoms" => self.displace_atoms(s)?,
             "coeff" => self.coeff(s)?,
+            "ramp" | "move" | "unmove" | "freeze" | "unfreeze" | "reset_rest" | "indent" => self.protocol_command(s)?,
             "constrain" | "unconstrain" => {
                 let usage =
                     if kw.text == "constrain" { "constrain BONDTYPE [tolerance T] [max_iterations N]" } else { "unconstrain BONDTYPE" };
@@ -815,6 +762,7 @@ impl Validator {
                 if !self.timestep_set {
                     return Err(kw.error("no timestep; expected a `timestep DT` command before `run`"));
                 }
+                self.protocols.run();
                 self.actions.push(Action::Run(n));
             }
             "write_state" => self.write_state(s)?,
@@ -872,6 +820,7 @@ pub(super) fn validate_in(v: &mut Validator, file: &std::sync::Arc<SourceFile>) 
         return Err(InputError::in_file(&file.path, "the deck is empty; expected at least `topology`, `forcefield`, `timestep` and `run`"));
     };
     v.model(&last)?;
+    v.protocols.finish()?;
     Ok(Plan {
         deck_path: PathBuf::from(&file.path),
         model: v.initial_model.take().expect("built above"),
@@ -904,6 +853,7 @@ impl Validator {
             timestep_set: false,
             actions: Vec::new(),
             allow_outside: options.allow_outside,
+            protocols: protocols::Protocols::default(),
         }
     }
 

@@ -618,6 +618,12 @@ impl Writer<'_> {
                 let line = self.pairs.coeff_line(&self.model, *k, &term)?;
                 self.line(line);
             }
+            CoeffTarget::BodyRule(_) => return Err("`coeff body` is not exported: LAMMPS has no surface terms of bodies".into()),
+            CoeffTarget::External(name) => {
+                return Err(format!(
+                    "`coeff external {name}` is not exported; give the external its new parameters with a new `external {name}` line"
+                ))
+            }
         }
         Ok(())
     }
@@ -644,6 +650,9 @@ impl Writer<'_> {
                     self.noise = s.noise;
                 }
                 Action::Neighbor(_) | Action::Device(_) => {}
+                Action::Protocol(_) => {
+                    return Err("protocols (`ramp`, `move`, `freeze`, `reset_rest`, `indent`) are not exported to LAMMPS".into())
+                }
                 Action::Constrain { .. } | Action::Unconstrain(_) => {
                     return Err("`constrain` (overdamped SHAKE) is not exported: LAMMPS' fix shake needs velocities and masses".into())
                 }

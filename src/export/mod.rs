@@ -6,9 +6,11 @@
 //! correspondence of every interaction type is in [`styles`]; an interaction
 //! LAMMPS cannot express is an error that names it. Bonds with their own
 //! rest lengths get one LAMMPS bond type per distinct (type, r0)
-//! ([`bond_types`]).
+//! ([`bond_types`]). [`import_lammps`] reads a LAMMPS data file (and script)
+//! back as a topology, force field and deck (`cellmd import-lammps`).
 
 pub mod bond_types;
+pub mod import_lammps;
 pub mod lammps;
 pub mod styles;
 

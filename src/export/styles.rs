@@ -15,6 +15,7 @@
 //! | `soft` | `pair_style soft` | identical |
 //! | `wall` (axis-aligned normal) | `fix wall/harmonic` ε(r−rc)² | ε = k/2, wall placed at d − rc |
 //! | `constant_force` | `fix addforce` | identical; its scalar is −F·x on unwrapped x |
+//! | `indenter` (K/3)(R−r)³ | `fix indent … sphere` | identical (K, centre, R) |
 
 use crate::forcefield::TermType;
 use crate::interactions::{param_index, Law};
@@ -111,6 +112,10 @@ pub fn external(term: &TermType, axis_length: impl Fn(usize) -> f64, periodic: i
     let p = |n| param(term, n);
     match term.interaction.name() {
         "constant_force" => Ok(format!("addforce {} {} {}", num(p("fx")), num(p("fy")), num(p("fz")))),
+        // LAMMPS: F(r) = −K(r − R)² outward inside the sphere, energy K(R − r)³/3.
+        "indenter" => {
+            Ok(format!("indent {} sphere {} {} {} {} units box", num(p("k")), num(p("x")), num(p("y")), num(p("z")), num(p("r"))))
+        }
         "wall" => {
             let n = [p("nx"), p("ny"), p("nz")];
             let axes: Vec<usize> = (0..3).filter(|&a| n[a] != 0.0).collect();

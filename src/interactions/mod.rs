@@ -90,9 +90,11 @@ mod contact_adhesion;
 mod contact_barrier;
 mod cosine_angle;
 mod fene;
+mod flat_punch;
 mod harmonic;
 mod harmonic_angle;
 mod helfrich_bending;
+mod indenter;
 mod lj;
 mod soft;
 mod soft_repulsion;
@@ -122,6 +124,8 @@ pub static REGISTRY: &[&dyn Interaction] = &[
     &soft::Soft,
     &wall::Wall,
     &constant_force::ConstantForce,
+    &indenter::Indenter,
+    &flat_punch::FlatPunch,
     &turgor::Turgor,
     &turgor_log::TurgorLog,
     &surface_tension::SurfaceTension,

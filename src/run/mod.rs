@@ -3,6 +3,7 @@
 //! ([`Simulation::resume`]).
 
 mod blowup;
+mod protocol;
 mod simulation;
 mod stop;
 pub mod thermo;

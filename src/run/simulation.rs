@@ -7,10 +7,11 @@ use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 
 use super::blowup::{culprit, RunError};
+use super::protocol::{reset_rest, Protocols};
 use super::stop::StopSignal;
 use super::thermo::{column_value, Thermo, ThermoInputs};
 use crate::backend::{CpuBackend, Forces};
-use crate::deck::{Action, CheckpointSpec, CoeffTarget, DumpSpec, NeighborSettings, Plan, ThermoColumn};
+use crate::deck::{Action, CheckpointSpec, CoeffTarget, DumpSpec, NeighborSettings, Plan, Protocol, ThermoColumn};
 use crate::gpu::backend::StepSettings;
 use crate::gpu::{DevicePreference, GpuBackend, GpuContext, GpuHalt};
 use crate::input::DeckInputs;
@@ -134,6 +135,8 @@ pub struct Simulation {
     /// Wall time by phase of the step loop (for the run log).
     pub times: PhaseTimes,
     log: Option<RunLog>,
+    /// Ramps, moved and frozen groups in force.
+    protocols: Protocols,
 }
 
 impl Simulation {
@@ -189,6 +192,7 @@ impl Simulation {
             checkpoints: None,
             times: PhaseTimes::default(),
             log: None,
+            protocols: Protocols::default(),
         }
     }
 
@@ -401,21 +405,23 @@ impl Simulation {
             }
             Action::Unexternal(name) => {
                 self.model.externals.retain(|e| e.term.label.text != *name);
+                self.protocols.forget_drive(name);
                 self.forces_current = false;
             }
             Action::Displace { group, delta } => self.displace(&group.members, *delta)?,
             Action::Coeff { target, param, value } => {
-                let term = match target {
-                    CoeffTarget::BondType(k) => &mut self.model.bond_types[*k],
-                    CoeffTarget::AngleType(k) => &mut self.model.angle_types[*k],
-                    CoeffTarget::PairRule(k) => {
-                        self.backend = None; // the cutoff may change
-                        &mut self.model.pair_rules[*k]
-                    }
-                };
-                term.params[*param] = *value;
+                if let CoeffTarget::PairRule(_) = target {
+                    self.backend = None; // the cutoff may change
+                }
+                target.term_mut(&mut self.model).params[*param] = *value;
                 self.forces_current = false;
             }
+            Action::Protocol(Protocol::ResetRest(bond_types)) => {
+                reset_rest(&mut self.model, &mut self.state, &self.sim_box, bond_types);
+                self.backend = None; // bonds now carry state
+                self.forces_current = false;
+            }
+            Action::Protocol(protocol) => self.protocols.apply(protocol),
             Action::Constrain { bond_type, tolerance, max_iterations } => {
                 self.constraints.list.retain(|c| self.model.bond_type[c.bond] as usize != *bond_type);
                 // Each bond at its rest length now (its own, or the type's `r0`; the deck checked it has one).
@@ -756,7 +762,12 @@ impl Simulation {
     /// header and the outputs of the first step.
     pub fn begin_run(&mut self, steps: u64) -> Result<ActiveRun, RunError> {
         self.check_kinetics_temperature()?;
+        self.protocols.begin_run(self.state.step, self.state.step + steps);
+        if self.protocols.set_ramps(&mut self.model, self.state.step) {
+            self.forces_current = false;
+        }
         self.ensure_forces()?;
+        self.protocols.check_drives(&self.model, &self.state, &self.sim_box);
         let gpu = self.gpu_for_run()?;
         let bar = (self.options.progress && steps >= 1000).then(|| {
             let bar = ProgressBar::new(steps);
@@ -798,6 +809,7 @@ impl Simulation {
             b.finish_and_clear();
         }
         self.run_end = None;
+        self.protocols.end_run();
         self.write_lifetimes()?;
         let seconds = run.started.elapsed().as_secs_f64();
         self.say(&format!(
@@ -819,6 +831,7 @@ impl Simulation {
             if !self.constraints.list.is_empty() {
                 before.clone_from(&self.state.positions);
             }
+            self.protocols.before_step(&mut self.forces.forces, &self.state);
             let moved = match self.integrator.implicit {
                 Some(implicit) => self.implicit_step(&implicit)?,
                 None => {
@@ -839,6 +852,7 @@ impl Simulation {
                     .inspect(|&fraction| self.contact_clamps += u64::from(fraction < 1.0))
                 }
             };
+            self.protocols.restore_forces(&mut self.forces.forces);
             let fraction = match moved {
                 Ok(fraction) => fraction,
                 Err(Blowup { particle, displacement }) => return Err(self.blowup(particle, self.displacement_message(displacement))),
@@ -861,12 +875,15 @@ impl Simulation {
                     )));
                 }
             }
+            self.protocols.after_step(&mut self.state, &self.sim_box, self.dt);
             clock.lap(&mut self.times, Phase::Integrate);
             self.check_in_box()?;
             if self.model.has_kinetics() {
                 self.kinetics_step(StepClock { step, start, length: fraction * self.dt })?;
                 clock.lap(&mut self.times, Phase::Kinetics);
             }
+            self.protocols.advance_drives(&mut self.model, self.dt);
+            self.protocols.set_ramps(&mut self.model, self.state.step);
             let final_step = self.state.step == last;
             let thermo_due = self.thermo.every > 0 && self.state.step.is_multiple_of(self.thermo.every);
             match self.backend.as_mut() {
@@ -880,6 +897,7 @@ impl Simulation {
                 // Bonds formed: the backend is rebuilt for the new bond list.
                 None => self.ensure_forces()?,
             }
+            self.protocols.check_drives(&self.model, &self.state, &self.sim_box);
             clock.lap(&mut self.times, Phase::Force);
             self.outputs_at_step(bar, final_step && !thermo_due)?;
             clock.lap(&mut self.times, Phase::Output);
@@ -935,7 +953,9 @@ impl Simulation {
     /// Why the next `run` cannot use the GPU backend: the first feature in
     /// use that only the CPU backend has (None when the GPU can run it).
     pub fn cpu_only_feature(&self) -> Option<&'static str> {
-        if self.integrator.implicit.is_some() {
+        if let Some(why) = self.protocols.cpu_only() {
+            Some(why)
+        } else if self.integrator.implicit.is_some() {
             Some("`integrator implicit` runs on the CPU backend only")
         } else if !self.constraints.list.is_empty() {
             Some("constrained bonds (`constrain`) run on the CPU backend only")
@@ -1165,13 +1185,14 @@ impl Simulation {
         let mass: Vec<f64> = self.model.types.iter().map(|&t| self.model.type_drag[t as usize] * self.dt).collect();
         let mut state = self.state.clone();
         let backend = self.backend.as_mut().expect("backend built");
-        let (model, sim_box, forces) = (&self.model, &self.sim_box, &mut self.forces);
+        let (model, sim_box, forces, protocols) = (&self.model, &self.sim_box, &mut self.forces, &self.protocols);
         let report = fire_minimize(&mut state, sim_box, &mass, self.dt, settings, |s, f, limits| {
             backend.update_neighbors(s, sim_box, true).map_err(RunError::Setup)?;
             backend.update_contacts(model, s, sim_box).map_err(RunError::Setup)?;
             backend.compute(model, s, sim_box, forces);
             backend.contact_step_limits(s.len(), limits);
             f.clone_from(&forces.forces);
+            protocols.mask(f);
             Ok::<f64, RunError>(forces.total_energy())
         })?;
         self.state = state;

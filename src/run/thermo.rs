@@ -27,11 +27,13 @@
 //! | `tcorr/BONDTYPE/LAG` | tangent correlation ⟨t_s·t_{s+LAG}⟩ along those chains, LAG in bonds | – |
 //! | `fx/GROUP`, `fy/GROUP`, `fz/GROUP` | Σ_{i∈GROUP} F_i along the axis; on `fixed` particles the reaction of their anchors (a sheared plate's load) | pN |
 //! | `xu/GROUP`, `yu/GROUP`, `zu/GROUP` | mean unwrapped coordinate (1/N)Σ_{i∈GROUP} (x_i + n_i·L) along the axis | µm |
+//! | `load/NAME`, `depth/NAME` | an indenter external's load \|Σ F\| on its group (its reaction) and its deepest penetration δ = (3E/K)^{1/3} | pN, µm |
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::PathBuf;
 
+use super::protocol::indenter_load;
 use crate::backend::Forces;
 use crate::deck::ThermoColumn;
 use crate::interactions::REGISTRY;
@@ -98,6 +100,8 @@ pub fn column_label(c: &ThermoColumn, model: &crate::system::Model) -> String {
         ThermoColumn::TangentCorrelation { bond_type, lag } => format!("tcorr/{}/{lag}", model.bond_types[*bond_type].label.text),
         ThermoColumn::GroupForce { group, axis } => format!("f{}/{}", ["x", "y", "z"][*axis], group.name),
         ThermoColumn::GroupPosition { group, axis } => format!("{}u/{}", ["x", "y", "z"][*axis], group.name),
+        ThermoColumn::IndenterLoad(name) => format!("load/{name}"),
+        ThermoColumn::IndenterDepth(name) => format!("depth/{name}"),
     }
 }
 
@@ -115,7 +119,8 @@ pub fn column_unit(c: &ThermoColumn, units: UnitSystem) -> &'static str {
         ThermoColumn::Tension(_) | ThermoColumn::ConstraintTension(_) | ThermoColumn::PlaneTension { .. } => units.label(Dim::Force),
         ThermoColumn::CorticalTension(_) => units.label(Dim::Tension),
         ThermoColumn::EndToEnd(_) | ThermoColumn::GroupPosition { .. } => units.label(Dim::Length),
-        ThermoColumn::GroupForce { .. } => units.label(Dim::Force),
+        ThermoColumn::GroupForce { .. } | ThermoColumn::IndenterLoad(_) => units.label(Dim::Force),
+        ThermoColumn::IndenterDepth(_) => units.label(Dim::Length),
         ThermoColumn::Time => units.label(Dim::Time),
         ThermoColumn::Pe | ThermoColumn::PeOf(_) => units.label(Dim::Energy),
         ThermoColumn::Fmax | ThermoColumn::Fnorm => units.label(Dim::Force),
@@ -175,6 +180,8 @@ pub fn column_value(c: &ThermoColumn, t: &ThermoInputs) -> f64 {
             filaments::tangent_correlation(&filaments::chains(t.model, *bond_type), t.positions, t.sim_box, *lag)
         }
         ThermoColumn::GroupForce { group, axis } => group.members.iter().map(|&i| t.forces.forces[i as usize][*axis]).sum(),
+        ThermoColumn::IndenterLoad(name) => indenter_load(t.model, t.state, t.sim_box, name).map_or(f64::NAN, |(load, _)| load),
+        ThermoColumn::IndenterDepth(name) => indenter_load(t.model, t.state, t.sim_box, name).map_or(f64::NAN, |(_, depth)| depth),
         ThermoColumn::GroupPosition { group, axis } => {
             let unwrapped = |i: usize| t.sim_box.unwrap(t.state.positions[i], t.state.images[i])[*axis];
             group.members.iter().map(|&i| unwrapped(i as usize)).sum::<f64>() / group.members.len() as f64

@@ -46,6 +46,7 @@
 //! `src/topology/surface.rs` for the checks and their messages, which name
 //! the offending face at its line.
 
+mod merge;
 mod parse;
 mod surface;
 

@@ -1,0 +1,38 @@
+//! `topology FILE [offset auto|N]`, repeatable: the deck's system is the
+//! topologies in order, composed by [`Topology::append`]'s rule.
+
+use super::{expect_len, options, Validator};
+use crate::input::{parse_u64, InputError, SourceFile, Token};
+use crate::topology::parse_topology;
+
+const USAGE: &str = "topology FILE [offset auto|N]";
+
+impl Validator {
+    pub(super) fn topology_command(&mut self, s: &[Token]) -> Result<(), InputError> {
+        expect_len(s, 1..=3, USAGE)?;
+        let opts = options(&s[2..], &["offset"], USAGE)?;
+        let offset = match opts.get("offset") {
+            Some(t) if t.text != "auto" => Some(parse_u64(t, "a particle id offset (a whole number, or `auto`)")?),
+            _ => None,
+        };
+        let file = SourceFile::read(&self.input_path(&s[1]), Some(&s[1]))?;
+        let parsed = parse_topology(&file)?;
+        let mut top = match self.topology.take() {
+            None if offset.unwrap_or(0) == 0 => {
+                self.topology = Some(parsed);
+                return Ok(());
+            }
+            previous => previous.unwrap_or_default(),
+        };
+        let used = top.max_id();
+        let offset = offset.unwrap_or(used);
+        top.append(parsed, offset).map_err(|id| {
+            s[1].error(format!(
+                "particle id {id} of `{}` plus offset {offset} is already used by an earlier topology; expected `offset auto` or an offset >= {used}",
+                s[1].text
+            ))
+        })?;
+        self.topology = Some(top);
+        Ok(())
+    }
+}

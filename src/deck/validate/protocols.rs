@@ -1,0 +1,302 @@
+//! Protocol commands: `ramp`, `move`/`unmove`, `freeze`/`unfreeze` and
+//! `reset_rest` (see [`crate::deck::Protocol`]).
+
+use std::collections::{BTreeMap, HashMap, HashSet};
+
+use glam::DVec3;
+
+use super::{expect_len, positive, Validator};
+use crate::deck::plan::{Action, CoeffTarget, ThermoColumn};
+use crate::deck::protocol::{Protocol, Ramp};
+use crate::input::{parse_f64, InputError, Token};
+use crate::interactions::param_index;
+
+const RAMP_USAGE: &str =
+    "ramp bond|angle NAME PARAM FROM TO | ramp pair A B PARAM FROM TO | ramp body TYPE LAW PARAM FROM TO | ramp external NAME PARAM FROM TO";
+const MOVE_USAGE: &str = "move GROUP linear VX VY VZ";
+const FREEZE_USAGE: &str = "freeze GROUP x|y|z ...";
+const INDENT_USAGE: &str = "indent NAME velocity VX VY VZ [until LOAD] | indent NAME stop";
+
+/// The interaction types whose centre `indent` drives and whose load and
+/// depth thermo reports (laws E = (K/3)δ³ with a centre `x y z` and a `k`).
+const INDENTERS: [&str; 2] = ["indenter", "flat_punch"];
+
+/// Intermediate fractions of a ramp whose parameter values the law's own
+/// checks must accept (besides both ends).
+const RAMP_SAMPLES: u32 = 1024;
+
+/// What the protocol commands seen so far leave in force.
+#[derive(Default)]
+pub(super) struct Protocols {
+    /// Ramps waiting for the next `run`: target, parameter, and the command's keyword.
+    pending: Vec<(CoeffTarget, usize, Token)>,
+    /// Moving groups: name → members.
+    moving: BTreeMap<String, Vec<u32>>,
+    /// Frozen groups.
+    frozen: HashSet<String>,
+    /// Bond types whose rest lengths `reset_rest` set: type → line.
+    reset: HashMap<usize, u32>,
+}
+
+impl Protocols {
+    /// The line of the `reset_rest` that set this bond type's rest lengths.
+    pub(super) fn reset_by(&self, target: &CoeffTarget) -> Option<u32> {
+        match target {
+            CoeffTarget::BondType(k) => self.reset.get(k).copied(),
+            _ => None,
+        }
+    }
+
+    /// Whether a ramp over the next run already changes this parameter.
+    pub(super) fn is_ramped(&self, target: &CoeffTarget, param: usize) -> bool {
+        self.pending.iter().any(|(t, p, _)| t == target && *p == param)
+    }
+
+    /// An external that a pending ramp changes may not be replaced or removed before the run.
+    pub(super) fn check_external_kept(&self, name: &Token) -> Result<(), InputError> {
+        if self.pending.iter().any(|(t, _, _)| *t == CoeffTarget::External(name.text.clone())) {
+            return Err(name.error(format!(
+                "external `{}` is ramped over the next `run`; expected to replace or remove it after that run",
+                name.text
+            )));
+        }
+        Ok(())
+    }
+
+    /// A `run` consumes the pending ramps.
+    pub(super) fn run(&mut self) {
+        self.pending.clear();
+    }
+
+    /// At the end of the deck no ramp may wait for a run that never comes.
+    pub(super) fn finish(&self) -> Result<(), InputError> {
+        match self.pending.first() {
+            Some((_, _, kw)) => Err(kw.error("`ramp` has no `run` after it; expected a `run N` to ramp over")),
+            None => Ok(()),
+        }
+    }
+}
+
+impl Validator {
+    pub(super) fn protocol_command(&mut self, s: &[Token]) -> Result<(), InputError> {
+        let protocol = match s[0].text.as_str() {
+            "ramp" => self.ramp(s)?,
+            "move" => self.move_group(s)?,
+            "unmove" | "unfreeze" => {
+                expect_len(s, 1..=1, &format!("{} GROUP", s[0].text))?;
+                let (active, what) = if s[0].text == "unmove" {
+                    (self.protocols.moving.remove(&s[1].text).is_some(), "moved")
+                } else {
+                    (self.protocols.frozen.remove(&s[1].text), "frozen")
+                };
+                if !active {
+                    return Err(s[1].error(format!(
+                        "found `{}`, expected a group {what} by a `{}` command before",
+                        s[1].text,
+                        &s[0].text[2..]
+                    )));
+                }
+                if s[0].text == "unmove" {
+                    Protocol::Unmove(s[1].text.clone())
+                } else {
+                    Protocol::Unfreeze(s[1].text.clone())
+                }
+            }
+            "freeze" => self.freeze(s)?,
+            "reset_rest" => self.reset_rest(s)?,
+            "indent" => self.indent(s)?,
+            _ => unreachable!("dispatched by keyword"),
+        };
+        self.actions.push(Action::Protocol(protocol));
+        Ok(())
+    }
+
+    /// `ramp TARGET PARAM FROM TO`: both ends and [`RAMP_SAMPLES`] values
+    /// between them must pass the law's checks; a pair rule's cutoff must
+    /// not change (the neighbour list is built for one cutoff per run).
+    fn ramp(&mut self, s: &[Token]) -> Result<Protocol, InputError> {
+        expect_len(s, 5..=usize::MAX, RAMP_USAGE)?;
+        let (targets, start) = self.coeff_targets(s, RAMP_USAGE)?;
+        expect_len(s, start + 2..=start + 2, RAMP_USAGE)?;
+        let [name, from_token, to_token] = [&s[start], &s[start + 1], &s[start + 2]];
+        let mut ramps = Vec::new();
+        for target in targets {
+            let param = self.target_param(&target, name)?;
+            let interaction = target.term_mut(self.model(name)?).interaction;
+            let spec = &interaction.params()[param];
+            let what = |end: &str| format!("the {end} value of `{}` in {}", spec.name, self.units.label(spec.dim));
+            let from = parse_f64(from_token, &what("start"))?;
+            let to = parse_f64(to_token, &what("end"))?;
+            let cutoff = self.pair_cutoff(&target, name)?;
+            self.set_target_param(&target, param, from, from_token)?;
+            let at_from = self.pair_cutoff(&target, name)?;
+            self.set_target_param(&target, param, to, to_token)?;
+            let at_to = self.pair_cutoff(&target, name)?;
+            if let (Some(before), Some(at_from), Some(at_to)) = (cutoff, at_from, at_to) {
+                if at_from != before || at_to != before {
+                    return Err(name.error(format!(
+                        "ramping `{}` moves the pair cutoff ({before} now, {at_from} to {at_to}); expected a parameter that leaves the cutoff alone (change it with `coeff` between runs)",
+                        name.text
+                    )));
+                }
+            }
+            for k in 1..RAMP_SAMPLES {
+                let value = from + (to - from) * f64::from(k) / f64::from(RAMP_SAMPLES);
+                self.set_target_param(&target, param, value, to_token)
+                    .map_err(|e| to_token.error(format!("the ramp from {from} to {to} passes through {value}, where {}", e.message)))?;
+            }
+            self.set_target_param(&target, param, to, to_token)?;
+            self.protocols.pending.push((target.clone(), param, s[0].clone()));
+            ramps.push(Ramp { target, param, from, to });
+        }
+        // `pair A B` may name several rules: all but the last become actions here.
+        let last = ramps.pop().expect("at least one target");
+        self.actions.extend(ramps.into_iter().map(|r| Action::Protocol(Protocol::Ramp(r))));
+        Ok(Protocol::Ramp(last))
+    }
+
+    /// `move GROUP linear VX VY VZ` (velocity in length/time units).
+    fn move_group(&mut self, s: &[Token]) -> Result<Protocol, InputError> {
+        expect_len(s, 5..=5, MOVE_USAGE)?;
+        self.model(&s[0])?;
+        let group = self.group_named(&s[1])?.clone();
+        if s[2].text != "linear" {
+            return Err(s[2].error(format!("found style `{}`, expected `linear` (`{MOVE_USAGE}`)", s[2].text)));
+        }
+        let mut velocity = DVec3::ZERO;
+        let unit = self.units.label(crate::units::Dim::Velocity);
+        for (a, (t, name)) in s[3..].iter().zip(["VX", "VY", "VZ"]).enumerate() {
+            velocity[a] = parse_f64(t, &format!("a velocity {name} in {unit}"))?;
+        }
+        let clash = self
+            .protocols
+            .moving
+            .iter()
+            .filter(|(other, _)| **other != group.name)
+            .find_map(|(other, members)| group.members.iter().find(|i| members.binary_search(i).is_ok()).map(|&i| (other.clone(), i)));
+        if let Some((other, i)) = clash {
+            let id = self.model(&s[0])?.ids[i as usize];
+            return Err(s[1].error(format!(
+                "particle {id} of group `{}` is already moved with group `{other}`; expected groups without common particles (or `unmove {other}` first)",
+                group.name
+            )));
+        }
+        self.protocols.moving.insert(group.name.clone(), group.members.clone());
+        Ok(Protocol::Move { group, velocity })
+    }
+
+    /// `freeze GROUP x|y|z ...`.
+    fn freeze(&mut self, s: &[Token]) -> Result<Protocol, InputError> {
+        expect_len(s, 2..=4, FREEZE_USAGE)?;
+        self.model(&s[0])?;
+        let group = self.group_named(&s[1])?.clone();
+        let mut axes = [false; 3];
+        for t in &s[2..] {
+            let a = ["x", "y", "z"]
+                .iter()
+                .position(|a| *a == t.text)
+                .ok_or_else(|| t.error(format!("found `{}`, expected an axis `x`, `y` or `z` (`{FREEZE_USAGE}`)", t.text)))?;
+            if std::mem::replace(&mut axes[a], true) {
+                return Err(t.error(format!("axis `{}` is given twice; expected each axis once", t.text)));
+            }
+        }
+        self.protocols.frozen.insert(group.name.clone());
+        Ok(Protocol::Freeze { group, axes })
+    }
+
+    /// `reset_rest BONDTYPE|all`: bond types whose law has a rest length `r0`.
+    fn reset_rest(&mut self, s: &[Token]) -> Result<Protocol, InputError> {
+        expect_len(s, 1..=1, "reset_rest BONDTYPE|all")?;
+        let model = self.model(&s[0])?;
+        let with_rest: Vec<usize> =
+            (0..model.bond_types.len()).filter(|&t| param_index(model.bond_types[t].interaction, "r0").is_some()).collect();
+        let types = if s[1].text == "all" {
+            let present: Vec<usize> = with_rest.into_iter().filter(|t| model.bond_type.iter().any(|&b| b as usize == *t)).collect();
+            if present.is_empty() {
+                return Err(s[1].error("no bond has a law with a rest length r0; expected bonds to reset"));
+            }
+            present
+        } else {
+            let t = model.bond_types.iter().position(|t| t.label.text == s[1].text).ok_or_else(|| {
+                let names: Vec<&str> = model.bond_types.iter().map(|t| t.label.text.as_str()).collect();
+                s[1].error(format!(
+                    "found bond type `{}`, expected `all` or one defined in the force field ({})",
+                    s[1].text,
+                    names.join(", ")
+                ))
+            })?;
+            if !with_rest.contains(&t) {
+                return Err(s[1].error(format!(
+                    "bond type `{}` uses `{}`, which has no rest length r0; expected a bond type whose law has one",
+                    s[1].text,
+                    model.bond_types[t].interaction.name()
+                )));
+            }
+            vec![t]
+        };
+        for &t in &types {
+            self.protocols.reset.insert(t, s[0].line);
+        }
+        Ok(Protocol::ResetRest(types))
+    }
+
+    /// The active external `name` names, which must be an indenter.
+    fn indenter_named(&self, t: &Token, name: &str) -> Result<(), InputError> {
+        let external = self.model.as_ref().and_then(|m| m.externals.iter().find(|e| e.term.label.text == name));
+        match external {
+            Some(e) if INDENTERS.contains(&e.term.interaction.name()) => Ok(()),
+            Some(e) => Err(t.error(format!(
+                "external `{name}` is a `{}`; expected the name of an active `{}` external",
+                e.term.interaction.name(),
+                INDENTERS.join("` or `")
+            ))),
+            None => Err(t.error(format!("found `{name}`, expected the name of an active `{}` external", INDENTERS.join("` or `")))),
+        }
+    }
+
+    /// `load/NAME` and `depth/NAME` thermo columns of an active indenter.
+    pub(super) fn indenter_column(&self, t: &Token, kind: &str, name: &str) -> Result<ThermoColumn, InputError> {
+        self.indenter_named(t, name)?;
+        Ok(if kind == "load" { ThermoColumn::IndenterLoad(name.to_string()) } else { ThermoColumn::IndenterDepth(name.to_string()) })
+    }
+
+    /// `indent NAME velocity VX VY VZ [until LOAD]` / `indent NAME stop`.
+    fn indent(&mut self, s: &[Token]) -> Result<Protocol, InputError> {
+        expect_len(s, 2..=7, INDENT_USAGE)?;
+        self.model(&s[0])?;
+        self.indenter_named(&s[1], &s[1].text)?;
+        if self.protocols.pending.iter().any(|(t, _, _)| *t == CoeffTarget::External(s[1].text.clone())) {
+            return Err(s[1]
+                .error(format!("external `{}` is ramped over the next `run`; expected either a `ramp` or an `indent` of it", s[1].text)));
+        }
+        let external = s[1].text.clone();
+        match s[2].text.as_str() {
+            "stop" => {
+                expect_len(s, 2..=2, INDENT_USAGE)?;
+                Ok(Protocol::Indent { external, velocity: DVec3::ZERO, until: None })
+            }
+            "velocity" => {
+                if s.len() != 6 && s.len() != 8 {
+                    expect_len(s, 5..=5, INDENT_USAGE)?;
+                }
+                let unit = self.units.label(crate::units::Dim::Velocity);
+                let mut velocity = DVec3::ZERO;
+                for (a, (t, name)) in s[3..6].iter().zip(["VX", "VY", "VZ"]).enumerate() {
+                    velocity[a] = parse_f64(t, &format!("a velocity {name} in {unit}"))?;
+                }
+                let until = match s.get(6) {
+                    None => None,
+                    Some(t) if t.text == "until" => {
+                        let load = positive(&s[7], &format!("a load in {}", self.units.label(crate::units::Dim::Force)))?;
+                        Some(load)
+                    }
+                    Some(t) => {
+                        return Err(t.error(format!("found `{}`, expected `until` or the end of the line (`{INDENT_USAGE}`)", t.text)))
+                    }
+                };
+                Ok(Protocol::Indent { external, velocity, until })
+            }
+            other => Err(s[2].error(format!("found `{other}`, expected `velocity` or `stop` (`{INDENT_USAGE}`)"))),
+        }
+    }
+}

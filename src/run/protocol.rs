@@ -1,0 +1,252 @@
+//! The protocols of a deck during runs (see [`crate::deck::Protocol`]):
+//! ramps set their parameters before every force evaluation of a run; moved
+//! and frozen particles take no drift along their held axes and are put back
+//! on their prescription after every step (noise and constraints included),
+//! so a frozen z stays bit-identical at any kT. `minimize` sees the same
+//! masked forces, so held particles stay put there too.
+
+use glam::DVec3;
+
+use crate::deck::{Protocol, Ramp};
+use crate::interactions::{param_index, Law};
+use crate::system::{Model, SimBox, State};
+
+/// One prescribed particle: which axes the protocol holds and, for a moved
+/// particle, its velocity (zero for a freeze).
+#[derive(Clone, Copy, Debug)]
+struct Held {
+    particle: u32,
+    axes: [bool; 3],
+    velocity: DVec3,
+}
+
+/// An indenter driven by `indent`.
+#[derive(Clone, Debug)]
+struct Drive {
+    external: String,
+    velocity: DVec3,
+    /// Stop where the load first reaches this.
+    until: Option<f64>,
+    /// The load was reached: the indenter stays where it is.
+    holding: bool,
+}
+
+/// The protocols in force.
+#[derive(Debug, Default)]
+pub(super) struct Protocols {
+    /// Ramps for the next run, then of the run in progress.
+    ramps: Vec<Ramp>,
+    /// First and last step of the run the ramps span.
+    span: (u64, u64),
+    /// Moving groups (name, members, velocity) and frozen groups (name, members, axes), in deck order.
+    moves: Vec<(String, Vec<u32>, DVec3)>,
+    freezes: Vec<(String, Vec<u32>, [bool; 3])>,
+    /// Every held particle, by ascending index (a moved particle ignores freezes).
+    held: Vec<Held>,
+    /// Driven indenters.
+    drives: Vec<Drive>,
+    /// Position, image and force of each held particle before the step.
+    before: Vec<(DVec3, [i64; 3], DVec3)>,
+}
+
+impl Protocols {
+    /// Records a protocol command; `ResetRest` is the caller's (it changes bonds now).
+    pub(super) fn apply(&mut self, protocol: &Protocol) {
+        match protocol {
+            Protocol::Ramp(ramp) => self.ramps.push(ramp.clone()),
+            Protocol::Move { group, velocity } => {
+                self.moves.retain(|m| m.0 != group.name);
+                self.moves.push((group.name.clone(), group.members.clone(), *velocity));
+            }
+            Protocol::Unmove(name) => self.moves.retain(|m| m.0 != *name),
+            Protocol::Freeze { group, axes } => {
+                self.freezes.retain(|f| f.0 != group.name);
+                self.freezes.push((group.name.clone(), group.members.clone(), *axes));
+            }
+            Protocol::Unfreeze(name) => self.freezes.retain(|f| f.0 != *name),
+            Protocol::Indent { external, velocity, until } => {
+                self.forget_drive(external);
+                if *velocity != DVec3::ZERO {
+                    self.drives.push(Drive { external: external.clone(), velocity: *velocity, until: *until, holding: false });
+                }
+            }
+            Protocol::ResetRest(_) => unreachable!("applied by the simulation"),
+        }
+        self.collect_held();
+    }
+
+    fn collect_held(&mut self) {
+        let mut held: Vec<Held> = Vec::new();
+        for (_, members, velocity) in &self.moves {
+            held.extend(members.iter().map(|&particle| Held { particle, axes: [true; 3], velocity: *velocity }));
+        }
+        held.sort_by_key(|h| h.particle);
+        let moved = held.len();
+        for (_, members, axes) in &self.freezes {
+            for &particle in members {
+                if held[..moved].binary_search_by_key(&particle, |h| h.particle).is_err() {
+                    held.push(Held { particle, axes: *axes, velocity: DVec3::ZERO });
+                }
+            }
+        }
+        held.sort_by_key(|h| h.particle);
+        // A particle in several frozen groups holds the union of their axes.
+        held.dedup_by(|later, kept| {
+            let same = later.particle == kept.particle;
+            if same {
+                (0..3).for_each(|a| kept.axes[a] |= later.axes[a]);
+            }
+            same
+        });
+        self.held = held;
+    }
+
+    /// `unexternal` ends the drive of that external.
+    pub(super) fn forget_drive(&mut self, external: &str) {
+        self.drives.retain(|d| d.external != external);
+    }
+
+    /// Why the GPU backend cannot run the next run (None: no protocol in force).
+    pub(super) fn cpu_only(&self) -> Option<&'static str> {
+        (!self.ramps.is_empty() || !self.held.is_empty() || !self.drives.is_empty())
+            .then_some("ramps, `move`, `freeze` and `indent` run on the CPU backend only")
+    }
+
+    /// Moves every driven indenter that has not reached its load by v·dt.
+    pub(super) fn advance_drives(&self, model: &mut Model, dt: f64) {
+        for drive in self.drives.iter().filter(|d| !d.holding) {
+            let Some(external) = model.externals.iter_mut().find(|e| e.term.label.text == drive.external) else { continue };
+            let term = &mut external.term;
+            for (a, name) in ["x", "y", "z"].into_iter().enumerate() {
+                let k = param_index(term.interaction, name).expect("the deck checked the indenter has a centre");
+                term.params[k] += drive.velocity[a] * dt;
+            }
+        }
+    }
+
+    /// Stops (for good) every driven indenter whose load reached its target
+    /// at the current state.
+    pub(super) fn check_drives(&mut self, model: &Model, state: &State, sim_box: &SimBox) {
+        for drive in self.drives.iter_mut().filter(|d| !d.holding) {
+            if let (Some(target), Some((load, _))) = (drive.until, indenter_load(model, state, sim_box, &drive.external)) {
+                drive.holding = load >= target;
+            }
+        }
+    }
+
+    /// Starts a run from `first` to `last`: the pending ramps span it.
+    pub(super) fn begin_run(&mut self, first: u64, last: u64) {
+        self.span = (first, last);
+    }
+
+    /// Sets every ramped parameter to its value at `step` of the run (the
+    /// end value from the last step on); returns whether any was set.
+    pub(super) fn set_ramps(&self, model: &mut Model, step: u64) -> bool {
+        let (first, last) = self.span;
+        let fraction = if last > first { (step - first) as f64 / (last - first) as f64 } else { 1.0 };
+        for ramp in &self.ramps {
+            ramp.target.term_mut(model).params[ramp.param] = ramp.value(fraction);
+        }
+        !self.ramps.is_empty()
+    }
+
+    /// Ends the run: its ramps are done (their parameters keep the end value).
+    pub(super) fn end_run(&mut self) {
+        self.ramps.clear();
+    }
+
+    /// Zeroes the held components of `forces` (what the integrator and
+    /// `minimize` see: a held particle takes no drift along its held axes).
+    pub(super) fn mask(&self, forces: &mut [DVec3]) {
+        for h in &self.held {
+            let f = &mut forces[h.particle as usize];
+            (0..3).filter(|&a| h.axes[a]).for_each(|a| f[a] = 0.0);
+        }
+    }
+
+    /// Before a step: records where the held particles are and their
+    /// forces, then masks `forces` ([`Self::restore_forces`] undoes it).
+    pub(super) fn before_step(&mut self, forces: &mut [DVec3], state: &State) {
+        self.before.clear();
+        self.before.extend(self.held.iter().map(|h| {
+            let i = h.particle as usize;
+            (state.positions[i], state.images[i], forces[i])
+        }));
+        self.mask(forces);
+    }
+
+    /// Gives the held particles their forces back after the integrator's step.
+    pub(super) fn restore_forces(&self, forces: &mut [DVec3]) {
+        for (h, before) in self.held.iter().zip(&self.before) {
+            forces[h.particle as usize] = before.2;
+        }
+    }
+
+    /// Puts the held particles on their prescription after a step of `dt`:
+    /// held axes back where they were, moved particles advanced by v·dt
+    /// (wrapped into the box, image counters kept).
+    pub(super) fn after_step(&self, state: &mut State, sim_box: &SimBox, dt: f64) {
+        for (h, (x0, image0, _)) in self.held.iter().zip(&self.before) {
+            let i = h.particle as usize;
+            let (x, image) = (&mut state.positions[i], &mut state.images[i]);
+            for a in (0..3).filter(|&a| h.axes[a]) {
+                x[a] = x0[a];
+                image[a] = image0[a];
+            }
+            if h.velocity != DVec3::ZERO {
+                *x += h.velocity * dt;
+                sim_box.wrap(x, image);
+            }
+        }
+    }
+}
+
+/// `reset_rest`: every bond of `bond_types` takes its current length
+/// (minimum image) as its rest length, in the model's per-bond rest lengths
+/// (topology bonds) and in the bond state (created if bonds had none).
+pub(super) fn reset_rest(model: &mut Model, state: &mut State, sim_box: &SimBox, bond_types: &[usize]) {
+    let images = sim_box.images();
+    let lengths: Vec<Option<f64>> = (0..model.bonds.len())
+        .map(|b| {
+            let [i, j] = model.bonds[b];
+            bond_types
+                .contains(&(model.bond_type[b] as usize))
+                .then(|| images.minimum_image(state.positions[j as usize] - state.positions[i as usize]).length())
+        })
+        .collect();
+    for (b, length) in lengths.iter().enumerate().take(model.topology_bonds) {
+        if length.is_some() {
+            model.bond_rest[b] = *length;
+        }
+    }
+    if state.bonds.is_none() {
+        state.bonds = crate::kinetics::initial_bond_state(model);
+    }
+    let bonds = state.bonds.as_mut().expect("bonds have their own rest lengths now");
+    for (b, length) in lengths.into_iter().enumerate() {
+        if length.is_some() {
+            bonds.rest[b] = length;
+        }
+    }
+}
+
+/// The load of the active external `name` (the magnitude of the summed
+/// force it exerts on its group: its reaction) and the deepest penetration
+/// of one of its particles, δ = (3E/K)^{1/3} for the indenter laws
+/// E = (K/3)δ³; `None` when no external of that name is active.
+pub(super) fn indenter_load(model: &Model, state: &State, sim_box: &SimBox, name: &str) -> Option<(f64, f64)> {
+    let external = model.externals.iter().find(|e| e.term.label.text == name)?;
+    let term = &external.term;
+    let Law::OneBody(eval) = term.interaction.law() else { unreachable!("external law is one-body") };
+    let k = param_index(term.interaction, "k").map_or(0.0, |k| term.params[k]);
+    let (mut total, mut deepest) = (DVec3::ZERO, 0.0f64);
+    for &m in &external.members {
+        let m = m as usize;
+        let out = eval(&term.params, sim_box.unwrap(state.positions[m], state.images[m]));
+        total += out.force;
+        if k > 0.0 {
+            deepest = deepest.max((3.0 * out.energy / k).cbrt());
+        }
+    }
+    Some((total.length(), deepest))
+}
