@@ -17,4 +17,4 @@ mod sources;
 pub use self::error::InputError;
 pub use self::lexer::{lex, statements, SourceFile, Statement, Statements, Token};
 pub use self::number::{evaluate_expression, parse_f64, parse_u64};
-pub use self::sources::{recording, replaying, DeckInputs, InputFile};
+pub use self::sources::{is_replaying, recording, replaying, DeckInputs, InputFile};
