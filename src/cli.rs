@@ -31,6 +31,10 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Validate and run a deck, or continue a stopped run from its restart.
+    ///
+    /// Exit status: 0 done; 1 bad input; 2 bad options; 3 the run failed
+    /// (blow-up); 5 stopped by SIGTERM/SIGINT or a closed stdout, outputs
+    /// finalised and a restart written; 6 an output file could not be written.
     Run {
         #[arg(required_unless_present = "resume")]
         deck: Option<PathBuf>,

@@ -4,7 +4,7 @@
 //!
 //! | module | role |
 //! |---|---|
-//! | [`input`] | shared nom lexer for decks, topologies and force fields; `file:line:col` diagnostics |
+//! | [`input`] | shared nom lexer for decks, topologies and force fields; `file:line:col` diagnostics; inputs recorded for restarts |
 //! | [`deck`] | deck commands → validated [`deck::Plan`] |
 //! | [`topology`] | particles, bonds, angles, triangles, bodies (checked: closed, oriented, sphere topology) |
 //! | [`mesh`] | closed triangulated surfaces: edges and wings, volume, area, bending angles, the icosphere |
@@ -17,11 +17,11 @@
 //! | [`kinetics`] | stateful bonds: force-dependent unbinding, rebinding, motors, ratchets, plasticity, maturation |
 //! | [`backend`] | the CPU reference force engine (f64, rayon, deterministic) |
 //! | [`measure`] | per-particle stress, plane and cortical tension, filament statistics (thermo columns, dump fields) |
-//! | [`output`] | MCAP, extended XYZ, LAMMPS dump (selectable columns), per-bond tension CSV, restart |
+//! | [`output`] | MCAP, extended XYZ, LAMMPS dump (selectable columns), per-bond tension CSV, restart (carrying the deck's inputs), run log |
 //! | [`export`] | a deck as LAMMPS data + input (`cellmd export-lammps`) |
 //! | [`compare`] | cellmd vs LAMMPS probes, agreement table, golden reference files (`cellmd compare`) |
 //! | [`build`] | topology generators (`cellmd build`: icosphere, filament, network, aster, cortex, branched, filopodium, cells, sheet, tensegrity) |
-//! | [`run`] | executes a plan: run loop, thermo, blow-up diagnosis, minimise |
+//! | [`run`] | executes a plan: run loop, thermo, blow-up diagnosis, minimise; clean stop on signals, `--continue` from a restart |
 //! | [`cli`] | the `cellmd` command line (the binary and the Python package's console script call [`cli::main`]) |
 
 pub mod backend;

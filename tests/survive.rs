@@ -48,10 +48,10 @@ fn seeded_fraction(seed: u64) -> f64 {
 }
 
 /// Bits of every position, image counter, bond state and counter of a restart.
-fn state_bits(path: &Path) -> (Vec<u64>, Vec<[i64; 3]>, String, cellmd::output::restart::Counters, u64) {
+fn state_bits(path: &Path) -> (Vec<u64>, String, String, cellmd::output::restart::Counters, u64) {
     let data = read_state(path).unwrap_or_else(|e| panic!("{e}"));
     let bits = data.positions.iter().flat_map(|x| x.to_array().map(f64::to_bits)).collect();
-    (bits, data.images, serde_json::to_string(&data.bonds).unwrap(), data.counters, data.step)
+    (bits, serde_json::to_string(&data.images).unwrap(), serde_json::to_string(&data.bonds).unwrap(), data.counters, data.step)
 }
 
 /// Every line of a thermo CSV is whole: a header, then rows with one number per column.
@@ -74,7 +74,11 @@ fn assert_complete_csv(path: &Path) -> usize {
 fn assert_finalised_mcap(path: &Path) -> u64 {
     let bytes = std::fs::read(path).unwrap();
     let summary = mcap::Summary::read(&bytes).unwrap().expect("a summary section: the MCAP was finished");
-    let messages = mcap::MessageStream::new(&bytes).unwrap().map(|m| m.unwrap()).count() as u64;
+    let mut messages = 0;
+    for message in mcap::MessageStream::new(&bytes).unwrap() {
+        message.unwrap();
+        messages += 1;
+    }
     assert_eq!(summary.stats.expect("statistics").message_count, messages);
     messages
 }
@@ -234,6 +238,26 @@ fn periodic_checkpoints_keep_the_last_k_and_each_continues_the_run() {
     }
 }
 
+/// A deck that starts from a restart file continues without it: the state
+/// comes from the checkpoint.
+#[test]
+fn a_run_that_read_a_state_continues_without_that_file() {
+    let first = chains_case("run 50\nwrite_state half.restart\n");
+    first.run();
+    let case = chains_case("read_state half.restart\nwrite_state ck.*.restart every 50\nrun 100\nwrite_state final.restart\n");
+    std::fs::copy(first.path("half.restart"), case.path("half.restart")).unwrap();
+    case.run();
+    let reference = state_bits(&case.path("final.restart"));
+    assert_eq!(reference.4, 150);
+    for input in ["deck.in", "t.top", "f.ff", "half.restart"] {
+        std::fs::remove_file(case.path(input)).unwrap();
+    }
+    let out =
+        cellmd().args(["run", "--quiet", "--continue", "ck.100.restart", "-o", "resumed"]).current_dir(case.output_dir()).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(state_bits(&case.path("resumed/final.restart")) == reference);
+}
+
 #[test]
 fn outputs_stay_under_the_output_directory_unless_allowed() {
     let outside = tempfile::tempdir().unwrap();
@@ -299,4 +323,33 @@ fn a_headless_gpu_run_prints_no_driver_errors() {
     assert!(out.status.success(), "the GPU run failed (is a Vulkan driver such as mesa-vulkan-drivers installed?):\n{stderr}");
     assert!(String::from_utf8_lossy(&out.stdout).contains("device: GPU"));
     assert!(!stderr.contains("XDG_RUNTIME_DIR"), "{stderr}");
+}
+
+/// On the GPU the stop is seen at the next synchronisation (at most 1000
+/// steps away; here every thermo row): the positions are read back, the
+/// outputs finalised and the restart written at that step.
+#[test]
+fn a_gpu_run_stops_at_its_next_synchronisation_with_its_outputs_finalised() {
+    let case = chains_case("device gpu\nthermo 100 step xu/all\nthermo_file thermo.csv\ndump m every 500 mcap traj.mcap\nrun 100000000\n");
+    let mut child = cellmd()
+        .args(["run", "deck.in", "--quiet", "-o", "out"])
+        .current_dir(case.output_dir())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    wait_for_rows(&case.path("out/thermo.csv"), 2, &mut child);
+    assert!(Command::new("kill").args(["-TERM", &child.id().to_string()]).status().unwrap().success());
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(i32::from(STOPPED_STATUS)), "{}", String::from_utf8_lossy(&out.stderr));
+    let data = read_state(&case.path("out/deck.restart")).unwrap();
+    assert!(data.step >= 100 && data.step.is_multiple_of(100), "stopped at step {}", data.step);
+    assert!(assert_complete_csv(&case.path("out/thermo.csv")) as u64 > data.step / 100);
+    // The restart holds the positions of its step (read back), not older ones.
+    let text = std::fs::read_to_string(case.path("out/thermo.csv")).unwrap();
+    let last: Vec<f64> = text.lines().last().unwrap().split(',').map(|f| f.parse().unwrap()).collect();
+    assert_eq!(last[0] as u64, data.step);
+    let xu = data.positions.iter().zip(&data.images).map(|(x, i)| x.x + 7.0 * i[0] as f64).sum::<f64>() / data.positions.len() as f64;
+    assert!((xu - last[1]).abs() <= 1e-9 * xu.abs().max(1.0), "restart x̄u {xu} vs thermo {}", last[1]);
+    assert_finalised_mcap(&case.path("out/traj.mcap"));
 }

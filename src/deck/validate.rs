@@ -10,7 +10,7 @@ use super::plan::{Action, CheckpointSpec, DumpSpec, Group, NeighborSettings, Pla
 use super::variables::Variables;
 use crate::forcefield::{load_forcefield, parse_params, ForceField};
 use crate::gpu::DevicePreference;
-use crate::input::{check_input_file, lex, parse_f64, parse_u64, recording, DeckInputs, InputError, InputFile, SourceFile, Statement, Token};
+use crate::input::{check_input_file, is_replaying, lex, parse_f64, parse_u64, recording, DeckInputs, InputError, InputFile, SourceFile, Statement, Token};
 use crate::integrate::fire::FireSettings;
 use crate::integrate::implicit::{ImplicitSettings, LinearSolver};
 use crate::integrate::overdamped::OverdampedSettings;
@@ -771,7 +771,8 @@ impl Validator {
                 self.model(kw)?;
                 let written = PathBuf::from(&s[1].text);
                 let path = if self.states_written.contains(&written) { written } else { self.input_path(&s[1]) };
-                if !self.states_written.contains(&path) {
+                // A continued run starts after this point from its own restart.
+                if !self.states_written.contains(&path) && !is_replaying() {
                     if !path.exists() {
                         return Err(s[1].error(format!(
                             "cannot read `{}`: no such file; expected a restart file written by `write_state`",

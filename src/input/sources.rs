@@ -80,6 +80,12 @@ pub(crate) fn replayed(path: &str) -> Option<Result<String, String>> {
     })
 }
 
+/// Whether inputs are being answered from a saved set (`cellmd run
+/// --continue`): checks of other files on disk do not apply then.
+pub fn is_replaying() -> bool {
+    SCOPES.with(|s| s.borrow().last().is_some_and(|top| top.replay.is_some()))
+}
+
 /// Notes a file read in the innermost scope, if any.
 pub(crate) fn note(path: &str, text: &str) {
     SCOPES.with(|s| {
