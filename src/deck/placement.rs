@@ -1,6 +1,9 @@
 //! Checks of the initial configuration in its box, at `cellmd check`: what
 //! would otherwise pass validation and blow up at step 0 (or run on silently).
 //!
+//! * a bond listed twice (same type, same particles) is counted twice: only a
+//!   bond type with kinetic rules may repeat a bond, each copy a molecule that
+//!   breaks and rebinds on its own (a documented opt-in: parallel bonds);
 //! * every particle is inside a fixed axis' bounds, and close enough to a
 //!   periodic box to be wrapped into it ([`SimBox::misplaced_axis`]; LAMMPS
 //!   refuses atoms outside a fixed box too);
@@ -42,6 +45,18 @@ fn pulls_at_zero_length(model: &Model, b: usize) -> bool {
 pub(super) fn check_placement(topology: &Topology, model: &Model, sim_box: &SimBox) -> Result<(), InputError> {
     let x = &topology.positions;
     let id = |p: u32| topology.ids[p as usize];
+    for &(b, first) in &topology.parallel_bonds {
+        if model.bond_kinetics[model.bond_type[b] as usize].rules.is_empty() {
+            let bond = &topology.bonds[b];
+            return Err(bond.type_name.error(format!(
+                "bond `{}` {}–{} is already listed at line {first}; expected each bond once (parallel bonds only of a bond type with \
+                 kinetic rules)",
+                bond.type_name.text,
+                id(bond.particles[0]),
+                id(bond.particles[1])
+            )));
+        }
+    }
     for (i, &at) in x.iter().enumerate() {
         if let Some(axis) = sim_box.misplaced_axis(at) {
             return Err(topology.type_names[i].error(format!(

@@ -42,6 +42,11 @@ pub struct Topology {
     pub triangles: Vec<(u64, [u32; 3])>,
     /// The first token of each triangle's line (for errors).
     pub face_tokens: Vec<Token>,
+    /// Bonds that repeat an earlier bond (same type, same particles), with
+    /// the earlier one's line: allowed only for a bond type with kinetic
+    /// rules, where each is a molecule of its own (checked with the force
+    /// field, `deck::placement`).
+    pub parallel_bonds: Vec<(usize, u32)>,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
@@ -94,8 +99,8 @@ struct Parser {
     body_ids: HashMap<u64, Token>,
     /// The id token of each body (for errors).
     body_tokens: Vec<Token>,
-    /// Line of each bonded term by (type, particles in canonical order): a
-    /// term listed twice would be counted twice. Type names are interned.
+    /// First line of each bonded term by (type, particles in canonical
+    /// order): a term listed twice is counted twice. Type names are interned.
     term_lines: HashMap<(u32, [u32; 3]), u32>,
     term_types: HashMap<String, u32>,
 }
@@ -163,12 +168,24 @@ impl Parser {
                 }
             }
         }
-        self.refuse_duplicate(s, particles)?;
+        match self.earlier_line(s, particles) {
+            Some(first) if N == 3 => {
+                let ids: Vec<&str> = s.tokens[1..=N].iter().map(|t| t.text.as_str()).collect();
+                return Err(s.tokens[0].error(format!(
+                    "angle `{}` {} is already listed at line {first}; expected each angle once",
+                    s.tokens[0].text,
+                    ids.join("–")
+                )));
+            }
+            Some(first) => self.topology.parallel_bonds.push((self.topology.bonds.len(), first)),
+            None => {}
+        }
         Ok(TypedTerm { type_name: s.tokens[0].clone(), particles })
     }
 
-    /// A bond `i j` is `j i`, an angle `i j k` is `k j i`; one listed twice is an error.
-    fn refuse_duplicate<const N: usize>(&mut self, s: &Statement, particles: [u32; N]) -> Result<(), InputError> {
+    /// The line of an earlier term of the same type on the same particles
+    /// (a bond `i j` is `j i`, an angle `i j k` is `k j i`).
+    fn earlier_line<const N: usize>(&mut self, s: &Statement, particles: [u32; N]) -> Option<u32> {
         let mut key = [u32::MAX; 3];
         key[..N].copy_from_slice(&particles);
         if key[0] > key[N - 1] {
@@ -177,18 +194,8 @@ impl Parser {
         let types = self.term_types.len() as u32;
         let ty = *self.term_types.entry(s.tokens[0].text.clone()).or_insert(types);
         let line = s.tokens[0].line;
-        match self.term_lines.insert((ty, key), line) {
-            Some(first) => {
-                let ids: Vec<&str> = s.tokens[1..=N].iter().map(|t| t.text.as_str()).collect();
-                let what = if N == 2 { "bond" } else { "angle" };
-                Err(s.tokens[0].error(format!(
-                    "{what} `{}` {} is already listed at line {first}; expected each {what} once",
-                    s.tokens[0].text,
-                    ids.join("–")
-                )))
-            }
-            None => Ok(()),
-        }
+        let first = *self.term_lines.entry((ty, key)).or_insert(line);
+        (first != line).then_some(first)
     }
 
     fn body(&mut self, s: &Statement) -> Result<(), InputError> {
@@ -378,12 +385,12 @@ mod tests {
         ] {
             assert_eq!(parse(&format!("{two}{line}\n")).unwrap_err(), expected, "{line}");
         }
-        // A term listed twice, in either direction, would be counted twice.
-        assert_eq!(
-            parse(&format!("{two}s 1 2\ns 2 1\n")).unwrap_err(),
-            "t.top:7:1: bond `s` 2–1 is already listed at line 6; expected each bond once"
-        );
-        assert!(parse(&format!("{two}s 1 2\nt 2 1\n")).is_ok(), "two bond types on one pair");
+        // A term listed twice, in either direction, is counted twice: an
+        // error for an angle; for a bond, only without kinetic rules (checked
+        // with the force field, so only recorded here).
+        let parallel = |bonds: &str| parse_topology(&SourceFile::new("t.top", format!("{two}{bonds}"))).unwrap().parallel_bonds;
+        assert_eq!(parallel("s 1 2\ns 2 1\ns 1 2\n"), [(1, 6), (2, 6)]);
+        assert!(parallel("s 1 2\nt 2 1\n").is_empty(), "two bond types on one pair");
         assert_eq!(
             parse(&format!("{two}[ angles ]\nb 1 2 3\nb 3 2 1\n")).unwrap_err(),
             "t.top:8:1: angle `b` 3–2–1 is already listed at line 7; expected each angle once"
