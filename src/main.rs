@@ -7,7 +7,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use cellmd::compare::{cellmd_probes, golden, run_lammps, Agreement, Lmp, Tolerance};
-use cellmd::deck::validate_file;
+use cellmd::deck::{validate_file, Plan};
 use cellmd::export::{self, ExportOptions};
 use cellmd::gpu::backend::StepSettings;
 use cellmd::gpu::{DevicePreference, GpuBackend, GpuContext};
@@ -158,7 +158,7 @@ fn main() -> ExitCode {
             ExitCode::SUCCESS
         }
         Command::ProfileGpu { deck, vars, repetitions, rebuild_rate } => {
-            let plan = match validate_file(&deck, &vars) {
+            let plan = match validated(&deck, &vars) {
                 Ok(plan) => plan,
                 Err(e) => return report(e),
             };
@@ -170,7 +170,7 @@ fn main() -> ExitCode {
                 }
             }
         }
-        Command::Check { deck, vars } => match validate_file(&deck, &vars) {
+        Command::Check { deck, vars } => match validated(&deck, &vars) {
             Ok(plan) => {
                 println!(
                     "{}: ok ({} particles, {} bonds, {} angles, {} actions)",
@@ -185,7 +185,7 @@ fn main() -> ExitCode {
             Err(e) => report(e),
         },
         Command::ExportLammps { deck, outdir, vars, probes } => {
-            let plan = match validate_file(&deck, &vars) {
+            let plan = match validated(&deck, &vars) {
                 Ok(plan) => plan,
                 Err(e) => return report(e),
             };
@@ -207,7 +207,7 @@ fn main() -> ExitCode {
             }
         }
         Command::Compare { deck, vars, lmp, workdir, tol, run_tol, write_golden, golden_header } => {
-            let plan = match validate_file(&deck, &vars) {
+            let plan = match validated(&deck, &vars) {
                 Ok(plan) => plan,
                 Err(e) => return report(e),
             };
@@ -227,7 +227,7 @@ fn main() -> ExitCode {
                     return ExitCode::from(2);
                 }
             }
-            let plan = match validate_file(&deck, &vars) {
+            let plan = match validated(&deck, &vars) {
                 Ok(plan) => plan,
                 Err(e) => return report(e),
             };
@@ -351,4 +351,13 @@ fn compare(
         std::fs::write(&path, golden::write(&[doc])).map_err(|e| format!("{}: {e}", path.display()))?;
     }
     Ok(agreement.agrees(tol))
+}
+
+/// Validates a deck and prints its warnings on stderr.
+fn validated(deck: &std::path::Path, vars: &[(String, String)]) -> Result<Plan, cellmd::input::InputError> {
+    let plan = validate_file(deck, vars)?;
+    for warning in &plan.warnings {
+        eprintln!("{warning}");
+    }
+    Ok(plan)
 }

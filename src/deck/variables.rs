@@ -1,10 +1,13 @@
 //! Deck variables: `variable NAME equal EXPR` / `variable NAME string TEXT`,
 //! used as `${NAME}` anywhere in a later token. Values given on the command
 //! line (`--var NAME=VALUE`) take precedence over the deck's definitions.
+//! An `equal` expression ([`crate::expr`]) may also read a numeric variable
+//! by its bare name (`variable dx equal (g2 - g)*height`).
 
 use std::collections::HashMap;
 
-use crate::input::{evaluate_expression, InputError, Token};
+use super::expression::DeckExpr;
+use crate::input::{InputError, Token};
 
 #[derive(Clone, Debug, Default)]
 pub struct Variables {
@@ -30,10 +33,7 @@ impl Variables {
         }
         let rest: Vec<&str> = tokens[2..].iter().map(|t| t.text.as_str()).collect();
         let value = match tokens[1].text.as_str() {
-            "equal" => {
-                let v = evaluate_expression(&rest.join(" ")).map_err(|e| tokens[2].error(e))?;
-                format!("{v}")
-            }
+            "equal" => format!("{}", DeckExpr::parse(&tokens[2..])?.eval(self)?),
             "string" => rest.join(" "),
             other => return Err(tokens[1].error(format!("found `{other}`, expected `equal` or `string`"))),
         };
@@ -41,6 +41,33 @@ impl Variables {
             self.values.insert(name.text.clone(), value);
         }
         Ok(())
+    }
+
+    /// The number a variable holds (for a bare name in an expression).
+    pub(super) fn number(&self, name: &str) -> Result<f64, String> {
+        let value = self.values.get(name).ok_or_else(|| {
+            format!("found undefined variable `{name}`, expected a `variable {name} ...` line before this one or `--var {name}=VALUE`")
+        })?;
+        value
+            .trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| format!("variable `{name}` holds `{value}`; expected a number (a string variable is used as `${{{name}}}`)"))
+    }
+
+    /// Sets a loop's variable (a command-line value does not hold it) and
+    /// returns its previous value, for [`restore`](Self::restore).
+    pub(super) fn set_loop(&mut self, name: &str, value: String) -> Option<String> {
+        self.values.insert(name.to_string(), value)
+    }
+
+    /// Puts back what a variable held before a loop.
+    pub(super) fn restore(&mut self, name: &str, previous: Option<String>) {
+        match previous {
+            Some(v) => self.values.insert(name.to_string(), v),
+            None => self.values.remove(name),
+        };
     }
 
     /// Replaces every `${NAME}` in a token.

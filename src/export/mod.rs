@@ -9,6 +9,7 @@
 //! ([`bond_types`]).
 
 pub mod bond_types;
+pub mod formula;
 pub mod lammps;
 pub mod styles;
 

@@ -15,6 +15,7 @@
 //! | `soft` | `pair_style soft` | identical |
 //! | `wall` (axis-aligned normal) | `fix wall/harmonic` ε(r−rc)² | ε = k/2, wall placed at d − rc |
 //! | `constant_force` | `fix addforce` | identical; its scalar is −F·x on unwrapped x |
+//! | `field` | `fix addforce v_fx v_fy v_fz energy v_e` | one atom-style variable per parameter ([`super::formula`]) |
 
 use crate::forcefield::TermType;
 use crate::interactions::{param_index, Law};

@@ -13,4 +13,4 @@ mod number;
 
 pub use self::error::InputError;
 pub use self::lexer::{lex, statements, SourceFile, Statement, Statements, Token};
-pub use self::number::{evaluate_expression, parse_f64, parse_u64};
+pub use self::number::{parse_f64, parse_u64};

@@ -1,19 +1,7 @@
-//! Numbers and the arithmetic of deck `variable ... equal` expressions (nom).
-//!
-//! ```text
-//! expr   := term (("+" | "-") term)*
-//! term   := factor (("*" | "/") factor)*
-//! factor := unary ("^" factor)?          (right-associative power)
-//! unary  := "-" unary | "(" expr ")" | number | pi
-//! ```
+//! Numbers in tokens (nom). Expressions are [`crate::expr`]'s.
 
-use nom::branch::alt;
-use nom::bytes::complete::tag;
-use nom::character::complete::{char, multispace0, one_of};
-use nom::combinator::{all_consuming, map};
-use nom::multi::many0;
+use nom::combinator::all_consuming;
 use nom::number::complete::double;
-use nom::sequence::{delimited, pair, preceded};
 use nom::{IResult, Parser};
 
 use super::{InputError, Token};
@@ -34,51 +22,6 @@ pub fn parse_u64(token: &Token, what: &str) -> Result<u64, InputError> {
     parsed.map(|(_, v)| v).map_err(|_| token.error(format!("found `{}`, expected {what} (a non-negative integer)", token.text)))
 }
 
-fn ws<'a, O>(
-    inner: impl Parser<&'a str, Output = O, Error = nom::error::Error<&'a str>>,
-) -> impl Parser<&'a str, Output = O, Error = nom::error::Error<&'a str>> {
-    delimited(multispace0, inner, multispace0)
-}
-
-fn unary(input: &str) -> IResult<&str, f64> {
-    alt((
-        map(preceded(ws(char('-')), unary), |v| -v),
-        delimited(ws(char('(')), expr, ws(char(')'))),
-        map(ws(tag("pi")), |_| std::f64::consts::PI),
-        ws(double),
-    ))
-    .parse(input)
-}
-
-fn factor(input: &str) -> IResult<&str, f64> {
-    let (input, base) = unary(input)?;
-    match preceded(ws(char('^')), factor).parse(input) {
-        Ok((input, exponent)) => Ok((input, base.powf(exponent))),
-        Err(_) => Ok((input, base)),
-    }
-}
-
-fn term(input: &str) -> IResult<&str, f64> {
-    let (input, first) = factor(input)?;
-    let (input, rest) = many0(pair(ws(one_of("*/")), factor)).parse(input)?;
-    Ok((input, rest.into_iter().fold(first, |acc, (op, v)| if op == '*' { acc * v } else { acc / v })))
-}
-
-fn expr(input: &str) -> IResult<&str, f64> {
-    let (input, first) = term(input)?;
-    let (input, rest) = many0(pair(ws(one_of("+-")), term)).parse(input)?;
-    Ok((input, rest.into_iter().fold(first, |acc, (op, v)| if op == '+' { acc + v } else { acc - v })))
-}
-
-/// Evaluates an arithmetic expression to a finite number.
-pub fn evaluate_expression(text: &str) -> Result<f64, String> {
-    match all_consuming(expr).parse(text) {
-        Ok((_, v)) if v.is_finite() => Ok(v),
-        Ok((_, v)) => Err(format!("`{text}` evaluates to {v}; expected a finite number")),
-        Err(_) => Err(format!("found `{text}`, expected an arithmetic expression of numbers, + - * / ^ and parentheses")),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -97,15 +40,5 @@ mod tests {
         assert!(parse_f64(&token("1.0x"), "a timestep").unwrap_err().to_string().contains("expected a timestep"));
         assert_eq!(parse_u64(&token("42"), "n").unwrap(), 42);
         assert!(parse_u64(&token("-1"), "n").is_err());
-    }
-
-    #[test]
-    fn expressions() {
-        assert_eq!(evaluate_expression("1 + 2*3").unwrap(), 7.0);
-        assert_eq!(evaluate_expression("(1+2)*3 - -1").unwrap(), 10.0);
-        assert_eq!(evaluate_expression("2^3^2").unwrap(), 512.0);
-        assert_eq!(evaluate_expression("10/4").unwrap(), 2.5);
-        assert!(evaluate_expression("1/0").is_err());
-        assert!(evaluate_expression("1 +").is_err());
     }
 }

@@ -89,6 +89,7 @@ mod contact_adhesion;
 mod contact_barrier;
 mod cosine_angle;
 mod fene;
+mod field;
 mod harmonic;
 mod harmonic_angle;
 mod helfrich_bending;
@@ -121,6 +122,7 @@ pub static REGISTRY: &[&dyn Interaction] = &[
     &soft::Soft,
     &wall::Wall,
     &constant_force::ConstantForce,
+    &field::Field,
     &turgor::Turgor,
     &turgor_log::TurgorLog,
     &surface_tension::SurfaceTension,

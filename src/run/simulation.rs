@@ -152,9 +152,9 @@ impl Simulation {
     /// error. The simulation takes the plan's model and initial positions
     /// (no second copy of the system stays resident during the run).
     pub fn execute(plan: Plan, options: RunOptions) -> Result<Simulation, RunError> {
-        let Plan { deck_path, model, sim_box, positions, actions } = plan;
+        let Plan { deck_path, model, sim_box, positions, actions, .. } = plan;
         let mut sim = Simulation::start(model, sim_box, positions, &deck_path, options);
-        let result = actions.iter().try_for_each(|a| sim.apply(a));
+        let result = sim.apply_all(&actions);
         let closed = sim.close_outputs();
         result?;
         closed?;
@@ -189,9 +189,37 @@ impl Simulation {
         }
     }
 
-    /// Applies one action.
+    /// Applies a plan's actions in order, following the jumps of its `if`s
+    /// decided during the run (and of a `break` inside one).
+    pub fn apply_all(&mut self, actions: &[Action]) -> Result<(), RunError> {
+        let mut next = 0;
+        while let Some(action) = actions.get(next) {
+            next += 1 + match action {
+                Action::Branch { condition, skip } => {
+                    let holds = condition.holds(&mut |c| self.thermo_value(c).map_err(|e| e.to_string())).map_err(RunError::Setup)?;
+                    if holds {
+                        0
+                    } else {
+                        *skip
+                    }
+                }
+                Action::Skip(n) => *n,
+                other => {
+                    self.apply(other)?;
+                    0
+                }
+            };
+        }
+        Ok(())
+    }
+
+    /// Applies one action (jumps only make sense within their plan: see
+    /// [`Self::apply_all`]).
     pub fn apply(&mut self, action: &Action) -> Result<(), RunError> {
         match action {
+            Action::Branch { .. } | Action::Skip(_) => {
+                return Err(RunError::Setup("a jump of an `if` decided during the run is applied by `apply_all`, with its plan".into()))
+            }
             Action::Temperature(kt) => self.kt = *kt,
             Action::Timestep(dt) => self.dt = *dt,
             Action::Seed(seed) => self.seed = *seed,
@@ -661,6 +689,10 @@ impl Simulation {
             Some("surface terms of bodies (`body` lines) run on the CPU backend only")
         } else if self.model.has_contact_terms() {
             Some("contact terms between bodies (`contact` lines) run on the CPU backend only")
+        } else if self.model.special_bonds.is_fractional() && !self.model.pair_rules.is_empty() {
+            Some("fractional `special_bonds` weights run on the CPU backend only")
+        } else if self.model.externals.iter().any(|e| !e.expressions.is_empty()) {
+            Some("externals with expression parameters (`field`, or a quoted formula of x, y, z, t) run on the CPU backend only")
         } else {
             None
         }

@@ -4,6 +4,6 @@ mod model;
 mod sim_box;
 mod state;
 
-pub use self::model::{registry_index, Body, External, Model, SpecialBonds};
+pub use self::model::{position_or_time, registry_index, Body, External, Model, SpecialBonds};
 pub use self::sim_box::{Images, SimBox};
 pub use self::state::State;
