@@ -39,13 +39,46 @@ mod tests {
     fn shared_checks() {
         // With constant parameters the field is conservative only when F = 0
         // (a constant e is a level potential): the generic checks then hold.
-        // Position-dependent fields are checked, with their expressions, in
-        // `crate::system::model` (`a_field_given_by_expressions_is_minus_the_gradient_of_its_energy`).
+        // Position-dependent fields: `a_field_given_by_expressions_is_minus_the_gradient_of_its_energy`.
         let p = params_of(&Field, &[("e", 2.5)]);
         for x in [DVec3::ZERO, DVec3::new(1.0, -2.0, 3.0)] {
             assert_all_checks(&Field, &p, &[x], 1e-4, 1.0);
         }
         assert_zero_force_at_rest(&Field, &p, &[DVec3::new(1.0, 2.0, 3.0)], 1.0);
+    }
+
+    /// The analytic reference (reference/NO_REFERENCE.md): the parameters
+    /// given as expressions of a 3-D harmonic trap, F = −k·(x − c), E =
+    /// ½k·|x − c|² with k = 3 and c = (1, −2, 0.5): F = −∇E by central
+    /// differences and the closed form, at points inside and outside the trap.
+    #[test]
+    fn a_field_given_by_expressions_is_minus_the_gradient_of_its_energy() {
+        use crate::expr::{parse, Ref};
+        let texts = ["-3*(x - 1)", "-3*(y + 2)", "-3*(z - 0.5)", "1.5*((x - 1)^2 + (y + 2)^2 + (z - 0.5)^2)"];
+        let exprs: Vec<_> = texts.iter().map(|t| parse(t).unwrap()).collect();
+        let at = |x: DVec3| {
+            let names = |r: Ref| match r {
+                Ref::Name("x") => Ok(x.x),
+                Ref::Name("y") => Ok(x.y),
+                Ref::Name("z") => Ok(x.z),
+                other => Err(format!("{other:?}")),
+            };
+            let p: Vec<f64> = exprs.iter().map(|e| e.eval(&mut names.clone()).unwrap()).collect();
+            eval(&p, x)
+        };
+        let h = 1e-5;
+        for x in [DVec3::new(1.0, -2.0, 0.5), DVec3::new(0.3, 0.4, -1.2), DVec3::new(-5.0, 2.0, 3.0)] {
+            let out = at(x);
+            let c = DVec3::new(1.0, -2.0, 0.5);
+            assert!((out.force - (-3.0 * (x - c))).length() < 1e-12);
+            assert!((out.energy - 1.5 * (x - c).length_squared()).abs() < 1e-12);
+            for axis in 0..3 {
+                let mut step = DVec3::ZERO;
+                step[axis] = h;
+                let gradient = (at(x + step).energy - at(x - step).energy) / (2.0 * h);
+                assert!((out.force[axis] + gradient).abs() < 1e-7, "axis {axis} at {x}: F = {} vs −∇E = {}", out.force[axis], -gradient);
+            }
+        }
     }
 
     #[test]

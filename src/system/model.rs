@@ -508,13 +508,12 @@ mod tests {
         assert_eq!(model(charmm).excluded_pairs(None).len(), 5 + 5 + 4);
     }
 
-    /// The analytic reference of `field` (no golden file: see
-    /// reference/NO_REFERENCE.md): a harmonic trap written as expressions,
-    /// F = −k·(x − c(t)) with its energy ½k|x − c(t)|², and a trap centre
-    /// moving with t. F = −∇E by central differences at several points and
-    /// times, and the closed form at one point.
+    /// `External::at` evaluates expression parameters at the particle's
+    /// position and time: a harmonic trap whose centre moves with t, F =
+    /// −2(x − c(t)) with energy |x − c(t)|², obeys F = −∇E by central
+    /// differences and its closed form; outside a domain the parameter is NaN.
     #[test]
-    fn a_field_given_by_expressions_is_minus_the_gradient_of_its_energy() {
+    fn an_external_evaluates_its_expression_parameters_at_each_position_and_time() {
         let label = crate::input::lex(&SourceFile::new("t.in", "trap")).unwrap()[0].tokens[0].clone();
         let field = crate::interactions::lookup("field").unwrap();
         let term = TermType { label, interaction: field, params: vec![0.0; 4] };
