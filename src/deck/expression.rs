@@ -31,15 +31,15 @@ impl DeckExpr {
             pieces.push((text.len(), t.clone()));
             text.push_str(&t.text);
         }
-        let mut out = Self { expr: crate::expr::Expr::Number(0.0, crate::expr::Span { start: 0, end: 0 }), pieces };
-        out.expr = parse(&text).map_err(|e| out.error(&e))?;
-        Ok(out)
+        match parse(&text) {
+            Ok(expr) => Ok(Self { expr, pieces }),
+            Err(e) => Err(locate(&pieces, &e)),
+        }
     }
 
     /// An expression error at its place in the deck.
     pub fn error(&self, e: &ExprError) -> InputError {
-        let (start, token) = self.pieces.iter().rev().find(|(start, _)| *start <= e.span.start).unwrap_or(&self.pieces[0]);
-        token.error_within(e.span.start - start, e.message.clone())
+        locate(&self.pieces, e)
     }
 
     /// The value now; every name must be a numeric deck variable.
@@ -58,6 +58,13 @@ impl DeckExpr {
     pub fn reads_thermo(&self) -> bool {
         self.expr.refs().iter().any(|(r, _)| matches!(r, Ref::Thermo(_)))
     }
+}
+
+/// The deck position of an error: the token its span starts in, and the
+/// column inside it.
+fn locate(pieces: &[(usize, Token)], e: &ExprError) -> InputError {
+    let (start, token) = pieces.iter().rev().find(|(start, _)| *start <= e.span.start).unwrap_or(&pieces[0]);
+    token.error_within(e.span.start - start, e.message.clone())
 }
 
 /// An `if` condition decided during the run: the tree, the values its deck
