@@ -121,9 +121,17 @@ fn a_wall_whose_position_is_an_expression_of_time_drives_the_bead() {
     let mut sim = Simulation::execute(plan.clone(), Default::default()).unwrap();
     assert!((sim.state.positions[0].x - 0.5 * 999.0 * 0.01).abs() < 1e-9, "{}", sim.state.positions[0].x);
     assert!((column(&mut sim, &plan, "fx/plate") - 0.5).abs() < 1e-6);
-    // LAMMPS' fix wall takes no formula of time here: a clear refusal.
-    let err = export(&plan, ExportOptions::default()).unwrap_err();
-    assert!(err.contains("expression parameters of `wall` are not exported"), "{err}");
+    // LAMMPS re-evaluates a wall face given as an equal-style variable of time
+    // (the face sits rc = 100 below d, as for a fixed wall).
+    let input = export(&plan, ExportOptions::default()).unwrap().input;
+    for line in ["variable x_plate_face equal \"(0.5*time)-100.0\"", "fix x_plate g_plate wall/harmonic xlo v_x_plate_face 50.0 1.0 100.0 units box"] {
+        assert!(input.lines().any(|l| l == line), "in.lammps lacks `{line}`:\n{input}");
+    }
+    // A wall that depends on the position, or another parameter as a formula, has no LAMMPS form: a clear refusal.
+    for external in ["external plate all wall nx 1 d \"0.1*y\" k 100\n", "external plate all wall nx 1 k \"100 + t\"\n"] {
+        let err = export(&bead(&format!("{external}run 1\n")).plan(), ExportOptions::default()).unwrap_err();
+        assert!(err.contains("external `plate`: expression parameters of `wall` are not exported"), "{err}");
+    }
 }
 
 #[test]

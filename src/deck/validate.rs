@@ -59,6 +59,9 @@ pub(super) struct Validator {
     warnings: Vec<String>,
 }
 
+/// An expression parameter of an `external`: its name token and its expression.
+type NamedExpr = (Token, DeckExpr);
+
 fn expect_len(s: &[Token], range: std::ops::RangeInclusive<usize>, usage: &str) -> Result<(), InputError> {
     let n = s.len() - 1;
     if range.contains(&n) {
@@ -528,7 +531,7 @@ impl Validator {
     /// (one that is not a number) replaced by its value at the group's first
     /// member at t = 0, for the schema's checks; and the expressions, deck
     /// variables folded in, with their value tokens.
-    fn external_expressions(&self, pairs: &[Token], group: &Group) -> Result<(Vec<Token>, Vec<(Token, DeckExpr)>), InputError> {
+    fn external_expressions(&self, pairs: &[Token], group: &Group) -> Result<(Vec<Token>, Vec<NamedExpr>), InputError> {
         let mut values = pairs.to_vec();
         let mut expressions = Vec::new();
         for k in (1..pairs.len()).step_by(2) {
@@ -558,7 +561,7 @@ impl Validator {
         &self,
         term: &TermType,
         group: &Group,
-        expressions: Vec<(Token, DeckExpr)>,
+        expressions: Vec<NamedExpr>,
     ) -> Result<Vec<(usize, crate::expr::Expr)>, InputError> {
         let indexed: Vec<(usize, DeckExpr)> = expressions
             .into_iter()

@@ -571,15 +571,15 @@ impl Writer<'_> {
         let id = ident("x_", &external.term.label.text);
         let args = if external.term.interaction.name() == "field" {
             self.field_variables(external, &id)?
-        } else if !external.expressions.is_empty() {
-            return Err(format!(
-                "external `{}`: expression parameters of `{}` are not exported (only `field` maps to LAMMPS, as `fix addforce` \
-                 with atom-style variables)",
-                external.term.label.text,
-                external.term.interaction.name()
-            ));
         } else {
-            styles::external(&external.term, |a| b.lengths()[a], |a| b.periodic[a])?
+            let d = moving_wall_offset(external).map_err(|e| format!("external `{}`: {e}", external.term.label.text))?;
+            let variable = format!("{id}_face");
+            let moving = d.as_deref().map(|d| styles::MovingWall { d, variable: &variable });
+            let (args, line) = styles::external(&external.term, |a| b.lengths()[a], |a| b.periodic[a], moving)?;
+            if let Some(line) = line {
+                self.line(line);
+            }
+            args
         };
         let mut ids: Vec<u64> = external.members.iter().map(|&m| self.model.ids[m as usize]).collect();
         let group = ident("g_", &external.term.label.text);
@@ -782,4 +782,25 @@ pub fn write(deck: &LammpsDeck, dir: &std::path::Path) -> std::io::Result<()> {
     std::fs::create_dir_all(dir)?;
     std::fs::write(dir.join(DATA_FILE), &deck.data)?;
     std::fs::write(dir.join(INPUT_FILE), &deck.input)
+}
+
+/// The LAMMPS formula of an external's expression parameters where LAMMPS
+/// can take one outside `field`: a wall's offset `d` as a function of t only
+/// (None: no expression parameters).
+fn moving_wall_offset(external: &External) -> Result<Option<String>, String> {
+    let name = external.term.interaction.name();
+    match &external.expressions[..] {
+        [] => Ok(None),
+        [(k, expr)]
+            if name == "wall"
+                && external.term.interaction.params()[*k].name == "d"
+                && expr.refs().iter().all(|(r, _)| *r == crate::expr::Ref::Name("t")) =>
+        {
+            formula::lammps_formula(expr).map(Some)
+        }
+        _ => Err(format!(
+            "expression parameters of `{name}` are not exported (LAMMPS takes a wall's `d` as a formula of t, and a `field` as \
+             `fix addforce` with atom-style variables)"
+        )),
+    }
 }
