@@ -124,7 +124,10 @@ fn a_wall_whose_position_is_an_expression_of_time_drives_the_bead() {
     // LAMMPS re-evaluates a wall face given as an equal-style variable of time
     // (the face sits rc = 100 below d, as for a fixed wall).
     let input = export(&plan, ExportOptions::default()).unwrap().input;
-    for line in ["variable x_plate_face equal \"(0.5*time)-100.0\"", "fix x_plate g_plate wall/harmonic xlo v_x_plate_face 50.0 1.0 100.0 units box"] {
+    for line in [
+        "variable x_plate_face equal \"(0.5*time)-100.0\"",
+        "fix x_plate g_plate wall/harmonic xlo v_x_plate_face 50.0 1.0 100.0 units box",
+    ] {
         assert!(input.lines().any(|l| l == line), "in.lammps lacks `{line}`:\n{input}");
     }
     // A wall that depends on the position, or another parameter as a formula, has no LAMMPS form: a clear refusal.

@@ -154,7 +154,11 @@ pub fn external(
                 // LAMMPS re-evaluates an equal-style face position every step.
                 (Some(m), lo) => {
                     let formula = if lo { format!("{}-{}", m.d, num(rc)) } else { format!("-{}+{}", m.d, num(rc)) };
-                    (if lo { "lo" } else { "hi" }, format!("v_{}", m.variable), Some(format!("variable {} equal \"{formula}\"", m.variable)))
+                    (
+                        if lo { "lo" } else { "hi" },
+                        format!("v_{}", m.variable),
+                        Some(format!("variable {} equal \"{formula}\"", m.variable)),
+                    )
                 }
             };
             Ok((format!("wall/harmonic {letter}{side} {position} {} 1.0 {} units box", num(0.5 * p("k")), num(rc)), variable))

@@ -161,13 +161,13 @@ impl Simulation {
         Ok(sim)
     }
 
-    /// The simulation as the deck sets it up before its first `run` or
-    /// `minimize`: settings, externals, coefficient edits and restarts are
+    /// The simulation as the deck sets it up before its first `run`,
+    /// `minimize` or `if` decided during the run: settings, externals, coefficient edits and restarts are
     /// applied; outputs are not opened. For tools that inspect or time the
     /// initial system (`cellmd profile-gpu`, tests).
     pub fn before_first_run(plan: &Plan, options: RunOptions) -> Result<Simulation, RunError> {
         let mut sim = Simulation::new(plan, options);
-        for action in plan.actions.iter().take_while(|a| !matches!(a, Action::Run(_) | Action::Minimize(_))) {
+        for action in plan.actions.iter().take_while(|a| !matches!(a, Action::Run(_) | Action::Minimize(_) | Action::Branch { .. })) {
             if !action.is_output() {
                 sim.apply(action)?;
             }
