@@ -9,7 +9,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use crate::compare::{cellmd_probes, golden, run_lammps, Agreement, Lmp, Tolerance};
-use crate::deck::{validate_file, validate_file_with, ValidateOptions};
+use crate::deck::{validate_file_with, Plan, ValidateOptions};
 use crate::export::{self, ExportOptions};
 use crate::gpu::backend::StepSettings;
 use crate::gpu::{DevicePreference, GpuBackend, GpuContext};
@@ -195,7 +195,7 @@ where
         }
         Command::ProfileGpu { deck, vars, repetitions, rebuild_rate } => {
             let _runtime_dir = headless_runtime_dir();
-            let plan = match validate_file(&deck, &vars) {
+            let plan = match validated(&deck, &vars, ValidateOptions::default()) {
                 Ok(plan) => plan,
                 Err(e) => return report(e),
             };
@@ -207,7 +207,7 @@ where
                 }
             }
         }
-        Command::Check { deck, vars, allow_outside } => match validate_file_with(&deck, &vars, ValidateOptions { allow_outside }) {
+        Command::Check { deck, vars, allow_outside } => match validated(&deck, &vars, ValidateOptions { allow_outside }) {
             Ok(plan) => {
                 println!(
                     "{}: ok ({} particles, {} bonds, {} angles, {} actions)",
@@ -222,7 +222,7 @@ where
             Err(e) => report(e),
         },
         Command::ExportLammps { deck, outdir, vars, probes } => {
-            let plan = match validate_file(&deck, &vars) {
+            let plan = match validated(&deck, &vars, ValidateOptions::default()) {
                 Ok(plan) => plan,
                 Err(e) => return report(e),
             };
@@ -257,7 +257,7 @@ where
             }
         },
         Command::Compare { deck, vars, lmp, workdir, tol, run_tol, write_golden, golden_header } => {
-            let plan = match validate_file(&deck, &vars) {
+            let plan = match validated(&deck, &vars, ValidateOptions::default()) {
                 Ok(plan) => plan,
                 Err(e) => return report(e),
             };
@@ -297,7 +297,7 @@ where
                         return ExitCode::from(1);
                     }
                 },
-                (None, Some(deck)) => validate_file_with(deck, &vars, options),
+                (None, Some(deck)) => validated(deck, &vars, options),
                 (None, None) => unreachable!("clap requires a deck or --continue"),
             };
             let plan = match plan {
@@ -456,4 +456,13 @@ fn compare(
         std::fs::write(&path, golden::write(&[doc])).map_err(|e| format!("{}: {e}", path.display()))?;
     }
     Ok(agreement.agrees(tol))
+}
+
+/// Validates a deck and prints its warnings on stderr.
+fn validated(deck: &Path, vars: &[(String, String)], options: ValidateOptions) -> Result<Plan, crate::input::InputError> {
+    let plan = validate_file_with(deck, vars, options)?;
+    for warning in &plan.warnings {
+        eprintln!("{warning}");
+    }
+    Ok(plan)
 }

@@ -4,6 +4,7 @@
 //!
 //! | module | role |
 //! |---|---|
+//! | [`expr`] | expression trees (parse with spans → evaluate): deck variables, loop bounds, `if` conditions |
 //! | [`input`] | shared nom lexer for decks, topologies and force fields; `file:line:col` diagnostics; inputs recorded for restarts |
 //! | [`deck`] | deck commands → validated [`deck::Plan`] |
 //! | [`topology`] | particles, bonds, angles, triangles, bodies (checked: closed, oriented, sphere topology) |
@@ -30,6 +31,7 @@ pub mod cli;
 pub mod compare;
 pub mod deck;
 pub mod export;
+pub mod expr;
 pub mod forcefield;
 pub mod gpu;
 pub mod hessian;

@@ -120,6 +120,37 @@ fn gpu_forces_match_cpu_on_the_mixed_random_system() {
     }
 }
 
+/// The `field` external with constant parameters runs on the GPU (its
+/// evaluator `shaders/interactions/field.wgsl`) like on the CPU; with an
+/// expression parameter the GPU refuses the deck with the CPU-only reason.
+#[test]
+fn a_field_external_runs_on_the_gpu_with_constant_parameters_only() {
+    let case = random_case(false, "");
+    let deck = std::fs::read_to_string(case.path("deck.in")).unwrap();
+    std::fs::write(case.path("deck.in"), format!("{deck}external trap all field fx 0.5 fy -0.25 fz 1 e 2\n")).unwrap();
+    let plan = case.plan();
+    let sim = Simulation::before_first_run(&plan, RunOptions::default()).unwrap();
+    assert_eq!(sim.model.externals.len(), 1);
+    assert_eq!(sim.cpu_only_feature(), None);
+    let state = initial_state(&plan);
+    let mut cpu = CpuBackend::new(&sim.model, &state, &plan.sim_box, 0.4).unwrap();
+    let mut forces = Forces::default();
+    cpu.compute(&sim.model, &state, &plan.sim_box, &mut forces);
+    let mut gpu = GpuBackend::new(&context(), &sim.model, &state, &plan.sim_box, &settings(0.4, 1e-3, 0.0)).unwrap();
+    gpu.evaluate().unwrap();
+    let (force_error, energy_error) = compare_forces(&forces, &gpu.forces_and_energies());
+    eprintln!("field external: force error {force_error:e}, energy error {energy_error:e}");
+    assert!(force_error < 1e-5 && energy_error < 1e-5, "force error {force_error:e}, energy error {energy_error:e}");
+
+    std::fs::write(case.path("deck.in"), format!("{deck}external trap all field fx \"-x\"\ntimestep 1e-3\nrun 1\n")).unwrap();
+    let plan = case.plan();
+    let why = Simulation::before_first_run(&plan, RunOptions::default()).unwrap().cpu_only_feature().unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let options = RunOptions { output_dir: dir.path().to_path_buf(), device: Some(DevicePreference::Gpu), ..Default::default() };
+    let refusal = Simulation::execute(plan, options).err().map(|e| e.to_string()).unwrap_or_default();
+    assert!(refusal.contains(why) && why.contains("expression parameters"), "{refusal}");
+}
+
 fn golden_documents() -> Vec<(std::path::PathBuf, cellmd::compare::golden::Document)> {
     let mut files: Vec<_> =
         std::fs::read_dir("reference").unwrap().map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|e| e == "yaml")).collect();

@@ -40,12 +40,13 @@ use super::candidates::Near;
 use super::contact::Contacts;
 use super::newton::{Newton, Scatter, BLOCK};
 use super::pair_table::{PairGeometry, PairTable};
+use super::special::SpecialPairs;
 use super::surface::Surfaces;
 use super::virial::add6;
 use crate::interactions::{Law, REGISTRY};
 use crate::kinetics::BondState;
 use crate::neighbor::{Exclusions, NeighborList};
-use crate::system::{registry_index, Model, SimBox, State};
+use crate::system::{registry_index, External, Model, SimBox, State};
 
 /// Result of a force evaluation.
 #[derive(Clone, Debug, Default)]
@@ -94,6 +95,8 @@ pub struct CpuBackend {
     pair_rule_column: Vec<usize>,
     /// Per bond: tension dE/dr (0 when unbound) and length at the last
     /// evaluation (filled only when bonds have kinetics).
+    /// Bonded neighbour pairs of fractional `special_bonds` weight.
+    special: SpecialPairs,
     bond_tension: Vec<f64>,
     bond_length: Vec<f64>,
 }
@@ -108,6 +111,7 @@ impl CpuBackend {
         let mut backend = Self {
             neighbors: NeighborList::half(model.max_pair_cutoff(), skin),
             exclusions: Exclusions::from_pairs(model.len(), &model.excluded_pairs(state.bonds.as_ref().map(|b| b.bound.as_slice()))),
+            special: SpecialPairs::new(model, state.bonds.as_ref().map(|b| b.bound.as_slice())),
             bonded: Bonded::new(model),
             surfaces: Surfaces::new(model),
             contacts: Contacts::new(model),
@@ -162,6 +166,7 @@ impl CpuBackend {
         }
         let bound = state.bonds.as_ref().map(|b| b.bound.as_slice());
         self.exclusions = Exclusions::from_pairs(model.len(), &model.excluded_pairs(bound));
+        self.special = SpecialPairs::new(model, bound);
         self.rebuild_neighbors(state, sim_box)
     }
 
@@ -227,6 +232,10 @@ impl CpuBackend {
 
     pub(super) fn contacts(&self) -> &Contacts {
         &self.contacts
+    }
+
+    pub(super) fn special_pairs(&self) -> &SpecialPairs {
+        &self.special
     }
 
     /// The half neighbour list, or None when the model has no pair terms.
@@ -300,6 +309,7 @@ impl CpuBackend {
             out.energy_by_interaction.clear();
             out.energy_by_interaction.resize(REGISTRY.len(), 0.0);
             out.virial = [0.0; 6];
+            self.special.add(model, x, &images, &mut out.forces, Some((&mut out.energy_by_interaction, &mut out.virial)));
             bonded.energy(model, x, &images, bond_state, &mut out.energy_by_interaction, &mut out.virial);
             surfaces.energy(model, &mut out.energy_by_interaction, &mut out.virial);
             contacts.energy(model, x, &images, &mut out.energy_by_interaction, &mut out.virial);
@@ -309,6 +319,8 @@ impl CpuBackend {
                 }
                 add6(&mut out.virial, virial);
             }
+        } else {
+            self.special.add(model, x, &images, &mut out.forces, None);
         }
         apply_externals(model, state, sim_box, out, energies);
     }
@@ -358,10 +370,20 @@ impl CpuBackend {
                 }
             }
         }
+        self.special.for_each(model, &state.positions, &images, |a, b, d, r, radial, rule| {
+            if a as usize == i || b as usize == i {
+                let term = &model.pair_rules[rule];
+                let f = radial.force_along(d, r);
+                let (label, force) = (
+                    format!("{} {}-{} (special_bonds)", term.label.text, model.ids[a as usize], model.ids[b as usize]),
+                    if a as usize == i { f } else { -f },
+                );
+                parts.push(ForceBreakdown { kind: "pair", label, interaction: term.interaction.name(), force });
+            }
+        });
         for external in &model.externals {
             if external.members.binary_search(&(i as u32)).is_ok() {
-                let Law::OneBody(eval) = external.term.interaction.law() else { continue };
-                let out = eval(&external.term.params, sim_box.unwrap(state.positions[i], state.images[i]));
+                let out = external.at(sim_box.unwrap(state.positions[i], state.images[i]), state.time);
                 parts.push(ForceBreakdown {
                     kind: "external",
                     label: external.term.label.text.clone(),
@@ -419,15 +441,24 @@ impl ScatterTerms<'_> {
     }
 }
 
-/// External fields: evaluated on unwrapped positions, members in ascending order.
+/// One external's field on each of its members (index, energy and force),
+/// evaluated on unwrapped positions, members in ascending order.
+pub fn external_field<'a>(
+    external: &'a External,
+    state: &'a State,
+    sim_box: &'a SimBox,
+) -> impl Iterator<Item = (usize, crate::interactions::OneBody)> + 'a {
+    external.members.iter().map(move |&m| {
+        let m = m as usize;
+        (m, external.at(sim_box.unwrap(state.positions[m], state.images[m]), state.time))
+    })
+}
+
 fn apply_externals(model: &Model, state: &State, sim_box: &SimBox, out: &mut Forces, energies: bool) {
     for external in &model.externals {
-        let Law::OneBody(eval) = external.term.interaction.law() else { unreachable!("external law is one-body") };
         let reg = registry_index(&external.term);
         let mut energy = 0.0;
-        for &m in &external.members {
-            let m = m as usize;
-            let field = eval(&external.term.params, sim_box.unwrap(state.positions[m], state.images[m]));
+        for (m, field) in external_field(external, state, sim_box) {
             out.forces[m] += field.force;
             energy += field.energy;
         }

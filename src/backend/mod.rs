@@ -8,11 +8,12 @@ mod contact;
 pub mod cpu;
 mod newton;
 mod pair_table;
+mod special;
 pub mod stiffness;
 mod surface;
 mod terms;
 mod virial;
 
 pub use self::contact::STEP_FRACTION as CONTACT_STEP_FRACTION;
-pub use self::cpu::{CpuBackend, ForceBreakdown, Forces};
+pub use self::cpu::{external_field, CpuBackend, ForceBreakdown, Forces};
 pub use self::terms::{Segment, Term, TermKind};

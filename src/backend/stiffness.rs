@@ -164,12 +164,12 @@ impl CpuBackend {
                 }
             }
         }
+        self.special_pairs().for_each(model, x, &images, |i, j, d, r, radial, _| push_pair(&mut blocks, i, j, radial_block(&radial, d, r)));
         self.contacts().stiffness(model, &mut blocks);
         for external in &model.externals {
-            let Law::OneBody(eval) = external.term.interaction.law() else { unreachable!("external law is one-body") };
             for &m in &external.members {
                 let at = sim_box.unwrap(x[m as usize], state.images[m as usize]);
-                projected_term_blocks(&[m], &[at], |p| vec![eval(&external.term.params, p[0]).force], &mut blocks);
+                projected_term_blocks(&[m], &[at], |p| vec![external.at(p[0], state.time).force], &mut blocks);
             }
         }
         let rank_one = self.surfaces().stiffness(model, &mut blocks);

@@ -82,6 +82,10 @@ impl CpuBackend {
                 });
             }
         }
+        self.special_pairs().for_each(model, x, &images, |i, j, d, r, radial, _| {
+            let segment = Segment { from: x[i as usize], d, force: -radial.force_along(d, r) };
+            visit(&Term { kind: TermKind::Pair, particles: &[i, j], segments: &[segment], bond: usize::MAX });
+        });
         for a in 0..model.angles.len() {
             let ([xi, xj, xk], out) = eval_angle(model, a, x, &images);
             let segments = [Segment { from: xj, d: xi - xj, force: out.forces[0] }, Segment { from: xj, d: xk - xj, force: out.forces[2] }];

@@ -5,19 +5,24 @@
 //! in order — loading the topology and force fields, resolving names, checking
 //! parameters against schemas — and produces a [`Plan`]. Nothing is written
 //! before the whole deck validates, so a bad deck never touches an output.
+//! Loops are unrolled and `if`s decided as the deck validates (`control.rs`),
+//! except an `if` that reads thermo values, which becomes a jump of the plan.
 //!
 //! Paths of inputs (`topology`, `forcefield`, `read_state`) are relative to the
 //! deck's directory; outputs (`dump`, `thermo_file`, `write_state`) are
 //! relative to the output directory (the working directory unless `cellmd run
 //! -o DIR`). See README.md for the command reference.
 
-mod placement;
+mod control;
+mod expression;
 mod open;
+mod placement;
 mod plan;
 mod protocol;
 mod validate;
 mod variables;
 
+pub use self::expression::Condition;
 pub use self::open::OpenDeck;
 pub use self::plan::{Action, CheckpointSpec, CoeffTarget, DumpSpec, Group, NeighborSettings, Plan, ThermoColumn};
 pub use self::protocol::{Protocol, Ramp};

@@ -31,8 +31,18 @@ impl Default for NeighborSettings {
 pub enum ThermoColumn {
     Step,
     Time,
-    /// Total potential energy.
+    /// Total potential energy less the potential −F·x of `constant_force` externals.
     Pe,
+    /// Σ F·x of the `constant_force` externals (unwrapped x): `pe − work` is the
+    /// whole potential energy.
+    Work,
+    /// Summed force of a named external on its particles along an axis (`fx/NAME`).
+    ExternalForce {
+        name: String,
+        axis: usize,
+    },
+    /// Energy of a named external (`pe/NAME`).
+    ExternalEnergy(String),
     /// Potential energy of one registered interaction type (registry index).
     PeOf(usize),
     /// Largest |F| on a particle.
@@ -183,6 +193,15 @@ pub enum Action {
     Checkpoint(CheckpointSpec),
     ReadState(PathBuf),
     Print(String),
+    /// An `if` decided during the run: when the condition does not hold,
+    /// the next `skip` actions (its then-branch) are skipped.
+    Branch {
+        condition: super::Condition,
+        skip: usize,
+    },
+    /// Skips the next N actions (the end of a then-branch jumping over its
+    /// else-branch, or a `break` decided during the run jumping to its loop's end).
+    Skip(usize),
 }
 
 impl Action {
@@ -217,6 +236,8 @@ impl Action {
                 | Action::WriteState(_)
                 | Action::ReadState(_)
                 | Action::Print(_)
+                | Action::Branch { .. }
+                | Action::Skip(_)
         )
     }
 }
@@ -260,4 +281,7 @@ pub struct Plan {
     pub actions: Vec<Action>,
     /// The deck's path, `--var` overrides and input files as read.
     pub inputs: crate::input::DeckInputs,
+    /// `file:line:col: warning: …` lines: accepted but suspicious input
+    /// (printed by `cellmd check` and `run`).
+    pub warnings: Vec<String>,
 }

@@ -5,12 +5,15 @@ use std::path::{Path, PathBuf};
 
 use glam::DVec3;
 
+use super::control::{blocks, ControlState};
+use super::expression::DeckExpr;
 use super::placement::check_placement;
 use super::plan::{Action, CheckpointSpec, DumpSpec, Group, NeighborSettings, Plan, ThermoColumn};
 use super::variables::Variables;
-use crate::forcefield::{load_forcefield, parse_params, ForceField};
+use crate::expr::{ExprError, Ref};
+use crate::forcefield::{load_forcefield, parse_params, ForceField, TermType};
 use crate::gpu::DevicePreference;
-use crate::input::{check_input_file, is_replaying, lex, parse_f64, parse_u64, recording, DeckInputs, InputError, InputFile, SourceFile, Statement, Token};
+use crate::input::{check_input_file, is_replaying, lex, parse_f64, parse_u64, recording, DeckInputs, InputError, InputFile, SourceFile, Token};
 use crate::integrate::fire::FireSettings;
 use crate::integrate::implicit::{ImplicitSettings, LinearSolver};
 use crate::integrate::overdamped::OverdampedSettings;
@@ -18,7 +21,7 @@ use crate::integrate::rng::Noise;
 use crate::interactions::{param_index, Kind, REGISTRY};
 use crate::kinetics::EventKind;
 use crate::output::{AtomColumn, DumpFormat, Encoding, WriterOptions};
-use crate::system::{External, Model, SimBox, SpecialBonds};
+use crate::system::{position_or_time, External, Model, SimBox, SpecialBonds};
 use crate::topology::{parse_box_axis, BoxAxis, Topology};
 use crate::units::UnitSystem;
 
@@ -27,15 +30,16 @@ mod protocols;
 mod targets;
 
 /// The commands a deck understands (for "expected ..." messages).
-const COMMANDS: &str = "units, variable, topology, forcefield, box, special_bonds, temperature, timestep, seed, device, integrator, neighbor, thermo, thermo_file, events, lifetimes, dump, undump, group, external, unexternal, displace_atoms, coeff, ramp, move, unmove, freeze, unfreeze, reset_rest, indent, constrain, unconstrain, minimize, run, write_state, read_state, print";
+const COMMANDS: &str = "units, variable, loop, endloop, if, else, endif, break, topology, forcefield, box, special_bonds, temperature, timestep, seed, device, integrator, neighbor, thermo, thermo_file, events, lifetimes, dump, undump, group, external, unexternal, displace_atoms, coeff, ramp, move, unmove, freeze, unfreeze, reset_rest, indent, constrain, unconstrain, minimize, run, write_state, read_state, print";
 
 /// Commands that define the system and must come before it is first used.
 const SETUP: [&str; 5] = ["units", "topology", "forcefield", "box", "special_bonds"];
 
 /// The state of a deck being validated: what its commands so far defined.
+#[derive(Clone)]
 pub(super) struct Validator {
     deck_dir: PathBuf,
-    vars: Variables,
+    pub(super) vars: Variables,
     units: UnitSystem,
     topology: Option<Topology>,
     forcefield: ForceField,
@@ -58,6 +62,10 @@ pub(super) struct Validator {
     allow_outside: bool,
     /// Ramps waiting for a run, moving and frozen groups, reset rest lengths.
     protocols: protocols::Protocols,
+    pub(super) control: ControlState,
+    /// The last command validated (where a deck-level error is reported).
+    pub(super) last: Option<Token>,
+    warnings: Vec<String>,
 }
 
 /// How a deck is validated.
@@ -67,6 +75,9 @@ pub struct ValidateOptions {
     /// a `..` component): `cellmd run --allow-outside`.
     pub allow_outside: bool,
 }
+
+/// An expression parameter of an `external`: its name token and its expression.
+type NamedExpr = (Token, DeckExpr);
 
 fn expect_len(s: &[Token], range: std::ops::RangeInclusive<usize>, usage: &str) -> Result<(), InputError> {
     let n = s.len() - 1;
@@ -163,7 +174,7 @@ impl Validator {
     }
 
     /// The model, built on first use from the setup commands seen so far.
-    fn model(&mut self, at: &Token) -> Result<&mut Model, InputError> {
+    pub(super) fn model(&mut self, at: &Token) -> Result<&mut Model, InputError> {
         if self.model.is_none() {
             let topology = self
                 .topology
@@ -230,20 +241,19 @@ impl Validator {
                 self.box_axes = Some(axes);
             }
             "special_bonds" => {
-                expect_len(s, 3..=3, "special_bonds W12 W13 W14   (each 0 = excluded or 1 = included)")?;
-                let mut exclude = [false; 3];
+                // LAMMPS' own form names the pair style family first: `special_bonds lj W12 W13 W14`.
+                let s = if s.get(1).is_some_and(|t| t.text == "lj") { [&s[..1], &s[2..]].concat() } else { s.to_vec() };
+                expect_len(&s, 3..=3, "special_bonds [lj] W12 W13 W14   (each from 0 = excluded to 1 = in full)")?;
+                let mut weights = [0.0; 3];
                 for (k, t) in s[1..].iter().enumerate() {
-                    exclude[k] = match parse_f64(t, "a weight")? {
-                        0.0 => true,
-                        1.0 => false,
-                        w => {
-                            return Err(t.error(format!(
-                                "found weight {w}, expected 0 (exclude) or 1 (include); fractional weights are not supported"
-                            )))
-                        }
-                    };
+                    weights[k] = parse_f64(t, "a weight")?;
+                    if !(0.0..=1.0).contains(&weights[k]) {
+                        return Err(
+                            t.error(format!("found weight {}, expected a weight from 0 (pair left out) to 1 (pair in full)", weights[k]))
+                        );
+                    }
                 }
-                self.special_bonds = SpecialBonds { exclude_12: exclude[0], exclude_13: exclude[1], exclude_14: exclude[2] };
+                self.special_bonds = SpecialBonds { weights };
             }
             _ => unreachable!(),
         }
@@ -252,7 +262,7 @@ impl Validator {
 
     pub(super) fn thermo_columns(&self, tokens: &[Token]) -> Result<Vec<ThermoColumn>, InputError> {
         const FIXED: &str =
-            "step, time, pe, pe/NAME, fmax, fnorm, press, pxx, pyy, pzz, pxy, pxz, pyz, nbuild, solver_iterations, solver_residual, ctension/BONDTYPE, breaks, rebinds, forms, resets, nbound/BONDTYPE, tension/BONDTYPE, volume/BODYTYPE, area/BODYTYPE, planetension/AXIS/POS, gamma/BODYTYPE, e2e/BONDTYPE, tcorr/BONDTYPE/LAG, fx/GROUP, fy/GROUP, fz/GROUP, xu/GROUP, yu/GROUP, zu/GROUP, load/INDENTER, depth/INDENTER, mindist, nclamp";
+            "step, time, pe, work, pe/NAME, pe/EXTERNAL, fmax, fnorm, press, pxx, pyy, pzz, pxy, pxz, pyz, nbuild, solver_iterations, solver_residual, ctension/BONDTYPE, breaks, rebinds, forms, resets, nbound/BONDTYPE, tension/BONDTYPE, volume/BODYTYPE, area/BODYTYPE, planetension/AXIS/POS, gamma/BODYTYPE, e2e/BONDTYPE, tcorr/BONDTYPE/LAG, fx/GROUP, fy/GROUP, fz/GROUP, fx/EXTERNAL, fy/EXTERNAL, fz/EXTERNAL, xu/GROUP, yu/GROUP, zu/GROUP, load/INDENTER, depth/INDENTER, mindist, nclamp";
         let bond_type = |t: &Token, name: &str| {
             self.forcefield.bond_types.iter().position(|b| b.label.text == name).ok_or_else(|| {
                 let names: Vec<&str> = self.forcefield.bond_types.iter().map(|b| b.label.text.as_str()).collect();
@@ -275,6 +285,7 @@ impl Validator {
                     "step" => ThermoColumn::Step,
                     "time" => ThermoColumn::Time,
                     "pe" => ThermoColumn::Pe,
+                    "work" => ThermoColumn::Work,
                     "fmax" => ThermoColumn::Fmax,
                     "fnorm" => ThermoColumn::Fnorm,
                     "press" => ThermoColumn::Press,
@@ -297,11 +308,31 @@ impl Validator {
                     "mindist" => ThermoColumn::MinDistance,
                     "nclamp" => ThermoColumn::ContactClamps,
                     other => match other.split_once('/') {
-                        Some(("pe", name)) => ThermoColumn::PeOf(REGISTRY.iter().position(|i| i.name() == name).ok_or_else(|| {
-                            t.error(format!(
-                                "found `pe/{name}`, expected pe/ followed by a registered interaction name (see `cellmd list`)"
-                            ))
-                        })?),
+                        Some(("pe", name)) => match (REGISTRY.iter().position(|i| i.name() == name), self.externals.contains(name)) {
+                            (Some(_), true) => {
+                                return Err(t.error(format!(
+                                "found `pe/{name}`, which names both an interaction and an active external; expected an external named \
+                                 otherwise than every interaction"
+                            )))
+                            }
+                            (Some(k), false) => ThermoColumn::PeOf(k),
+                            (None, true) => ThermoColumn::ExternalEnergy(name.to_string()),
+                            (None, false) => {
+                                return Err(t.error(format!(
+                                    "found `pe/{name}`, expected pe/ followed by a registered interaction name (see `cellmd list`) or \
+                                 the name of an active external"
+                                )))
+                            }
+                        },
+                        Some((prefix, name)) if self.externals.contains(name) && group_column(prefix).is_some_and(|(force, _)| force) => {
+                            if self.groups.contains_key(name) {
+                                return Err(t.error(format!(
+                                    "found `{other}`, where `{name}` names both a group and an active external; expected an external \
+                                     named otherwise than every group"
+                                )));
+                            }
+                            ThermoColumn::ExternalForce { name: name.to_string(), axis: group_column(prefix).expect("matched").1 }
+                        }
                         Some(("nbound", name)) => ThermoColumn::Bound(bond_type(t, name)?),
                         Some(("tension", name)) => ThermoColumn::Tension(bond_type(t, name)?),
                         Some(("ctension", name)) => ThermoColumn::ConstraintTension(bond_type(t, name)?),
@@ -521,6 +552,72 @@ impl Validator {
         Ok(())
     }
 
+    /// The `name value` tokens of an `external` with each expression value
+    /// (one that is not a number) replaced by its value at the group's first
+    /// member at t = 0, for the schema's checks; and the expressions, deck
+    /// variables folded in, with their value tokens.
+    fn external_expressions(&self, pairs: &[Token], group: &Group) -> Result<(Vec<Token>, Vec<NamedExpr>), InputError> {
+        let mut values = pairs.to_vec();
+        let mut expressions = Vec::new();
+        for k in (1..pairs.len()).step_by(2) {
+            if parse_f64(&pairs[k], "").is_ok() {
+                continue;
+            }
+            let mut expr = DeckExpr::parse(std::slice::from_ref(&pairs[k]))?;
+            for (r, span) in expr.expr.refs() {
+                let known = matches!(r, Ref::Name("x" | "y" | "z" | "t"));
+                if let (Ref::Name(name), false) = (r, known) {
+                    self.vars.number(name).map_err(|message| expr.error(&ExprError { span, message }))?;
+                }
+            }
+            expr.expr = expr.expr.substitute(&|name| self.vars.number(name).ok().filter(|_| !matches!(name, "x" | "y" | "z" | "t")));
+            let first = group.members.first().copied().unwrap_or(0);
+            let x = self.positions[first as usize];
+            let value = expr.expr.eval(&mut |r| position_or_time(r, x, 0.0)).map_err(|e| self.at_particle(&expr, &e, first))?;
+            values[k] = pairs[k].with_text(format!("{value}"));
+            expressions.push((pairs[k - 1].clone(), expr));
+        }
+        Ok((values, expressions))
+    }
+
+    /// Checks each expression parameter at every member's initial position
+    /// at t = 0 (domain, the parameter's range, the law's own checks).
+    fn check_external_expressions(
+        &self,
+        term: &TermType,
+        group: &Group,
+        expressions: Vec<NamedExpr>,
+    ) -> Result<Vec<(usize, crate::expr::Expr)>, InputError> {
+        let indexed: Vec<(usize, DeckExpr)> = expressions
+            .into_iter()
+            .map(|(name, expr)| (param_index(term.interaction, &name.text).expect("checked by parse_params"), expr))
+            .collect();
+        for &m in &group.members {
+            let x = self.positions[m as usize];
+            let mut params = term.params.clone();
+            for (k, expr) in &indexed {
+                params[*k] = expr.expr.eval(&mut |r| position_or_time(r, x, 0.0)).map_err(|e| self.at_particle(expr, &e, m))?;
+                let spec = &term.interaction.params()[*k];
+                spec.check(params[*k])
+                    .map_err(|why| self.at_particle(expr, &ExprError { span: expr.expr.span(), message: format!("expected {why}") }, m))?;
+            }
+            term.interaction.validate(&params).map_err(|why| {
+                let (_, first) = &indexed[0];
+                let message = format!("invalid `{}` parameters: expected {why}", term.interaction.name());
+                self.at_particle(first, &ExprError { span: first.expr.span(), message }, m)
+            })?;
+        }
+        Ok(indexed.into_iter().map(|(k, e)| (k, e.expr)).collect())
+    }
+
+    /// An error of an external's expression evaluated at particle `m`'s initial position.
+    fn at_particle(&self, expr: &DeckExpr, e: &ExprError, m: u32) -> InputError {
+        let mut located = expr.error(e);
+        let id = self.model.as_ref().expect("built").ids[m as usize];
+        located.message = format!("at particle {id} (x = {}) and t = 0: {}", self.positions[m as usize], located.message);
+        located
+    }
+
     pub(super) fn command(&mut self, s: &[Token]) -> Result<(), InputError> {
         let kw = &s[0];
         match kw.text.as_str() {
@@ -532,6 +629,15 @@ impl Validator {
                     UnitSystem::Lj => "a reduced temperature kT",
                 };
                 let t = non_negative(&s[1], what)?;
+                if self.units == UnitSystem::Cell && t > 0.0 && t < 1.0 {
+                    self.warnings.push(format!(
+                        "{}:{}:{}: warning: temperature {t} K; did you mean kT? temperature is in kelvin (kT = {:.3e} pN·µm at 300 K)",
+                        s[1].file.path,
+                        s[1].line,
+                        s[1].col,
+                        self.units.kt(300.0)
+                    ));
+                }
                 self.actions.push(Action::Temperature(self.units.kt(t)));
             }
             "timestep" => {
@@ -675,9 +781,11 @@ impl Validator {
                 self.protocols.check_external_kept(&s[1])?;
                 let units = self.units;
                 self.model(kw)?;
-                let group = self.group_named(&s[2])?;
-                let term = parse_params(&s[1], &s[3], &s[4..], Kind::External, units)?;
-                let external = External { term, group: group.name.clone(), members: group.members.clone() };
+                let group = self.group_named(&s[2])?.clone();
+                let (values, expressions) = self.external_expressions(&s[4..], &group)?;
+                let term = parse_params(&s[1], &s[3], &values, Kind::External, units)?;
+                let expressions = self.check_external_expressions(&term, &group, expressions)?;
+                let external = External { term, group: group.name.clone(), members: group.members.clone(), expressions };
                 self.externals.insert(s[1].text.clone());
                 // The working model holds the active externals for `coeff` and `ramp`.
                 let model = self.model(kw)?;
@@ -829,6 +937,7 @@ pub(super) fn validate_in(v: &mut Validator, file: &std::sync::Arc<SourceFile>) 
         positions: std::mem::take(&mut v.positions),
         actions: std::mem::take(&mut v.actions),
         inputs: DeckInputs::default(),
+        warnings: std::mem::take(&mut v.warnings),
     })
 }
 
@@ -855,26 +964,17 @@ impl Validator {
             actions: Vec::new(),
             allow_outside: options.allow_outside,
             protocols: protocols::Protocols::default(),
+            control: ControlState::default(),
+            last: None,
+            warnings: Vec::new(),
         }
     }
 
     /// Validates every statement of `file` in order, appending to the
     /// actions; returns the keyword of the last command (None: no command).
     pub(super) fn statements(&mut self, file: &std::sync::Arc<SourceFile>) -> Result<Option<Token>, InputError> {
-        let statements: Vec<Statement> = lex(file)?;
-        let mut last = None;
-        for statement in &statements {
-            let kw = statement.keyword();
-            if kw.text == "variable" {
-                let rest = self.vars.substitute_all(&statement.tokens[1..])?;
-                self.vars.define(kw, &rest)?;
-                continue;
-            }
-            let tokens = self.vars.substitute_all(&statement.tokens)?;
-            self.command(&tokens)?;
-            last = Some(kw.clone());
-        }
-        Ok(last)
+        self.block(&blocks(lex(file)?)?)?;
+        Ok(self.last.clone())
     }
 }
 

@@ -6,10 +6,14 @@
 //! together, hold at most [`MAX_VARIABLE_BYTES`], and all values together at
 //! most [`MAX_VARIABLES_BYTES`] (28 string variables that each doubled the
 //! last took 3.1 GB before these caps).
+//!
+//! An `equal` expression ([`crate::expr`]) may also read a numeric variable
+//! by its bare name (`variable dx equal (g2 - g)*height`).
 
 use std::collections::HashMap;
 
-use crate::input::{evaluate_expression, InputError, Token};
+use super::expression::DeckExpr;
+use crate::input::{InputError, Token};
 
 /// The longest value of a variable, and of the substituted words of one statement: 1 MiB.
 pub const MAX_VARIABLE_BYTES: usize = 1 << 20;
@@ -47,10 +51,7 @@ impl Variables {
         }
         let rest: Vec<&str> = tokens[2..].iter().map(|t| t.text.as_str()).collect();
         let value = match tokens[1].text.as_str() {
-            "equal" => {
-                let v = evaluate_expression(&rest.join(" ")).map_err(|e| tokens[2].error(e))?;
-                format!("{v}")
-            }
+            "equal" => format!("{}", DeckExpr::parse(&tokens[2..])?.eval(self)?),
             "string" => rest.join(" "),
             other => return Err(tokens[1].error(format!("found `{other}`, expected `equal` or `string`"))),
         };
@@ -70,6 +71,38 @@ impl Variables {
         Ok(())
     }
 
+    /// The number a variable holds (for a bare name in an expression).
+    pub(super) fn number(&self, name: &str) -> Result<f64, String> {
+        let value = self.values.get(name).ok_or_else(|| {
+            format!("found undefined variable `{name}`, expected a `variable {name} ...` line before this one or `--var {name}=VALUE`")
+        })?;
+        value
+            .trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| format!("variable `{name}` holds `{value}`; expected a number (a string variable is used as `${{{name}}}`)"))
+    }
+
+    /// Sets a loop's variable (a command-line value does not hold it) and
+    /// returns its previous value, for [`restore`](Self::restore).
+    pub(super) fn set_loop(&mut self, name: &str, value: String) -> Option<String> {
+        self.values.insert(name.to_string(), value)
+    }
+
+    /// Puts back what a variable held before a loop.
+    pub(super) fn restore(&mut self, name: &str, previous: Option<String>) {
+        match previous {
+            Some(v) => self.values.insert(name.to_string(), v),
+            None => self.values.remove(name),
+        };
+    }
+
+    /// Replaces every `${NAME}` in a token.
+    pub fn substitute(&self, token: &Token) -> Result<Token, InputError> {
+        self.substitute_after(token, 0)
+    }
+
     /// Substitutes every token of a statement; the substituted ones may hold
     /// [`MAX_VARIABLE_BYTES`] together.
     pub fn substitute_all(&self, tokens: &[Token]) -> Result<Vec<Token>, InputError> {
@@ -77,7 +110,7 @@ impl Variables {
         tokens
             .iter()
             .map(|t| {
-                let out = self.substitute(t, grown)?;
+                let out = self.substitute_after(t, grown)?;
                 if t.text.contains("${") {
                     grown += out.text.len();
                 }
@@ -88,7 +121,7 @@ impl Variables {
 
     /// Replaces every `${NAME}` in a token, after `before` substituted bytes
     /// of the same statement.
-    fn substitute(&self, token: &Token, before: usize) -> Result<Token, InputError> {
+    fn substitute_after(&self, token: &Token, before: usize) -> Result<Token, InputError> {
         if !token.text.contains("${") {
             return Ok(token.clone());
         }

@@ -45,6 +45,7 @@ use std::collections::BTreeMap;
 use std::fmt::Write;
 
 use super::bond_types::LammpsBondTypes;
+use super::formula;
 use super::styles::{self, num, PairStyled, Styled};
 use crate::deck::{Action, CoeffTarget, Plan};
 use crate::forcefield::TermType;
@@ -326,7 +327,7 @@ fn kinetic_fixes(plan: &Plan, bond_types: &LammpsBondTypes) -> Result<KineticFix
             ));
         }
         let sb = m.special_bonds;
-        if sb.exclude_13 || sb.exclude_14 {
+        if sb.weights[1] == 0.0 || sb.weights[2] == 0.0 {
             return Err(format!(
                 "{name}: `special_bonds` excludes 1-3 or 1-4 neighbours, which LAMMPS leaves out of `fix bond/create`'s neighbour list while cellmd binds them"
             ));
@@ -391,8 +392,7 @@ impl Writer<'_> {
             self.line(format!("read_data {DATA_FILE} extra/bond/per/atom {bonds} extra/special/per/atom {special}"));
         }
         let sb = self.model.special_bonds;
-        let w = |excluded: bool| if excluded { "0.0" } else { "1.0" };
-        self.line(format!("special_bonds lj {} {} {}", w(sb.exclude_12), w(sb.exclude_13), w(sb.exclude_14)));
+        self.line(format!("special_bonds lj {} {} {}", num(sb.weights[0]), num(sb.weights[1]), num(sb.weights[2])));
         if !self.bonds.styles.is_empty() {
             // LAMMPS shifts a lepton bond's energy to zero at r0 unless told not to.
             let list: Vec<&str> = self.bonds.styles.iter().map(|&s| if s == "lepton" { "lepton no_offset" } else { s }).collect();
@@ -568,8 +568,19 @@ impl Writer<'_> {
 
     fn external(&mut self, external: &External) -> Result<(), String> {
         let b = self.plan.sim_box;
-        let args = styles::external(&external.term, |a| b.lengths()[a], |a| b.periodic[a])?;
         let id = ident("x_", &external.term.label.text);
+        let args = if external.term.interaction.name() == "field" {
+            self.field_variables(external, &id)?
+        } else {
+            let d = moving_wall_offset(external).map_err(|e| format!("external `{}`: {e}", external.term.label.text))?;
+            let variable = format!("{id}_face");
+            let moving = d.as_deref().map(|d| styles::MovingWall { d, variable: &variable });
+            let (args, line) = styles::external(&external.term, |a| b.lengths()[a], |a| b.periodic[a], moving)?;
+            if let Some(line) = line {
+                self.line(line);
+            }
+            args
+        };
         let mut ids: Vec<u64> = external.members.iter().map(|&m| self.model.ids[m as usize]).collect();
         let group = ident("g_", &external.term.label.text);
         if ids.is_empty() {
@@ -581,6 +592,22 @@ impl Writer<'_> {
         self.fixes.push((id, external.term.interaction.name()));
         self.thermo_style();
         Ok(())
+    }
+
+    /// A `field` as `fix addforce` with one atom-style variable per parameter
+    /// (its arguments after the group).
+    fn field_variables(&mut self, external: &External, id: &str) -> Result<String, String> {
+        let mut names = Vec::new();
+        for (k, spec) in external.term.interaction.params().iter().enumerate() {
+            let formula = match external.expressions.iter().find(|(p, _)| *p == k) {
+                Some((_, expr)) => formula::lammps_formula(expr).map_err(|e| format!("external `{}`: {e}", external.term.label.text))?,
+                None => styles::num(external.term.params[k]),
+            };
+            let name = format!("{id}_{}", spec.name);
+            self.line(format!("variable {name} atom \"{formula}\""));
+            names.push(name);
+        }
+        Ok(format!("addforce v_{} v_{} v_{} energy v_{}", names[0], names[1], names[2], names[3]))
     }
 
     fn unexternal(&mut self, name: &str) {
@@ -682,6 +709,11 @@ impl Writer<'_> {
                         "`minimize` (FIRE with drag-scaled masses) has no exact LAMMPS equivalent; export the deck without it".into()
                     )
                 }
+                Action::Branch { .. } | Action::Skip(_) => {
+                    return Err("an `if` that reads thermo values cannot be exported: LAMMPS would need it as an `if` on a variable of \
+                                thermo keywords, which this exporter does not write"
+                        .into())
+                }
                 Action::ReadState(_) => return Err("`read_state` cannot be exported: LAMMPS cannot read cellmd restart files".into()),
                 Action::WriteState(path) => self.line(format!("# write_state {}: not exported", path.display())),
                 Action::Checkpoint(spec) => self.line(format!("# write_state {} every {}: not exported", spec.path.display(), spec.every)),
@@ -760,4 +792,25 @@ pub fn write(deck: &LammpsDeck, dir: &std::path::Path) -> std::io::Result<()> {
     std::fs::create_dir_all(dir)?;
     std::fs::write(dir.join(DATA_FILE), &deck.data)?;
     std::fs::write(dir.join(INPUT_FILE), &deck.input)
+}
+
+/// The LAMMPS formula of an external's expression parameters where LAMMPS
+/// can take one outside `field`: a wall's offset `d` as a function of t only
+/// (None: no expression parameters).
+fn moving_wall_offset(external: &External) -> Result<Option<String>, String> {
+    let name = external.term.interaction.name();
+    match &external.expressions[..] {
+        [] => Ok(None),
+        [(k, expr)]
+            if name == "wall"
+                && external.term.interaction.params()[*k].name == "d"
+                && expr.refs().iter().all(|(r, _)| *r == crate::expr::Ref::Name("t")) =>
+        {
+            formula::lammps_formula(expr).map(Some)
+        }
+        _ => Err(format!(
+            "expression parameters of `{name}` are not exported (LAMMPS takes a wall's `d` as a formula of t, and a `field` as \
+             `fix addforce` with atom-style variables)"
+        )),
+    }
 }

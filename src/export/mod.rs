@@ -10,6 +10,7 @@
 //! back as a topology, force field and deck (`cellmd import-lammps`).
 
 pub mod bond_types;
+pub mod formula;
 pub mod import_lammps;
 pub mod lammps;
 pub mod styles;

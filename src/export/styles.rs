@@ -13,9 +13,10 @@
 //! | `wca` | `pair_style lj/cut` at 2^(1/6)σ | `pair_modify shift yes` |
 //! | `soft_repulsion` ½k(σ−r)² | `pair_style harmonic/cut` k(rc−r)² | k/2, rc = σ |
 //! | `soft` | `pair_style soft` | identical |
-//! | `wall` (axis-aligned normal) | `fix wall/harmonic` ε(r−rc)² | ε = k/2, wall placed at d − rc |
+//! | `wall` (axis-aligned normal) | `fix wall/harmonic` ε(r−rc)² | ε = k/2, wall placed at d − rc; a `d` of t only is an equal-style variable of `time` |
 //! | `constant_force` | `fix addforce` | identical; its scalar is −F·x on unwrapped x |
 //! | `indenter` (K/3)(R−r)³ | `fix indent … sphere` | identical (K, centre, R) |
+//! | `field` | `fix addforce v_fx v_fy v_fz energy v_e` | one atom-style variable per parameter ([`super::formula`]) |
 
 use crate::forcefield::TermType;
 use crate::interactions::{param_index, Law};
@@ -105,17 +106,31 @@ pub fn pair(term: &TermType) -> Result<PairStyled, String> {
     Ok(PairStyled { style, coeffs, cutoff, shift })
 }
 
+/// A wall whose offset d is a formula of time: the LAMMPS formula of d and
+/// the equal-style variable that will hold the wall's face position.
+pub struct MovingWall<'a> {
+    pub d: &'a str,
+    pub variable: &'a str,
+}
+
 /// A LAMMPS fix equivalent to an external field: the fix style and its
-/// arguments after the group. `axis_length(a)` is the box edge along axis a,
+/// arguments after the group, and for a [`MovingWall`] the `variable` line
+/// to write before the fix. `axis_length(a)` is the box edge along axis a,
 /// `periodic(a)` whether that axis is periodic.
-pub fn external(term: &TermType, axis_length: impl Fn(usize) -> f64, periodic: impl Fn(usize) -> bool) -> Result<String, String> {
+pub fn external(
+    term: &TermType,
+    axis_length: impl Fn(usize) -> f64,
+    periodic: impl Fn(usize) -> bool,
+    moving: Option<MovingWall>,
+) -> Result<(String, Option<String>), String> {
     let p = |n| param(term, n);
     match term.interaction.name() {
-        "constant_force" => Ok(format!("addforce {} {} {}", num(p("fx")), num(p("fy")), num(p("fz")))),
+        "constant_force" => Ok((format!("addforce {} {} {}", num(p("fx")), num(p("fy")), num(p("fz"))), None)),
         // LAMMPS: F(r) = −K(r − R)² outward inside the sphere, energy K(R − r)³/3.
-        "indenter" => {
-            Ok(format!("indent {} sphere {} {} {} {} units box", num(p("k")), num(p("x")), num(p("y")), num(p("z")), num(p("r"))))
-        }
+        "indenter" => Ok((
+            format!("indent {} sphere {} {} {} {} units box", num(p("k")), num(p("x")), num(p("y")), num(p("z")), num(p("r"))),
+            None,
+        )),
         "wall" => {
             let n = [p("nx"), p("ny"), p("nz")];
             let axes: Vec<usize> = (0..3).filter(|&a| n[a] != 0.0).collect();
@@ -139,8 +154,20 @@ pub fn external(term: &TermType, axis_length: impl Fn(usize) -> f64, periodic: i
             let rc = axis_length(axis).max(1.0);
             let d = p("d");
             let letter = "xyz".as_bytes()[axis] as char;
-            let face = if n[axis] > 0.0 { format!("{letter}lo {}", num(d - rc)) } else { format!("{letter}hi {}", num(-d + rc)) };
-            Ok(format!("wall/harmonic {face} {} 1.0 {} units box", num(0.5 * p("k")), num(rc)))
+            let (side, position, variable) = match (&moving, n[axis] > 0.0) {
+                (None, true) => ("lo", num(d - rc), None),
+                (None, false) => ("hi", num(-d + rc), None),
+                // LAMMPS re-evaluates an equal-style face position every step.
+                (Some(m), lo) => {
+                    let formula = if lo { format!("{}-{}", m.d, num(rc)) } else { format!("-{}+{}", m.d, num(rc)) };
+                    (
+                        if lo { "lo" } else { "hi" },
+                        format!("v_{}", m.variable),
+                        Some(format!("variable {} equal \"{formula}\"", m.variable)),
+                    )
+                }
+            };
+            Ok((format!("wall/harmonic {letter}{side} {position} {} 1.0 {} units box", num(0.5 * p("k")), num(rc)), variable))
         }
         _ => Err(unsupported(term)),
     }

@@ -101,6 +101,20 @@ impl Token {
     pub fn error(&self, message: impl Into<String>) -> InputError {
         InputError::at(self, message)
     }
+
+    /// An error at byte `at` of this token's text: at that very column when
+    /// the text is still the file's (not changed by `${var}` substitution),
+    /// else at the token.
+    pub fn error_within(&self, at: usize, message: impl Into<String>) -> InputError {
+        let quoted = usize::from(self.text_len == self.text.len() + 2);
+        let start = self.offset + quoted;
+        let unchanged = self.file.text.get(start..start + self.text.len()) == Some(self.text.as_str());
+        if unchanged && at <= self.text.len() {
+            InputError::at_offset(&self.file, start + at, message)
+        } else {
+            InputError::at(self, message)
+        }
+    }
 }
 
 /// One logical statement: its tokens, never empty.

@@ -19,5 +19,5 @@ mod sources;
 pub use self::error::InputError;
 pub use self::file::{check_input_file, read_input_file, MAX_INPUT_BYTES};
 pub use self::lexer::{lex, statements, SourceFile, Statement, Statements, Token};
-pub use self::number::{evaluate_expression, parse_f64, parse_u64};
+pub use self::number::{parse_f64, parse_u64};
 pub use self::sources::{is_replaying, recording, replaying, DeckInputs, InputFile};

@@ -90,6 +90,7 @@ mod contact_adhesion;
 mod contact_barrier;
 mod cosine_angle;
 mod fene;
+mod field;
 mod flat_punch;
 mod harmonic;
 mod harmonic_angle;
@@ -126,6 +127,7 @@ pub static REGISTRY: &[&dyn Interaction] = &[
     &constant_force::ConstantForce,
     &indenter::Indenter,
     &flat_punch::FlatPunch,
+    &field::Field,
     &turgor::Turgor,
     &turgor_log::TurgorLog,
     &surface_tension::SurfaceTension,

@@ -200,7 +200,7 @@ impl Simulation {
     /// error. The simulation takes the plan's model and initial positions
     /// (no second copy of the system stays resident during the run).
     pub fn execute(plan: Plan, options: RunOptions) -> Result<Simulation, RunError> {
-        let Plan { deck_path, model, sim_box, positions, actions, inputs } = plan;
+        let Plan { deck_path, model, sim_box, positions, actions, inputs, .. } = plan;
         let mut sim = Simulation::start(model, sim_box, positions, &deck_path, inputs, options);
         let result = sim.open_log().and_then(|()| sim.perform(&actions, 0));
         sim.finish(result)
@@ -217,13 +217,19 @@ impl Simulation {
         let Some(resume) = data.resume.clone() else {
             return Err(RunError::Setup(format!("{}: the restart carries no deck to continue", restart.display())));
         };
-        let Plan { deck_path, model, sim_box, positions, actions, inputs } = plan;
+        let Plan { deck_path, model, sim_box, positions, actions, inputs, .. } = plan;
         let mut sim = Simulation::start(model, sim_box, positions, &deck_path, inputs, options);
         let result = (|| {
             sim.open_log()?;
             let before = actions.get(..resume.action).ok_or_else(|| {
                 RunError::Setup(format!("{}: action {} is beyond the deck's {}", restart.display(), resume.action, actions.len()))
             })?;
+            if before.iter().any(|a| matches!(a, Action::Branch { .. })) {
+                return Err(RunError::Setup(format!(
+                    "{}: an `if` decided during the run comes before the stopping point; --continue cannot tell which branch ran",
+                    restart.display()
+                )));
+            }
             for (k, action) in before.iter().enumerate().filter(|(_, a)| a.replays_on_continue()) {
                 sim.action = k;
                 sim.apply(action)?;
@@ -244,12 +250,29 @@ impl Simulation {
         sim.finish(result)
     }
 
-    /// Applies `actions[from..]`, checking for a stop request before each.
+    /// Applies `actions[from..]` in order, checking for a stop request
+    /// before each and following the jumps of the `if`s decided during the
+    /// run (and of a `break` inside one).
     fn perform(&mut self, actions: &[Action], from: usize) -> Result<(), RunError> {
-        for (k, action) in actions.iter().enumerate().skip(from) {
-            self.action = k;
+        let mut next = from;
+        while let Some(action) = actions.get(next) {
+            self.action = next;
             self.stop_if_requested()?;
-            self.apply(action)?;
+            next += 1 + match action {
+                Action::Branch { condition, skip } => {
+                    let holds = condition.holds(&mut |c| self.thermo_value(c).map_err(|e| e.to_string())).map_err(RunError::Setup)?;
+                    if holds {
+                        0
+                    } else {
+                        *skip
+                    }
+                }
+                Action::Skip(n) => *n,
+                other => {
+                    self.apply(other)?;
+                    0
+                }
+            };
         }
         Ok(())
     }
@@ -328,13 +351,13 @@ impl Simulation {
         RunError::Io(format!("{}: {e} (at step {})", path.display(), self.state.step))
     }
 
-    /// The simulation as the deck sets it up before its first `run` or
-    /// `minimize`: settings, externals, coefficient edits and restarts are
+    /// The simulation as the deck sets it up before its first `run`,
+    /// `minimize` or `if` decided during the run: settings, externals, coefficient edits and restarts are
     /// applied; outputs are not opened. For tools that inspect or time the
     /// initial system (`cellmd profile-gpu`, tests).
     pub fn before_first_run(plan: &Plan, options: RunOptions) -> Result<Simulation, RunError> {
         let mut sim = Simulation::new(plan, options);
-        for action in plan.actions.iter().take_while(|a| !matches!(a, Action::Run(_) | Action::Minimize(_))) {
+        for action in plan.actions.iter().take_while(|a| !matches!(a, Action::Run(_) | Action::Minimize(_) | Action::Branch { .. })) {
             if !action.is_output() {
                 sim.apply(action)?;
             }
@@ -356,9 +379,13 @@ impl Simulation {
         }
     }
 
-    /// Applies one action.
+    /// Applies one action (jumps only make sense within their plan: see
+    /// [`Self::perform`]).
     pub fn apply(&mut self, action: &Action) -> Result<(), RunError> {
         match action {
+            Action::Branch { .. } | Action::Skip(_) => {
+                return Err(RunError::Setup("a jump of an `if` decided during the run is applied with its plan".into()))
+            }
             Action::Temperature(kt) => self.kt = *kt,
             Action::Timestep(dt) => self.dt = *dt,
             Action::Seed(seed) => self.seed = *seed,
@@ -963,6 +990,10 @@ impl Simulation {
             Some("surface terms of bodies (`body` lines) run on the CPU backend only")
         } else if self.model.has_contact_terms() {
             Some("contact terms between bodies (`contact` lines) run on the CPU backend only")
+        } else if self.model.special_bonds.is_fractional() && !self.model.pair_rules.is_empty() {
+            Some("fractional `special_bonds` weights run on the CPU backend only")
+        } else if self.model.externals.iter().any(|e| !e.expressions.is_empty()) {
+            Some("externals with expression parameters (`field`, or a quoted formula of x, y, z, t) run on the CPU backend only")
         } else {
             None
         }

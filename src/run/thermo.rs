@@ -7,8 +7,10 @@
 //! |---|---|---|
 //! | `step` | steps since the deck started | – |
 //! | `time` | simulated time | s |
-//! | `pe` | total potential energy | pN·µm |
-//! | `pe/NAME` | potential energy of interaction type NAME | pN·µm |
+//! | `pe` | total potential energy, less the −F·x of `constant_force` externals (see `work`) | pN·µm |
+//! | `work` | Σ F·x of the `constant_force` externals on their particles (unwrapped x); `pe − work` is the whole potential energy, LAMMPS' `pe` with `fix_modify … energy yes` | pN·µm |
+//! | `pe/NAME` | potential energy of interaction type NAME, or of the active external NAME | pN·µm |
+//! | `fx/NAME`, `fy/NAME`, `fz/NAME` | force of the active external NAME summed over its particles (a wall's or plate's load; the reaction is its negative) | pN |
 //! | `fmax` | largest |F| on one particle | pN |
 //! | `fnorm` | √(Σ|F|²) | pN |
 //! | `press`, `pxx` … `pyz` | pressure tensor P = (N·kT/V)·I + W/V | Pa |
@@ -78,6 +80,9 @@ pub fn column_label(c: &ThermoColumn, model: &crate::system::Model) -> String {
         ThermoColumn::Step => "step".into(),
         ThermoColumn::Time => "time".into(),
         ThermoColumn::Pe => "pe".into(),
+        ThermoColumn::Work => "work".into(),
+        ThermoColumn::ExternalForce { name, axis } => format!("f{}/{name}", ["x", "y", "z"][*axis]),
+        ThermoColumn::ExternalEnergy(name) => format!("pe/{name}"),
         ThermoColumn::PeOf(k) => format!("pe/{}", REGISTRY[*k].name()),
         ThermoColumn::Fmax => "fmax".into(),
         ThermoColumn::Fnorm => "fnorm".into(),
@@ -119,10 +124,10 @@ pub fn column_unit(c: &ThermoColumn, units: UnitSystem) -> &'static str {
         ThermoColumn::Tension(_) | ThermoColumn::ConstraintTension(_) | ThermoColumn::PlaneTension { .. } => units.label(Dim::Force),
         ThermoColumn::CorticalTension(_) => units.label(Dim::Tension),
         ThermoColumn::EndToEnd(_) | ThermoColumn::GroupPosition { .. } => units.label(Dim::Length),
-        ThermoColumn::GroupForce { .. } | ThermoColumn::IndenterLoad(_) => units.label(Dim::Force),
+        ThermoColumn::GroupForce { .. } | ThermoColumn::ExternalForce { .. } | ThermoColumn::IndenterLoad(_) => units.label(Dim::Force),
         ThermoColumn::IndenterDepth(_) => units.label(Dim::Length),
         ThermoColumn::Time => units.label(Dim::Time),
-        ThermoColumn::Pe | ThermoColumn::PeOf(_) => units.label(Dim::Energy),
+        ThermoColumn::Pe | ThermoColumn::PeOf(_) | ThermoColumn::Work | ThermoColumn::ExternalEnergy(_) => units.label(Dim::Energy),
         ThermoColumn::Fmax | ThermoColumn::Fnorm => units.label(Dim::Force),
         ThermoColumn::Press | ThermoColumn::Pressure(_) => units.label(Dim::Pressure),
         ThermoColumn::BodyVolume(_) => units.label(Dim::Volume),
@@ -145,7 +150,10 @@ pub fn column_value(c: &ThermoColumn, t: &ThermoInputs) -> f64 {
     match c {
         ThermoColumn::Step => t.step as f64,
         ThermoColumn::Time => t.time,
-        ThermoColumn::Pe => t.forces.total_energy(),
+        ThermoColumn::Pe => t.forces.total_energy() + constant_force_work(t),
+        ThermoColumn::Work => constant_force_work(t),
+        ThermoColumn::ExternalForce { name, axis } => external_sums(t, name).0[*axis],
+        ThermoColumn::ExternalEnergy(name) => external_sums(t, name).1,
         ThermoColumn::PeOf(k) => t.forces.energy_by_interaction[*k],
         ThermoColumn::Fmax => t.forces.max_force().0,
         ThermoColumn::Fnorm => t.forces.forces.iter().map(|f| f.length_squared()).sum::<f64>().sqrt(),
@@ -187,6 +195,19 @@ pub fn column_value(c: &ThermoColumn, t: &ThermoInputs) -> f64 {
             group.members.iter().map(|&i| unwrapped(i as usize)).sum::<f64>() / group.members.len() as f64
         }
     }
+}
+
+/// Σ F·x of the `constant_force` externals: minus their energy.
+fn constant_force_work(t: &ThermoInputs) -> f64 {
+    let k = REGISTRY.iter().position(|i| i.name() == "constant_force").expect("registered");
+    -t.forces.energy_by_interaction.get(k).copied().unwrap_or(0.0)
+}
+
+/// Summed force and energy of the active external `name` (zero once it is removed).
+fn external_sums(t: &ThermoInputs, name: &str) -> (glam::DVec3, f64) {
+    let Some(external) = t.model.externals.iter().find(|e| e.term.label.text == name) else { return (glam::DVec3::ZERO, 0.0) };
+    crate::backend::external_field(external, t.state, t.sim_box)
+        .fold((glam::DVec3::ZERO, 0.0), |(f, e), (_, field)| (f + field.force, e + field.energy))
 }
 
 /// Indices of the bound bonds of a bond type.

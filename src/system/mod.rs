@@ -6,6 +6,6 @@ mod sim_box;
 mod state;
 
 pub use self::clock::StepClock;
-pub use self::model::{registry_index, Body, External, Model, SpecialBonds};
+pub use self::model::{position_or_time, registry_index, Body, External, Model, SpecialBonds};
 pub use self::sim_box::{Images, SimBox};
 pub use self::state::State;

@@ -16,6 +16,40 @@ pub struct External {
     pub group: String,
     /// Internal indices of the particles it acts on, ascending.
     pub members: Vec<u32>,
+    /// Parameters given as expressions of the particle's unwrapped position
+    /// `x`, `y`, `z` and the simulated time `t` (parameter index, tree):
+    /// they replace `term.params` entries wherever the field is evaluated.
+    pub expressions: Vec<(usize, crate::expr::Expr)>,
+}
+
+impl External {
+    /// The field on a particle at unwrapped position `x` at time `t`. An
+    /// expression outside its domain there (e.g. `sqrt(x)` at x < 0) gives
+    /// a NaN parameter, so the run stops with a blow-up report naming this
+    /// external as the particle's culprit.
+    pub fn at(&self, x: glam::DVec3, t: f64) -> crate::interactions::OneBody {
+        let Law::OneBody(eval) = self.term.interaction.law() else { unreachable!("external law is one-body") };
+        if self.expressions.is_empty() {
+            return eval(&self.term.params, x);
+        }
+        let mut params = self.term.params.clone();
+        for (k, expr) in &self.expressions {
+            params[*k] = expr.eval(&mut |r| position_or_time(r, x, t)).unwrap_or(f64::NAN);
+        }
+        eval(&params, x)
+    }
+}
+
+/// The value of `x`, `y`, `z` or `t` in an external's parameter expression.
+pub fn position_or_time(r: crate::expr::Ref, x: glam::DVec3, t: f64) -> Result<f64, String> {
+    match r {
+        crate::expr::Ref::Name("x") => Ok(x.x),
+        crate::expr::Ref::Name("y") => Ok(x.y),
+        crate::expr::Ref::Name("z") => Ok(x.z),
+        crate::expr::Ref::Name("t") => Ok(t),
+        crate::expr::Ref::Name(other) => Err(format!("found `{other}`, expected x, y, z, t or a numeric deck variable")),
+        crate::expr::Ref::Thermo(c) => Err(format!("found `thermo({c})`, expected x, y, z, t or a numeric deck variable")),
+    }
 }
 
 /// A closed surface of the topology (a cell, a nucleus): its nodes and mesh.
@@ -30,19 +64,26 @@ pub struct Body {
     pub mesh: std::sync::Arc<crate::mesh::SurfaceMesh>,
 }
 
-/// Which bonded neighbours are excluded from pair interactions
-/// (LAMMPS `special_bonds lj W12 W13 W14` with weights 0 or 1).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// Weights of the pair terms between bonded neighbours (LAMMPS
+/// `special_bonds lj W12 W13 W14`): for 1-2, 1-3 and 1-4 neighbours along
+/// the bonds, 0 leaves the pair out, 1 counts it in full, and a weight in
+/// between scales its energy and force.
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SpecialBonds {
-    pub exclude_12: bool,
-    pub exclude_13: bool,
-    pub exclude_14: bool,
+    pub weights: [f64; 3],
+}
+
+impl SpecialBonds {
+    /// Whether some weight lies strictly between 0 and 1.
+    pub fn is_fractional(&self) -> bool {
+        self.weights.iter().any(|&w| w > 0.0 && w < 1.0)
+    }
 }
 
 impl Default for SpecialBonds {
     /// Directly bonded pairs are excluded; 1-3 and 1-4 pairs interact.
     fn default() -> Self {
-        Self { exclude_12: true, exclude_13: false, exclude_14: false }
+        Self { weights: [0.0, 1.0, 1.0] }
     }
 }
 
@@ -351,9 +392,17 @@ impl Model {
             .fold(0.0, f64::max)
     }
 
-    /// Pairs excluded from pair interactions by `special_bonds` (i < j),
-    /// following the bonds that are bound (`bound` = None: all of them).
+    /// Pairs left out of the neighbour list by `special_bonds` (i < j): those
+    /// whose weight is not 1, following the bonds that are bound (`bound` =
+    /// None: all of them).
     pub fn excluded_pairs(&self, bound: Option<&[bool]>) -> Vec<(u32, u32)> {
+        self.special_pairs(bound).into_iter().map(|(i, j, _)| (i, j)).collect()
+    }
+
+    /// Bonded neighbour pairs (i < j) whose `special_bonds` weight is not 1,
+    /// with that weight: the nearest relation along bound bonds (a pair both
+    /// 1-2 and 1-3, in a triangle, is 1-2).
+    pub fn special_pairs(&self, bound: Option<&[bool]>) -> Vec<(u32, u32, f64)> {
         let n = self.len();
         let mut adjacency: Vec<Vec<u32>> = vec![Vec::new(); n];
         for (b, &[i, j]) in self.bonds.iter().enumerate() {
@@ -363,7 +412,7 @@ impl Model {
             adjacency[i as usize].push(j);
             adjacency[j as usize].push(i);
         }
-        let sb = self.special_bonds;
+        let weights = self.special_bonds.weights;
         let mut pairs = Vec::new();
         for start in 0..n as u32 {
             // Breadth-first to depth 3 along bonds.
@@ -376,13 +425,9 @@ impl Model {
                         if !seen.contains(&q) {
                             seen.push(q);
                             next.push(q);
-                            let excluded = match depth {
-                                1 => sb.exclude_12,
-                                2 => sb.exclude_13,
-                                _ => sb.exclude_14,
-                            };
-                            if excluded && start < q {
-                                pairs.push((start, q));
+                            let w = weights[depth - 1];
+                            if w != 1.0 && start < q {
+                                pairs.push((start, q, w));
                             }
                         }
                     }
@@ -390,8 +435,8 @@ impl Model {
                 frontier = next;
             }
         }
-        pairs.sort_unstable();
-        pairs.dedup();
+        pairs.sort_unstable_by_key(|&(i, j, _)| (i, j));
+        pairs.dedup_by_key(|&mut (i, j, _)| (i, j));
         pairs
     }
 
@@ -448,11 +493,53 @@ mod tests {
     fn special_bonds_follow_the_bond_graph() {
         let only_12 = SpecialBonds::default();
         assert_eq!(one_based(model(only_12).excluded_pairs(None)), vec![(1, 2), (2, 3), (3, 4), (3, 6), (4, 5)]);
-        let only_13 = SpecialBonds { exclude_12: false, exclude_13: true, exclude_14: false };
+        let only_13 = SpecialBonds { weights: [1.0, 0.0, 1.0] };
         assert_eq!(one_based(model(only_13).excluded_pairs(None)), vec![(1, 3), (2, 4), (2, 6), (3, 5), (4, 6)]);
-        let only_14 = SpecialBonds { exclude_12: false, exclude_13: false, exclude_14: true };
+        let only_14 = SpecialBonds { weights: [1.0, 1.0, 0.0] };
         assert_eq!(one_based(model(only_14).excluded_pairs(None)), vec![(1, 4), (1, 6), (2, 5), (5, 6)]);
-        let none = SpecialBonds { exclude_12: false, exclude_13: false, exclude_14: false };
+        let none = SpecialBonds { weights: [1.0; 3] };
         assert!(model(none).excluded_pairs(None).is_empty());
+        // Fractional weights: every pair whose weight is not 1 leaves the neighbour list, with its weight.
+        let charmm = SpecialBonds { weights: [0.0, 0.0, 0.5] };
+        assert_eq!(
+            model(charmm).special_pairs(None).into_iter().filter(|p| p.2 != 0.0).map(|(i, j, w)| (i + 1, j + 1, w)).collect::<Vec<_>>(),
+            vec![(1, 4, 0.5), (1, 6, 0.5), (2, 5, 0.5), (5, 6, 0.5)]
+        );
+        assert_eq!(model(charmm).excluded_pairs(None).len(), 5 + 5 + 4);
+    }
+
+    /// `External::at` evaluates expression parameters at the particle's
+    /// position and time: a harmonic trap whose centre moves with t, F =
+    /// −2(x − c(t)) with energy |x − c(t)|², obeys F = −∇E by central
+    /// differences and its closed form; outside a domain the parameter is NaN.
+    #[test]
+    fn an_external_evaluates_its_expression_parameters_at_each_position_and_time() {
+        let label = crate::input::lex(&SourceFile::new("t.in", "trap")).unwrap()[0].tokens[0].clone();
+        let field = crate::interactions::lookup("field").unwrap();
+        let term = TermType { label, interaction: field, params: vec![0.0; 4] };
+        let exprs = ["-2*(x - 0.5*t)", "-2*y", "-2*(z - sin(t))", "(x - 0.5*t)^2 + y^2 + (z - sin(t))^2"];
+        let expressions = exprs.iter().enumerate().map(|(k, e)| (k, crate::expr::parse(e).unwrap())).collect();
+        let trap = External { term, group: "all".into(), members: vec![0], expressions };
+        let h = 1e-5;
+        for (x, t) in [(glam::DVec3::new(1.0, 2.0, -1.0), 0.0), (glam::DVec3::new(-0.3, 0.1, 0.7), 2.5)] {
+            let at = trap.at(x, t);
+            for axis in 0..3 {
+                let mut step = glam::DVec3::ZERO;
+                step[axis] = h;
+                let gradient = (trap.at(x + step, t).energy - trap.at(x - step, t).energy) / (2.0 * h);
+                assert!(
+                    (at.force[axis] + gradient).abs() < 1e-8,
+                    "axis {axis} at {x} t = {t}: F = {} vs −∇E = {}",
+                    at.force[axis],
+                    -gradient
+                );
+            }
+        }
+        let at = trap.at(glam::DVec3::new(2.0, 1.0, 0.0), 2.0);
+        assert_eq!(at.force, glam::DVec3::new(-2.0, -2.0, 2.0 * 2f64.sin()));
+        assert!((at.energy - (1.0 + 1.0 + 2f64.sin().powi(2))).abs() < 1e-15);
+        // Outside an expression's domain the parameter is NaN (the run stops as a blow-up).
+        let sqrt = External { expressions: vec![(0, crate::expr::parse("sqrt(x)").unwrap())], ..trap };
+        assert!(sqrt.at(glam::DVec3::new(-1.0, 0.0, 0.0), 0.0).force.x.is_nan());
     }
 }

@@ -26,7 +26,7 @@ const INDENTERS: [&str; 2] = ["indenter", "flat_punch"];
 const RAMP_SAMPLES: u32 = 1024;
 
 /// What the protocol commands seen so far leave in force.
-#[derive(Default)]
+#[derive(Clone, Default)]
 pub(super) struct Protocols {
     /// Ramps waiting for the next `run`: target, parameter, and the command's keyword.
     pending: Vec<(CoeffTarget, usize, Token)>,
