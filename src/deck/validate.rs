@@ -86,7 +86,13 @@ fn expect_len(s: &[Token], range: std::ops::RangeInclusive<usize>, usage: &str) 
     }
     let at = if n > *range.end() { &s[*range.end() + 1] } else { s.last().unwrap() };
     let what = if n > *range.end() { "too many arguments" } else { "too few arguments" };
-    Err(at.error(format!("{what} ({n}); expected `{usage}`")))
+    // Each form quoted on its own: a quote is clipped past 80 characters.
+    let forms: Vec<String> = usage.split(" | ").map(|form| format!("`{form}`")).collect();
+    let expected = match forms.split_last() {
+        Some((last, rest)) if !rest.is_empty() => format!("{} or {last}", rest.join(", ")),
+        _ => forms.concat(),
+    };
+    Err(at.error(format!("{what} ({n}); expected {expected}")))
 }
 
 fn yes_no(token: &Token) -> Result<bool, InputError> {

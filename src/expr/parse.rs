@@ -100,6 +100,8 @@ struct Parser {
     at: usize,
     /// How deep `(`, unary operators and `^` nest at the current token.
     depth: usize,
+    /// Numbers, names and thermo values read so far.
+    operands: usize,
 }
 
 /// How deep `(`, unary `-`, `+`, `!` and `^` may nest in one expression.
@@ -216,6 +218,12 @@ impl Parser {
     fn atom(&mut self) -> Result<Expr, ExprError> {
         const OPERAND: &str = "a number, a name, a function call or `(`";
         let (tok, span) = self.peek().clone();
+        if matches!(tok, Tok::Number(_) | Tok::Name(_) | Tok::Thermo(_)) {
+            self.operands += 1;
+            if self.operands > MAX_OPERANDS {
+                return Err(ExprError::new(span, format!("found more than {MAX_OPERANDS} numbers and names in one expression; expected a shorter one")));
+            }
+        }
         match tok {
             Tok::Number(v) => {
                 self.next();
@@ -278,15 +286,7 @@ impl Parser {
 
 /// Parses an expression (the grammar is in the [module docs](super)).
 pub fn parse(text: &str) -> Result<Expr, ExprError> {
-    let toks = tokenize(text)?;
-    let operands = toks.iter().filter(|(t, _)| matches!(t, Tok::Number(_) | Tok::Name(_) | Tok::Thermo(_))).count();
-    if operands > MAX_OPERANDS {
-        return Err(ExprError::new(
-            Span { start: 0, end: text.len() },
-            format!("found an expression of {operands} numbers and names; expected at most {MAX_OPERANDS}"),
-        ));
-    }
-    let mut parser = Parser { toks, at: 0, depth: 0 };
+    let mut parser = Parser { toks: tokenize(text)?, at: 0, depth: 0, operands: 0 };
     if parser.peek().0 == Tok::End {
         return Err(ExprError::new(Span { start: 0, end: text.len() }, "found an empty expression, expected a number or a formula"));
     }
@@ -329,6 +329,7 @@ mod tests {
     fn operands_are_limited() {
         assert_eq!(value(&format!("{}1", "1+".repeat(MAX_OPERANDS - 1))), MAX_OPERANDS as f64);
         let e = parse(&format!("{}1", "1+".repeat(500_000))).unwrap_err();
-        assert_eq!(e.message, "found an expression of 500001 numbers and names; expected at most 4096");
+        assert_eq!(e.message, "found more than 4096 numbers and names in one expression; expected a shorter one");
+        assert_eq!(e.span.start, 2 * MAX_OPERANDS, "at the first operand beyond the limit");
     }
 }
