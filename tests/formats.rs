@@ -85,7 +85,7 @@ fn dumped_case() -> Case {
     let ff = "particle a drag 1\nparticle b drag 2\nbond s harmonic k 2 r0 0.5\nangle t cosine_angle K 0.3\n\
               pair a a soft A 1 rc 0.9\npair a b soft A 1 rc 0.7\n";
     std::fs::write(case.path("f.ff"), ff).unwrap();
-    let body = "temperature 1\ntimestep 0.001\nseed 3\nintegrator overdamped max_displacement 0.05\n\
+    let body = "temperature 1\ntimestep 0.001\nseed 3\n\
                 external floor all wall nz 1 d 1 k 5\ndump l every 10 lammps t.lammpstrj\ndump x every 10 xyz t.xyz\n\
                 dump d every 10 dcd t.dcd\ndump m every 10 mcap t.mcap\nrun 30\n";
     let deck = std::fs::read_to_string(case.path("deck.in")).unwrap() + body;

@@ -27,9 +27,12 @@
 //!
 //! # Compression
 //!
-//! Chunks are compressed with zstd (the MCAP default chunk size, 768 KiB):
-//! ~10× smaller than uncompressed JSON. Every MCAP reader (the `mcap` CLI,
-//! Foxglove, the Python and Rust libraries) decompresses them.
+//! Chunks are compressed with zstd (default level, the MCAP default chunk
+//! size of 768 KiB, single-threaded so the bytes do not depend on the
+//! machine). The full quickstart (81 frames of 1500 particles) writes
+//! 7.2 MB; its messages are 31 MB uncompressed, and 64.7 MB with the scene
+//! as JSON (`encoding json`: 6.5 MB compressed). Every MCAP reader (the
+//! `mcap` CLI, Foxglove, the Python and Rust libraries) decompresses them.
 //!
 //! # Time stamps
 //!
@@ -213,6 +216,8 @@ impl McapWriter {
         check_topology(topology)?;
         let options = mcap::WriteOptions::new()
             .compression(Some(mcap::Compression::Zstd))
+            // One thread: the bytes then never depend on the machine's core count.
+            .compression_threads(0)
             .profile("")
             .library(format!("cellmd {}", env!("CARGO_PKG_VERSION")));
         let mut writer = options.create(BufWriter::new(File::create(path)?)).map_err(mcap_err)?;

@@ -353,9 +353,11 @@ mod tests {
         frame.bound = &[false, true];
         let drawn = segments(&frame);
         assert_eq!(drawn[0].len(), 2);
-        // Bond 1 joins particles 0 and 3 (no periodic image in between).
-        let p3 = s.frames[0][3];
-        assert_eq!((drawn[0][1].x, drawn[0][1].y, drawn[0][1].z), (p3.x, p3.y, p3.z));
+        // Bond 1 joins particles 0 and 3, drawn to 3's nearest image (across the periodic y face).
+        let (p0, p3) = (s.frames[0][0], s.frames[0][3]);
+        let end = p0 + s.sim_box.minimum_image(p3 - p0);
+        assert_eq!((drawn[0][1].x, drawn[0][1].y, drawn[0][1].z), (end.x, end.y, end.z));
+        assert_eq!(end.y, -2.75);
         frame.bound = &[false, false];
         assert!(segments(&frame).is_empty(), "no line primitive without a bound bond");
     }
