@@ -520,3 +520,100 @@ fn tensegrity() {
     println!("mean strut length / L = {strut:.4}, mean cortex edge / built = {cortex:.4}");
     assert!(strut > 0.9 && strut < 1.0 && cortex > 0.8 && cortex < 1.0, "{strut} {cortex}");
 }
+
+/// The system a deck builds, as text: the whole model, the box and the
+/// positions (f64 in its round-trip form, so equal text is equal bits).
+fn system_of(deck: &Path) -> String {
+    let plan = cellmd::deck::validate_file(deck, &[]).unwrap_or_else(|e| panic!("{e}"));
+    format!("{:?}\n{:?}\n{:?}", plan.model, plan.sim_box, plan.positions)
+}
+
+#[test]
+fn merge_writes_what_a_deck_with_several_topology_lines_builds() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let root = env!("CARGO_MANIFEST_DIR");
+    // The four parts of inputs/composed_cell.in, then a filament with its own
+    // r0 per bond and a [ box ] (the first one given) at an explicit offset.
+    build_in(
+        d,
+        &[
+            "filament",
+            "--length",
+            "3",
+            "--segments",
+            "10",
+            "--direction",
+            "1",
+            "1",
+            "0",
+            "--box",
+            "7",
+            "--particle-type",
+            "actin",
+            "--bond-type",
+            "actin_segment",
+            "--angle-type",
+            "actin_bend",
+            "--rest-from-geometry",
+        ],
+    );
+    let mut files: Vec<String> = ["membrane", "cortex", "aster", "nucleus"].iter().map(|p| format!("{root}/topologies/composed_cell/{p}.top")).collect();
+    files.push("out.top".into());
+    let mut args: Vec<&str> = vec!["build", "merge"];
+    args.extend(files.iter().map(String::as_str));
+    args.extend(["--offset", "auto", "--offset", "auto", "--offset", "426", "--offset", "auto", "--offset", "5000", "-o", "merged.top"]);
+    let merged = cellmd(d, &args);
+    let said = String::from_utf8_lossy(&merged.stdout);
+    assert!(merged.status.success(), "{}", String::from_utf8_lossy(&merged.stderr));
+    assert!(said.starts_with("wrote merged.top: ") && said.contains("564 particles"), "{said}");
+    assert!(said.contains("out.top: 11 particles, ids 5001–5011 (id offset 5000, body ids shifted by 2)"), "{said}");
+
+    let deck = |name: &str, topologies: &str| {
+        let text = format!("units cell\n{topologies}forcefield {root}/forcefields/composed_cell.ff\ntimestep 5e-6\nrun 1\n");
+        std::fs::write(d.join(name), text).unwrap();
+        d.join(name)
+    };
+    let offsets = ["auto", "auto", "426", "auto", "5000"];
+    let lines: String = files.iter().zip(offsets).map(|(f, o)| format!("topology {f} offset {o}\n")).collect();
+    let composed = system_of(&deck("parts.in", &lines));
+    assert_eq!(system_of(&deck("merged.in", "topology merged.top\n")), composed);
+
+    let text = std::fs::read_to_string(d.join("merged.top")).unwrap();
+    assert!(text.contains("\n[ bodies ]\n1 membrane\n2 nucleus\n"), "body ids follow");
+    let filament = std::fs::read_to_string(d.join("out.top")).unwrap();
+    let box_lines = &filament[filament.find("[ box ]").unwrap()..filament.find("[ particles ]").unwrap()];
+    assert!(text.contains(box_lines), "the filament's box, the first given");
+    let r0 = filament.lines().find_map(|l| l.strip_prefix("actin_segment 1 2 ")).unwrap();
+    assert!(text.contains(&format!("\nactin_segment 5001 5002 {r0}\n")), "its own r0 kept: {r0}");
+}
+
+#[test]
+fn merge_refuses_clashes_and_bad_files_naming_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("a.top"), "[ particles ]\n1 a 0 0 0\n2 a 1 0 0\n[ bonds ]\ns 1 2\n").unwrap();
+    std::fs::write(d.join("bad.top"), "[ particles ]\n1 a 0 0\n").unwrap();
+    for (args, expected) in [
+        (
+            &["a.top", "a.top", "--offset", "auto", "--offset", "1"][..],
+            "error: particle id 1 of `a.top` plus offset 1 is already used by an earlier topology; expected `--offset auto` or an offset >= 2",
+        ),
+        (&["a.top", "bad.top"][..], "error: bad.top:2:7: found 4 fields, expected `id type x y z [body]`"),
+        (&["a.top", "missing.top"][..], "error: missing.top:1:1: cannot read `missing.top`"),
+        (&["a.top", "a.top", "--offset", "auto"][..], "error: found 1 --offset values for 2 files, expected one per file or none"),
+        (&["a.top", "a.top", "--offset", "x", "--offset", "auto"][..], "error: found --offset `x`, expected `auto` or a whole number >= 0"),
+    ] {
+        let mut all = vec!["build", "merge"];
+        all.extend_from_slice(args);
+        all.extend_from_slice(&["-o", "x.top"]);
+        let out = cellmd(d, &all);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{all:?}: {err}");
+        assert!(err.contains(expected), "{all:?}: {err}");
+        assert!(!d.join("x.top").exists());
+    }
+    cellmd(d, &["build", "merge", "a.top", "a.top", "--offset", "auto", "--offset", "2", "-o", "x.top"]);
+    let text = std::fs::read_to_string(d.join("x.top")).unwrap();
+    assert!(text.contains("[ particles ]\n# id  type  x  y  z  [body]\n1 a 0.0 0.0 0.0\n2 a 1.0 0.0 0.0\n3 a 0.0 0.0 0.0\n4 a 1.0 0.0 0.0\n[ bonds ]\n# type  i  j  [r0]\ns 1 2\ns 3 4\n"), "{text}");
+}

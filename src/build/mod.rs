@@ -23,6 +23,7 @@
 //! | [`cells()`] | `cells` | many icosphere cells packed in a spheroid or a confluent layer |
 //! | [`sheet()`] | `sheet` | a 2D epithelial sheet (seed 001): hexagonal cells as rings of nodes (or single particles) joined by junction bonds |
 //! | [`tensegrity()`] | `tensegrity` | a tensegrity cell (seed 003): cortex and nucleus shells, radial microtubule struts, actin cables and stress fibres from focal adhesions |
+//! | [`merge()`] | `merge` | several topology files composed into one by the deck's rule for several `topology` lines |
 //!
 //! **Rest lengths** (`--rest-from-geometry`, every generator): by default a
 //! bond line is `type i j`, and the force field's `r0` of the type applies to
@@ -73,6 +74,7 @@ mod cortex;
 mod filament;
 mod filopodium;
 mod icosphere;
+mod merge;
 mod network;
 mod sheet;
 mod tensegrity;
@@ -93,6 +95,7 @@ pub use self::cortex::{cortex, CortexArgs};
 pub use self::filament::{filament, FilamentArgs};
 pub use self::filopodium::{filopodium, FilopodiumArgs};
 pub use self::icosphere::{icosphere, icosphere_cell, IcosphereArgs, IcosphereCell, Nucleus, ShellOptions};
+pub use self::merge::{merge, MergeArgs};
 pub use self::network::{network, NetworkArgs, SlabAxis};
 pub use self::sheet::{sheet, SheetArgs};
 pub use self::tensegrity::{tensegrity, TensegrityArgs};
@@ -129,6 +132,10 @@ pub enum Generator {
     /// centrosome node), radial microtubule struts, actin cables from the
     /// cortex to the nucleus and stress fibres from focal adhesions.
     Tensegrity(TensegrityArgs),
+    /// Several topology files composed into one by the rule of a deck with
+    /// several `topology` lines (ids shifted by --offset, by default the
+    /// largest so far; body ids follow; shared type names; the first box).
+    Merge(MergeArgs),
 }
 
 impl Generator {
@@ -145,6 +152,7 @@ impl Generator {
             Self::Cells(a) => cells(a),
             Self::Sheet(a) => sheet(a),
             Self::Tensegrity(a) => tensegrity(a),
+            Self::Merge(a) => merge(a),
         }
     }
 
@@ -161,6 +169,7 @@ impl Generator {
             Self::Cells(a) => a.common.output.as_path(),
             Self::Sheet(a) => a.common.output.as_path(),
             Self::Tensegrity(a) => a.common.output.as_path(),
+            Self::Merge(a) => a.output.as_path(),
         }
     }
 }

@@ -11,10 +11,29 @@
 
 use super::Topology;
 
+/// A refused [`Topology::append_at`]: particle `id` of the appended topology
+/// plus `offset` is taken; `used` is the largest id before it (the least
+/// offset that cannot clash).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Clash {
+    pub id: u64,
+    pub offset: u64,
+    pub used: u64,
+}
+
 impl Topology {
     /// The largest particle id (0 when empty).
     pub fn max_id(&self) -> u64 {
         self.ids.iter().copied().max().unwrap_or(0)
+    }
+
+    /// Appends `other` by the composition rule: its particle ids shifted by
+    /// `offset`, by default (`None`, `offset auto`) the largest id so far.
+    /// Returns the offset applied.
+    pub fn append_at(&mut self, other: Topology, offset: Option<u64>) -> Result<u64, Clash> {
+        let used = self.max_id();
+        let offset = offset.unwrap_or(used);
+        self.append(other, offset).map(|()| offset).map_err(|id| Clash { id, offset, used })
     }
 
     /// Appends `other` with its particle ids shifted by `id_offset` and its
@@ -28,6 +47,9 @@ impl Topology {
         }
         let body_offset = self.bodies.iter().map(|(id, _)| *id).max().unwrap_or(0);
         let base = self.ids.len() as u32;
+        let bond_base = self.bonds.len();
+        self.parallel_bonds.extend(other.parallel_bonds.iter().map(|&(b, line)| (b + bond_base, line)));
+        self.face_tokens.extend(other.face_tokens);
         self.path = if self.path.is_empty() { other.path.clone() } else { format!("{} + {}", self.path, other.path) };
         if self.box_axes.is_none() {
             self.box_axes = other.box_axes;
@@ -78,6 +100,14 @@ mod tests {
         assert_eq!(top.bonds[1].type_name.text, "e");
         assert_eq!(top.positions[4].x, 5.0);
         assert_eq!(top.path, "a.top + b.top");
+        assert_eq!(top.face_tokens.len(), 8, "faces keep their lines for later errors");
+    }
+
+    #[test]
+    fn a_repeated_bond_of_a_later_topology_is_still_recorded() {
+        let mut top = parse("a.top", CELL);
+        top.append_at(parse("b.top", &format!("{CELL}e 2 1\n")), None).unwrap();
+        assert_eq!(top.parallel_bonds, [(2, 14)], "bond 2 of the whole repeats line 14 of b.top");
     }
 
     #[test]
@@ -85,5 +115,7 @@ mod tests {
         let mut top = parse("a.top", CELL);
         assert_eq!(top.append(parse("b.top", CELL), 2), Err(1), "id 1 + 2 is taken");
         assert_eq!(top.ids.len(), 4, "nothing appended");
+        assert_eq!(top.append_at(parse("b.top", CELL), Some(3)), Err(super::Clash { id: 1, offset: 3, used: 4 }));
+        assert_eq!(top.append_at(parse("b.top", CELL), None), Ok(4), "auto: after the largest id");
     }
 }

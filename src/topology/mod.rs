@@ -50,4 +50,5 @@ mod merge;
 mod parse;
 mod surface;
 
+pub use self::merge::Clash;
 pub use self::parse::{parse_box_axis, parse_topology, BoxAxis, Topology, TypedTerm};

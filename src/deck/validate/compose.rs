@@ -24,12 +24,10 @@ impl Validator {
             }
             previous => previous.unwrap_or_default(),
         };
-        let used = top.max_id();
-        let offset = offset.unwrap_or(used);
-        top.append(parsed, offset).map_err(|id| {
+        top.append_at(parsed, offset).map_err(|c| {
             s[1].error(format!(
-                "particle id {id} of `{}` plus offset {offset} is already used by an earlier topology; expected `offset auto` or an offset >= {used}",
-                s[1].text
+                "particle id {} of `{}` plus offset {} is already used by an earlier topology; expected `offset auto` or an offset >= {}",
+                c.id, s[1].text, c.offset, c.used
             ))
         })?;
         self.topology = Some(top);
