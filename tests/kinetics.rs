@@ -430,19 +430,10 @@ fn maturation_follows_its_exact_time_course() {
 /// on one and two threads, events included.
 #[test]
 fn kinetics_runs_are_bit_identical_across_thread_counts() {
-    let mut top = String::from("[ particles ]\n");
-    let mut bonds = String::from("[ bonds ]\n");
-    for m in 0..300 {
-        let (x, y) = ((m % 20) as f64 * 2.0, (m / 20) as f64 * 2.0);
-        top += &format!("{} a {x} {y} 0\n{} bead {x} {y} 0.5\n", 2 * m + 1, 2 * m + 2);
-        bonds += &format!("b {} {}\n", 2 * m + 1, 2 * m + 2);
-    }
-    // Beads also form (and lose) bonds to the neighbouring sites within reach.
-    let ff = "particle a fixed\nparticle bead drag 1\nbond b harmonic k 20 r0 0.5 kinetics slip k0 0.5 x_beta 0.2 kinetics rebind k_on 2 capture 1 kinetics motor v0 0.1 fs 3\n\
-              bond x harmonic k 5 r0 1.5 kinetics slip k0 1 x_beta 0.1\nbind a bead x k_on 0.5 capture 2.2 max_bonds 2\npair bead bead wca epsilon 1 sigma 0.3\n";
+    let (top, ff) = common::kinetic_sites();
     let deck = "units lj\ntopology t.top\nforcefield f.ff\nbox x -5 45 f y -5 35 f z -5 5 f\nneighbor skin 0.2\ntemperature 1\ntimestep 2e-4\nseed 3\nevents events.csv\nrun 3000\n";
     let run = |threads: usize| {
-        let c = Case::new(&[("t.top", &(top.clone() + &bonds)), ("f.ff", ff), ("deck.in", deck)]);
+        let c = Case::new(&[("t.top", &top), ("f.ff", ff), ("deck.in", deck)]);
         let sim = c.run_with_threads(threads);
         let log = std::fs::read(c.path("events.csv")).unwrap();
         (common::position_bits(&sim), sim.state.bonds.clone().unwrap(), log, sim.kinetics.breaks, sim.kinetics.forms)

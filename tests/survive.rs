@@ -22,21 +22,13 @@ fn cellmd() -> Command {
 /// Bonds that break, rebind and form (the system of the kinetics tests),
 /// with every kind of output; `steps` steps, then the final state is saved.
 fn kinetics_case(steps: u64) -> Case {
-    let mut top = String::from("[ particles ]\n");
-    let mut bonds = String::from("[ bonds ]\n");
-    for m in 0..300 {
-        let (x, y) = ((m % 20) as f64 * 2.0, (m / 20) as f64 * 2.0);
-        top += &format!("{} a {x} {y} 0\n{} bead {x} {y} 0.5\n", 2 * m + 1, 2 * m + 2);
-        bonds += &format!("b {} {}\n", 2 * m + 1, 2 * m + 2);
-    }
-    let ff = "particle a fixed\nparticle bead drag 1\nbond b harmonic k 20 r0 0.5 kinetics slip k0 0.5 x_beta 0.2 kinetics rebind k_on 2 capture 1 kinetics motor v0 0.1 fs 3\n\
-              bond x harmonic k 5 r0 1.5 kinetics slip k0 1 x_beta 0.1\nbind a bead x k_on 0.5 capture 2.2 max_bonds 2\npair bead bead wca epsilon 1 sigma 0.3\n";
+    let (top, ff) = common::kinetic_sites();
     let deck = format!(
         "units lj\ntopology t.top\nforcefield f.ff\nbox x -5 45 f y -5 35 f z -5 5 f\nneighbor skin 0.2\ntemperature 1\ntimestep 2e-4\nseed 3\n\
          thermo 20 step time pe breaks rebinds forms\nthermo_file thermo.csv\nevents events.csv\n\
          dump m every 50 mcap traj.mcap\ndump l every 50 lammps traj.dump\nrun {steps}\nwrite_state final.restart\n"
     );
-    Case::new(&[("t.top", &(top + &bonds)), ("f.ff", ff), ("deck.in", &deck)])
+    Case::new(&[("t.top", &top), ("f.ff", ff), ("deck.in", &deck)])
 }
 
 /// A fixed seed's pseudo-random fraction in [0, 1) (splitmix64).
@@ -214,7 +206,7 @@ fn chains_case(extra: &str) -> Case {
     let deck = format!(
         "units lj\ntopology t.top\nforcefield f.ff\nbox x 0 7 p y 0 7 p z 0 9.7 p\nneighbor skin 0.3\ntemperature 1.0\ntimestep 0.0005\nseed 99\n{extra}"
     );
-    Case::new(&[("t.top", &(top + &bonds)), ("f.ff", ff), ("deck.in", &deck)])
+    Case::new(&[("t.top", &top), ("f.ff", ff), ("deck.in", &deck)])
 }
 
 #[test]

@@ -60,7 +60,7 @@ class Simulation:
     @positions.setter
     def positions(self, value: npt.ArrayLike) -> None: ...
     @property
-    def images(self) -> npt.NDArray[np.int32]:
+    def images(self) -> npt.NDArray[np.int64]:
         """N×3 periodic image counters."""
     @property
     def unwrapped_positions(self) -> npt.NDArray[np.float64]: ...

@@ -149,7 +149,7 @@ impl PySimulation {
         let output_dir = output_dir.unwrap_or_else(|| PathBuf::from("."));
         std::fs::create_dir_all(&output_dir)
             .map_err(|e| RunError::new_err(format!("cannot create output directory {}: {e}", output_dir.display())))?;
-        let options = RunOptions { output_dir, progress: false, echo, device };
+        let options = RunOptions { output_dir, progress: false, echo, device, ..Default::default() };
         let mut pending: VecDeque<Action> = plan.actions.iter().cloned().collect();
         let sim = Simulation::new(&plan, options);
         drop(plan);
@@ -319,8 +319,8 @@ impl PySimulation {
 
     /// Periodic image counters (N×3); unwrapped = positions + images·box lengths.
     #[getter]
-    fn images<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<i32>> {
-        let flat: Vec<i32> = self.sim.state.images.iter().flatten().copied().collect();
+    fn images<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<i64>> {
+        let flat: Vec<i64> = self.sim.state.images.iter().flatten().copied().collect();
         Array2::from_shape_vec((self.sim.state.images.len(), 3), flat).expect("n×3").into_pyarray(py)
     }
 

@@ -940,7 +940,9 @@ pub(super) fn validate_in(v: &mut Validator, file: &std::sync::Arc<SourceFile>) 
         deck_path: PathBuf::from(&file.path),
         model: v.initial_model.take().expect("built above"),
         sim_box: v.sim_box.expect("built with the model"),
-        positions: std::mem::take(&mut v.positions),
+        // Kept by the validator too: commands validated later (an `OpenDeck`) check
+        // expressions at the initial positions.
+        positions: v.positions.clone(),
         actions: std::mem::take(&mut v.actions),
         inputs: DeckInputs::default(),
         warnings: std::mem::take(&mut v.warnings),

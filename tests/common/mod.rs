@@ -176,3 +176,21 @@ pub fn stretch_particles(text: &str, scale: glam::DVec3) -> String {
     }
     out
 }
+
+/// Fixed sites under free beads, 300 of each on a 20 × 15 grid, each bead
+/// bonded to its site by a slip bond that rebinds and contracts (`motor`),
+/// and forming (and losing) bonds to the neighbouring sites within reach:
+/// the system of the kinetics tests. Returns the topology and force field
+/// for a deck in `units lj` with `box x -5 45 f y -5 35 f z -5 5 f`.
+pub fn kinetic_sites() -> (String, &'static str) {
+    let mut top = String::from("[ particles ]\n");
+    let mut bonds = String::from("[ bonds ]\n");
+    for m in 0..300 {
+        let (x, y) = ((m % 20) as f64 * 2.0, (m / 20) as f64 * 2.0);
+        top += &format!("{} a {x} {y} 0\n{} bead {x} {y} 0.5\n", 2 * m + 1, 2 * m + 2);
+        bonds += &format!("b {} {}\n", 2 * m + 1, 2 * m + 2);
+    }
+    let ff = "particle a fixed\nparticle bead drag 1\nbond b harmonic k 20 r0 0.5 kinetics slip k0 0.5 x_beta 0.2 kinetics rebind k_on 2 capture 1 kinetics motor v0 0.1 fs 3\n\
+              bond x harmonic k 5 r0 1.5 kinetics slip k0 1 x_beta 0.1\nbind a bead x k_on 0.5 capture 2.2 max_bonds 2\npair bead bead wca epsilon 1 sigma 0.3\n";
+    (top + &bonds, ff)
+}
