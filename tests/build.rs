@@ -558,7 +558,8 @@ fn merge_writes_what_a_deck_with_several_topology_lines_builds() {
             "--rest-from-geometry",
         ],
     );
-    let mut files: Vec<String> = ["membrane", "cortex", "aster", "nucleus"].iter().map(|p| format!("{root}/topologies/composed_cell/{p}.top")).collect();
+    let mut files: Vec<String> =
+        ["membrane", "cortex", "aster", "nucleus"].iter().map(|p| format!("{root}/topologies/composed_cell/{p}.top")).collect();
     files.push("out.top".into());
     let mut args: Vec<&str> = vec!["build", "merge"];
     args.extend(files.iter().map(String::as_str));

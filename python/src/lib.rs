@@ -34,7 +34,12 @@ pyo3::create_exception!(
     PyValueError,
     "A bad deck, topology, force field or command: `file:line:col: found …, expected …` (attributes path, line, col, message)."
 );
-pyo3::create_exception!(cellmd, RunError, PyRuntimeError, "A run that stopped: a blow-up (with its diagnosis), an output error or a setup the backend refuses.");
+pyo3::create_exception!(
+    cellmd,
+    RunError,
+    PyRuntimeError,
+    "A run that stopped: a blow-up (with its diagnosis), an output error or a setup the backend refuses."
+);
 
 /// The `InputError` of a cellmd input error, with its position as attributes.
 fn input_error(py: Python<'_>, e: cellmd::input::InputError) -> PyErr {
@@ -133,7 +138,8 @@ impl PySimulation {
         let device = match device {
             None => None,
             Some(d) => Some(
-                DevicePreference::from_keyword(d).ok_or_else(|| PyValueError::new_err(format!("found device `{d}`, expected cpu, gpu or auto")))?,
+                DevicePreference::from_keyword(d)
+                    .ok_or_else(|| PyValueError::new_err(format!("found device `{d}`, expected cpu, gpu or auto")))?,
             ),
         };
         let pool = match threads {
@@ -201,7 +207,9 @@ impl PySimulation {
     fn run(slf: &Bound<'_, Self>, steps: u64, callback: Option<Bound<'_, PyAny>>, every: Option<u64>) -> PyResult<()> {
         let py = slf.py();
         let every = match (&callback, every) {
-            (Some(_), Some(0)) | (Some(_), None) => return Err(PyValueError::new_err("a callback needs `every` > 0 (steps between calls)")),
+            (Some(_), Some(0)) | (Some(_), None) => {
+                return Err(PyValueError::new_err("a callback needs `every` > 0 (steps between calls)"))
+            }
             (None, Some(_)) => return Err(PyValueError::new_err("`every` without a callback; expected both or neither")),
             (_, every) => every,
         };
@@ -256,7 +264,11 @@ impl PySimulation {
     fn minimize(&mut self, py: Python<'_>, ftol: Option<f64>, maxiter: Option<u64>, dmax: Option<f64>) -> PyResult<()> {
         self.not_running("minimize()")?;
         let mut line = String::from("minimize");
-        for (key, value) in [("ftol", ftol.map(|v| format!("{v:e}"))), ("maxiter", maxiter.map(|v| v.to_string())), ("dmax", dmax.map(|v| format!("{v:e}")))] {
+        for (key, value) in [
+            ("ftol", ftol.map(|v| format!("{v:e}"))),
+            ("maxiter", maxiter.map(|v| v.to_string())),
+            ("dmax", dmax.map(|v| format!("{v:e}"))),
+        ] {
             if let Some(value) = value {
                 line.push_str(&format!(" {key} {value}"));
             }
@@ -450,7 +462,13 @@ fn build_topology(py: Python<'_>, args: Vec<String>) -> PyResult<(String, String
     let command = BuildCommand::try_parse_from(&args).map_err(|e| PyValueError::new_err(e.render().to_string()))?;
     let built = command.what.build().map_err(PyValueError::new_err)?;
     let counts = PyDict::new(py);
-    for (key, n) in [("particles", built.particles), ("bonds", built.bonds), ("angles", built.angles), ("bodies", built.bodies), ("triangles", built.triangles)] {
+    for (key, n) in [
+        ("particles", built.particles),
+        ("bonds", built.bonds),
+        ("angles", built.angles),
+        ("bodies", built.bodies),
+        ("triangles", built.triangles),
+    ] {
         counts.set_item(key, n)?;
     }
     Ok((built.text.clone(), built.summary(), counts.unbind()))

@@ -13,7 +13,9 @@ use super::variables::Variables;
 use crate::expr::{ExprError, Ref};
 use crate::forcefield::{load_forcefield, parse_params, ForceField, TermType};
 use crate::gpu::DevicePreference;
-use crate::input::{check_input_file, is_replaying, lex, parse_f64, parse_u64, recording, DeckInputs, InputError, InputFile, SourceFile, Token};
+use crate::input::{
+    check_input_file, is_replaying, lex, parse_f64, parse_u64, recording, DeckInputs, InputError, InputFile, SourceFile, Token,
+};
 use crate::integrate::fire::FireSettings;
 use crate::integrate::implicit::{ImplicitSettings, LinearSolver};
 use crate::integrate::overdamped::OverdampedSettings;

@@ -127,10 +127,9 @@ pub fn external(
     match term.interaction.name() {
         "constant_force" => Ok((format!("addforce {} {} {}", num(p("fx")), num(p("fy")), num(p("fz"))), None)),
         // LAMMPS: F(r) = −K(r − R)² outward inside the sphere, energy K(R − r)³/3.
-        "indenter" => Ok((
-            format!("indent {} sphere {} {} {} {} units box", num(p("k")), num(p("x")), num(p("y")), num(p("z")), num(p("r"))),
-            None,
-        )),
+        "indenter" => {
+            Ok((format!("indent {} sphere {} {} {} {} units box", num(p("k")), num(p("x")), num(p("y")), num(p("z")), num(p("r"))), None))
+        }
         "wall" => {
             let n = [p("nx"), p("ny"), p("nz")];
             let axes: Vec<usize> = (0..3).filter(|&a| n[a] != 0.0).collect();

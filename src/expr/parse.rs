@@ -221,7 +221,10 @@ impl Parser {
         if matches!(tok, Tok::Number(_) | Tok::Name(_) | Tok::Thermo(_)) {
             self.operands += 1;
             if self.operands > MAX_OPERANDS {
-                return Err(ExprError::new(span, format!("found more than {MAX_OPERANDS} numbers and names in one expression; expected a shorter one")));
+                return Err(ExprError::new(
+                    span,
+                    format!("found more than {MAX_OPERANDS} numbers and names in one expression; expected a shorter one"),
+                ));
             }
         }
         match tok {

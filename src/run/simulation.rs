@@ -415,8 +415,8 @@ impl Simulation {
             }
             Action::Dump(spec) => {
                 let path = self.output_path(&spec.path);
-                let writer = open_writer_with(spec.format, &path, &self.topology_view(), &spec.options)
-                    .map_err(|e| self.output_error(&path, e))?;
+                let writer =
+                    open_writer_with(spec.format, &path, &self.topology_view(), &spec.options).map_err(|e| self.output_error(&path, e))?;
                 self.dumps.push(ActiveDump { spec: spec.clone(), path, writer, last_step: None });
             }
             Action::Undump(name) => {
