@@ -1,0 +1,244 @@
+//! The folder-level import graph of `src/` has no cycle: the crate is layered.
+//!
+//! A node is a top-level module of the library: a folder (`src/system/`) or
+//! a file (`src/mesh.rs`); `lib.rs` and `main.rs` only declare or call them.
+//! A file of module A depends on module B when its text names a path
+//! `crate::B…` (or `$crate::B…` in a macro), including every item of a group
+//! `crate::{B::x, C::{y, z}}` written over any number of lines.
+//!
+//! Comments count: an intra-doc link ``[`x`](crate::B::x)`` is resolved by
+//! rustdoc like a `use`, so a lower layer that links up to a higher one ties
+//! the two as much as code would (a rename upstairs breaks the docs
+//! downstairs). A lower layer that wants to mention a higher one names it in
+//! plain text (`` `backend::stiffness` ``), without `crate::`.
+//!
+//! Not read: `super::` paths (they stay inside one folder, except from a
+//! folder's `mod.rs` or a top-level file, where no `super::` path leaves the
+//! module today) and `cellmd::` paths (only `main.rs` uses them).
+//!
+//! When the graph has a cycle the test fails naming it, with the file and
+//! line of one reference per edge.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+/// Edges A → B with, for each, one place (`file:line`) that makes it.
+type Graph = BTreeMap<String, BTreeMap<String, String>>;
+
+/// The top-level module of a file under `src/` (None for the crate roots).
+fn module_of(relative: &Path) -> Option<String> {
+    let parts: Vec<String> = relative.components().map(|c| c.as_os_str().to_string_lossy().into_owned()).collect();
+    match parts.as_slice() {
+        [file] if file == "lib.rs" || file == "main.rs" => None,
+        [file] => file.strip_suffix(".rs").map(str::to_owned),
+        [folder, ..] => Some(folder.clone()),
+        [] => None,
+    }
+}
+
+/// The top-level module names of the crate that `text` reaches through
+/// `crate::` paths, with the line of each first occurrence.
+fn crate_references(text: &str) -> Vec<(String, usize)> {
+    let bytes = text.as_bytes();
+    let mut found = Vec::new();
+    let mut from = 0;
+    while let Some(offset) = text[from..].find("crate::") {
+        let at = from + offset;
+        from = at + "crate::".len();
+        let before = at.checked_sub(1).map(|i| bytes[i]);
+        if before.is_some_and(|c| c.is_ascii_alphanumeric() || c == b'_') {
+            continue; // e.g. `some_crate::`
+        }
+        let line = text[..at].matches('\n').count() + 1;
+        let rest = &text[from..];
+        if let Some(group) = rest.strip_prefix('{') {
+            for name in group_heads(group) {
+                found.push((name, line));
+            }
+        } else {
+            found.push((leading_identifier(rest), line));
+        }
+    }
+    found
+}
+
+fn leading_identifier(text: &str) -> String {
+    text.chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect()
+}
+
+/// The first identifier of every top-level item of a `{…}` group (`text`
+/// starts after the opening brace).
+fn group_heads(text: &str) -> Vec<String> {
+    let mut heads = Vec::new();
+    let mut depth = 0;
+    let mut item_start = true;
+    for (i, c) in text.char_indices() {
+        match c {
+            '{' => depth += 1,
+            '}' if depth == 0 => break,
+            '}' => depth -= 1,
+            ',' if depth == 0 => item_start = true,
+            c if item_start && (c.is_alphanumeric() || c == '_') => {
+                heads.push(leading_identifier(&text[i..]));
+                item_start = false;
+            }
+            _ => {}
+        }
+    }
+    heads
+}
+
+fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().path()).collect();
+    entries.sort();
+    for path in entries {
+        if path.is_dir() {
+            rust_files(&path, out);
+        } else if path.extension().is_some_and(|e| e == "rs") {
+            out.push(path);
+        }
+    }
+}
+
+/// The folder-level graph of sources given as (path relative to `src/`, text).
+fn graph(sources: &[(PathBuf, String)]) -> Graph {
+    let modules: BTreeSet<String> = sources.iter().filter_map(|(p, _)| module_of(p)).collect();
+    let mut edges = Graph::new();
+    for (path, text) in sources {
+        let Some(from) = module_of(path) else { continue };
+        let targets = edges.entry(from.clone()).or_default();
+        for (to, line) in crate_references(text) {
+            if to != from && modules.contains(&to) {
+                targets.entry(to).or_insert_with(|| format!("src/{}:{line}", path.display()));
+            }
+        }
+    }
+    edges
+}
+
+/// Every strongly connected component of more than one module, each as one
+/// cycle through all of its members' first edges found (a → b → … → a).
+fn cycles(graph: &Graph) -> Vec<Vec<String>> {
+    // Tarjan's algorithm, iterative over a small graph.
+    struct Tarjan<'a> {
+        graph: &'a Graph,
+        index: BTreeMap<&'a str, usize>,
+        low: BTreeMap<&'a str, usize>,
+        stack: Vec<&'a str>,
+        components: Vec<Vec<&'a str>>,
+    }
+    impl<'a> Tarjan<'a> {
+        fn visit(&mut self, v: &'a str) {
+            let n = self.index.len();
+            self.index.insert(v, n);
+            self.low.insert(v, n);
+            self.stack.push(v);
+            let graph = self.graph;
+            for w in graph.get(v).into_iter().flat_map(|t| t.keys()) {
+                let w = w.as_str();
+                if !self.index.contains_key(w) {
+                    self.visit(w);
+                    let low = self.low[v].min(self.low[w]);
+                    self.low.insert(v, low);
+                } else if self.stack.contains(&w) {
+                    let low = self.low[v].min(self.index[w]);
+                    self.low.insert(v, low);
+                }
+            }
+            if self.low[v] == self.index[v] {
+                let at = self.stack.iter().position(|&x| x == v).unwrap();
+                self.components.push(self.stack.split_off(at));
+            }
+        }
+    }
+    let mut t = Tarjan { graph, index: BTreeMap::new(), low: BTreeMap::new(), stack: Vec::new(), components: Vec::new() };
+    let nodes: BTreeSet<&str> = graph.iter().flat_map(|(a, t)| std::iter::once(a.as_str()).chain(t.keys().map(String::as_str))).collect();
+    for v in nodes {
+        if !t.index.contains_key(v) {
+            t.visit(v);
+        }
+    }
+    t.components.into_iter().filter(|c| c.len() > 1).map(|c| cycle_within(graph, &c)).collect()
+}
+
+/// One closed path inside a strongly connected component, from its first
+/// member (breadth-first, so the path is a shortest cycle through it).
+fn cycle_within(graph: &Graph, component: &[&str]) -> Vec<String> {
+    let members: BTreeSet<&str> = component.iter().copied().collect();
+    let start = *members.iter().next().unwrap();
+    let mut parent: BTreeMap<&str, &str> = BTreeMap::new();
+    let mut queue = std::collections::VecDeque::from([start]);
+    while let Some(v) = queue.pop_front() {
+        for w in graph[v].keys().map(String::as_str).filter(|w| members.contains(w)) {
+            if w == start {
+                let mut back = vec![v];
+                while let Some(&p) = parent.get(back[back.len() - 1]) {
+                    back.push(p);
+                }
+                // `back` runs v → … → start (start has no parent).
+                let mut cycle: Vec<String> = back.iter().rev().map(|s| s.to_string()).collect();
+                cycle.push(start.to_owned());
+                return cycle;
+            }
+            if !parent.contains_key(w) && w != start {
+                parent.insert(w, v);
+                queue.push_back(w);
+            }
+        }
+    }
+    unreachable!("a strongly connected component of several modules has a cycle through each member")
+}
+
+fn describe(graph: &Graph, cycle: &[String]) -> String {
+    let steps: Vec<String> = cycle.windows(2).map(|w| format!("  {} -> {}   ({})", w[0], w[1], graph[&w[0]][&w[1]])).collect();
+    format!("{}\n{}", cycle.join(" -> "), steps.join("\n"))
+}
+
+fn crate_sources() -> Vec<(PathBuf, String)> {
+    // Read at run time, so the built test can also check another checkout.
+    let manifest = std::env::var("CARGO_MANIFEST_DIR").unwrap_or_else(|_| env!("CARGO_MANIFEST_DIR").to_owned());
+    let root = Path::new(&manifest).join("src");
+    let mut files = Vec::new();
+    rust_files(&root, &mut files);
+    files.into_iter().map(|p| (p.strip_prefix(&root).unwrap().to_path_buf(), std::fs::read_to_string(&p).unwrap())).collect()
+}
+
+#[test]
+fn folder_level_import_graph_has_no_cycle() {
+    let graph = graph(&crate_sources());
+    assert!(graph.len() > 10, "found {} modules under src/, expected the crate's (is this the repository root?)", graph.len());
+    let cycles = cycles(&graph);
+    let report: Vec<String> = cycles.iter().map(|c| describe(&graph, c)).collect();
+    assert!(cycles.is_empty(), "the folder-level import graph of src/ has {} cycle(s):\n{}", cycles.len(), report.join("\n"));
+}
+
+fn sources(files: &[(&str, &str)]) -> Vec<(PathBuf, String)> {
+    files.iter().map(|(p, t)| (PathBuf::from(p), t.to_string())).collect()
+}
+
+#[test]
+fn reads_groups_doc_links_and_qualified_paths() {
+    let text = "use crate::{alpha::X,\n    beta::{Y, Z}, gamma};\n/// See [`W`](crate::delta::W).\nfn f() -> crate::epsilon::T { $crate::zeta::g() }\nuse other_crate::eta;";
+    let names: Vec<(String, usize)> = crate_references(text);
+    let expected = [("alpha", 1), ("beta", 1), ("gamma", 1), ("delta", 3), ("epsilon", 4), ("zeta", 4)];
+    assert_eq!(names, expected.map(|(n, l)| (n.to_owned(), l)));
+}
+
+#[test]
+fn finds_a_cycle_through_files_of_three_folders() {
+    let tree = sources(&[
+        ("lib.rs", "pub mod a; pub mod b; pub mod c; pub mod leaf;"),
+        ("a/mod.rs", "use crate::b::B;"),
+        ("a/deep.rs", "use crate::leaf::L;"),
+        ("b/mod.rs", "//! Uses [`C`](crate::c::C).\n"),
+        ("c/x.rs", "use crate::{leaf::L, a::A};"),
+        ("leaf.rs", "use crate::unknown::U;"),
+    ]);
+    let g = graph(&tree);
+    assert_eq!(g["b"]["c"], "src/b/mod.rs:1");
+    let found = cycles(&g);
+    assert_eq!(found, vec![vec!["a", "b", "c", "a"]]);
+    assert!(describe(&g, &found[0]).contains("c -> a   (src/c/x.rs:1)"));
+    let acyclic = sources(&[("a/mod.rs", "use crate::b::B;"), ("b/mod.rs", "use crate::leaf::L;"), ("leaf.rs", "")]);
+    assert!(cycles(&graph(&acyclic)).is_empty());
+}
