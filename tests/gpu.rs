@@ -9,7 +9,7 @@ use cellmd::deck::{Action, Plan};
 use cellmd::gpu::backend::StepSettings;
 use cellmd::gpu::{DevicePreference, GpuBackend, GpuContext};
 use cellmd::integrate::overdamped::OverdampedSettings;
-use cellmd::integrate::rng::Noise;
+use cellmd::rng::Noise;
 use cellmd::run::{RunOptions, Simulation};
 use cellmd::system::State;
 use common::random_case;
@@ -27,7 +27,7 @@ fn initial_state(plan: &Plan) -> State {
     for (x, image) in state.positions.iter_mut().zip(state.images.iter_mut()) {
         plan.sim_box.wrap(x, image);
     }
-    state.bonds = cellmd::kinetics::initial_bond_state(&plan.model);
+    state.bonds = cellmd::kinetics_engine::initial_bond_state(&plan.model);
     state
 }
 

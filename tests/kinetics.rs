@@ -291,7 +291,7 @@ fn fibre_bundle_with_uniform_thresholds_peaks_at_a_quarter() {
 }
 
 /// Reads the bond state saved by `write_state`.
-fn saved_bonds(case: &Case, file: &str) -> (cellmd::system::State, cellmd::kinetics::BondState) {
+fn saved_bonds(case: &Case, file: &str) -> (cellmd::system::State, cellmd::system::BondState) {
     let state = cellmd::output::restart::read_state(&case.path(file)).unwrap().to_state();
     let bonds = state.bonds.clone().unwrap();
     (state, bonds)

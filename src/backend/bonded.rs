@@ -21,7 +21,7 @@ use rayon::prelude::*;
 
 use super::virial::{add6, outer};
 use crate::interactions::{Law, Radial, ThreeBody};
-use crate::kinetics::BondState;
+use crate::system::BondState;
 use crate::system::{registry_index, Images, Model};
 
 /// Groups entries by owning particle: entry `s` belongs to `owner[s]`.

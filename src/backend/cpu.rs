@@ -44,8 +44,8 @@ use super::special::SpecialPairs;
 use super::surface::Surfaces;
 use super::virial::add6;
 use crate::interactions::{Law, REGISTRY};
-use crate::kinetics::BondState;
 use crate::neighbor::{Exclusions, NeighborList};
+use crate::system::BondState;
 use crate::system::{registry_index, External, Model, SimBox, State};
 
 /// Result of a force evaluation.

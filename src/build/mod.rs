@@ -4,7 +4,7 @@
 //! Every generator prints a summary (also written atop the file as `#`
 //! comments) with what a force field needs: counts, rest lengths and, for
 //! filaments, the bending stiffness. Randomness is counter-based: each draw is
-//! Philox4x32-10 ([`crate::integrate::rng::block`]) keyed by `--seed` and a
+//! Philox4x32-10 ([`crate::rng::block`]) keyed by `--seed` and a
 //! counter naming what it is for (which filament, which crosslink, which
 //! component), never a stateful generator, so the same seed gives the same
 //! bytes on every machine and a change to one part of a system does not
@@ -85,7 +85,7 @@ use std::path::PathBuf;
 
 use glam::{DQuat, DVec3};
 
-use crate::integrate::rng::{block, open_unit_52};
+use crate::rng::{block, open_unit_52};
 use crate::units::BOLTZMANN_PN_UM_PER_K;
 
 pub use self::aster::{aster, AsterArgs};

@@ -56,7 +56,7 @@ pub enum ThermoColumn {
     /// Neighbour-list builds so far.
     Nbuild,
     /// Cumulative count of bond events of one kind.
-    Events(crate::kinetics::EventKind),
+    Events(crate::kinetics_engine::EventKind),
     /// Bound bonds of a bond type (index into `Model::bond_types`).
     Bound(usize),
     /// Summed tension of the bound bonds of a bond type (e.g. clutch traction).

@@ -19,10 +19,10 @@ use crate::input::{
 use crate::integrate::fire::FireSettings;
 use crate::integrate::implicit::{ImplicitSettings, LinearSolver};
 use crate::integrate::overdamped::OverdampedSettings;
-use crate::integrate::rng::Noise;
 use crate::interactions::{param_index, Kind, REGISTRY};
-use crate::kinetics::EventKind;
+use crate::kinetics_engine::EventKind;
 use crate::output::{AtomColumn, DumpFormat, Encoding, WriterOptions};
+use crate::rng::Noise;
 use crate::system::{position_or_time, External, Model, SimBox, SpecialBonds};
 use crate::topology::{parse_box_axis, BoxAxis, Topology};
 use crate::units::UnitSystem;

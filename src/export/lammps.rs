@@ -49,8 +49,8 @@ use super::formula;
 use super::styles::{self, num, PairStyled, Styled};
 use crate::deck::{Action, CoeffTarget, Plan};
 use crate::forcefield::TermType;
-use crate::integrate::rng::Noise;
 use crate::kinetics::deterministic_strain;
+use crate::rng::Noise;
 use crate::system::{External, Model};
 use crate::units::UnitSystem;
 

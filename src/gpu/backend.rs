@@ -209,7 +209,7 @@ impl GpuBackend {
             neighbor_check: settings.neighbor_check as u32,
             scan_blocks,
             groups_x,
-            gaussian: (settings.integrator.noise == crate::integrate::rng::Noise::Gaussian) as u32,
+            gaussian: (settings.integrator.noise == crate::rng::Noise::Gaussian) as u32,
             topo_offsets: packed.topo_offsets,
             fparam_offsets: packed.fparam_offsets,
         };

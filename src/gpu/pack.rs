@@ -21,8 +21,8 @@
 
 use bytemuck::{Pod, Zeroable};
 
-use crate::kinetics::BondState;
 use crate::neighbor::Exclusions;
+use crate::system::BondState;
 use crate::system::{registry_index, Model, SimBox};
 
 /// Parameter slots per term on the GPU.

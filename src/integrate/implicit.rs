@@ -44,9 +44,9 @@ use faer::{dyn_stack::MemBuffer, dyn_stack::MemStack, Col, Mat, Par, Side};
 use glam::DVec3;
 
 use super::overdamped::{clamp_fraction, Blowup, OverdampedSettings};
-use super::rng::noise3;
 use super::system_matrix::SystemMatrix;
 use crate::backend::stiffness::Stiffness;
+use crate::rng::noise3;
 use crate::system::{Model, SimBox, State};
 
 /// The linear solver of `integrator implicit`.

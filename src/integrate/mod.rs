@@ -4,5 +4,4 @@ pub mod constraints;
 pub mod fire;
 pub mod implicit;
 pub mod overdamped;
-pub mod rng;
 pub mod system_matrix;

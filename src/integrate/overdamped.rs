@@ -4,7 +4,7 @@
 //!
 //! with γ the drag of the particle's type and ξ a vector of three independent
 //! zero-mean, unit-variance numbers from the counter-based Philox stream keyed
-//! by (seed, step, particle index) — see [`super::rng`]. The default noise is
+//! by (seed, step, particle index) — see [`crate::rng`]. The default noise is
 //! uniform on [−√3, √3) (exact mean and variance, no transcendentals, the same
 //! bits on CPU and GPU; the Euler–Maruyama step only needs the first two
 //! moments); `noise gaussian` uses Box–Muller normals instead. kT = 0 is
@@ -31,7 +31,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::rng::{noise3, Noise};
+use crate::rng::{noise3, Noise};
 use crate::system::{Model, SimBox, State};
 
 /// Options of `integrator overdamped`.

@@ -24,12 +24,6 @@
 
 use crate::interactions::ParamSpec;
 
-mod engine;
-mod events;
-mod formation;
-mod lifetimes;
-mod state;
-
 mod cadherin;
 mod catch_slip;
 mod maturation;
@@ -40,11 +34,6 @@ mod rebind;
 mod slip;
 mod threshold;
 
-pub use self::engine::{initial_bond_state, Kinetics, KineticsReport};
-pub use self::events::{Event, EventKind, EventLog};
-pub use self::formation::{parse_bind, BindLine, BindRule, Binding, Formation};
-pub use self::lifetimes::LifetimeTable;
-pub use self::state::{BondState, FormedBond};
 pub(crate) use self::threshold::deterministic_strain;
 
 /// Every registered kinetic rule.

@@ -112,7 +112,7 @@ pub const FRAME_SCHEMA: &str = r#"{
   "required": ["step", "time", "box", "positions", "images"]
 }"#;
 
-/// JSON Schema of `cellmd.BondEvents`: the events of one step (see `crate::kinetics::Event`).
+/// JSON Schema of `cellmd.BondEvents`: the events of one step (see `crate::kinetics_engine::Event`).
 pub const BOND_EVENTS_SCHEMA: &str = r#"{
   "title": "cellmd.BondEvents",
   "type": "object",
@@ -346,13 +346,13 @@ impl TrajectoryWriter for McapWriter {
         Ok(())
     }
 
-    fn write_bond_events(&mut self, events: &[crate::kinetics::Event], bound: &[bool]) -> io::Result<()> {
+    fn write_bond_events(&mut self, events: &[crate::kinetics_engine::Event], bound: &[bool]) -> io::Result<()> {
         let Some(first) = events.first() else { return Ok(()) };
         #[derive(Serialize)]
         struct BondEvents<'a> {
             step: u64,
             time: f64,
-            events: &'a [crate::kinetics::Event],
+            events: &'a [crate::kinetics_engine::Event],
         }
         let ns = time_ns(first.time);
         self.sink.publish(self.channel_events, ns, &BondEvents { step: first.step, time: first.time, events })?;

@@ -46,6 +46,7 @@ pub mod atomic;
 pub mod bond_csv;
 pub mod dcd;
 pub mod lammps_dump;
+pub mod lifetimes;
 pub mod mcap_writer;
 pub mod restart;
 pub mod run_log;
@@ -55,6 +56,7 @@ pub mod xyz;
 pub use self::bond_csv::BondCsvWriter;
 pub use self::dcd::DcdWriter;
 pub use self::lammps_dump::{AtomColumn, LammpsDumpWriter};
+pub use self::lifetimes::LifetimeTable;
 pub use self::mcap_writer::McapWriter;
 pub use self::restart::{read_state, write_state, RestartData};
 pub use self::xyz::XyzWriter;
@@ -155,7 +157,7 @@ pub trait TrajectoryWriter: Send {
     fn finish(self: Box<Self>) -> io::Result<()>;
     /// Records the bond events of one step and the bound flags after them.
     /// Formats without a channel for them ignore this.
-    fn write_bond_events(&mut self, _events: &[crate::kinetics::Event], _bound: &[bool]) -> io::Result<()> {
+    fn write_bond_events(&mut self, _events: &[crate::kinetics_engine::Event], _bound: &[bool]) -> io::Result<()> {
         Ok(())
     }
     /// The quantities the writer reads from [`FrameView::measures`].

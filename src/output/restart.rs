@@ -24,7 +24,7 @@
 //!   against the topology ([`RestartData::check_ids`]) so a restart is never
 //!   applied to a different system or ordering.
 //! * `positions` are stored (wrapped) positions, `images` their counters.
-//! * `bonds` is the bond state ([`BondState`](crate::kinetics::BondState)),
+//! * `bonds` is the bond state ([`BondState`](crate::system::BondState)),
 //!   present when bonds have one (kinetics, or per-bond rest lengths from
 //!   the topology): per bond whether it is bound, its age, its own rest
 //!   length (`null`: its type's `r0`) and stiffness scale, then the bonds
@@ -85,7 +85,7 @@ pub struct RestartData {
     pub images: Vec<[i64; 3]>,
     /// Bond state (bound, age, rest length, scale) when bonds have kinetics.
     #[serde(default)]
-    pub bonds: Option<crate::kinetics::BondState>,
+    pub bonds: Option<crate::system::BondState>,
     /// Cumulative thermo counters, so they go on counting after a restart.
     #[serde(default)]
     pub counters: Counters,
@@ -262,7 +262,7 @@ mod tests {
                 DVec3::new(std::f64::consts::PI, 1e22, 9007199254740993.0),
             ],
             images: vec![[0, 0, 0], [-1, 2, 0], [i64::MIN, i64::MAX, 3]],
-            bonds: Some(crate::kinetics::BondState {
+            bonds: Some(crate::system::BondState {
                 bound: vec![true, false],
                 age: vec![0.1 + 0.2, 5e-324],
                 rest: vec![Some(0.8), None],

@@ -220,7 +220,7 @@ pub(super) fn reset_rest(model: &mut Model, state: &mut State, sim_box: &SimBox,
         }
     }
     if state.bonds.is_none() {
-        state.bonds = crate::kinetics::initial_bond_state(model);
+        state.bonds = crate::kinetics_engine::initial_bond_state(model);
     }
     let bonds = state.bonds.as_mut().expect("bonds have their own rest lengths now");
     for (b, length) in lengths.into_iter().enumerate() {

@@ -45,10 +45,10 @@ use crate::units::{Dim, UnitSystem};
 /// Values a thermo row is made from.
 pub struct ThermoInputs<'a> {
     pub model: &'a crate::system::Model,
-    pub bonds: Option<&'a crate::kinetics::BondState>,
+    pub bonds: Option<&'a crate::system::BondState>,
     /// Per-bond tension of the last force pass.
     pub bond_tension: &'a [f64],
-    pub kinetics: &'a crate::kinetics::Kinetics,
+    pub kinetics: &'a crate::kinetics_engine::Kinetics,
     pub step: u64,
     pub time: f64,
     pub forces: &'a Forces,

@@ -1,10 +1,12 @@
 //! Simulation state: the box and the per-particle arrays (f64, structure of arrays).
 
+mod bond_state;
 mod clock;
 mod model;
 mod sim_box;
 mod state;
 
+pub use self::bond_state::{BondState, FormedBond};
 pub use self::clock::StepClock;
 pub use self::model::{position_or_time, registry_index, Body, External, Model, SpecialBonds};
 pub use self::sim_box::{Images, SimBox};

@@ -107,12 +107,12 @@ pub struct Model {
     pub bond_type: Vec<u32>,
     /// The topology's per-bond rest lengths (`type i j r0`), by topology
     /// bond; `None`: the bond type's `r0`. Only the source of each bond's
-    /// initial [`BondState::rest`](crate::kinetics::BondState); forces read the state.
+    /// initial [`BondState::rest`](crate::system::BondState); forces read the state.
     pub bond_rest: Vec<Option<f64>>,
     /// How many of `bonds` come from the topology (the rest were formed).
     pub topology_bonds: usize,
     /// Bond formation rules (`bind` lines).
-    pub bind_rules: Vec<crate::kinetics::BindRule>,
+    pub bind_rules: Vec<crate::kinetics_engine::BindRule>,
     pub angle_types: Vec<TermType>,
     pub angles: Vec<[u32; 3]>,
     pub angle_type: Vec<u32>,
@@ -195,7 +195,7 @@ impl Model {
             .iter()
             .map(|line| {
                 let index = |t: &Token| ff.particle_type(&t.text).expect("checked by check_pair_types") as u32;
-                Ok(crate::kinetics::BindRule {
+                Ok(crate::kinetics_engine::BindRule {
                     type_a: index(&line.type_a),
                     type_b: index(&line.type_b),
                     bond_type: resolve(&line.bond_type, &ff.bond_types, "bond")?,
@@ -302,14 +302,14 @@ impl Model {
         self.bond_kinetics.iter().any(|k| !k.rules.is_empty()) || !self.bind_rules.is_empty()
     }
 
-    /// Whether bonds carry state ([`BondState`](crate::kinetics::BondState)):
+    /// Whether bonds carry state ([`BondState`](crate::system::BondState)):
     /// with kinetics, or when some bond has its own rest length.
     pub fn has_bond_state(&self) -> bool {
         self.has_kinetics() || self.bond_rest.iter().any(Option::is_some)
     }
 
     /// Makes the bond list the topology's plus the bonds `formed` in a run.
-    pub fn set_formed_bonds(&mut self, formed: &[crate::kinetics::FormedBond]) {
+    pub fn set_formed_bonds(&mut self, formed: &[crate::system::FormedBond]) {
         self.bonds.truncate(self.topology_bonds);
         self.bond_type.truncate(self.topology_bonds);
         for f in formed {
@@ -335,7 +335,7 @@ impl Model {
 
     /// The rest length bond `b` has now, from its state if bonds have one
     /// (NaN if its law has none).
-    pub fn rest_length(&self, b: usize, bonds: Option<&crate::kinetics::BondState>) -> f64 {
+    pub fn rest_length(&self, b: usize, bonds: Option<&crate::system::BondState>) -> f64 {
         let t = self.bond_type[b] as usize;
         bonds.and_then(|s| s.rest[b]).or_else(|| self.bond_kinetics[t].rest_index.map(|k| self.bond_types[t].params[k])).unwrap_or(f64::NAN)
     }

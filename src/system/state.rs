@@ -16,7 +16,7 @@ pub struct State {
     pub images: Vec<[i64; 3]>,
     /// Bond state, when some bond type has kinetic rules.
     #[serde(default)]
-    pub bonds: Option<crate::kinetics::BondState>,
+    pub bonds: Option<crate::system::BondState>,
 }
 
 impl State {

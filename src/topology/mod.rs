@@ -38,7 +38,7 @@
 //! --rest-from-geometry` writes every bond's length as built here, so an
 //! irregular mesh starts force-free.
 //!
-//! [`BondState::rest`]: crate::kinetics::BondState
+//! [`BondState::rest`]: crate::system::BondState
 //!
 //! Each body must be a closed, consistently oriented 2-manifold of sphere
 //! topology (every edge in exactly two faces, once in each direction; one fan

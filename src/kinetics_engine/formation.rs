@@ -37,9 +37,9 @@
 use rayon::prelude::*;
 
 use crate::input::{parse_u64, InputError, Token};
-use crate::integrate::rng::philox4x32_10;
 use crate::interactions::ParamSpec;
 use crate::neighbor::{Exclusions, NeighborList};
+use crate::rng::philox4x32_10;
 use crate::system::{Model, SimBox, State, StepClock};
 use crate::units::{Dim, UnitSystem};
 

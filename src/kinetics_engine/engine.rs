@@ -19,10 +19,9 @@ use rayon::prelude::*;
 
 use super::events::{Event, EventKind};
 use super::formation::Binding;
-use super::state::{BondState, FormedBond};
-use super::Effect;
-use crate::integrate::rng::block;
-use crate::system::{Model, SimBox, State, StepClock};
+use crate::kinetics::Effect;
+use crate::rng::block;
+use crate::system::{BondState, FormedBond, Model, SimBox, State, StepClock};
 
 /// Philox stream of per-step kinetic decisions.
 const STREAM_KINETICS: u32 = 2;

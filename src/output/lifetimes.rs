@@ -24,9 +24,9 @@
 use std::io::{self, Write};
 use std::path::Path;
 
-use super::{BondState, Event, EventKind};
-use crate::output::atomic::write_atomically;
-use crate::system::Model;
+use super::atomic::write_atomically;
+use crate::kinetics_engine::{Event, EventKind};
+use crate::system::{BondState, Model};
 use crate::units::Dim;
 
 /// Running sums of the breaks of one bond type.

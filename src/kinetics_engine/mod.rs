@@ -1,0 +1,12 @@
+//! The bond-kinetics engine: after every force pass it applies the kinetic
+//! rules of each bond type (the registry in [`crate::kinetics`]) to the bond
+//! state ([`crate::system::BondState`]), and forms new bonds from `bind`
+//! rules.
+
+mod engine;
+mod events;
+mod formation;
+
+pub use self::engine::{initial_bond_state, Kinetics, KineticsReport};
+pub use self::events::{Event, EventKind, EventLog};
+pub use self::formation::{parse_bind, BindLine, BindRule, Binding, Formation};
