@@ -57,7 +57,7 @@ pub struct ForceField {
     /// Contact terms between bodies by body-type pair (`contact` lines).
     pub contact_rules: Vec<ContactRule>,
     /// Bond formation rules (`bind` lines).
-    pub bind_lines: Vec<crate::kinetics_engine::BindLine>,
+    pub bind_lines: Vec<super::BindLine>,
 }
 
 impl ForceField {
@@ -215,7 +215,7 @@ pub fn load_forcefield(
                 let term = parse_params(&t[1], &t[3], &t[4..], Kind::Contact, units)?;
                 ff.contact_rules.push(ContactRule { type_a: t[1].clone(), type_b: t[2].clone(), term });
             }
-            "bind" => ff.bind_lines.push(crate::kinetics_engine::parse_bind(kw, &t[1..], units)?),
+            "bind" => ff.bind_lines.push(super::parse_bind(kw, &t[1..], units)?),
             other => {
                 return Err(kw.error(format!(
                     "found `{other}`, expected `include`, `particle`, `bond`, `angle`, `pair`, `body`, `contact` or `bind`"

@@ -36,100 +36,12 @@
 
 use rayon::prelude::*;
 
-use crate::input::{parse_u64, InputError, Token};
-use crate::interactions::ParamSpec;
 use crate::neighbor::{Exclusions, NeighborList};
 use crate::rng::philox4x32_10;
 use crate::system::{Model, SimBox, State, StepClock};
-use crate::units::{Dim, UnitSystem};
 
 /// Philox key salt separating formation decisions from every other stream.
 const FORMATION_SALT: u32 = 0x6269_6E64; // ASCII "bind"
-
-static PARAMS: [ParamSpec; 2] = [
-    ParamSpec::new("k_on", Dim::Rate, "formation rate of a pair within capture").non_negative(),
-    ParamSpec::new("capture", Dim::Length, "capture radius").positive(),
-];
-
-/// A resolved `bind` line.
-#[derive(Clone, Debug)]
-pub struct BindRule {
-    pub type_a: u32,
-    pub type_b: u32,
-    pub bond_type: u32,
-    pub k_on: f64,
-    pub capture: f64,
-    pub max_bonds: u32,
-    /// Only mutual-nearest pairs are candidates.
-    pub nearest: bool,
-    /// Only particles of two different bodies bind.
-    pub between_bodies: bool,
-}
-
-/// A `bind` line as parsed (names resolved later against the model).
-#[derive(Clone, Debug)]
-pub struct BindLine {
-    pub type_a: Token,
-    pub type_b: Token,
-    pub bond_type: Token,
-    pub k_on: f64,
-    pub capture: f64,
-    pub max_bonds: u32,
-    pub nearest: bool,
-    pub between_bodies: bool,
-}
-
-/// Parses `bind A B BONDTYPE k_on K capture R [max_bonds N] [partner random|nearest]`
-/// (tokens after `bind`).
-pub fn parse_bind(keyword: &Token, t: &[Token], units: UnitSystem) -> Result<BindLine, InputError> {
-    const USAGE: &str = "bind TYPE_A TYPE_B BONDTYPE k_on K capture R [max_bonds N] [partner random|nearest] [between any|bodies]";
-    if t.len() < 3 {
-        return Err(keyword.error(format!("expected `{USAGE}`")));
-    }
-    let (mut max_bonds, mut nearest, mut between_bodies) = (1, false, false);
-    let mut values = Vec::new();
-    for pair in t[3..].chunks(2) {
-        let Some(value) = pair.get(1) else {
-            return Err(pair[0].error(format!("`{}` has no value; expected `{USAGE}`", pair[0].text)));
-        };
-        match pair[0].text.as_str() {
-            "max_bonds" => {
-                max_bonds = parse_u64(value, "a maximum number of bonds per particle")? as u32;
-                if max_bonds == 0 {
-                    return Err(value.error("found 0, expected `max_bonds` >= 1"));
-                }
-            }
-            "partner" => {
-                nearest = match value.text.as_str() {
-                    "random" => false,
-                    "nearest" => true,
-                    other => return Err(value.error(format!("found `{other}`, expected `random` or `nearest`"))),
-                }
-            }
-            "between" => {
-                between_bodies = match value.text.as_str() {
-                    "any" => false,
-                    "bodies" => true,
-                    other => {
-                        return Err(value.error(format!("found `{other}`, expected `any` or `bodies` (particles of different bodies)")))
-                    }
-                }
-            }
-            _ => values.extend_from_slice(pair),
-        }
-    }
-    let values = crate::forcefield::parse_values(&PARAMS, "bind", keyword, &values, units)?;
-    Ok(BindLine {
-        type_a: t[0].clone(),
-        type_b: t[1].clone(),
-        bond_type: t[2].clone(),
-        k_on: values[0],
-        capture: values[1],
-        max_bonds,
-        nearest,
-        between_bodies,
-    })
-}
 
 fn uniform_for_pair(seed: u64, step: u64, i: u32, j: u32) -> f64 {
     let x = philox4x32_10([i, j, step as u32, (step >> 32) as u32], [seed as u32, (seed >> 32) as u32 ^ FORMATION_SALT])[0];

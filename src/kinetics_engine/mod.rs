@@ -9,4 +9,4 @@ mod formation;
 
 pub use self::engine::{initial_bond_state, Kinetics, KineticsReport};
 pub use self::events::{Event, EventKind, EventLog};
-pub use self::formation::{parse_bind, BindLine, BindRule, Binding, Formation};
+pub use self::formation::{Binding, Formation};

@@ -112,7 +112,7 @@ pub struct Model {
     /// How many of `bonds` come from the topology (the rest were formed).
     pub topology_bonds: usize,
     /// Bond formation rules (`bind` lines).
-    pub bind_rules: Vec<crate::kinetics_engine::BindRule>,
+    pub bind_rules: Vec<crate::forcefield::BindRule>,
     pub angle_types: Vec<TermType>,
     pub angles: Vec<[u32; 3]>,
     pub angle_type: Vec<u32>,
@@ -195,7 +195,7 @@ impl Model {
             .iter()
             .map(|line| {
                 let index = |t: &Token| ff.particle_type(&t.text).expect("checked by check_pair_types") as u32;
-                Ok(crate::kinetics_engine::BindRule {
+                Ok(crate::forcefield::BindRule {
                     type_a: index(&line.type_a),
                     type_b: index(&line.type_b),
                     bond_type: resolve(&line.bond_type, &ff.bond_types, "bond")?,
