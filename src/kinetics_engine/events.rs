@@ -1,18 +1,5 @@
-//! Bond events and the plain-text event log.
-//!
-//! The CSV event file (`events FILE` in a deck) has one row per event:
-//! `step,time[s],event,bond,type,i,j,force[pN],length[µm],age[s]` — `event` is
-//! `break`, `rebind`, `form` or `reset`, `bond` the bond's index (0-based, in
-//! topology order, new bonds appended), `i j` the particle ids, `force` the
-//! tension the bond carried (dE/dr, positive when stretched) and `length` its
-//! length when the event was decided, `age` the time the bond had been bound
-//! through the end of that step (a break's age is the bond's lifetime, to
-//! within the step in which it broke; rebinds and formations have age 0).
-
-use std::fs::File;
-use std::io::{BufWriter, Write};
-
-use crate::units::{Dim, UnitSystem};
+//! Bond events: the state changes of one step, as the engine decides them
+//! (written by the event log and the MCAP writer of `output`).
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
@@ -48,49 +35,4 @@ pub struct Event {
     pub length: f64,
     /// Time bound through the end of the event's step (0 for rebind and form).
     pub age: f64,
-}
-
-/// The CSV event file.
-pub struct EventLog {
-    out: BufWriter<File>,
-}
-
-impl EventLog {
-    pub fn create(file: File, units: UnitSystem) -> std::io::Result<Self> {
-        let mut out = BufWriter::new(file);
-        writeln!(
-            out,
-            "step,time[{}],event,bond,type,i,j,force[{}],length[{}],age[{}]",
-            units.label(Dim::Time),
-            units.label(Dim::Force),
-            units.label(Dim::Length),
-            units.label(Dim::Time)
-        )?;
-        Ok(Self { out })
-    }
-
-    pub fn write(&mut self, events: &[Event]) -> std::io::Result<()> {
-        for e in events {
-            writeln!(
-                self.out,
-                "{},{:e},{},{},{},{},{},{:e},{:e},{:e}",
-                e.step,
-                e.time,
-                e.kind.name(),
-                e.bond,
-                e.bond_type,
-                e.particles[0],
-                e.particles[1],
-                e.force,
-                e.length,
-                e.age
-            )?;
-        }
-        Ok(())
-    }
-
-    pub fn finish(mut self) -> std::io::Result<()> {
-        self.out.flush()?;
-        self.out.get_ref().sync_data()
-    }
 }

@@ -8,5 +8,5 @@ mod events;
 mod formation;
 
 pub use self::engine::{initial_bond_state, Kinetics, KineticsReport};
-pub use self::events::{Event, EventKind, EventLog};
+pub use self::events::{Event, EventKind};
 pub use self::formation::{Binding, Formation};

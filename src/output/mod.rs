@@ -45,6 +45,7 @@ use crate::units::UnitSystem;
 pub mod atomic;
 pub mod bond_csv;
 pub mod dcd;
+pub mod event_log;
 pub mod lammps_dump;
 pub mod lifetimes;
 pub mod mcap_writer;
@@ -55,6 +56,7 @@ pub mod xyz;
 
 pub use self::bond_csv::BondCsvWriter;
 pub use self::dcd::DcdWriter;
+pub use self::event_log::EventLog;
 pub use self::lammps_dump::{AtomColumn, LammpsDumpWriter};
 pub use self::lifetimes::LifetimeTable;
 pub use self::mcap_writer::McapWriter;

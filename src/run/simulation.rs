@@ -19,10 +19,10 @@ use crate::integrate::constraints::{Constraint, Constraints};
 use crate::integrate::fire::{fire_minimize, FireReport, FireSettings};
 use crate::integrate::implicit::{implicit_step, ConstrainedBonds, ImplicitError, ImplicitSettings, SolveReport};
 use crate::integrate::overdamped::{overdamped_step, Blowup, OverdampedSettings};
-use crate::kinetics_engine::{initial_bond_state, Binding, EventLog, Formation, Kinetics};
+use crate::kinetics_engine::{initial_bond_state, Binding, Formation, Kinetics};
 use crate::output::restart::{read_state, write_state, Counters, RestartData, Resume};
 use crate::output::run_log::{model_parameters, LogHeader, Phase, PhaseTimes, RunLog};
-use crate::output::{open_writer_with, FrameView, LifetimeTable, Measures, TopologyView, TrajectoryWriter, WallPlane};
+use crate::output::{open_writer_with, EventLog, FrameView, LifetimeTable, Measures, TopologyView, TrajectoryWriter, WallPlane};
 use crate::system::{Model, SimBox, State, StepClock};
 
 mod stepping;
