@@ -1,5 +1,5 @@
 //! Local Hessians of interaction terms, for the stiffness matrix of the
-//! linearly implicit step ([`crate::backend::stiffness`]).
+//! linearly implicit step (`backend::stiffness`, a layer above, assembles it).
 //!
 //! A term acting on k particles (an angle, an external field, one face or one
 //! node's one-ring of a body) has a 3k×3k Hessian H = ∂²E/∂x∂x. The implicit

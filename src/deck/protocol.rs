@@ -6,7 +6,7 @@
 //! step s of an N-step run the parameter is `from + (to − from)·s/N`, so the
 //! forces of the run's first step use `from` and the state at its end has
 //! seen `to`, which the parameter keeps afterwards. Moves and freezes stay in
-//! force until `unmove` / `unfreeze`. [`crate::run`] applies them.
+//! force until `unmove` / `unfreeze`. The run (`run::protocol`) applies them.
 
 use glam::DVec3;
 

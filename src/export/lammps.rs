@@ -13,7 +13,7 @@
 //! the script writes `cellmd_probe.txt` (step, energy by interaction, virial
 //! W = P·V) and `cellmd_probe_init.dump` / `cellmd_probe_final.dump` (id,
 //! unwrapped positions and forces, 17 digits) before the first and after the
-//! last run; [`crate::compare`] reads them back. Decks with kinetics also
+//! last run; `cellmd compare` (module `compare`) reads them back. Decks with kinetics also
 //! get `cellmd_probe_init.bonds` / `cellmd_probe_final.bonds` (the bound
 //! bonds: type, atom, atom).
 //!

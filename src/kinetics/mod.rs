@@ -9,18 +9,25 @@
 //! bond clutch harmonic k 1 r0 0.02 kinetics catch_slip kc0 10 xc 0.002 ks0 0.1 xs 0.001 kinetics rebind k_on 5 capture 0.05
 //! ```
 //!
-//! Each bond then carries state ([`BondState`]): bound or not, its age since
-//! formation, its current rest length and a stiffness scale. After every force
-//! pass the [`Kinetics`] engine reads each bond's tension F (= dE/dr, positive
-//! when stretched) and length, decides every state change with counter-based
-//! random numbers keyed by (seed, step, bond index), queues the events, and
-//! applies them together; the run loop then recomputes the forces. A bond
+//! Each bond then carries state (`system::BondState`): bound or not, its age
+//! since formation, its current rest length and a stiffness scale. After every
+//! force pass the engine (`kinetics_engine::Kinetics`) reads each bond's
+//! tension F (= dE/dr, positive when stretched) and length, decides every
+//! state change with counter-based random numbers keyed by (seed, step, bond
+//! index), queues the events, and applies them together; the run loop then
+//! recomputes the forces. A bond
 //! survives a step at rate k(F) with the exact probability exp(−k·dt); when
 //! k·dt > 0.1 the step is too coarse to resolve the bond's lifetime, and a
 //! warning is printed once per bond type.
 //!
 //! Rules are registered in [`RULES`], one file each, with the same
 //! documentation layout as interactions (`cellmd list NAME`).
+//!
+//! This folder is the registry only: what each rule is (parameters, effect,
+//! documentation). The force-field parser reads rule names and parameters
+//! here, so the registry sits below `forcefield`; the engine that applies the
+//! rules every step reads the system and the neighbour list, which sit above
+//! `forcefield`, so it is a folder of its own, `kinetics_engine`.
 
 use crate::interactions::ParamSpec;
 

@@ -9,7 +9,7 @@
 //! | quantity | where | module |
 //! |---|---|---|
 //! | per-particle virial W_i, stress S_i = −W_i, von Mises | LAMMPS dump columns `wxx`…`wyz`, `sxx`…`syz`, `vonmises` | [`stress`] |
-//! | per-bond tension and length | `dump NAME every N bonds FILE.csv` | [`crate::output::bond_csv`] |
+//! | per-bond tension and length | `dump NAME every N bonds FILE.csv` | `output::bond_csv` |
 //! | force across a plane | thermo `planetension/AXIS/POS` | [`planes`] |
 //! | cortical tension γ (method of planes) | thermo `gamma/BODYTYPE` | [`planes`] |
 //! | end-to-end distance, tangent correlation | thermo `e2e/BONDTYPE`, `tcorr/BONDTYPE/LAG` | [`filaments`] |

@@ -31,14 +31,12 @@
 //! A bond line may end with the bond's own rest length r0 (length units: µm
 //! under `units cell`; a positive finite number). It replaces the bond type's
 //! `r0` for that bond alone, everywhere a rest length is used; it is the
-//! bond's initial rest length in its state ([`BondState::rest`]), so kinetic
+//! bond's initial rest length in its state (`system::BondState::rest`), so kinetic
 //! rules that move the rest length (plastic reset, motor, ratchet) start from
 //! it. Only a bond type whose law has an `r0` parameter accepts one (checked
 //! when the deck is validated, at the value's position). `cellmd build …
 //! --rest-from-geometry` writes every bond's length as built here, so an
 //! irregular mesh starts force-free.
-//!
-//! [`BondState::rest`]: crate::system::BondState
 //!
 //! Each body must be a closed, consistently oriented 2-manifold of sphere
 //! topology (every edge in exactly two faces, once in each direction; one fan
