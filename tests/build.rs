@@ -332,7 +332,7 @@ fn sheet() {
 
     // A regular sheet of hexagons (7 particles a cell, ids cell by cell, rows
     // from −y, each from −x) is at rest as built. Junctions break beyond a
-    // force threshold F_c (seed 001). Pull the first column of cells S to
+    // force threshold F_c (Prakash et al. 2022). Pull the first column of cells S to
     // −x and the last to +x: only junctions join S to the rest, so at
     // equilibrium their tensions' x-components sum to the pull, and a pull
     // above n_S·F_c must break one; well below it the sheet holds.
@@ -459,7 +459,7 @@ fn tensegrity() {
 
     // Level 2 with everything: a strut on every ray, 12 focal adhesions held
     // fixed, stress fibres of 3 cables, actin cables, and the shells as
-    // bodies whose turgor stands for seed 003's cytosol and nucleoskeleton
+    // bodies whose turgor stands for Vassaux & Milan's cytosol and nucleoskeleton
     // (without them the cable cortex folds up and the spring nucleus buckles
     // in). Relaxed, the cell holds its shape with every cable in tension and
     // every strut in compression.

@@ -46,7 +46,7 @@ fn arc(segments: usize, segment: f64, radius: f64) -> Vec<DVec3> {
 }
 
 /// The bending energy of a quarter circle approaches κL/2R²: p segments have
-/// p − 1 joints, so the discrete energy times p/(p − 1) (seed 000's end
+/// p − 1 joints, so the discrete energy times p/(p − 1) (the end
 /// correction) must be within 0.5 % of the continuum from p = 8 on.
 #[test]
 fn wlc_bending_energy_of_an_arc_is_kappa_l_over_2r2() {

@@ -21,8 +21,8 @@
 //! | [`branched()`] | `branched` | Arp2/3 network: mother filaments with daughters at 70° ± a spread |
 //! | [`filopodium()`] | `filopodium` | a hexagonal bundle of parallel filaments, crosslinked between neighbours |
 //! | [`cells()`] | `cells` | many icosphere cells packed in a spheroid or a confluent layer |
-//! | [`sheet()`] | `sheet` | a 2D epithelial sheet (seed 001): hexagonal cells as rings of nodes (or single particles) joined by junction bonds |
-//! | [`tensegrity()`] | `tensegrity` | a tensegrity cell (seed 003): cortex and nucleus shells, radial microtubule struts, actin cables and stress fibres from focal adhesions |
+//! | [`sheet()`] | `sheet` | a 2D epithelial sheet (Prakash et al. 2022): hexagonal cells as rings of nodes (or single particles) joined by junction bonds |
+//! | [`tensegrity()`] | `tensegrity` | a tensegrity cell (Vassaux & Milan 2017): cortex and nucleus shells, radial microtubule struts, actin cables and stress fibres from focal adhesions |
 //! | [`merge()`] | `merge` | several topology files composed into one by the deck's rule for several `topology` lines |
 //!
 //! **Rest lengths** (`--rest-from-geometry`, every generator): by default a
@@ -124,11 +124,11 @@ pub enum Generator {
     Filopodium(FilopodiumArgs),
     /// Many icosphere cells packed without overlap in a spheroid or a confluent layer.
     Cells(CellsArgs),
-    /// A 2D epithelial sheet (seed 001): hexagonal cells, each a ring of
+    /// A 2D epithelial sheet (Prakash et al. 2022): hexagonal cells, each a ring of
     /// nodes with edge bonds and a centre node with spokes (or one particle),
     /// neighbours joined by junction bonds.
     Sheet(SheetArgs),
-    /// A tensegrity cell (seed 003): a cortex shell, a nucleus shell (or a
+    /// A tensegrity cell (Vassaux & Milan 2017): a cortex shell, a nucleus shell (or a
     /// centrosome node), radial microtubule struts, actin cables from the
     /// cortex to the nucleus and stress fibres from focal adhesions.
     Tensegrity(TensegrityArgs),

@@ -1,5 +1,7 @@
-//! `cellmd build sheet`: a 2D epithelial cell sheet, the tissue of seed 001
-//! (fracture of *Trichoplax* epithelia), as explicit particles and bonds.
+//! `cellmd build sheet`: a 2D epithelial cell sheet, the tissue of Prakash,
+//! Bull & Prakash (Nat. Phys. 18, 444, 2022, and its Supplementary
+//! Information: fracture of *Trichoplax* epithelia), as explicit particles
+//! and bonds.
 //!
 //! # Geometry
 //!
@@ -39,7 +41,7 @@
 //!
 //! With `--nodes-per-edge 0` each cell is a single particle of `--centre-type`
 //! at its hexagon's centroid and the junctions join neighbouring cells'
-//! particles (length D on a regular lattice): seed 001's reduced model.
+//! particles (length D on a regular lattice): their reduced model.
 //!
 //! Particle ids run cell by cell, rows from the bottom (−y) and each row from
 //! left (−x): cell (i, j) is the (j·NX + i)-th, its centre node first and then
@@ -51,14 +53,14 @@
 //!
 //! # Why this representation
 //!
-//! Seed 001 writes a cell's energy as a vertex model plus its junctions,
+//! Prakash et al. write a cell's energy as a vertex model plus its junctions,
 //! ε_i = k_A(A_i − A0)² + Γ·P_i² + α·P_i + Σ_j δ_ij·ε_junction, where
 //! δ_ij ∈ {0, 1} says whether the junction between cells i and j is bound,
 //! breaks at a force (or strain) threshold and rebinds with maturation
 //! N(t) = N0(1 − e^(−t/τ_mature)). A vertex model shares the vertices and
 //! edges of neighbouring cells, so a junction cannot be a thing that breaks.
 //! Here every cell keeps its own boundary, and what holds two cells together
-//! is a separate bond type — the δ_ij of seed 001 made explicit — to which the
+//! is a separate bond type — the δ_ij of Prakash et al. made explicit — to which the
 //! force field gives that kinetics:
 //!
 //! ```text
@@ -71,10 +73,10 @@
 //! P0 = n·ℓ_r, i.e. Γ·P² + α·P up to a constant with α = −2Γ·P0 (`harmonic`:
 //! k_e = k, ℓ_r = r0; `spring`/`cable` with pre-strain τ: k_e = k/r0,
 //! ℓ_r = r0(1 − τ), a contractile cortex). The spokes stand for the area term
-//! linearised, as seed 001's second model linearises the vertex energy into
+//! linearised, as Prakash et al.'s second model linearises the vertex energy into
 //! springs: on a regular n-gon with spokes of length s0 (A0 = (n/2)s0²·sin(2π/n)),
 //! harmonic spokes of constant k_s resist a uniform dilation as
-//! k_A(A − A0)² with k_A = k_s/(2n·s0²·sin²(2π/n)). Seed 001's phase diagram
+//! k_A(A − A0)² with k_A = k_s/(2n·s0²·sin²(2π/n)). Their phase diagram
 //! comes from its reduced model, cells as particles joined by junction
 //! springs, which `--nodes-per-edge 0` writes.
 //!
@@ -202,7 +204,7 @@ fn inset(p: &[DVec2; 6], h: f64) -> Option<[DVec2; 6]> {
 /// a plane, each a ring of nodes with edge bonds and a centre node with
 /// spokes (or one particle with `--nodes-per-edge 0`), neighbouring cells
 /// joined by junction bonds; `--jitter` makes the hexagons irregular. The
-/// construction and why it suits seed 001's junction model are in the module
+/// construction and why it suits Prakash et al.'s junction model are in the module
 /// documentation (`src/build/sheet.rs`).
 pub fn sheet(a: &SheetArgs) -> Result<Built, String> {
     let d = positive("--cell-size", a.cell_size)?;

@@ -1,25 +1,26 @@
 //! `cellmd build tensegrity`: a tensegrity cell, the discrete-element model of
-//! an adherent mesenchymal stem cell of seed 003 reduced to what a force field
-//! of cables and springs needs.
+//! an adherent mesenchymal stem cell of Vassaux & Milan (Biomech. Model.
+//! Mechanobiol. 16, 1295, 2017) reduced to what a force field of cables and
+//! springs needs.
 //!
 //! # Geometry
 //!
-//! - **Cortex** (seed 003's cell membrane with its actomyosin cortex): an
+//! - **Cortex** (Vassaux & Milan's cell membrane with its actomyosin cortex): an
 //!   icosphere of `--level` n (10·4ⁿ + 2 nodes) and `--radius` R (µm) around
 //!   `--centre`; its mesh edges are bonds of `--bond-type` (default `edge`):
 //!   give them the `cable` law with a pre-strain τ > 0 (the contractile
 //!   cortex). Node and bond types as for `cellmd build icosphere`.
 //! - **Nucleus** (`--nucleus RN`, µm): a concentric icosphere of the same
-//!   level, edges of `--nucleus-bond-type` (seed 003's nuclear membrane; a
+//!   level, edges of `--nucleus-bond-type` (Vassaux & Milan's nuclear membrane; a
 //!   `spring` law carries the compression the struts put on it). Without a
 //!   nucleus a single **centrosome** node (`--centrosome-type`) sits at the
 //!   centre instead.
-//! - Seed 003's membranes are nets of cables and springs, not surfaces, so
+//! - Vassaux & Milan's membranes are nets of cables and springs, not surfaces, so
 //!   the shells are written as nodes and edges alone; `--bodies` also writes
 //!   them as closed bodies with outward-wound faces (the cortex body 1 of
 //!   `--body-type`, the nucleus body 2 of `--nucleus-body-type`), for `body`
 //!   terms such as `turgor` (the cytosol's and the nucleoplasm's resistance
-//!   to compression, which seed 003 models with packed particles).
+//!   to compression, which Vassaux & Milan model with packed particles).
 //! - **Radial elements**: the cortex and the nucleus share their directions
 //!   (node k of both lies on the same ray), so elements joining a cortex node
 //!   to the nucleus node on its ray (or to the centrosome) all have length
@@ -29,11 +30,11 @@
 //!   - a **stress fibre** on the ray of each focal adhesion: a chain of
 //!     `--fibre-segments` m cables (`--stress-fibre-type`, default
 //!     `stress_fibre`, each L/m long) with m − 1 beads (`--fibre-bead-type`)
-//!     between, running from the adhesion towards the nucleus centre as seed
-//!     003 grows its fibres. A ray may carry a strut too (microtubules reach
+//!     between, running from the adhesion towards the nucleus centre as Vassaux
+//!     & Milan grow their fibres. A ray may carry a strut too (microtubules reach
 //!     focal adhesions), and some rays carry neither.
-//! - **Actin cables** (`--cable-type`, default `actin`; with a nucleus): seed
-//!   003's microfilament and intermediate-filament networks joining the
+//! - **Actin cables** (`--cable-type`, default `actin`; with a nucleus): the
+//!   model's microfilament and intermediate-filament networks joining the
 //!   cortex to the nucleus, here a cable from every cortex node to the
 //!   nucleus node on each neighbouring ray (two per mesh edge, crossing). Not
 //!   radial, they brace the cortex against turning about the nucleus — with
@@ -45,7 +46,7 @@
 //!   type `--adhesion-type` (default `focal_adhesion`), so the force field can
 //!   fix them (`particle focal_adhesion fixed`) or hold them on a substrate.
 //! - **Which rays carry microtubules** (`--microtubules M`, default half of
-//!   the rays): seed 003 draws its microtubules around a
+//!   the rays): Vassaux & Milan draw their microtubules around a
 //!   centrosome direction c, itself uniform on the sphere, with an angular
 //!   spread σ² = π/2. Here c is drawn from `--seed`, and M rays are drawn
 //!   without replacement with weights w_k = exp(−θ_k²/(2σ²)), θ_k the angle
@@ -66,7 +67,7 @@
 //! the actin cables pull the cortex towards the nucleus; the struts push back,
 //! so at equilibrium the cables are in tension and the struts in compression
 //! with no load from outside: the structure holds its shape by prestress
-//! (seed 003, after Ingber's cellular tensegrity). Without pre-strain the
+//! (Vassaux & Milan 2017, after Ingber's cellular tensegrity). Without pre-strain the
 //! same structure built at its rest lengths carries no force at all: exactly
 //! so with `--rest-from-geometry` (each bond's length as built is its own
 //! r0, e.g. the actin cables, whose lengths spread), and τ then pre-strains
@@ -75,8 +76,8 @@
 //! It holds only while its cables stay taut, and nothing here resists a
 //! change of volume: struts pivot about their ends, so a pre-stressed cable
 //! cortex can fold up, and the spring nucleus, a triangulated shell without
-//! bending stiffness, buckles inwards under the struts. Seed 003 fills the
-//! cell with packed cytosol particles and the nucleus with nucleoskeleton
+//! bending stiffness, buckles inwards under the struts. Vassaux & Milan fill
+//! the cell with packed cytosol particles and the nucleus with nucleoskeleton
 //! particles; here `--bodies` lets the force field give both shells a
 //! `turgor` term instead. In the level-2 cell of `tests/build.rs` (a strut on
 //! every ray, 12 fixed adhesions) every cable stays taut and every strut
@@ -131,7 +132,7 @@ pub struct TensegrityArgs {
     /// Microtubule struts [default: half of the rays].
     #[arg(long)]
     pub microtubules: Option<u32>,
-    /// Angular spread σ (rad) of the microtubules around the centrosome direction [default: √(π/2), seed 003's σ² = π/2].
+    /// Angular spread σ (rad) of the microtubules around the centrosome direction [default: √(π/2), Vassaux & Milan's σ² = π/2].
     #[arg(allow_negative_numbers = true, long)]
     pub spread: Option<f64>,
     /// Focal adhesions: the cortex nodes lowest in z, each the foot of a stress fibre.
@@ -424,7 +425,7 @@ mod tests {
         assert_eq!(tensegrity(&a(5, None)).unwrap().text, built.text);
         assert_ne!(tensegrity(&a(6, None)).unwrap().text, built.text);
         // Mean cosine of the struts to the centrosome direction. Uniformly
-        // random rays would give 0 ± 0.09 (1/√3 over √40); seed 003's spread
+        // random rays would give 0 ± 0.09 (1/√3 over √40); Vassaux & Milan's spread
         // must lie clearly above that, and a narrow spread takes the cap of
         // the 40 nearest rays, whose mean cosine is (1 + cos θ_cap)/2 with
         // cos θ_cap = 1 − 2·40/162 (equal area per ray).

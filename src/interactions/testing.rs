@@ -1,4 +1,4 @@
-//! Shared physics checks run on every interaction type (CONVENTIONS §5).
+//! Shared physics checks run on every interaction type.
 //!
 //! Each [`Law`] is viewed as a function of the positions of its particles,
 //! E(r₁…rₙ) with forces f₁…fₙ, and checked for:

@@ -73,7 +73,7 @@ mod tests {
 
     #[test]
     fn force_is_the_pressure_on_a_third_of_each_face() {
-        // The seed's rule: ΔP·(A_t n̂_t)/3 on each corner of each face.
+        // The rule of turgor.md: ΔP·(A_t n̂_t)/3 on each corner of each face.
         let (mesh, x) = deformed_icosphere(2, 2.0, 0.03);
         let v = mesh.volume(&x);
         let p = params_of(&Turgor, &[("k", 700.0), ("dp0", 20.0), ("v0", 1.2 * v)]);

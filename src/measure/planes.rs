@@ -22,8 +22,8 @@
 //!
 //! # Cortical tension
 //!
-//! Thermo column `gamma/BODYTYPE`: the method-of-planes estimator of the
-//! cortical tension of seed 000,
+//! Thermo column `gamma/BODYTYPE`: the method-of-planes estimator (Todd,
+//! Evans & Daivis, Phys. Rev. E 52, 1627, 1995) of the cortical tension,
 //!
 //! γ = ⟨ Σ_cut T·|û·n̂| ⟩_planes / (2πR),
 //!
