@@ -12,8 +12,8 @@
 //! the second part acting on node k and the corners of its nearest face
 //! exactly as a node–face term with b′ = ε·s′_k·B_k ([`node_face_forces`]).
 //!
-//! After the node–face pair pass of [`Contacts`](super::contact::Contacts)
-//! (which has every candidate pair's closest point):
+//! After the node–face pair pass of the contact terms (`contact::Contacts`,
+//! which has every candidate pair's closest point):
 //!
 //! 1. **Faces** (parallel): A_t and ∂A_t/∂x of every contact face, corners
 //!    image-consistent around the first.
@@ -32,8 +32,8 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::contact::{csr, face_corners, push_pair_blocks, Candidates, ContactMesh};
-use super::stiffness::StiffnessBlock;
+use super::contact_mesh::{csr, face_corners, push_pair_blocks, Candidates, ContactMesh};
+use super::stiffness_blocks::StiffnessBlock;
 use super::virial::{add6, outer};
 use crate::interactions::{node_face_forces, Law, Radial};
 use crate::mesh::triangle_area_gradient;

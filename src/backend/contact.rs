@@ -34,11 +34,12 @@
 //! a pair closes by at most 0.8·d (additive CCD bound: the distance is
 //! 1-Lipschitz in each point), so no node passes through a face.
 
-use glam::{DMat3, DVec3};
+use glam::DVec3;
 use rayon::prelude::*;
 
 use super::adhesion::Adhesion;
-use super::stiffness::StiffnessBlock;
+use super::contact_mesh::{csr, face_corners, push_pair_blocks, Candidates, ContactMesh, Face};
+use super::stiffness_blocks::StiffnessBlock;
 use super::virial::{add6, outer};
 use crate::forcefield::TermType;
 use crate::interactions::{node_face_forces, Law, Radial};
@@ -48,38 +49,6 @@ use crate::system::{registry_index, Images, Model, SimBox};
 
 /// Fraction of the distance to its closest contact a particle may move in one step.
 pub const STEP_FRACTION: f64 = 0.4;
-
-/// A face of a contact body: its corners (particle indices) and its body.
-type Face = ([u32; 3], u32);
-
-/// The nodes and faces of the bodies some contact rule names (fixed for a model).
-#[derive(Default)]
-pub(super) struct ContactMesh {
-    /// Particles that are nodes of those bodies (ascending), and their body.
-    pub(super) nodes: Vec<u32>,
-    pub(super) node_body: Vec<u32>,
-    /// Faces of those bodies.
-    pub(super) faces: Vec<Face>,
-}
-
-impl ContactMesh {
-    /// The compact index of contact node `p` (a particle).
-    pub(super) fn compact(&self, p: u32) -> usize {
-        self.nodes.binary_search(&p).expect("a contact node")
-    }
-}
-
-/// The candidate pairs and, at the last evaluation, their geometry and forces.
-#[derive(Default)]
-pub(super) struct Candidates {
-    /// (compact node, face), sorted; node k's pairs are `offsets[k]..offsets[k + 1]`.
-    pub(super) pairs: Vec<[u32; 2]>,
-    pub(super) offsets: Vec<u32>,
-    /// Per pair: the closest point of the face to the node, and the forces
-    /// [node, corner 0, corner 1, corner 2] of every term on the pair.
-    pub(super) points: Vec<PointTriangle>,
-    pub(super) forces: Vec<[DVec3; 4]>,
-}
 
 /// Candidate pairs, their per-pair results and each particle's slots.
 #[derive(Default)]
@@ -348,47 +317,9 @@ impl Contacts {
     }
 }
 
-/// Appends the Gauss–Newton blocks c·g_a g_bᵀ of candidate pair `k` for a
-/// curvature c = ∂²E/∂d² > 0 (nothing for c ≤ 0), g = (n̂, −w_0 n̂, −w_1 n̂,
-/// −w_2 n̂) over (node, corner 0, corner 1, corner 2) at its closest point.
-pub(super) fn push_pair_blocks(mesh: &ContactMesh, candidates: &Candidates, k: usize, curvature: f64, blocks: &mut Vec<StiffnessBlock>) {
-    if curvature <= 0.0 {
-        return;
-    }
-    let (pt, [node, face]) = (&candidates.points[k], candidates.pairs[k]);
-    let corners = mesh.faces[face as usize].0;
-    let nn = DMat3::from_cols(pt.normal * pt.normal.x, pt.normal * pt.normal.y, pt.normal * pt.normal.z) * curvature;
-    let particles = [mesh.nodes[node as usize], corners[0], corners[1], corners[2]];
-    let g = [1.0, -pt.weights[0], -pt.weights[1], -pt.weights[2]];
-    for a in 0..4 {
-        for b in 0..4 {
-            blocks.push(StiffnessBlock { i: particles[a], j: particles[b], block: nn * (g[a] * g[b]) });
-        }
-    }
-}
-
-/// Corners of face `corners`, image-consistent around the first.
-#[inline]
-pub(super) fn face_corners(x: &[DVec3], images: &Images, corners: [u32; 3]) -> [DVec3; 3] {
-    let a = x[corners[0] as usize];
-    corners.map(|q| a + images.minimum_image(x[q as usize] - a))
-}
-
 /// Closest point of face `corners` to particle `p`, image-consistent around corner 0.
 #[inline]
 fn closest(x: &[DVec3], images: &Images, p: u32, corners: [u32; 3]) -> PointTriangle {
     let face = face_corners(x, images, corners);
     point_triangle(face[0] + images.minimum_image(x[p as usize] - face[0]), face)
-}
-
-/// Rows to CSR (offsets, flat).
-pub(super) fn csr<T>(rows: Vec<Vec<T>>) -> (Vec<u32>, Vec<T>) {
-    let mut offsets = Vec::with_capacity(rows.len() + 1);
-    let mut flat = Vec::new();
-    offsets.push(0);
-    for row in rows {
-        flat.extend(row);
-        offsets.push(flat.len() as u32);
-    }
-    (offsets, flat)
 }

@@ -65,37 +65,14 @@
 //! bodies by body, term and stencil), so the assembled matrix is the same on
 //! any thread count.
 
-use faer::Mat;
 use glam::{DMat3, DVec3};
 
 use super::bonded::eval_angle;
 use super::cpu::CpuBackend;
-use crate::hessian::{block, finite_difference_hessian, project_psd};
+use super::stiffness_blocks::{push_blocks, Stiffness, StiffnessBlock};
+use crate::hessian::{finite_difference_hessian, project_psd};
 use crate::interactions::{Law, Radial};
 use crate::system::{Images, Model, SimBox, State};
-
-/// A Gauss–Newton term w·g gᵀ of K̃ (w ≥ 0): g[k] on particle `particles[k]`.
-#[derive(Clone, Debug, PartialEq)]
-pub struct RankOneTerm {
-    pub weight: f64,
-    pub particles: Vec<u32>,
-    pub gradient: Vec<DVec3>,
-}
-
-/// K̃ = Σ blocks + Σ rank-one terms.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct Stiffness {
-    pub blocks: Vec<StiffnessBlock>,
-    pub rank_one: Vec<RankOneTerm>,
-}
-
-/// One 3×3 block K̃_ij of the stiffness matrix (particle indices i, j).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct StiffnessBlock {
-    pub i: u32,
-    pub j: u32,
-    pub block: DMat3,
-}
 
 /// The projected block of a radial term along `d` (length r).
 fn radial_block(radial: &Radial, d: DVec3, r: f64) -> DMat3 {
@@ -112,15 +89,6 @@ fn push_pair(blocks: &mut Vec<StiffnessBlock>, i: u32, j: u32, h: DMat3) {
     blocks.push(StiffnessBlock { i: j, j, block: h });
     blocks.push(StiffnessBlock { i, j, block: -h });
     blocks.push(StiffnessBlock { i: j, j: i, block: -h });
-}
-
-/// Appends the blocks of the 3k×3k matrix `h` over `particles`.
-pub(super) fn push_blocks(particles: &[u32], h: &Mat<f64>, blocks: &mut Vec<StiffnessBlock>) {
-    for (a, &i) in particles.iter().enumerate() {
-        for (b, &j) in particles.iter().enumerate() {
-            blocks.push(StiffnessBlock { i, j, block: block(h, a, b) });
-        }
-    }
 }
 
 /// The PSD projection of a term's finite-difference Hessian, as blocks.

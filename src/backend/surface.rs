@@ -24,7 +24,7 @@
 use glam::{DMat3, DVec3};
 use rayon::prelude::*;
 
-use super::stiffness::{push_blocks, RankOneTerm, StiffnessBlock};
+use super::stiffness_blocks::{push_blocks, RankOneTerm, StiffnessBlock};
 use super::virial::{add6, outer};
 use crate::hessian::{project_psd, SurfaceHessian};
 use crate::interactions::Law;

@@ -1,7 +1,7 @@
 //! The input files a deck was read from, kept so that a restart can carry
 //! them and a run can continue with no file of the original on disk.
 //!
-//! Every [`SourceFile::read`](super::SourceFile::read) inside
+//! Every `SourceFile::read` (the lexer's) inside
 //! [`recording`] is noted with its path as shown in diagnostics and its
 //! text; inside [`replaying`] the same reads are answered from a saved set
 //! instead of the disk (a path missing from the set is an error, never a

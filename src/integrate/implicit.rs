@@ -45,7 +45,7 @@ use glam::DVec3;
 
 use super::overdamped::{clamp_fraction, Blowup, OverdampedSettings};
 use super::system_matrix::SystemMatrix;
-use crate::backend::stiffness::Stiffness;
+use crate::backend::Stiffness;
 use crate::rng::noise3;
 use crate::system::{Model, SimBox, State};
 

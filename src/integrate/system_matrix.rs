@@ -25,7 +25,7 @@ use faer::sparse::{SparseColMat, Triplet};
 use faer::{Col, Mat, MatMut, MatRef, Par, Side};
 use glam::{DMat3, DVec3};
 
-use crate::backend::stiffness::Stiffness;
+use crate::backend::Stiffness;
 
 /// A = S + Σ_k w_k·g_k g_kᵀ over 3n degrees of freedom.
 #[derive(Debug)]
@@ -163,7 +163,7 @@ impl LinOp<f64> for SystemMatrix {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::backend::stiffness::{RankOneTerm, StiffnessBlock};
+    use crate::backend::{RankOneTerm, StiffnessBlock};
 
     /// Products and the Woodbury solve agree with the dense matrix.
     #[test]

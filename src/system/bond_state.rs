@@ -1,5 +1,5 @@
-//! Per-bond dynamic state, part of the simulation [`State`](crate::system::State)
-//! and of restart files.
+//! Per-bond dynamic state, part of the simulation state (`State::bonds`) and
+//! of restart files.
 
 /// State of every bond (indexed like `Model::bonds`).
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
