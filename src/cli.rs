@@ -397,7 +397,7 @@ fn profile_gpu(plan: &crate::deck::Plan, repetitions: u32, rebuild_rate: Option<
         skin: sim.neighbor.skin,
         neighbor_every: sim.neighbor.every,
         neighbor_check: sim.neighbor.check,
-        integrator: sim.integrator,
+        integrator: *sim.integrator.common(),
     };
     let mut gpu = GpuBackend::new(&context, &sim.model, &sim.state, &sim.sim_box, &settings)?;
     let rate = match rebuild_rate {

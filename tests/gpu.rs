@@ -9,6 +9,7 @@ use cellmd::deck::{Action, Plan};
 use cellmd::gpu::backend::StepSettings;
 use cellmd::gpu::{DevicePreference, GpuBackend, GpuContext};
 use cellmd::integrate::overdamped::OverdampedSettings;
+use cellmd::integrate::Integrator;
 use cellmd::rng::Noise;
 use cellmd::run::{RunOptions, Simulation};
 use cellmd::system::State;
@@ -456,9 +457,13 @@ fn thermal_statistics(device: DevicePreference, steps: u64, kt: f64, dt: f64, no
         }
         _ => {
             let mut sim = Simulation::new(&plan, RunOptions::default());
-            for action in
-                [Action::Temperature(kt), Action::Timestep(dt), Action::Seed(7), Action::Integrator(integrator), Action::Run(steps)]
-            {
+            for action in [
+                Action::Temperature(kt),
+                Action::Timestep(dt),
+                Action::Seed(7),
+                Action::Integrator(Integrator::Overdamped(integrator)),
+                Action::Run(steps),
+            ] {
                 sim.apply(&action).unwrap();
             }
             state = sim.state;

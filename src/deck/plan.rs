@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use super::protocol::Protocol;
 use crate::forcefield::TermType;
 use crate::integrate::fire::FireSettings;
-use crate::integrate::overdamped::OverdampedSettings;
+use crate::integrate::Integrator;
 use crate::output::DumpFormat;
 use crate::system::{External, Model, SimBox};
 
@@ -148,7 +148,7 @@ pub enum Action {
     Seed(u64),
     /// Which backend runs the steps (`device cpu|gpu|auto`).
     Device(crate::gpu::DevicePreference),
-    Integrator(OverdampedSettings),
+    Integrator(Integrator),
     Neighbor(NeighborSettings),
     Thermo {
         every: u64,

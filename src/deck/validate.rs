@@ -19,6 +19,7 @@ use crate::input::{
 use crate::integrate::fire::FireSettings;
 use crate::integrate::implicit::{ImplicitSettings, LinearSolver};
 use crate::integrate::overdamped::OverdampedSettings;
+use crate::integrate::Integrator;
 use crate::interactions::{param_index, Kind, REGISTRY};
 use crate::kinetics_engine::EventKind;
 use crate::output::{AtomColumn, DumpFormat, Encoding, WriterOptions};
@@ -689,6 +690,7 @@ impl Validator {
                 if let Some(t) = opts.get("max_displacement") {
                     settings.max_displacement = positive(t, "a maximum displacement per step")?;
                 }
+                let mut choice = Integrator::Overdamped(settings);
                 if implicit {
                     let mut solve = ImplicitSettings::default();
                     if let Some(t) = opts.get("solver") {
@@ -704,9 +706,9 @@ impl Validator {
                     if let Some(t) = opts.get("max_iterations") {
                         solve.max_iterations = parse_u64(t, "an iteration count")?.max(1) as usize;
                     }
-                    settings.implicit = Some(solve);
+                    choice = Integrator::Implicit(settings, solve);
                 }
-                self.actions.push(Action::Integrator(settings));
+                self.actions.push(Action::Integrator(choice));
             }
             "neighbor" => {
                 expect_len(s, 2..=6, "neighbor skin S [every N] [check yes|no]")?;

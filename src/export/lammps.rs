@@ -49,6 +49,7 @@ use super::formula;
 use super::styles::{self, num, PairStyled, Styled};
 use crate::deck::{Action, CoeffTarget, Plan};
 use crate::forcefield::TermType;
+use crate::integrate::Integrator;
 use crate::kinetics::deterministic_strain;
 use crate::rng::Noise;
 use crate::system::{External, Model};
@@ -671,10 +672,10 @@ impl Writer<'_> {
                 }
                 Action::Seed(seed) => self.seed = *seed,
                 Action::Integrator(s) => {
-                    if s.implicit.is_some() {
+                    if matches!(s, Integrator::Implicit(..)) {
                         return Err("`integrator implicit` has no LAMMPS counterpart (LAMMPS' fix brownian is the explicit step)".into());
                     }
-                    self.noise = s.noise;
+                    self.noise = s.common().noise;
                 }
                 Action::Neighbor(_) | Action::Device(_) => {}
                 Action::Protocol(_) => {

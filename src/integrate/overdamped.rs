@@ -34,21 +34,18 @@ use rayon::prelude::*;
 use crate::rng::{noise3, Noise};
 use crate::system::{Model, SimBox, State};
 
-/// Options of `integrator overdamped`.
+/// Options of `integrator overdamped`, which `integrator implicit` shares.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct OverdampedSettings {
     pub noise: Noise,
     /// Largest displacement allowed in one step (length units) before the run
     /// is stopped as blown up.
     pub max_displacement: f64,
-    /// `integrator implicit`: the linearly implicit step and its solver
-    /// ([`super::implicit`]); `None` for the explicit step.
-    pub implicit: Option<super::implicit::ImplicitSettings>,
 }
 
 impl Default for OverdampedSettings {
     fn default() -> Self {
-        Self { noise: Noise::Uniform, max_displacement: 1.0, implicit: None }
+        Self { noise: Noise::Uniform, max_displacement: 1.0 }
     }
 }
 

@@ -18,7 +18,8 @@ use crate::input::DeckInputs;
 use crate::integrate::constraints::{Constraint, Constraints};
 use crate::integrate::fire::{fire_minimize, FireReport, FireSettings};
 use crate::integrate::implicit::{implicit_step, ConstrainedBonds, ImplicitError, ImplicitSettings, SolveReport};
-use crate::integrate::overdamped::{overdamped_step, Blowup, OverdampedSettings};
+use crate::integrate::overdamped::{overdamped_step, Blowup};
+use crate::integrate::Integrator;
 use crate::kinetics_engine::{initial_bond_state, Binding, Formation, Kinetics};
 use crate::output::restart::{read_state, write_state, Counters, RestartData, Resume};
 use crate::output::run_log::{model_parameters, LogHeader, Phase, PhaseTimes, RunLog};
@@ -88,7 +89,7 @@ pub struct Simulation {
     pub kt: f64,
     pub dt: f64,
     pub seed: u64,
-    pub integrator: OverdampedSettings,
+    pub integrator: Integrator,
     pub neighbor: NeighborSettings,
     backend: Option<CpuBackend>,
     forces_current: bool,
@@ -165,7 +166,7 @@ impl Simulation {
             kt: 0.0,
             dt: 0.0,
             seed: 1,
-            integrator: OverdampedSettings::default(),
+            integrator: Integrator::default(),
             neighbor: NeighborSettings::default(),
             backend: None,
             forces_current: false,
@@ -859,9 +860,9 @@ impl Simulation {
                 before.clone_from(&self.state.positions);
             }
             self.protocols.before_step(&mut self.forces.forces, &self.state);
-            let moved = match self.integrator.implicit {
-                Some(implicit) => self.implicit_step(&implicit)?,
-                None => {
+            let moved = match self.integrator {
+                Integrator::Implicit(_, implicit) => self.implicit_step(&implicit)?,
+                Integrator::Overdamped(_) => {
                     let n = self.model.len();
                     let limited = self.backend.as_ref().is_some_and(|b| b.contact_step_limits(n, &mut self.step_limits));
                     overdamped_step(
@@ -872,7 +873,7 @@ impl Simulation {
                         self.dt,
                         self.kt,
                         self.seed,
-                        &self.integrator,
+                        self.integrator.common(),
                         limited.then_some(self.step_limits.as_slice()),
                         &mut self.scratch,
                     )
@@ -955,7 +956,7 @@ impl Simulation {
             self.dt,
             self.kt,
             self.seed,
-            &self.integrator,
+            self.integrator.common(),
             implicit,
             &mut constrained,
             limited.then_some(self.step_limits.as_slice()),
@@ -974,7 +975,7 @@ impl Simulation {
     }
 
     fn displacement_message(&self, displacement: f64) -> String {
-        format!("displacement {displacement:e} in one step exceeds max_displacement {:e}", self.integrator.max_displacement)
+        format!("displacement {displacement:e} in one step exceeds max_displacement {:e}", self.integrator.common().max_displacement)
     }
 
     /// Why the next `run` cannot use the GPU backend: the first feature in
@@ -982,7 +983,7 @@ impl Simulation {
     pub fn cpu_only_feature(&self) -> Option<&'static str> {
         if let Some(why) = self.protocols.cpu_only() {
             Some(why)
-        } else if self.integrator.implicit.is_some() {
+        } else if matches!(self.integrator, Integrator::Implicit(..)) {
             Some("`integrator implicit` runs on the CPU backend only")
         } else if !self.constraints.list.is_empty() {
             Some("constrained bonds (`constrain`) run on the CPU backend only")
@@ -1050,7 +1051,7 @@ impl Simulation {
             skin: self.neighbor.skin,
             neighbor_every: self.neighbor.every,
             neighbor_check: self.neighbor.check,
-            integrator: self.integrator,
+            integrator: *self.integrator.common(),
         };
         let mut gpu = GpuBackend::new(context, &self.model, &self.state, &self.sim_box, &settings).map_err(RunError::Setup)?;
         let kinetics = self.model.has_kinetics();
@@ -1088,7 +1089,7 @@ impl Simulation {
                 self.refresh_cpu_forces(false)?;
                 let what = format!(
                     "its GPU step was non-finite or longer than max_displacement {:e} (force here {:e})",
-                    self.integrator.max_displacement,
+                    self.integrator.common().max_displacement,
                     self.forces.forces[particle].length()
                 );
                 return Err(self.blowup(particle, what));
