@@ -47,6 +47,8 @@
 mod merge;
 mod parse;
 mod surface;
+mod types;
 
 pub use self::merge::Clash;
-pub use self::parse::{parse_box_axis, parse_topology, BoxAxis, Topology, TypedTerm};
+pub use self::parse::{parse_box_axis, parse_topology};
+pub use self::types::{BoxAxis, Topology, TypedTerm};

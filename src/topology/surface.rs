@@ -21,7 +21,7 @@
 
 use std::collections::HashMap;
 
-use super::parse::Topology;
+use super::types::Topology;
 use crate::input::{InputError, Token};
 
 fn face_text(top: &Topology, face: [u32; 3]) -> String {
