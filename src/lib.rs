@@ -1,6 +1,12 @@
 //! # cellmd — overdamped molecular dynamics whose force fields are cell mechanics
 //!
-//! Architecture map (data flows top to bottom):
+//! Architecture map (data flows top to bottom). The modules are layered: a
+//! module imports only modules of the layers before its own, in this order:
+//! leaves (`units`, `expr`, `input`, `rng`, `mesh`), then `hessian`,
+//! `interactions`, `kinetics`, `forcefield`, `topology`, `system`,
+//! `neighbor`, `backend`, `integrate`, `kinetics_engine`, `measure`,
+//! `output`, `gpu`, `deck`, `run`, `export`, `compare`, `build`, `cli`.
+//! `tests/architecture.rs` fails on any cycle among them.
 //!
 //! | module | role |
 //! |---|---|
@@ -10,15 +16,17 @@
 //! | [`topology`] | particles, bonds, angles, triangles, bodies (checked: closed, oriented, sphere topology) |
 //! | [`mesh`] | closed triangulated surfaces: edges and wings, volume, area, bending angles, the icosphere |
 //! | [`hessian`] | local Hessians (finite differences, PSD projection) and surface terms' second-order models for the implicit step |
-//! | [`forcefield`] | particle/bond/angle/pair types checked against each interaction's schema |
+//! | [`forcefield`] | particle/bond/angle/pair types checked against each interaction's schema; `bind` lines |
 //! | [`interactions`] | the registry: one file per interaction type (its evaluator + docs) |
-//! | [`system`] | box, f64 state and the resolved [`system::Model`] |
+//! | [`system`] | box, f64 state (with the bond state) and the resolved [`system::Model`] |
 //! | [`neighbor`] | cell list + Verlet list with skin, exclusions |
-//! | [`integrate`] | Philox RNG, overdamped Euler–Maruyama, FIRE |
-//! | [`kinetics`] | stateful bonds: force-dependent unbinding, rebinding, motors, ratchets, plasticity, maturation |
+//! | [`rng`] | counter-based Philox4x32-10 streams and noise (a leaf: imports nothing of the crate) |
+//! | [`integrate`] | the integrator choice: overdamped Euler–Maruyama, the linearly implicit step, constraints, FIRE |
+//! | [`kinetics`] | the kinetic-rule registry (one file per rule, like interactions): force-dependent unbinding, rebinding, motors, ratchets, plasticity, maturation |
+//! | [`kinetics_engine`] | applies the rules to the bond state every step, forms bonds from `bind` lines, bond events |
 //! | [`backend`] | the CPU reference force engine (f64, rayon, deterministic) |
 //! | [`measure`] | per-particle stress, plane and cortical tension, filament statistics (thermo columns, dump fields) |
-//! | [`output`] | MCAP, extended XYZ, LAMMPS dump (selectable columns), per-bond tension CSV, restart (carrying the deck's inputs), run log |
+//! | [`output`] | MCAP, extended XYZ, LAMMPS dump (selectable columns), per-bond tension CSV, bond events and lifetimes, restart (carrying the deck's inputs), run log |
 //! | [`export`] | a deck as LAMMPS data + input (`cellmd export-lammps`) |
 //! | [`compare`] | cellmd vs LAMMPS probes, agreement table, golden reference files (`cellmd compare`) |
 //! | [`build`] | topology generators (`cellmd build`: icosphere, filament, network, aster, cortex, branched, filopodium, cells, sheet, tensegrity) |

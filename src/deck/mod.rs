@@ -12,6 +12,20 @@
 //! deck's directory; outputs (`dump`, `thermo_file`, `write_state`) are
 //! relative to the output directory (the working directory unless `cellmd run
 //! -o DIR`). See README.md for the command reference.
+//!
+//! File-level circles that remain (the folder as a whole imports no module
+//! that imports it back, `tests/architecture.rs`):
+//! - `control.rs` ↔ `validate.rs`: control flow (`loop`, `if`) is a second
+//!   `impl Validator` that validates the commands of a block, and the
+//!   validator hands blocks to it;
+//! - `plan.rs` ↔ `expression.rs` and `expression.rs` ↔ `variables.rs`: an
+//!   `if` action holds a [`Condition`], whose expressions name the plan's
+//!   thermo columns and read [`Variables`], which hold expressions;
+//! - `plan.rs` ↔ `protocol.rs`: actions hold [`Protocol`]s, which name the
+//!   plan's coefficient targets and groups.
+//!
+//! These files are one vocabulary (the plan's) split for length; the command
+//! table asked for `validate.rs` (issue 14, item 5) is where to revisit them.
 
 mod control;
 mod expression;

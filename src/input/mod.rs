@@ -9,6 +9,11 @@
 //! by [`read_input_file`]: regular files of at most [`MAX_INPUT_BYTES`]. Every
 //! file read can be recorded, and later served from the record instead of the
 //! disk ([`recording`], [`replaying`]): restarts carry a deck's inputs this way.
+//!
+//! One file-level circle remains, on purpose: `error.rs` ↔ `lexer.rs`. An
+//! [`InputError`] points at a [`Token`] of a [`SourceFile`], and tokens make
+//! their errors (`Token::error`); the error and the token are one vocabulary,
+//! kept in two files for length.
 
 mod error;
 mod file;
