@@ -15,7 +15,7 @@ use crate::gpu::backend::StepSettings;
 use crate::gpu::{DevicePreference, GpuBackend, GpuContext};
 use crate::input::replaying;
 use crate::interactions::{documentation, lookup, REGISTRY};
-use crate::kinetics::{lookup_rule, rule_documentation, RULES};
+use crate::kinetics::{lookup_rule, RULES};
 use crate::output::read_state;
 use crate::output::run_log::LogHeader;
 use crate::run::{RunOptions, Simulation, StopReason, StopSignal, OUTPUT_ERROR_STATUS};
@@ -183,7 +183,7 @@ where
                 }
                 Some(name) => match (lookup(&name), lookup_rule(&name)) {
                     (Some(i), _) => println!("{}", documentation(i, units)),
-                    (None, Some(r)) => println!("{}", rule_documentation(r, units)),
+                    (None, Some(r)) => println!("{}", documentation(r, units)),
                     (None, None) => {
                         let names: Vec<&str> = REGISTRY.iter().map(|i| i.name()).chain(RULES.iter().map(|r| r.name())).collect();
                         eprintln!("error: unknown interaction or kinetic rule `{name}`; expected one of: {}", names.join(", "));

@@ -64,7 +64,7 @@ interaction!(
 mod tests {
     use super::*;
     use crate::interactions::testing::*;
-    use crate::interactions::Interaction;
+    use crate::interactions::{Entry, Interaction};
 
     fn switch(p: &[f64], d: f64) -> Radial {
         let Law::ContactArea { switch, .. } = ContactAdhesion.law() else { unreachable!() };

@@ -8,6 +8,10 @@
 //! accumulation live once in the backend; an interaction file holds only its
 //! functional form (HOOMD-blue's evaluator pattern).
 //!
+//! Name, summary, Markdown page and schema make an interaction type a
+//! documented registry [`Entry`], the trait kinetic rules share; `cellmd list
+//! NAME` prints [`documentation`] of either.
+//!
 //! Parameters reach an evaluator as a slice in schema order, already checked
 //! against the schema and by [`Interaction::validate`].
 //!
@@ -30,40 +34,28 @@
 
 use glam::DVec3;
 
+pub(crate) use self::entry::entry;
+pub use self::entry::{documentation, Entry};
 pub use self::wall::plane as wall_plane;
 pub use crate::hessian::SurfaceHessian;
 pub use crate::mesh::SurfaceMesh;
 use crate::units::Dim;
 
-/// Implements [`Interaction`] for a unit struct from its registration data:
-/// the name (also the stem of its `.md` doc file), kind, one-line summary,
-/// the module's `PARAMS` schema, its law, and optionally a `validate` function.
+/// Implements [`Entry`] and [`Interaction`] for a unit struct from its
+/// registration data: the name (also the stem of its `.md` doc file), kind,
+/// one-line summary, the module's `PARAMS` schema, its law, and optionally a
+/// `validate` function.
 macro_rules! interaction {
     ($ty:ident, $name:literal, $kind:expr, $summary:literal, $law:expr $(, validate = $validate:path)?) => {
-        pub struct $ty;
+        $crate::interactions::entry!($ty, $name, $kind.keyword(), $summary $(, validate = $validate)?);
 
         impl $crate::interactions::Interaction for $ty {
-            fn name(&self) -> &'static str {
-                $name
-            }
             fn kind(&self) -> $crate::interactions::Kind {
                 $kind
-            }
-            fn summary(&self) -> &'static str {
-                $summary
-            }
-            fn doc(&self) -> &'static str {
-                include_str!(concat!($name, ".md"))
-            }
-            fn params(&self) -> &'static [$crate::interactions::ParamSpec] {
-                &PARAMS
             }
             fn law(&self) -> $crate::interactions::Law {
                 $law
             }
-            $(fn validate(&self, params: &[f64]) -> Result<(), String> {
-                $validate(params)
-            })?
         }
     };
 }
@@ -80,6 +72,7 @@ macro_rules! radial_force {
     };
 }
 
+mod entry;
 pub mod testing;
 
 mod area_conservation;
@@ -403,60 +396,15 @@ impl ParamSpec {
 }
 
 /// A registered interaction type.
-pub trait Interaction: Sync + Send {
-    /// Force-field keyword and registry name (snake_case).
-    fn name(&self) -> &'static str;
+/// Its [`Entry`] doc has the headings Potential, References, Example.
+pub trait Interaction: Entry {
     fn kind(&self) -> Kind;
-    /// One line for `cellmd list`.
-    fn summary(&self) -> &'static str;
-    /// Markdown with the headings Potential, References, Example (the
-    /// module's own doc; the parameter table is generated from the schema).
-    fn doc(&self) -> &'static str;
-    fn params(&self) -> &'static [ParamSpec];
     fn law(&self) -> Law;
-    /// Checks relations between parameters beyond per-parameter ranges.
-    fn validate(&self, _params: &[f64]) -> Result<(), String> {
-        Ok(())
-    }
 }
 
 /// Index of a parameter in an interaction's schema.
 pub fn param_index(interaction: &dyn Interaction, name: &str) -> Option<usize> {
     interaction.params().iter().position(|p| p.name == name)
-}
-
-/// Full documentation page of an interaction type (what `cellmd list NAME` prints).
-pub fn documentation(interaction: &dyn Interaction, units: crate::units::UnitSystem) -> String {
-    documentation_page(
-        interaction.name(),
-        interaction.kind().keyword(),
-        interaction.summary(),
-        interaction.params(),
-        interaction.doc(),
-        units,
-    )
-}
-
-/// A documentation page: title with its kind, summary, the `## Parameters`
-/// table (units of `units`, generated from the schema), then the module doc.
-pub fn documentation_page(
-    name: &str,
-    kind: &str,
-    summary: &str,
-    params: &[ParamSpec],
-    doc: &str,
-    units: crate::units::UnitSystem,
-) -> String {
-    let mut page = format!(
-        "# {name} ({kind})\n\n{summary}\n\n## Parameters\n\n| name | unit | allowed | default | meaning |\n|---|---|---|---|---|\n"
-    );
-    for p in params {
-        let default = p.default.map_or("required".to_string(), |d| d.to_string());
-        page += &format!("| `{}` | {} | {} | {} | {} |\n", p.name, units.label(p.dim), p.range_text(), default, p.doc);
-    }
-    page += "\n";
-    page += doc;
-    page
 }
 
 #[cfg(test)]
@@ -479,7 +427,7 @@ mod tests {
         for entry in std::fs::read_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/src/interactions")).unwrap() {
             let path = entry.unwrap().path();
             let stem = path.file_stem().unwrap().to_str().unwrap().to_string();
-            if ["mod", "testing"].contains(&stem.as_str()) {
+            if ["mod", "entry", "testing"].contains(&stem.as_str()) {
                 continue;
             }
             assert!(lookup(&stem).is_some(), "{} has no REGISTRY entry", path.display());

@@ -21,7 +21,7 @@
 
 use glam::{DMat3, DVec3};
 
-pub use super::Interaction;
+pub use super::{Entry, Interaction};
 use super::{Law, SurfaceHessian, SurfaceMesh};
 use crate::hessian::project_psd;
 use faer::{Col, Mat};

@@ -20,8 +20,9 @@
 //! k·dt > 0.1 the step is too coarse to resolve the bond's lifetime, and a
 //! warning is printed once per bond type.
 //!
-//! Rules are registered in [`RULES`], one file each, with the same
-//! documentation layout as interactions (`cellmd list NAME`).
+//! Rules are registered in [`RULES`], one file each; like an interaction type
+//! each is a documented registry [`Entry`] (name, summary, Markdown page,
+//! schema: `cellmd list NAME`).
 //!
 //! This folder is the registry only: what each rule is (parameters, effect,
 //! documentation). The force-field parser reads rule names and parameters
@@ -29,7 +30,7 @@
 //! rules every step reads the system and the neighbour list, which sit above
 //! `forcefield`, so it is a folder of its own, `kinetics_engine`.
 
-use crate::interactions::ParamSpec;
+use crate::interactions::Entry;
 
 mod cadherin;
 mod catch_slip;
@@ -81,17 +82,10 @@ pub enum Effect {
     Maturation(fn(&[f64], f64) -> f64),
 }
 
-/// A registered kinetic rule.
-pub trait KineticRule: Sync + Send {
-    fn name(&self) -> &'static str;
-    fn summary(&self) -> &'static str;
-    /// Markdown with the headings Rate, References, Example.
-    fn doc(&self) -> &'static str;
-    fn params(&self) -> &'static [ParamSpec];
+/// A registered kinetic rule; its [`Entry`] doc has the headings Rate,
+/// References, Example.
+pub trait KineticRule: Entry {
     fn effect(&self) -> Effect;
-    fn validate(&self, _params: &[f64]) -> Result<(), String> {
-        Ok(())
-    }
     /// Whether the rule's rates depend on kT (it then needs `temperature` > 0).
     fn needs_temperature(&self) -> bool {
         matches!(self.effect(), Effect::Unbind(_))
@@ -120,30 +114,16 @@ impl std::fmt::Debug for RuleUse {
     }
 }
 
-/// Implements [`KineticRule`] for a unit struct (name = stem of its `.md`).
+/// Implements [`Entry`] and [`KineticRule`] for a unit struct (name = stem
+/// of its `.md`, category `kinetic rule`).
 macro_rules! kinetic_rule {
     ($ty:ident, $name:literal, $summary:literal, $effect:expr $(, validate = $validate:path)? $(, needs_temperature = $needs_kt:expr)?) => {
-        pub struct $ty;
+        $crate::interactions::entry!($ty, $name, "kinetic rule", $summary $(, validate = $validate)?);
 
         impl $crate::kinetics::KineticRule for $ty {
-            fn name(&self) -> &'static str {
-                $name
-            }
-            fn summary(&self) -> &'static str {
-                $summary
-            }
-            fn doc(&self) -> &'static str {
-                include_str!(concat!($name, ".md"))
-            }
-            fn params(&self) -> &'static [$crate::interactions::ParamSpec] {
-                &PARAMS
-            }
             fn effect(&self) -> $crate::kinetics::Effect {
                 $effect
             }
-            $(fn validate(&self, params: &[f64]) -> Result<(), String> {
-                $validate(params)
-            })?
             $(fn needs_temperature(&self) -> bool {
                 $needs_kt
             })?
@@ -151,11 +131,6 @@ macro_rules! kinetic_rule {
     };
 }
 pub(crate) use kinetic_rule;
-
-/// Documentation page of a rule (what `cellmd list NAME` prints).
-pub fn rule_documentation(rule: &dyn KineticRule, units: crate::units::UnitSystem) -> String {
-    crate::interactions::documentation_page(rule.name(), "kinetic rule", rule.summary(), rule.params(), rule.doc(), units)
-}
 
 #[cfg(test)]
 mod tests {
