@@ -116,10 +116,10 @@ fn graph(sources: &[(PathBuf, String)]) -> Graph {
     edges
 }
 
-/// Every strongly connected component of more than one module, each as one
-/// cycle through all of its members' first edges found (a → b → … → a).
+/// Every strongly connected component of more than one module, each as a
+/// shortest closed path through its first member (a → b → … → a).
 fn cycles(graph: &Graph) -> Vec<Vec<String>> {
-    // Tarjan's algorithm, iterative over a small graph.
+    // Tarjan's algorithm (recursive: the graph has a few dozen nodes).
     struct Tarjan<'a> {
         graph: &'a Graph,
         index: BTreeMap<&'a str, usize>,
