@@ -18,6 +18,16 @@
 //!
 //! When the graph has a cycle the test fails naming it, with the file and
 //! line of one reference per edge.
+//!
+//! Inside a folder, files may still import each other in a circle where they
+//! share one vocabulary; each such circle must be named, with its reason, in
+//! the folder's module doc (`mod.rs`), which the second test checks. There a
+//! node is a direct child of the folder (`x.rs`, and `x/` with it), and a
+//! child depends on another through `super::x…`, `crate::folder::x…`, or an
+//! item that `mod.rs` re-exports from `x` (`pub use self::x::Item`); items
+//! defined in `mod.rs` itself (a registry's trait) and `#[cfg(test)]` code
+//! after the file's first `#[cfg(test)]` are not read. A file nested deeper
+//! is read for `crate::folder::` paths only.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -39,15 +49,22 @@ fn module_of(relative: &Path) -> Option<String> {
 /// The top-level module names of the crate that `text` reaches through
 /// `crate::` paths, with the line of each first occurrence.
 fn crate_references(text: &str) -> Vec<(String, usize)> {
+    path_references(text, "crate::")
+}
+
+/// The first segment after every `prefix` in `text` (`prefix` not preceded
+/// by an identifier character or `:`), each item's first segment for a
+/// group `prefix{…}`, with their lines.
+fn path_references(text: &str, prefix: &str) -> Vec<(String, usize)> {
     let bytes = text.as_bytes();
     let mut found = Vec::new();
     let mut from = 0;
-    while let Some(offset) = text[from..].find("crate::") {
+    while let Some(offset) = text[from..].find(prefix) {
         let at = from + offset;
-        from = at + "crate::".len();
+        from = at + prefix.len();
         let before = at.checked_sub(1).map(|i| bytes[i]);
-        if before.is_some_and(|c| c.is_ascii_alphanumeric() || c == b'_') {
-            continue; // e.g. `some_crate::`
+        if before.is_some_and(|c| c.is_ascii_alphanumeric() || c == b'_' || c == b':') {
+            continue; // e.g. `some_crate::`, `super::super::`
         }
         let line = text[..at].matches('\n').count() + 1;
         let rest = &text[from..];
@@ -116,9 +133,14 @@ fn graph(sources: &[(PathBuf, String)]) -> Graph {
     edges
 }
 
-/// Every strongly connected component of more than one module, each as a
+/// Every strongly connected component of more than one node, each as a
 /// shortest closed path through its first member (a → b → … → a).
 fn cycles(graph: &Graph) -> Vec<Vec<String>> {
+    components(graph).into_iter().map(|c| cycle_within(graph, &c)).collect()
+}
+
+/// The strongly connected components of more than one node.
+fn components(graph: &Graph) -> Vec<Vec<String>> {
     // Tarjan's algorithm (recursive: the graph has a few dozen nodes).
     struct Tarjan<'a> {
         graph: &'a Graph,
@@ -158,13 +180,13 @@ fn cycles(graph: &Graph) -> Vec<Vec<String>> {
             t.visit(v);
         }
     }
-    t.components.into_iter().filter(|c| c.len() > 1).map(|c| cycle_within(graph, &c)).collect()
+    t.components.into_iter().filter(|c| c.len() > 1).map(|c| c.into_iter().map(str::to_owned).collect()).collect()
 }
 
 /// One closed path inside a strongly connected component, from its first
 /// member (breadth-first, so the path is a shortest cycle through it).
-fn cycle_within(graph: &Graph, component: &[&str]) -> Vec<String> {
-    let members: BTreeSet<&str> = component.iter().copied().collect();
+fn cycle_within(graph: &Graph, component: &[String]) -> Vec<String> {
+    let members: BTreeSet<&str> = component.iter().map(String::as_str).collect();
     let start = *members.iter().next().unwrap();
     let mut parent: BTreeMap<&str, &str> = BTreeMap::new();
     let mut queue = std::collections::VecDeque::from([start]);
@@ -212,6 +234,122 @@ fn folder_level_import_graph_has_no_cycle() {
     assert!(cycles.is_empty(), "the folder-level import graph of src/ has {} cycle(s):\n{}", cycles.len(), report.join("\n"));
 }
 
+/// A folder under `src/` as the file-level check reads it: its name, its
+/// `mod.rs`, and each direct child's files (text, nested deeper than the
+/// child's own `x.rs`).
+struct Folder {
+    name: String,
+    root: String,
+    children: BTreeMap<String, Vec<(String, bool)>>,
+}
+
+/// What `root` (a `mod.rs`) re-exports, by the name it is visible under,
+/// with the child it comes from (`pub use self::x::{A, B as C};`).
+fn reexports(root: &str) -> BTreeMap<String, String> {
+    let mut map = BTreeMap::new();
+    let text = format!("\n{root}");
+    for (at, _) in text.match_indices("\npub") {
+        let statement = &text[at + "\npub".len()..];
+        let statement = &statement[..statement.find(';').unwrap_or(statement.len())];
+        let statement = match statement.strip_prefix('(') {
+            Some(rest) => rest.split_once(')').map_or("", |(_, r)| r),
+            None => statement,
+        };
+        let Some(path) = statement.trim_start().strip_prefix("use ") else { continue };
+        let path = path.trim();
+        let Some((child, items)) = path.strip_prefix("self::").unwrap_or(path).split_once("::") else { continue };
+        for item in items.trim_start_matches('{').trim_end_matches('}').split(',') {
+            if let Some(name) = item.split_whitespace().last() {
+                map.insert(name.rsplit("::").next().unwrap_or(name).to_owned(), child.to_owned());
+            }
+        }
+    }
+    map
+}
+
+/// The file-level graph of one folder (see the module doc).
+fn folder_graph(folder: &Folder) -> Graph {
+    let reexported = reexports(&folder.root);
+    let own = format!("crate::{}::", folder.name);
+    let mut edges = Graph::new();
+    for (child, files) in &folder.children {
+        let targets = edges.entry(child.clone()).or_default();
+        for (text, nested) in files {
+            let code = text.split("#[cfg(test)]").next().unwrap_or_default();
+            let mut references = path_references(code, &own);
+            if !nested {
+                references.extend(path_references(code, "super::"));
+            }
+            for (name, line) in references {
+                let to = if folder.children.contains_key(&name) { Some(name) } else { reexported.get(&name).cloned() };
+                if let Some(to) = to.filter(|to| to != child && folder.children.contains_key(to)) {
+                    targets.entry(to).or_insert_with(|| format!("src/{}/{child}…:{line}", folder.name));
+                }
+            }
+        }
+    }
+    edges
+}
+
+/// The members of each file-level circle of `folder` that its module doc
+/// does not name (as `` `x.rs` `` or `` `x/` ``), with the circle.
+fn unnamed_circles(folder: &Folder) -> Vec<(Vec<String>, Vec<String>)> {
+    let doc: Vec<&str> = folder.root.lines().filter_map(|l| l.trim_start().strip_prefix("//!")).collect();
+    let doc = doc.join("\n");
+    let graph = folder_graph(folder);
+    components(&graph)
+        .into_iter()
+        .filter_map(|members| {
+            let missing: Vec<String> =
+                members.iter().filter(|m| !doc.contains(&format!("`{m}.rs`")) && !doc.contains(&format!("`{m}/`"))).cloned().collect();
+            (!missing.is_empty()).then(|| (missing, cycle_within(&graph, &members)))
+        })
+        .collect()
+}
+
+fn crate_folders() -> Vec<Folder> {
+    let manifest = std::env::var("CARGO_MANIFEST_DIR").unwrap_or_else(|_| env!("CARGO_MANIFEST_DIR").to_owned());
+    let src = Path::new(&manifest).join("src");
+    let mut dirs: Vec<PathBuf> =
+        std::fs::read_dir(&src).unwrap().map(|e| e.unwrap().path()).filter(|p| p.join("mod.rs").is_file()).collect();
+    dirs.sort();
+    dirs.into_iter()
+        .map(|dir| {
+            let mut children: BTreeMap<String, Vec<(String, bool)>> = BTreeMap::new();
+            let mut files = Vec::new();
+            rust_files(&dir, &mut files);
+            for file in files {
+                let relative = file.strip_prefix(&dir).unwrap();
+                let first = relative.components().next().unwrap().as_os_str().to_string_lossy().into_owned();
+                if first == "mod.rs" {
+                    continue;
+                }
+                let nested = relative.components().count() > 1;
+                let child = first.strip_suffix(".rs").unwrap_or(&first).to_owned();
+                children.entry(child).or_default().push((std::fs::read_to_string(&file).unwrap(), nested));
+            }
+            Folder {
+                name: dir.file_name().unwrap().to_string_lossy().into_owned(),
+                root: std::fs::read_to_string(dir.join("mod.rs")).unwrap(),
+                children,
+            }
+        })
+        .collect()
+}
+
+#[test]
+fn file_level_circles_are_named_in_their_folders_doc() {
+    let folders = crate_folders();
+    assert!(folders.len() > 10, "found {} folders under src/", folders.len());
+    let mut report = Vec::new();
+    for folder in &folders {
+        for (missing, cycle) in unnamed_circles(folder) {
+            report.push(format!("src/{}/: {} (mod.rs does not name {})", folder.name, cycle.join(" -> "), missing.join(", ")));
+        }
+    }
+    assert!(report.is_empty(), "file-level circles not named, with their reason, in their folder's module doc:\n{}", report.join("\n"));
+}
+
 fn sources(files: &[(&str, &str)]) -> Vec<(PathBuf, String)> {
     files.iter().map(|(p, t)| (PathBuf::from(p), t.to_string())).collect()
 }
@@ -241,4 +379,26 @@ fn finds_a_cycle_through_files_of_three_folders() {
     assert!(describe(&g, &found[0]).contains("c -> a   (src/c/x.rs:1)"));
     let acyclic = sources(&[("a/mod.rs", "use crate::b::B;"), ("b/mod.rs", "use crate::leaf::L;"), ("leaf.rs", "")]);
     assert!(cycles(&graph(&acyclic)).is_empty());
+}
+
+#[test]
+fn finds_a_file_level_circle_through_a_reexport_and_checks_the_doc() {
+    let folder = |root: &str| Folder {
+        name: "f".into(),
+        root: root.into(),
+        children: BTreeMap::from([
+            ("a".to_owned(), vec![("use super::b::B;\n#[cfg(test)]\nuse super::c::C;".to_owned(), false)]),
+            ("b".to_owned(), vec![("fn g() -> super::A { todo!() }".to_owned(), false)]),
+            ("c".to_owned(), vec![("use super::a::A;".to_owned(), false), ("use super::b::B;".to_owned(), true)]),
+        ]),
+    };
+    let root = "//! The folder.\n\nmod a;\nmod b;\nmod c;\n\npub use self::a::{A, Other as Renamed};\n";
+    let g = folder_graph(&folder(root));
+    assert_eq!(g["b"]["a"], "src/f/b…:1");
+    assert!(!g["a"].contains_key("c") && !g["c"].contains_key("b"), "{g:?}");
+    assert_eq!(reexports(root).get("Renamed").map(String::as_str), Some("a"));
+    let unnamed = unnamed_circles(&folder(root));
+    assert_eq!(unnamed, vec![(vec!["a".to_owned(), "b".to_owned()], vec!["a".to_owned(), "b".to_owned(), "a".to_owned()])]);
+    let named = format!("//! `a.rs` and `b.rs` share one type.\n{root}");
+    assert!(unnamed_circles(&folder(&named)).is_empty());
 }
