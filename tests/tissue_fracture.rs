@@ -26,12 +26,27 @@ struct Outcome {
 }
 
 /// Runs the study deck on a 6 × 10 sheet with the force field's
-/// `threshold strain`, binding rate `k_on` and maturation time `tau`.
+/// `threshold strain`, binding rate `k_on` and maturation time `tau` (and
+/// capture D·(1 + 0.75·strain), as studies/tissue_fracture/sweep.py sets it).
 fn run_point(g: f64, strain: f64, k_on: f64, tau: f64, steps: u64) -> Outcome {
     let dir = tempfile::tempdir().unwrap();
     let top = dir.path().join("sheet.top");
     let status = Command::new(env!("CARGO_BIN_EXE_cellmd"))
-        .args(["build", "sheet", "--rows", "6", "--columns", "10", "--cell-size", "3", "--nodes-per-edge", "0", "--centre-type", "cell", "-o"])
+        .args([
+            "build",
+            "sheet",
+            "--rows",
+            "6",
+            "--columns",
+            "10",
+            "--cell-size",
+            "3",
+            "--nodes-per-edge",
+            "0",
+            "--centre-type",
+            "cell",
+            "-o",
+        ])
         .arg(&top)
         .output()
         .unwrap();
@@ -40,8 +55,13 @@ fn run_point(g: f64, strain: f64, k_on: f64, tau: f64, steps: u64) -> Outcome {
         .unwrap()
         .replace("threshold strain 0.2", &format!("threshold strain {strain}"))
         .replace("k_on 2 ", &format!("k_on {k_on} "))
-        .replace("maturation tau 5", &format!("maturation tau {tau}"));
-    assert!(ff.contains(&format!("strain {strain}")) && ff.contains(&format!("k_on {k_on} ")) && ff.contains(&format!("tau {tau}")));
+        .replace("maturation tau 5", &format!("maturation tau {tau}"))
+        .replace("capture 3.45", &format!("capture {}", 3.0 * (1.0 + 0.75 * strain)));
+    for changed in
+        [format!("strain {strain} "), format!("k_on {k_on} "), format!("tau {tau}"), format!("capture {}", 3.0 * (1.0 + 0.75 * strain))]
+    {
+        assert!(ff.contains(&changed), "the force field no longer has the values this test replaces ({changed})");
+    }
     std::fs::write(dir.path().join("point.ff"), ff).unwrap();
     let vars: Vec<(String, String)> = [
         ("g", g.to_string()),
@@ -74,7 +94,7 @@ fn run_point(g: f64, strain: f64, k_on: f64, tau: f64, steps: u64) -> Outcome {
 
 #[test]
 fn strong_rebinding_at_a_low_gradient_is_ductile() {
-    let o = run_point(0.4, 0.1, 20.0, 0.5, 3000);
+    let o = run_point(1.0, 0.8, 20.0, 0.5, 3000);
     println!("ductile corner: {o:?}");
     assert_eq!(o.label, 1.0, "{o:?}");
     assert_eq!(o.pieces, 1.0);
@@ -84,7 +104,7 @@ fn strong_rebinding_at_a_low_gradient_is_ductile() {
 
 #[test]
 fn weak_rebinding_at_a_high_gradient_is_brittle() {
-    let o = run_point(2.0, 0.1, 0.05, 20.0, 3000);
+    let o = run_point(2.0, 0.1, 0.05, 10.0, 3000);
     println!("brittle corner: {o:?}");
     assert_eq!(o.label, 2.0, "{o:?}");
     assert!(o.pieces >= 2.0, "the sheet did not separate: {o:?}");

@@ -374,7 +374,8 @@ impl Validator {
                         Some(("fracture", rest)) => {
                             use crate::measure::fracture::FractureQuantity;
                             let names: Vec<&str> = FractureQuantity::ALL.iter().map(|q| q.name()).collect();
-                            let usage = format!("found `{other}`, expected fracture/BONDTYPE/QUANTITY with QUANTITY one of {}", names.join(", "));
+                            let usage =
+                                format!("found `{other}`, expected fracture/BONDTYPE/QUANTITY with QUANTITY one of {}", names.join(", "));
                             let (name, quantity) = rest.rsplit_once('/').ok_or_else(|| t.error(usage.clone()))?;
                             let quantity = FractureQuantity::from_name(quantity).ok_or_else(|| t.error(usage))?;
                             ThermoColumn::Fracture { bond_type: bond_type(t, name)?, quantity }

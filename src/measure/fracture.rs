@@ -155,7 +155,12 @@ pub fn fracture(model: &Model, bound: Option<&[bool]>, bond_type: usize) -> Frac
         (0..model.bonds.len()).filter(|&b| of_type(b) && is_bound(b)).map(|b| pair(model.bonds[b][0], model.bonds[b][1])).collect();
     let broken: HashSet<(u32, u32)> = original.iter().copied().filter(|p| !joined.contains(p)).collect();
     let rearranged = (model.topology_bonds..model.bonds.len()).filter(|&b| of_type(b) && is_bound(b)).count();
-    Fracture { broken: broken.len(), rearranged, crack: largest_crack(model.len(), &original, &broken), pieces: pieces(model.len(), &original, &joined) }
+    Fracture {
+        broken: broken.len(),
+        rearranged,
+        crack: largest_crack(model.len(), &original, &broken),
+        pieces: pieces(model.len(), &original, &joined),
+    }
 }
 
 /// Union–find root with path halving.

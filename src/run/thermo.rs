@@ -104,7 +104,9 @@ pub fn column_label(c: &ThermoColumn, model: &crate::system::Model) -> String {
         ThermoColumn::CorticalTension(t) => format!("gamma/{}", model.body_type_names[*t]),
         ThermoColumn::EndToEnd(t) => format!("e2e/{}", model.bond_types[*t].label.text),
         ThermoColumn::TangentCorrelation { bond_type, lag } => format!("tcorr/{}/{lag}", model.bond_types[*bond_type].label.text),
-        ThermoColumn::Fracture { bond_type, quantity } => format!("fracture/{}/{}", model.bond_types[*bond_type].label.text, quantity.name()),
+        ThermoColumn::Fracture { bond_type, quantity } => {
+            format!("fracture/{}/{}", model.bond_types[*bond_type].label.text, quantity.name())
+        }
         ThermoColumn::GroupForce { group, axis } => format!("f{}/{}", ["x", "y", "z"][*axis], group.name),
         ThermoColumn::GroupPosition { group, axis } => format!("{}u/{}", ["x", "y", "z"][*axis], group.name),
         ThermoColumn::IndenterLoad(name) => format!("load/{name}"),

@@ -73,14 +73,14 @@ def run_point(cellmd, out, g, strain, k_on, tau, ramp, steps):
 
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--cellmd", default=str(ROOT / "target" / "release" / "cellmd"))
+    p.add_argument("--cellmd", default=str(ROOT / "target" / "debug" / "cellmd"))
     p.add_argument("--out", default=str(ROOT / "out" / "tissue_fracture"))
-    p.add_argument("--gradients", default="0.05,0.1,0.2,0.4,0.8,1.6", help="pN/µm")
-    p.add_argument("--strains", default="0.06,0.1,0.15,0.2,0.3,0.4")
+    p.add_argument("--gradients", default="0.2,0.4,0.8,1.2,1.6,2.4", help="pN/µm")
+    p.add_argument("--strains", default="0.1,0.2,0.3,0.45,0.6,0.8")
     p.add_argument("--k-on", type=float, default=2.0, help="1/s, binding rate within capture")
     p.add_argument("--tau", type=float, default=5.0, help="s, maturation time")
     p.add_argument("--ramp", type=float, default=0.0, help="s: 0 steady pulling, else the pull grows over this time")
-    p.add_argument("--steps", type=int, default=6000, help="pulling steps (dt = 0.01 s)")
+    p.add_argument("--steps", type=int, default=3000, help="pulling steps (dt = 0.01 s)")
     p.add_argument("--workers", type=int, default=os.cpu_count())
     a = p.parse_args()
     out = Path(a.out).resolve()
