@@ -53,10 +53,10 @@ fn run_point(g: f64, strain: f64, k_on: f64, tau: f64, steps: u64) -> Outcome {
     assert!(status.status.success(), "{}", String::from_utf8_lossy(&status.stderr));
     let ff = std::fs::read_to_string("forcefields/tissue_fracture.ff")
         .unwrap()
-        .replace("threshold strain 0.2", &format!("threshold strain {strain}"))
-        .replace("k_on 2 ", &format!("k_on {k_on} "))
-        .replace("maturation tau 5", &format!("maturation tau {tau}"))
-        .replace("capture 3.45", &format!("capture {}", 3.0 * (1.0 + 0.75 * strain)));
+        .replace("threshold strain 0.8 ", &format!("threshold strain {strain} "))
+        .replace("k_on 20 ", &format!("k_on {k_on} "))
+        .replace("maturation tau 0.5", &format!("maturation tau {tau}"))
+        .replace("capture 4.8 ", &format!("capture {} ", 3.0 * (1.0 + 0.75 * strain)));
     for changed in
         [format!("strain {strain} "), format!("k_on {k_on} "), format!("tau {tau}"), format!("capture {}", 3.0 * (1.0 + 0.75 * strain))]
     {
