@@ -91,6 +91,12 @@ pub enum ThermoColumn {
         bond_type: usize,
         lag: usize,
     },
+    /// Fracture of a sheet's junctions of a bond type (`fracture/BONDTYPE/QUANTITY`;
+    /// see [`crate::measure::fracture`]).
+    Fracture {
+        bond_type: usize,
+        quantity: crate::measure::fracture::FractureQuantity,
+    },
     /// Summed force on a group's particles along an axis (`fx/GROUP`,
     /// `fy/GROUP`, `fz/GROUP`); on `fixed` particles, the reaction of their anchors.
     GroupForce {

@@ -271,7 +271,7 @@ impl Validator {
 
     pub(super) fn thermo_columns(&self, tokens: &[Token]) -> Result<Vec<ThermoColumn>, InputError> {
         const FIXED: &str =
-            "step, time, pe, work, pe/NAME, pe/EXTERNAL, fmax, fnorm, press, pxx, pyy, pzz, pxy, pxz, pyz, nbuild, solver_iterations, solver_residual, ctension/BONDTYPE, breaks, rebinds, forms, resets, nbound/BONDTYPE, tension/BONDTYPE, volume/BODYTYPE, area/BODYTYPE, planetension/AXIS/POS, gamma/BODYTYPE, e2e/BONDTYPE, tcorr/BONDTYPE/LAG, fx/GROUP, fy/GROUP, fz/GROUP, fx/EXTERNAL, fy/EXTERNAL, fz/EXTERNAL, xu/GROUP, yu/GROUP, zu/GROUP, load/INDENTER, depth/INDENTER, mindist, nclamp";
+            "step, time, pe, work, pe/NAME, pe/EXTERNAL, fmax, fnorm, press, pxx, pyy, pzz, pxy, pxz, pyz, nbuild, solver_iterations, solver_residual, ctension/BONDTYPE, breaks, rebinds, forms, resets, nbound/BONDTYPE, tension/BONDTYPE, volume/BODYTYPE, area/BODYTYPE, planetension/AXIS/POS, gamma/BODYTYPE, e2e/BONDTYPE, tcorr/BONDTYPE/LAG, fracture/BONDTYPE/QUANTITY, fx/GROUP, fy/GROUP, fz/GROUP, fx/EXTERNAL, fy/EXTERNAL, fz/EXTERNAL, xu/GROUP, yu/GROUP, zu/GROUP, load/INDENTER, depth/INDENTER, mindist, nclamp";
         let bond_type = |t: &Token, name: &str| {
             self.forcefield.bond_types.iter().position(|b| b.label.text == name).ok_or_else(|| {
                 let names: Vec<&str> = self.forcefield.bond_types.iter().map(|b| b.label.text.as_str()).collect();
@@ -371,6 +371,15 @@ impl Validator {
                             let (name, lag) = rest.rsplit_once('/').ok_or_else(|| t.error(usage.clone()))?;
                             let lag = lag.parse::<usize>().map_err(|_| t.error(usage))?;
                             ThermoColumn::TangentCorrelation { bond_type: bond_type(t, name)?, lag }
+                        }
+                        Some(("fracture", rest)) => {
+                            use crate::measure::fracture::FractureQuantity;
+                            let names: Vec<&str> = FractureQuantity::ALL.iter().map(|q| q.name()).collect();
+                            let usage =
+                                format!("found `{other}`, expected fracture/BONDTYPE/QUANTITY with QUANTITY one of {}", names.join(", "));
+                            let (name, quantity) = rest.rsplit_once('/').ok_or_else(|| t.error(usage.clone()))?;
+                            let quantity = FractureQuantity::from_name(quantity).ok_or_else(|| t.error(usage))?;
+                            ThermoColumn::Fracture { bond_type: bond_type(t, name)?, quantity }
                         }
                         _ => return Err(t.error(format!("found thermo column `{other}`, expected one of: {FIXED}"))),
                     },

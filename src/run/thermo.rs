@@ -27,6 +27,7 @@
 //! | `gamma/BODYTYPE` | cortical tension γ = ⟨Σ_cut T·\|û·n̂\|⟩/(2πR) over diametral planes of each body, mean over the type's bodies ([`planes`](crate::measure::planes)) | pN/µm |
 //! | `e2e/BONDTYPE` | mean end-to-end distance of the chains of bonds of the type ([`filaments`](crate::measure::filaments)) | µm |
 //! | `tcorr/BONDTYPE/LAG` | tangent correlation ⟨t_s·t_{s+LAG}⟩ along those chains, LAG in bonds | – |
+//! | `fracture/BONDTYPE/QUANTITY` | a sheet's junctions: `broken` original junctions, `rearranged` (bound junctions to new neighbours), `ratio` (rearranged per broken), largest `crack` (broken junctions), `pieces`, `label` (0 elastic, 1 ductile, 2 brittle) ([`fracture`](crate::measure::fracture)) | – |
 //! | `fx/GROUP`, `fy/GROUP`, `fz/GROUP` | Σ_{i∈GROUP} F_i along the axis; on `fixed` particles the reaction of their anchors (a sheared plate's load) | pN |
 //! | `xu/GROUP`, `yu/GROUP`, `zu/GROUP` | mean unwrapped coordinate (1/N)Σ_{i∈GROUP} (x_i + n_i·L) along the axis | µm |
 //! | `load/NAME`, `depth/NAME` | an indenter external's load \|Σ F\| on its group (its reaction) and its deepest penetration δ = (3E/K)^{1/3} | pN, µm |
@@ -39,7 +40,7 @@ use super::protocol::indenter_load;
 use crate::backend::Forces;
 use crate::deck::ThermoColumn;
 use crate::interactions::REGISTRY;
-use crate::measure::{filaments, planes};
+use crate::measure::{filaments, fracture, planes};
 use crate::units::{Dim, UnitSystem};
 
 /// Values a thermo row is made from.
@@ -103,6 +104,9 @@ pub fn column_label(c: &ThermoColumn, model: &crate::system::Model) -> String {
         ThermoColumn::CorticalTension(t) => format!("gamma/{}", model.body_type_names[*t]),
         ThermoColumn::EndToEnd(t) => format!("e2e/{}", model.bond_types[*t].label.text),
         ThermoColumn::TangentCorrelation { bond_type, lag } => format!("tcorr/{}/{lag}", model.bond_types[*bond_type].label.text),
+        ThermoColumn::Fracture { bond_type, quantity } => {
+            format!("fracture/{}/{}", model.bond_types[*bond_type].label.text, quantity.name())
+        }
         ThermoColumn::GroupForce { group, axis } => format!("f{}/{}", ["x", "y", "z"][*axis], group.name),
         ThermoColumn::GroupPosition { group, axis } => format!("{}u/{}", ["x", "y", "z"][*axis], group.name),
         ThermoColumn::IndenterLoad(name) => format!("load/{name}"),
@@ -119,7 +123,8 @@ pub fn column_unit(c: &ThermoColumn, units: UnitSystem) -> &'static str {
         | ThermoColumn::SolverIterations
         | ThermoColumn::SolverResidual
         | ThermoColumn::ContactClamps
-        | ThermoColumn::TangentCorrelation { .. } => "-",
+        | ThermoColumn::TangentCorrelation { .. }
+        | ThermoColumn::Fracture { .. } => "-",
         ThermoColumn::MinDistance => units.label(Dim::Length),
         ThermoColumn::Tension(_) | ThermoColumn::ConstraintTension(_) | ThermoColumn::PlaneTension { .. } => units.label(Dim::Force),
         ThermoColumn::CorticalTension(_) => units.label(Dim::Tension),
@@ -187,6 +192,9 @@ pub fn column_value(c: &ThermoColumn, t: &ThermoInputs) -> f64 {
         ThermoColumn::TangentCorrelation { bond_type, lag } => {
             filaments::tangent_correlation(&filaments::chains(t.model, *bond_type), t.positions, t.sim_box, *lag)
         }
+        ThermoColumn::Fracture { bond_type, quantity } => {
+            fracture::fracture(t.model, t.bonds.map(|s| s.bound.as_slice()), *bond_type).value(*quantity)
+        }
         ThermoColumn::GroupForce { group, axis } => group.members.iter().map(|&i| t.forces.forces[i as usize][*axis]).sum(),
         ThermoColumn::IndenterLoad(name) => indenter_load(t.model, t.state, t.sim_box, name).map_or(f64::NAN, |(load, _)| load),
         ThermoColumn::IndenterDepth(name) => indenter_load(t.model, t.state, t.sim_box, name).map_or(f64::NAN, |(_, depth)| depth),
@@ -216,6 +224,9 @@ fn bonds_of_type<'a>(t: &'a ThermoInputs, ty: usize) -> impl Iterator<Item = usi
 }
 
 fn is_integer(c: &ThermoColumn) -> bool {
+    if let ThermoColumn::Fracture { quantity, .. } = c {
+        return quantity.is_integer();
+    }
     matches!(
         c,
         ThermoColumn::Step
