@@ -36,10 +36,11 @@
 //!
 //! Chunks are compressed with zstd (default level, the MCAP default chunk
 //! size of 768 KiB, single-threaded so the bytes do not depend on the
-//! machine). The full quickstart (81 frames of 1500 particles) writes
-//! 7.2 MB; its messages are 31 MB uncompressed, and 64.7 MB with the scene
-//! as JSON (`encoding json`: 6.5 MB compressed). Every MCAP reader (the
-//! `mcap` CLI, Foxglove, the Python and Rust libraries) decompresses them.
+//! machine). The quickstart shortened to 9 frames of 1500 particles
+//! (`--var steps=2000`) writes 0.73 MB for 2.98 MB of messages; its frames
+//! take 365 kB in protobuf and 874 kB as JSON, and with `encoding json`
+//! 7.25 MB of messages compress to 0.75 MB. Every MCAP reader (the `mcap`
+//! CLI, Foxglove, the Python and Rust libraries) decompresses them.
 //!
 //! # Time stamps
 //!
