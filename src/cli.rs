@@ -2,7 +2,7 @@
 //! build | profile-gpu. The `cellmd` binary (src/main.rs) and the Python
 //! package's `cellmd` console script both call [`main`].
 
-use std::io::IsTerminal;
+use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -150,6 +150,32 @@ fn parse_var(s: &str) -> Result<(String, String), String> {
     s.split_once('=').map(|(a, b)| (a.to_string(), b.to_string())).ok_or_else(|| format!("expected NAME=VALUE, found `{s}`"))
 }
 
+/// Prints a line on stdout like `println!`, which would panic when the
+/// reader has gone (`cellmd list | head -3`). A closed pipe only stops the
+/// printing: the command goes on to its own exit status (a `compare` that
+/// disagrees still exits 4). Any other write error (a full disk behind a
+/// redirection) names itself and returns exit status 6 from the caller.
+macro_rules! out {
+    ($($arg:tt)*) => {
+        if let Err(code) = emit(format_args!($($arg)*)) {
+            return code;
+        }
+    };
+}
+
+/// Writes one line for [`out!`]: `Err` carries the exit status when stdout
+/// failed for a reason other than a departed reader.
+fn emit(line: std::fmt::Arguments) -> Result<(), ExitCode> {
+    let mut stdout = std::io::stdout().lock();
+    match stdout.write_fmt(line).and_then(|()| stdout.write_all(b"\n")).and_then(|()| stdout.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            eprintln!("error: cannot write to stdout: {e}");
+            Err(ExitCode::from(OUTPUT_ERROR_STATUS))
+        }
+        _ => Ok(()),
+    }
+}
+
 fn report(error: impl miette::Diagnostic + Send + Sync + 'static) -> ExitCode {
     eprintln!("{:?}", miette::Report::new(error));
     ExitCode::from(1)
@@ -173,17 +199,17 @@ where
             let units = if lj { UnitSystem::Lj } else { UnitSystem::Cell };
             match name {
                 None => {
-                    println!("{:<16} {:<9} summary", "name", "kind");
+                    out!("{:<16} {:<9} summary", "name", "kind");
                     for i in REGISTRY {
-                        println!("{:<16} {:<9} {}", i.name(), i.kind().keyword(), i.summary());
+                        out!("{:<16} {:<9} {}", i.name(), i.kind().keyword(), i.summary());
                     }
                     for r in RULES {
-                        println!("{:<16} {:<9} {}", r.name(), "kinetics", r.summary());
+                        out!("{:<16} {:<9} {}", r.name(), "kinetics", r.summary());
                     }
                 }
                 Some(name) => match (lookup(&name), lookup_rule(&name)) {
-                    (Some(i), _) => println!("{}", documentation(i, units)),
-                    (None, Some(r)) => println!("{}", documentation(r, units)),
+                    (Some(i), _) => out!("{}", documentation(i, units)),
+                    (None, Some(r)) => out!("{}", documentation(r, units)),
                     (None, None) => {
                         let names: Vec<&str> = REGISTRY.iter().map(|i| i.name()).chain(RULES.iter().map(|r| r.name())).collect();
                         eprintln!("error: unknown interaction or kinetic rule `{name}`; expected one of: {}", names.join(", "));
@@ -200,7 +226,10 @@ where
                 Err(e) => return report(e),
             };
             match profile_gpu(&plan, repetitions, rebuild_rate) {
-                Ok(()) => ExitCode::SUCCESS,
+                Ok(table) => {
+                    out!("{}", table.trim_end());
+                    ExitCode::SUCCESS
+                }
                 Err(e) => {
                     eprintln!("error: {e}");
                     ExitCode::from(3)
@@ -209,7 +238,7 @@ where
         }
         Command::Check { deck, vars, allow_outside } => match validated(&deck, &vars, ValidateOptions { allow_outside }) {
             Ok(plan) => {
-                println!(
+                out!(
                     "{}: ok ({} particles, {} bonds, {} angles, {} actions)",
                     deck.display(),
                     plan.model.len(),
@@ -229,7 +258,7 @@ where
             match export::export(&plan, ExportOptions { probes }) {
                 Ok(lammps) => match export::lammps::write(&lammps, &outdir) {
                     Ok(()) => {
-                        println!("wrote {0}/data.lammps and {0}/in.lammps", outdir.display());
+                        out!("wrote {0}/data.lammps and {0}/in.lammps", outdir.display());
                         ExitCode::SUCCESS
                     }
                     Err(e) => {
@@ -245,9 +274,9 @@ where
         }
         Command::ImportLammps { data, input, output } => match export::import_lammps::import_files(&data, input.as_deref(), &output) {
             Ok(imported) => {
-                println!("wrote {0}/system.top, {0}/system.ff and {0}/system.in", output.display());
+                out!("wrote {0}/system.top, {0}/system.ff and {0}/system.in", output.display());
                 for note in &imported.notes {
-                    println!("not translated: {note}");
+                    out!("not translated: {note}");
                 }
                 ExitCode::SUCCESS
             }
@@ -262,8 +291,14 @@ where
                 Err(e) => return report(e),
             };
             match compare(&plan, lmp, workdir, Tolerance { single_point: tol, run: run_tol }, write_golden, golden_header) {
-                Ok(true) => ExitCode::SUCCESS,
-                Ok(false) => ExitCode::from(4),
+                Ok((table, agrees)) => {
+                    out!("{}", table.trim_end());
+                    if agrees {
+                        ExitCode::SUCCESS
+                    } else {
+                        ExitCode::from(4)
+                    }
+                }
                 Err(e) => {
                     eprintln!("error: {e}");
                     ExitCode::from(2)
@@ -382,12 +417,13 @@ fn build(what: Box<crate::build::Generator>) -> ExitCode {
         eprintln!("error: cannot write {}: {e}", output.display());
         return ExitCode::from(1);
     }
-    println!("wrote {}: {}", output.display(), built.summary());
+    out!("wrote {}: {}", output.display(), built.summary());
     ExitCode::SUCCESS
 }
 
-/// `cellmd profile-gpu`: the GPU phase times on the deck's initial system.
-fn profile_gpu(plan: &crate::deck::Plan, repetitions: u32, rebuild_rate: Option<f64>) -> Result<(), String> {
+/// `cellmd profile-gpu`: the table of GPU phase times on the deck's initial
+/// system.
+fn profile_gpu(plan: &crate::deck::Plan, repetitions: u32, rebuild_rate: Option<f64>) -> Result<String, String> {
     let sim = Simulation::before_first_run(plan, RunOptions::default()).map_err(|e| e.to_string())?;
     let context = GpuContext::open(false)?;
     let settings = StepSettings {
@@ -412,9 +448,10 @@ fn profile_gpu(plan: &crate::deck::Plan, repetitions: u32, rebuild_rate: Option<
     let t = gpu.profile(repetitions)?;
     let step = t.check + rate * t.neighbor_build + t.forces + t.integrate;
     let n = sim.model.len() as f64;
-    println!("device: {}", context.describe());
-    println!("{} particles; {rate:.4} neighbour rebuilds per step", sim.model.len());
-    println!("{:<26} {:>14} {:>12}", "phase", "µs per call", "share/step");
+    let mut table = String::new();
+    table += &format!("device: {}\n", context.describe());
+    table += &format!("{} particles; {rate:.4} neighbour rebuilds per step\n", sim.model.len());
+    table += &format!("{:<26} {:>14} {:>12}\n", "phase", "µs per call", "share/step");
     let rows = [
         ("neighbour check", t.check, t.check),
         ("neighbour rebuild", t.neighbor_build, rate * t.neighbor_build),
@@ -422,14 +459,14 @@ fn profile_gpu(plan: &crate::deck::Plan, repetitions: u32, rebuild_rate: Option<
         ("integration", t.integrate, t.integrate),
     ];
     for (name, per_call, per_step) in rows {
-        println!("{name:<26} {:>14.1} {:>11.1}%", per_call * 1e6, 100.0 * per_step / step);
+        table += &format!("{name:<26} {:>14.1} {:>11.1}%\n", per_call * 1e6, 100.0 * per_step / step);
     }
-    println!("{:<26} {:>14.1} {:>12}", "read-back of positions", t.readback * 1e6, "per output");
-    println!("GPU step: {:.1} µs = {:.3e} particle-steps/s (kernels only, no read-back)", step * 1e6, n / step);
-    Ok(())
+    table += &format!("{:<26} {:>14.1} {:>12}\n", "read-back of positions", t.readback * 1e6, "per output");
+    table += &format!("GPU step: {:.1} µs = {:.3e} particle-steps/s (kernels only, no read-back)\n", step * 1e6, n / step);
+    Ok(table)
 }
 
-/// `cellmd compare`: prints the table; returns whether the engines agree.
+/// `cellmd compare`: the agreement table, and whether the engines agree.
 fn compare(
     plan: &crate::deck::Plan,
     lmp: Option<PathBuf>,
@@ -437,7 +474,7 @@ fn compare(
     tol: Tolerance,
     write_golden: Option<PathBuf>,
     header: Vec<(String, String)>,
-) -> Result<bool, String> {
+) -> Result<(String, bool), String> {
     let lmp = match lmp {
         Some(p) => Lmp::at(p),
         None => Lmp::find()?,
@@ -447,15 +484,15 @@ fn compare(
     let (reference, version) = run_lammps(plan, &lmp, &dir)?;
     let ours = cellmd_probes(plan)?;
     let agreement = Agreement::new(&ours, &reference)?;
-    println!("cellmd {} vs {version} on {}", env!("CARGO_PKG_VERSION"), plan.deck_path.display());
-    print!("{}", agreement.table("LAMMPS", tol));
+    let table =
+        format!("cellmd {} vs {version} on {}\n{}", env!("CARGO_PKG_VERSION"), plan.deck_path.display(), agreement.table("LAMMPS", tol));
     if let Some(path) = write_golden {
         let mut entries = vec![("generator", format!("{version} via cellmd export-lammps"))];
         entries.extend(header.iter().map(|(k, v)| (k.as_str(), v.clone())));
         let doc = golden::document_of(&entries, &reference);
         std::fs::write(&path, golden::write(&[doc])).map_err(|e| format!("{}: {e}", path.display()))?;
     }
-    Ok(agreement.agrees(tol))
+    Ok((table, agreement.agrees(tol)))
 }
 
 /// Validates a deck and prints its warnings on stderr.

@@ -24,7 +24,7 @@ fn mcap_frame_steps(path: &std::path::Path) -> Vec<u64> {
         .unwrap()
         .map(|m| m.unwrap())
         .filter(|m| m.channel.topic == "/cellmd/frame")
-        .map(|m| serde_json::from_slice::<serde_json::Value>(&m.data).unwrap()["step"].as_u64().unwrap())
+        .map(|m| cellmd::output::mcap_messages::message_json(&m).unwrap()["step"].as_u64().unwrap())
         .collect()
 }
 

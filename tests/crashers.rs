@@ -124,3 +124,45 @@ fn generated_crashers_are_diagnosed_quickly() {
         assert!(got.stderr.contains("it is a FIFO (named pipe); expected a regular file"), "{}", got.stderr);
     }
 }
+
+/// `cellmd ARGS` with stdout connected to `stdout`; returns the exit status
+/// and stderr.
+fn cellmd_writing_to(args: &[&str], stdout: impl Into<Stdio>) -> (i32, String) {
+    let got = Command::new(env!("CARGO_BIN_EXE_cellmd")).args(args).stdout(stdout).stderr(Stdio::piped()).output().unwrap();
+    (got.status.code().unwrap_or(-1), String::from_utf8_lossy(&got.stderr).into_owned())
+}
+
+/// `cellmd list | head -3` and friends: every subcommand but `run` (which
+/// tests/survive.rs covers) ends quietly with its own exit status when the
+/// reader of its stdout has gone. The pipe's read end is closed before the
+/// command starts, so its first line already meets a departed reader.
+#[test]
+fn every_subcommand_ends_quietly_when_its_reader_has_gone() {
+    let dir = tempfile::tempdir().unwrap();
+    let shell = dir.path().join("cell.top");
+    let cases: [(&[&str], i32); 5] = [
+        (&["list"], 0),
+        (&["list", "harmonic"], 0),
+        (&["check", "inputs/dimer.in"], 0),
+        (&["build", "icosphere", "--level", "1", "--radius", "5", "-o", shell.to_str().unwrap()], 0),
+        // The command's own verdict survives the closed pipe.
+        (&["list", "no_such_interaction"], 2),
+    ];
+    for (args, expected) in cases {
+        let (reader, writer) = std::io::pipe().unwrap();
+        drop(reader);
+        let (status, stderr) = cellmd_writing_to(args, writer);
+        assert!(!stderr.contains("panicked") && !stderr.contains("Broken pipe"), "cellmd {args:?}:\n{stderr}");
+        assert_eq!(status, expected, "cellmd {args:?}:\n{stderr}");
+    }
+}
+
+/// Any other failure to write stdout (here a full disk, `/dev/full`) is an
+/// output error: named, exit status 6.
+#[test]
+fn a_failing_stdout_is_an_output_error() {
+    let full = std::fs::OpenOptions::new().write(true).open("/dev/full").unwrap();
+    let (status, stderr) = cellmd_writing_to(&["list"], full);
+    assert_eq!(status, 6, "{stderr}");
+    assert!(stderr.contains("cannot write to stdout: No space left on device"), "{stderr}");
+}

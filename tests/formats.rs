@@ -2,9 +2,10 @@
 //! extended XYZ by ASE (`ase.io.read`), the DCD by MDAnalysis, both compared
 //! with the LAMMPS dump of the same frames (text, bit-exact); the LAMMPS
 //! dump's `element` column; the MCAP's compressed chunks and protobuf scene
-//! (box, walls, bound bonds only).
+//! (box, walls, bound bonds only), and its own protobuf channels as the
+//! Python `mcap-protobuf-support` decoder reads them from their descriptors.
 //!
-//! ASE and MDAnalysis come from the reference venv (`scripts/reference-venv`,
+//! ASE, MDAnalysis and the mcap libraries come from the reference venv (`scripts/reference-venv`,
 //! which `scripts/test-all` creates before the tests run). Where it is absent
 //! the reader checks print why and pass without reading.
 
@@ -192,6 +193,77 @@ fn mdanalysis_reads_the_dcd_in_id_order() {
         for (got, x) in positions.iter().zip(want.positions()) {
             assert_eq!(*got, x.map(|v| v as f32 as f64));
         }
+    }
+}
+
+const MCAP_PROTOBUF_READ: &str = r#"
+import json, sys
+from mcap.reader import make_reader
+from mcap_protobuf.decoder import DecoderFactory
+
+def plain(message):
+    out = {}
+    for f in message.DESCRIPTOR.fields:
+        value = getattr(message, f.name)
+        repeated = f.is_repeated if hasattr(f, "is_repeated") else f.label == f.LABEL_REPEATED
+        if repeated:
+            out[f.name] = [plain(v) if f.message_type else v for v in value]
+        else:
+            out[f.name] = plain(value) if f.message_type else value
+    return out
+
+with open(sys.argv[1], "rb") as fh:
+    reader = make_reader(fh, decoder_factories=[DecoderFactory()])
+    print(json.dumps([[channel.topic, schema.name, plain(decoded)]
+                      for schema, channel, _, decoded in reader.iter_decoded_messages()
+                      if channel.topic.startswith("/cellmd/")]))
+"#;
+
+/// cellmd's own MCAP channels are typed protobuf: the Python decoder Foxglove
+/// publishes builds the message classes from the file's descriptor sets alone
+/// and reads every message (topology, frames, bond states and bond events)
+/// to the same values cellmd's reader gets, bit for bit.
+#[test]
+fn python_reads_the_mcap_protobuf_channels_from_their_descriptors() {
+    let Some(python) = reference_python() else {
+        eprintln!("SKIPPED: no reference venv (run `bash scripts/reference-venv`); Python cannot read the MCAP");
+        return;
+    };
+    let case = random_case(true, "");
+    // Stretched slip bonds that rebind: bond events in the first steps.
+    let ff = "particle a drag 1\nparticle b drag 2\n\
+              bond s harmonic k 2 r0 0.5 kinetics slip k0 2 x_beta 0.2 kinetics rebind k_on 3 capture 2\n\
+              angle t cosine_angle K 0.3\npair a a soft A 1 rc 0.9\n";
+    std::fs::write(case.path("f.ff"), ff).unwrap();
+    let deck = std::fs::read_to_string(case.path("deck.in")).unwrap()
+        + "temperature 1\ntimestep 0.001\nseed 3\ndump m every 10 mcap t.mcap\nrun 30\n";
+    std::fs::write(case.path("deck.in"), deck).unwrap();
+    case.run();
+    let bytes = std::fs::read(case.path("t.mcap")).unwrap();
+    let ours: Vec<Value> = mcap::MessageStream::new(&bytes)
+        .unwrap()
+        .map(|m| m.unwrap())
+        .filter(|m| m.channel.topic.starts_with("/cellmd/"))
+        .map(|m| {
+            assert_eq!(m.channel.message_encoding, "protobuf", "{}", m.channel.topic);
+            let mut json = cellmd::output::mcap_messages::message_json(&m).unwrap();
+            // The JSON form nests bonds, angles and triangles; protobuf keeps them flat.
+            for key in ["bonds", "angles", "triangles"] {
+                if let Some(nested) = json.get(key).and_then(Value::as_array) {
+                    json[key] = nested.iter().flat_map(|v| v.as_array().unwrap().clone()).collect();
+                }
+            }
+            serde_json::json!([m.channel.topic, m.channel.schema.as_ref().unwrap().name, json])
+        })
+        .collect();
+    let theirs = python_json(&python, MCAP_PROTOBUF_READ, &[&case.path("t.mcap")]);
+    let theirs = theirs.as_array().unwrap();
+    let count = |topic: &str| ours.iter().filter(|m| m[0] == topic).count();
+    assert_eq!((count("/cellmd/topology"), count("/cellmd/frame")), (1, 4));
+    assert!(count("/cellmd/events") > 0 && count("/cellmd/bond_state") > 1, "no bond events to read");
+    assert_eq!(theirs.len(), ours.len());
+    for (theirs, ours) in theirs.iter().zip(&ours) {
+        assert_eq!(theirs, ours);
     }
 }
 

@@ -57,7 +57,7 @@ fn quickstart_writes_thermo_and_a_foxglove_mcap() {
         .unwrap()
         .map(|m| m.unwrap())
         .filter(|m| m.channel.topic == "/cellmd/frame")
-        .map(|m| serde_json::from_slice(&m.data).unwrap())
+        .map(|m| cellmd::output::mcap_messages::message_json(&m).unwrap())
         .collect();
     assert_eq!(frames.len(), 1);
     let positions = frames[0]["positions"].as_array().unwrap();

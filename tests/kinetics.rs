@@ -603,7 +603,7 @@ fn mcap_event_channel_carries_the_event_log() {
             states_after_events += 1;
         }
         if topic == "/cellmd/events" {
-            let doc: serde_json::Value = serde_json::from_slice(&message.data).unwrap();
+            let doc = cellmd::output::mcap_messages::message_json(&message).unwrap();
             for e in doc["events"].as_array().unwrap() {
                 assert_eq!(e["step"], doc["step"]);
                 from_mcap.push(e.clone());

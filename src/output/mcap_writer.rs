@@ -1,24 +1,31 @@
 //! MCAP trajectories, viewable in Foxglove: zstd-compressed chunks, cellmd's
-//! own channels as JSON with a JSON Schema, and the 3D scene as Foxglove's
-//! protobuf `foxglove.SceneUpdate` (or JSON, when the deck asks).
+//! own channels as typed protobuf messages (see
+//! [`mcap_messages`](super::mcap_messages)) and the 3D scene as Foxglove's
+//! protobuf `foxglove.SceneUpdate`; every channel as JSON with a JSON Schema
+//! when the deck asks (`encoding json`).
 //!
 //! # Channels
 //!
 //! | topic | schema | encoding | when | contents |
 //! |---|---|---|---|---|
-//! | `/cellmd/topology` | `cellmd.Topology` | json | once, with the first frame | units, ids, type names, per-particle types and radii, bonds/angles/triangles as user ids |
-//! | `/cellmd/frame` | `cellmd.Frame` | json | every frame | step, time, box, flat positions and image counters |
-//! | `/cellmd/bond_state` | `cellmd.BondState` | json | with the first frame, then after each step with bond events | per-bond `bound` flags |
-//! | `/cellmd/events` | `cellmd.BondEvents` | json | each step with bond events | break / rebind / form / reset events |
-//! | `/scene` | `foxglove.SceneUpdate` | protobuf (schema: its `FileDescriptorSet`), or json with `encoding json` | every frame | see [`scene`](super::scene): particles, bound bonds, surfaces, box, walls |
+//! | `/cellmd/topology` | `cellmd.Topology` | protobuf or json | once, with the first frame | units, ids, type names, per-particle types and radii, bonds/angles/triangles as user ids |
+//! | `/cellmd/frame` | `cellmd.Frame` | protobuf or json | every frame | step, time, box, flat positions and image counters |
+//! | `/cellmd/bond_state` | `cellmd.BondState` | protobuf or json | with the first frame, then after each step with bond events | per-bond `bound` flags |
+//! | `/cellmd/events` | `cellmd.BondEvents` | protobuf or json | each step with bond events | break / rebind / form / reset events |
+//! | `/scene` | `foxglove.SceneUpdate` | protobuf (schema: its `FileDescriptorSet`) or json | every frame | see [`scene`](super::scene): particles, bound bonds, surfaces, box, walls |
 //!
-//! cellmd's own schemas are the `*_SCHEMA` constants below (JSON Schema, the
-//! form Foxglove's Raw Messages and Plot panels and `mcap cat --json` read).
-//! `cellmd.Frame` positions are one flat array `[x0, y0, z0, x1, …]` in
+//! In protobuf (the default) cellmd's own schemas are the descriptor set of
+//! [`mcap_messages`](super::mcap_messages), whose module doc gives the
+//! `.proto` text. With `encoding json` they are the `*_SCHEMA` constants
+//! below (JSON Schema); the JSON forms carry the same fields, with bonds,
+//! angles and triangles as nested arrays (`[[i, j], …]`) where protobuf
+//! flattens them. Foxglove's Raw Messages and Plot panels and
+//! `mcap cat --json` read both. `cellmd.Frame` positions are one flat array `[x0, y0, z0, x1, …]` in
 //! internal particle order — the order of `ids` in `cellmd.Topology` — and
 //! `images` likewise `[ix0, iy0, iz0, …]`; the unwrapped position is
-//! `x + image·(hi − lo)`. JSON numbers are written in shortest round-trip
-//! form, so positions decode bit-exactly (non-finite values become `null`).
+//! `x + image·(hi − lo)`. Positions decode bit-exactly from either encoding
+//! (JSON numbers are written in shortest round-trip form; non-finite values
+//! become `null` in JSON and stay themselves in protobuf).
 //! Bond `k` of `cellmd.BondState.bound` is bond `k` of `cellmd.Topology`;
 //! the first state is the one at the first frame (a run continued from a
 //! restart starts with its broken bonds). Once `bind` rules have formed new
@@ -29,10 +36,11 @@
 //!
 //! Chunks are compressed with zstd (default level, the MCAP default chunk
 //! size of 768 KiB, single-threaded so the bytes do not depend on the
-//! machine). The full quickstart (81 frames of 1500 particles) writes
-//! 7.2 MB; its messages are 31 MB uncompressed, and 64.7 MB with the scene
-//! as JSON (`encoding json`: 6.5 MB compressed). Every MCAP reader (the
-//! `mcap` CLI, Foxglove, the Python and Rust libraries) decompresses them.
+//! machine). The quickstart shortened to 9 frames of 1500 particles
+//! (`--var steps=2000`) writes 0.73 MB for 2.98 MB of messages; its frames
+//! take 365 kB in protobuf and 874 kB as JSON, and with `encoding json`
+//! 7.25 MB of messages compress to 0.75 MB. Every MCAP reader (the `mcap`
+//! CLI, Foxglove, the Python and Rust libraries) decompresses them.
 //!
 //! # Time stamps
 //!
@@ -49,14 +57,11 @@ use std::io::{self, BufWriter, Write};
 use std::path::Path;
 
 use foxglove::Encode;
-use glam::DVec3;
 use mcap::records::MessageHeader;
-use serde::ser::{SerializeSeq, Serializer};
-use serde::Serialize;
 
-use super::scene::{self, Scene, SCENE_UPDATE_SCHEMA};
+use super::mcap_messages::{self as proto, descriptor_set, JsonForm};
+use super::scene::{Scene, SCENE_UPDATE_SCHEMA};
 use super::{check_frame, check_topology, invalid_input, units_keyword, Encoding, FrameView, TopologyView, TrajectoryWriter};
-use crate::system::SimBox;
 
 /// Topic of the topology channel.
 pub const TOPIC_TOPOLOGY: &str = "/cellmd/topology";
@@ -181,15 +186,13 @@ struct Sink {
 }
 
 impl Sink {
-    /// Publishes `message` as JSON.
-    fn publish<T: Serialize>(&mut self, channel_id: u16, ns: u64, message: &T) -> io::Result<()> {
-        self.publish_with(channel_id, ns, |buf| serde_json::to_writer(buf, message).map_err(io::Error::other))
-    }
-
-    /// Publishes what `encode` writes into the (cleared) buffer.
-    fn publish_with(&mut self, channel_id: u16, ns: u64, encode: impl FnOnce(&mut Vec<u8>) -> io::Result<()>) -> io::Result<()> {
+    /// Publishes `message` in `encoding`.
+    fn publish(&mut self, channel_id: u16, ns: u64, encoding: Encoding, message: &(impl prost::Message + JsonForm)) -> io::Result<()> {
         self.buffer.clear();
-        encode(&mut self.buffer)?;
+        match encoding {
+            Encoding::Protobuf => message.encode(&mut self.buffer).map_err(io::Error::other)?,
+            Encoding::Json => serde_json::to_writer(&mut self.buffer, &message.to_json()).map_err(io::Error::other)?,
+        }
         let sequence = self.sequence.entry(channel_id).or_insert(0);
         *sequence += 1;
         let header = MessageHeader { channel_id, sequence: *sequence, log_time: ns, publish_time: ns };
@@ -197,21 +200,14 @@ impl Sink {
     }
 }
 
-#[derive(Serialize)]
-struct BondState<'a> {
-    step: u64,
-    time: f64,
-    bound: &'a [bool],
-}
-
 impl McapWriter {
-    /// Creates (or truncates) `path` with the protobuf scene.
+    /// Creates (or truncates) `path` with protobuf channels.
     pub fn create(path: &Path, topology: &TopologyView) -> io::Result<Self> {
         Self::create_with(path, topology, Encoding::Protobuf)
     }
 
-    /// Creates (or truncates) `path` and registers the schemas and channels;
-    /// `encoding` is the scene's.
+    /// Creates (or truncates) `path` and registers the schemas and channels
+    /// in `encoding`.
     pub fn create_with(path: &Path, topology: &TopologyView, encoding: Encoding) -> io::Result<Self> {
         check_topology(topology)?;
         let options = mcap::WriteOptions::new()
@@ -227,18 +223,39 @@ impl McapWriter {
                 let schema_id = writer.add_schema(schema_name, schema_encoding, schema).map_err(mcap_err)?;
                 writer.add_channel(schema_id, topic, message_encoding, &no_metadata).map_err(mcap_err)
             };
-        let mut json_channel = |name: &str, schema: &str, topic: &str| channel(name, "jsonschema", schema.as_bytes(), topic, "json");
-        let channel_topology = json_channel("cellmd.Topology", TOPOLOGY_SCHEMA, TOPIC_TOPOLOGY)?;
-        let channel_frame = json_channel("cellmd.Frame", FRAME_SCHEMA, TOPIC_FRAME)?;
-        let channel_bond_state = json_channel("cellmd.BondState", BOND_STATE_SCHEMA, TOPIC_BOND_STATE)?;
-        let channel_events = json_channel("cellmd.BondEvents", BOND_EVENTS_SCHEMA, TOPIC_EVENTS)?;
-        let channel_scene = match encoding {
-            Encoding::Json => json_channel("foxglove.SceneUpdate", SCENE_UPDATE_SCHEMA, TOPIC_SCENE)?,
+        let channels = match encoding {
+            Encoding::Json => {
+                let mut json_channel =
+                    |name: &str, schema: &str, topic: &str| channel(name, "jsonschema", schema.as_bytes(), topic, "json");
+                [
+                    json_channel("cellmd.Topology", TOPOLOGY_SCHEMA, TOPIC_TOPOLOGY)?,
+                    json_channel("cellmd.Frame", FRAME_SCHEMA, TOPIC_FRAME)?,
+                    json_channel("cellmd.BondState", BOND_STATE_SCHEMA, TOPIC_BOND_STATE)?,
+                    json_channel("cellmd.BondEvents", BOND_EVENTS_SCHEMA, TOPIC_EVENTS)?,
+                    json_channel("foxglove.SceneUpdate", SCENE_UPDATE_SCHEMA, TOPIC_SCENE)?,
+                ]
+            }
             Encoding::Protobuf => {
+                let ours = descriptor_set();
+                let mut proto_channel = |name: &str, topic: &str| channel(name, "protobuf", &ours, topic, "protobuf");
+                let own = [
+                    proto_channel("cellmd.Topology", TOPIC_TOPOLOGY)?,
+                    proto_channel("cellmd.Frame", TOPIC_FRAME)?,
+                    proto_channel("cellmd.BondState", TOPIC_BOND_STATE)?,
+                    proto_channel("cellmd.BondEvents", TOPIC_EVENTS)?,
+                ];
                 let schema = foxglove::schemas::SceneUpdate::get_schema().expect("Foxglove's schemas carry their descriptors");
-                channel(&schema.name, &schema.encoding, &schema.data, TOPIC_SCENE, &foxglove::schemas::SceneUpdate::get_message_encoding())?
+                let scene = channel(
+                    &schema.name,
+                    &schema.encoding,
+                    &schema.data,
+                    TOPIC_SCENE,
+                    &foxglove::schemas::SceneUpdate::get_message_encoding(),
+                )?;
+                [own[0], own[1], own[2], own[3], scene]
             }
         };
+        let [channel_topology, channel_frame, channel_bond_state, channel_events, channel_scene] = channels;
         Ok(Self {
             sink: Sink { writer, sequence: BTreeMap::new(), buffer: Vec::new() },
             channel_topology,
@@ -275,43 +292,32 @@ impl McapWriter {
         if bound.len() != self.bonds.len() {
             return Err(invalid_input(format!("bond state at step {step} has {} flags for {} bonds", bound.len(), self.bonds.len())));
         }
-        self.sink.publish(self.channel_bond_state, time_ns(time), &BondState { step, time, bound })
+        self.publish_bond_state(time_ns(time), step, time, bound)
+    }
+
+    fn publish_bond_state(&mut self, ns: u64, step: u64, time: f64, bound: &[bool]) -> io::Result<()> {
+        self.sink.publish(self.channel_bond_state, ns, self.encoding, &proto::BondState { step, time, bound: bound.to_vec() })
     }
 
     fn write_topology(&mut self, ns: u64) -> io::Result<()> {
-        #[derive(Serialize)]
-        struct Topology<'a> {
-            units: &'a str,
-            ids: &'a [u64],
-            type_names: &'a [String],
-            types: &'a [u32],
-            type_radius: &'a [f64],
-            radii: Vec<f64>,
-            bonds: Vec<[u64; 2]>,
-            angles: Vec<[u64; 3]>,
-            triangles: Vec<[u64; 3]>,
-        }
         let ids = &self.ids;
-        let message = Topology {
-            units: self.units,
-            ids,
-            type_names: &self.type_names,
-            types: &self.types,
-            type_radius: &self.type_radius,
+        let message = proto::Topology {
+            units: self.units.to_string(),
+            ids: ids.clone(),
+            type_names: self.type_names.clone(),
+            types: self.types.clone(),
+            type_radius: self.type_radius.clone(),
             radii: self.types.iter().map(|&t| self.type_radius.get(t as usize).copied().unwrap_or(0.0)).collect(),
-            bonds: self.bonds.iter().map(|b| b.map(|i| ids[i as usize])).collect(),
-            angles: self.angles.iter().map(|a| a.map(|i| ids[i as usize])).collect(),
-            triangles: self.triangles.iter().map(|t| t.map(|i| ids[i as usize])).collect(),
+            bonds: self.bonds.iter().flat_map(|b| b.map(|i| ids[i as usize])).collect(),
+            angles: self.angles.iter().flat_map(|a| a.map(|i| ids[i as usize])).collect(),
+            triangles: self.triangles.iter().flat_map(|t| t.map(|i| ids[i as usize])).collect(),
         };
-        self.sink.publish(self.channel_topology, ns, &message)
+        self.sink.publish(self.channel_topology, ns, self.encoding, &message)
     }
 
     fn write_scene(&mut self, ns: u64, frame: &FrameView) -> io::Result<()> {
         let update = self.scene.update(frame, ns);
-        match self.encoding {
-            Encoding::Protobuf => self.sink.publish_with(self.channel_scene, ns, |buf| update.encode(buf).map_err(io::Error::other)),
-            Encoding::Json => self.sink.publish(self.channel_scene, ns, &scene::to_json(&update)),
-        }
+        self.sink.publish(self.channel_scene, ns, self.encoding, &update)
     }
 }
 
@@ -329,17 +335,17 @@ impl TrajectoryWriter for McapWriter {
         if first {
             self.write_topology(ns)?;
             let bound: Vec<bool> = (0..self.bonds.len()).map(|k| frame.is_bound(k)).collect();
-            let state = BondState { step: frame.step, time: frame.time, bound: &bound };
-            self.sink.publish(self.channel_bond_state, ns, &state)?;
+            self.publish_bond_state(ns, frame.step, frame.time, &bound)?;
         }
-        let message = Frame {
+        let b = frame.sim_box;
+        let message = proto::Frame {
             step: frame.step,
             time: frame.time,
-            sim_box: BoxMessage::from(frame.sim_box),
-            positions: FlatPositions(frame.positions),
-            images: FlatImages { images: frame.images, n: frame.positions.len() },
+            sim_box: Some(proto::BoxBounds { lo: b.lo.to_array().into(), hi: b.hi.to_array().into(), periodic: b.periodic.into() }),
+            positions: frame.positions.iter().flat_map(|x| x.to_array()).collect(),
+            images: (0..frame.positions.len()).flat_map(|i| frame.images.get(i).copied().unwrap_or([0; 3])).collect(),
         };
-        self.sink.publish(self.channel_frame, ns, &message)?;
+        self.sink.publish(self.channel_frame, ns, self.encoding, &message)?;
         if self.scene_enabled {
             self.write_scene(ns, frame)?;
         }
@@ -348,14 +354,8 @@ impl TrajectoryWriter for McapWriter {
 
     fn write_bond_events(&mut self, events: &[crate::kinetics_engine::Event], bound: &[bool]) -> io::Result<()> {
         let Some(first) = events.first() else { return Ok(()) };
-        #[derive(Serialize)]
-        struct BondEvents<'a> {
-            step: u64,
-            time: f64,
-            events: &'a [crate::kinetics_engine::Event],
-        }
-        let ns = time_ns(first.time);
-        self.sink.publish(self.channel_events, ns, &BondEvents { step: first.step, time: first.time, events })?;
+        let message = proto::BondEvents { step: first.step, time: first.time, events: events.iter().map(proto::BondEvent::from).collect() };
+        self.sink.publish(self.channel_events, time_ns(first.time), self.encoding, &message)?;
         if bound.len() == self.bonds.len() {
             self.write_bond_state(first.step, first.time, bound)?;
         }
@@ -380,64 +380,10 @@ fn time_ns(time: f64) -> u64 {
     }
 }
 
-#[derive(Serialize)]
-struct Frame<'a> {
-    step: u64,
-    time: f64,
-    #[serde(rename = "box")]
-    sim_box: BoxMessage,
-    positions: FlatPositions<'a>,
-    images: FlatImages<'a>,
-}
-
-#[derive(Serialize)]
-struct BoxMessage {
-    lo: [f64; 3],
-    hi: [f64; 3],
-    periodic: [bool; 3],
-}
-
-impl From<&SimBox> for BoxMessage {
-    fn from(b: &SimBox) -> Self {
-        Self { lo: b.lo.to_array(), hi: b.hi.to_array(), periodic: b.periodic }
-    }
-}
-
-/// Serializes positions as one flat array `[x0, y0, z0, x1, …]`.
-struct FlatPositions<'a>(&'a [DVec3]);
-
-impl Serialize for FlatPositions<'_> {
-    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        let mut seq = s.serialize_seq(Some(3 * self.0.len()))?;
-        for x in self.0 {
-            seq.serialize_element(&x.x)?;
-            seq.serialize_element(&x.y)?;
-            seq.serialize_element(&x.z)?;
-        }
-        seq.end()
-    }
-}
-
-/// Serializes image counters flat, zeros when none are given.
-struct FlatImages<'a> {
-    images: &'a [[i64; 3]],
-    n: usize,
-}
-
-impl Serialize for FlatImages<'_> {
-    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        let mut seq = s.serialize_seq(Some(3 * self.n))?;
-        for i in 0..self.n {
-            for v in self.images.get(i).copied().unwrap_or([0; 3]) {
-                seq.serialize_element(&v)?;
-            }
-        }
-        seq.end()
-    }
-}
-
 #[cfg(test)]
 mod tests {
+    use super::super::mcap_messages::message_json;
+    use super::super::scene;
     use super::super::test_support::Sample;
     use super::*;
     use serde_json::Value;
@@ -450,15 +396,6 @@ mod tests {
             w.write_frame(&frame).unwrap();
         }
         Box::new(w).finish().unwrap();
-    }
-
-    /// A `/scene` message as the JSON of [`SCENE_UPDATE_SCHEMA`], whichever its encoding.
-    pub(crate) fn scene_json(message: &mcap::Message) -> Value {
-        match message.channel.message_encoding.as_str() {
-            "protobuf" => scene::to_json(&<foxglove::schemas::SceneUpdate as prost::Message>::decode(&message.data[..]).unwrap()),
-            "json" => serde_json::from_slice(&message.data).unwrap(),
-            other => panic!("unexpected scene encoding {other}"),
-        }
     }
 
     #[test]
@@ -475,13 +412,13 @@ mod tests {
         }
     }
 
-    /// The file is chunked with zstd, and both scene encodings carry the
-    /// same scene: protobuf decoded equals the JSON written.
+    /// The file is chunked with zstd, and both encodings carry the same
+    /// messages on every channel: protobuf decoded equals the JSON written.
     #[test]
-    fn chunks_are_zstd_and_both_scene_encodings_agree() {
+    fn chunks_are_zstd_and_both_encodings_agree() {
         let s = Sample::new(2);
         let dir = tempfile::tempdir().unwrap();
-        let mut scenes = Vec::new();
+        let mut messages = Vec::new();
         for (encoding, name) in [(Encoding::Protobuf, "p.mcap"), (Encoding::Json, "j.mcap")] {
             let path = dir.path().join(name);
             write_sample(&path, &s, &[0.1, 0.2], encoding);
@@ -502,11 +439,12 @@ mod tests {
                 let set = <prost_types::FileDescriptorSet as prost::Message>::decode(&schema.data[..]).unwrap();
                 assert!(set.file.iter().any(|f| f.package() == "foxglove" && f.message_type.iter().any(|m| m.name() == "SceneUpdate")));
             }
-            let mut stream = mcap::MessageStream::new(&bytes).unwrap().map(|m| m.unwrap());
-            scenes.push(stream.by_ref().filter(|m| m.channel.topic == TOPIC_SCENE).map(|m| scene_json(&m)).collect::<Vec<_>>());
+            let stream = mcap::MessageStream::new(&bytes).unwrap().map(|m| m.unwrap());
+            messages.push(stream.map(|m| (m.channel.topic.clone(), message_json(&m).unwrap())).collect::<Vec<_>>());
         }
-        assert_eq!(scenes[0].len(), 2);
-        assert_eq!(scenes[0], scenes[1]);
+        // topology, bond state, then frame and scene twice.
+        assert_eq!(messages[0].len(), 6);
+        assert_eq!(messages[0], messages[1]);
     }
 
     #[test]
@@ -536,28 +474,28 @@ mod tests {
             let channel = &message.channel;
             let schema = channel.schema.as_ref().expect("every channel has a schema");
             let expected_schema = match channel.topic.as_str() {
-                TOPIC_TOPOLOGY => ("cellmd.Topology", TOPOLOGY_SCHEMA),
-                TOPIC_FRAME => ("cellmd.Frame", FRAME_SCHEMA),
-                TOPIC_BOND_STATE => ("cellmd.BondState", BOND_STATE_SCHEMA),
-                TOPIC_SCENE => ("foxglove.SceneUpdate", ""),
+                TOPIC_TOPOLOGY => "cellmd.Topology",
+                TOPIC_FRAME => "cellmd.Frame",
+                TOPIC_BOND_STATE => "cellmd.BondState",
+                TOPIC_SCENE => "foxglove.SceneUpdate",
                 other => panic!("unexpected topic {other}"),
             };
-            assert_eq!(schema.name, expected_schema.0);
+            assert_eq!(schema.name, expected_schema);
             if channel.topic != TOPIC_SCENE {
-                assert_eq!(channel.message_encoding, "json");
-                assert_eq!(schema.encoding, "jsonschema");
-                assert_eq!(&schema.data[..], expected_schema.1.as_bytes());
+                assert_eq!(channel.message_encoding, "protobuf");
+                assert_eq!(schema.encoding, "protobuf");
+                assert_eq!(schema.data, descriptor_set());
             }
             assert_eq!(message.log_time, message.publish_time);
             *counts.entry(channel.topic.clone()).or_default() += 1;
             match channel.topic.as_str() {
-                TOPIC_TOPOLOGY => topology = Some(serde_json::from_slice::<Value>(&message.data).unwrap()),
-                TOPIC_BOND_STATE => bond_state = Some(serde_json::from_slice::<Value>(&message.data).unwrap()),
+                TOPIC_TOPOLOGY => topology = Some(message_json(&message).unwrap()),
+                TOPIC_BOND_STATE => bond_state = Some(message_json(&message).unwrap()),
                 TOPIC_FRAME => {
                     frame_stamps.push(message.log_time);
-                    frames.push(serde_json::from_slice::<Value>(&message.data).unwrap());
+                    frames.push(message_json(&message).unwrap());
                 }
-                _ => scenes.push((message.log_time, scene_json(&message))),
+                _ => scenes.push((message.log_time, message_json(&message).unwrap())),
             }
         }
         assert_eq!(counts[TOPIC_TOPOLOGY], 1);
@@ -653,7 +591,7 @@ mod tests {
             match message.channel.topic.as_str() {
                 TOPIC_BOND_STATE => {
                     assert_eq!(message.sequence as usize, states.len() + 1);
-                    states.push(serde_json::from_slice::<Value>(&message.data).unwrap()["bound"].clone());
+                    states.push(message_json(&message).unwrap()["bound"].clone());
                 }
                 TOPIC_SCENE => scenes += 1,
                 _ => {}

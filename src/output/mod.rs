@@ -48,6 +48,7 @@ pub mod dcd;
 pub mod event_log;
 pub mod lammps_dump;
 pub mod lifetimes;
+pub mod mcap_messages;
 pub mod mcap_writer;
 pub mod restart;
 pub mod run_log;
@@ -212,14 +213,15 @@ impl DumpFormat {
     }
 }
 
-/// How the MCAP writer encodes the Foxglove-typed `/scene` channel (deck:
-/// `dump … mcap FILE encoding protobuf|json`).
+/// How the MCAP writer encodes its channels (deck: `dump … mcap FILE
+/// encoding protobuf|json`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Encoding {
-    /// `foxglove.SceneUpdate` as protobuf with its descriptor set (the default).
+    /// Typed protobuf messages with their descriptor sets (the default):
+    /// cellmd's own (see [`mcap_messages`]) and Foxglove's `SceneUpdate`.
     #[default]
     Protobuf,
-    /// The same scene as JSON with a JSON Schema.
+    /// The same messages as JSON with JSON Schemas.
     Json,
 }
 
@@ -239,7 +241,7 @@ impl Encoding {
 pub struct WriterOptions {
     /// LAMMPS dump atom columns (empty: the default `id type element x y z ix iy iz`).
     pub columns: Vec<AtomColumn>,
-    /// Encoding of the MCAP scene.
+    /// Encoding of the MCAP channels.
     pub encoding: Encoding,
 }
 
