@@ -31,8 +31,11 @@
 //! A `bond` line may end with kinetic rules (see [`crate::kinetics`]):
 //! `bond clutch harmonic k 5 r0 0.02 kinetics catch_slip kc0 10 xc 0.002 ks0 0.05 xs 0.001`.
 
+mod custom;
 mod params;
 mod parse;
+
+pub use self::custom::{parse_custom, parse_custom_external};
 
 pub use self::params::{parse_kinetics, parse_params, parse_values, BondTypeKinetics, TermType};
 pub use self::parse::{check_pair_types, load_forcefield, BodyRule, ContactRule, ForceField, PairRule, ParticleType};

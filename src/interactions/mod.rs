@@ -80,6 +80,7 @@ macro_rules! radial_force {
     };
 }
 
+pub mod custom;
 pub mod testing;
 
 mod area_conservation;
@@ -136,6 +137,7 @@ pub static REGISTRY: &[&dyn Interaction] = &[
     &helfrich_bending::HelfrichBending,
     &contact_barrier::ContactBarrier,
     &contact_adhesion::ContactAdhesion,
+    &custom::Custom,
 ];
 
 /// Looks an interaction type up by its registered name.
@@ -417,6 +419,11 @@ pub trait Interaction: Sync + Send {
     /// Checks relations between parameters beyond per-parameter ranges.
     fn validate(&self, _params: &[f64]) -> Result<(), String> {
         Ok(())
+    }
+    /// The energy expression of a [`custom`] law (for translations to other
+    /// engines); `None` for the registered laws.
+    fn expression(&self) -> Option<&crate::expr::Expr> {
+        None
     }
 }
 

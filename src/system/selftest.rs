@@ -1,0 +1,100 @@
+//! `cellmd check --selftest`: the shared physics checks of
+//! [`crate::interactions::testing`] (F = −∇E by central differences, Σf = 0,
+//! Σ r×f = 0, rigid-motion invariance, E″ against differences of E′ for
+//! radial laws) run on every `custom` term of a model, at geometries taken
+//! from the deck's initial configuration: each bond type at the length of
+//! its first bond and ±10 %, each pair rule at ¼, ½, ¾ and 0.95 of its
+//! cutoff, each angle type at its first angle and at 45°, 100° and 160°,
+//! each external at its first members' positions, each body term on the
+//! first body it acts on.
+
+use std::panic::{catch_unwind, AssertUnwindSafe};
+
+use glam::DVec3;
+
+use super::{Model, SimBox};
+use crate::forcefield::TermType;
+use crate::interactions::testing::{assert_all_checks, assert_surface_checks};
+
+/// One line per custom term: `Ok("bond spring: 3 geometries")` or the
+/// first check that failed.
+pub fn check_custom_terms(model: &Model, positions: &[DVec3], sim_box: &SimBox) -> Vec<Result<String, String>> {
+    let custom = |t: &TermType| t.interaction.name() == "custom";
+    let images = sim_box.images();
+    let mut out = Vec::new();
+    for (k, term) in model.bond_types.iter().enumerate().filter(|(_, t)| custom(t)) {
+        let length = model
+            .bonds
+            .iter()
+            .zip(&model.bond_type)
+            .find(|(_, &t)| t as usize == k)
+            .map(|([i, j], _)| images.minimum_image(positions[*j as usize] - positions[*i as usize]).length())
+            .filter(|r| *r > 0.0)
+            .unwrap_or(1.0);
+        let geometries = [0.9, 1.0, 1.1].map(|s| pair_at(s * length)).to_vec();
+        out.push(run("bond", term, &geometries, length));
+    }
+    for term in model.pair_rules.iter().filter(|t| custom(t)) {
+        let cutoff = term.params[0];
+        let geometries = [0.25, 0.5, 0.75, 0.95].map(|s| pair_at(s * cutoff)).to_vec();
+        out.push(run("pair", term, &geometries, cutoff));
+    }
+    for (k, term) in model.angle_types.iter().enumerate().filter(|(_, t)| custom(t)) {
+        let first = model.angles.iter().zip(&model.angle_type).find(|(_, &t)| t as usize == k).map(|(a, _)| *a);
+        let mut geometries: Vec<Vec<DVec3>> = [45.0, 100.0, 160.0].map(angle_at).to_vec();
+        let mut size = 1.0;
+        if let Some([i, j, l]) = first {
+            let xj = positions[j as usize];
+            let (u, v) = (images.minimum_image(positions[i as usize] - xj), images.minimum_image(positions[l as usize] - xj));
+            size = u.length().max(v.length()).max(f64::MIN_POSITIVE);
+            geometries.push(vec![xj + u, xj, xj + v]);
+        }
+        out.push(run("angle", term, &geometries, size));
+    }
+    for external in model.externals.iter().filter(|e| custom(&e.term)) {
+        let geometries: Vec<Vec<DVec3>> = external.members.iter().take(3).map(|&m| vec![positions[m as usize]]).collect();
+        out.push(run("external", &external.term, &geometries, 1.0));
+    }
+    for (term, &body_type) in model.body_rules.iter().zip(&model.body_rule_type).filter(|(t, _)| custom(t)) {
+        let Some(body) = model.bodies.iter().find(|b| b.body_type == body_type) else { continue };
+        let mut x = Vec::new();
+        body.mesh.unwrap_into(|n| positions[body.nodes[n as usize] as usize], |d| images.minimum_image(d), &mut x);
+        let centre = body.mesh.centroid(&x);
+        let size = x.iter().map(|p| (*p - centre).length()).fold(0.0, f64::max).max(f64::MIN_POSITIVE);
+        let result = checked(|| assert_surface_checks(term.interaction, &term.params, &body.mesh, &x, 1e-6 * size, 1e-9));
+        out.push(result.map(|()| format!("body {} custom: ok on body {}", term.label.text, body.id)).map_err(|e| format!("body {}: {e}", term.label.text)));
+    }
+    out
+}
+
+fn pair_at(r: f64) -> Vec<DVec3> {
+    let a = DVec3::new(0.2, -0.1, 0.3) * r;
+    vec![a, a + DVec3::new(2.0, -2.0, 1.0) / 3.0 * r]
+}
+
+fn angle_at(deg: f64) -> Vec<DVec3> {
+    let t = f64::to_radians(deg);
+    vec![DVec3::new(0.0, 1.0, 0.2), DVec3::ZERO, DVec3::new(0.3, t.cos(), t.sin())]
+}
+
+fn run(kind: &str, term: &TermType, geometries: &[Vec<DVec3>], size: f64) -> Result<String, String> {
+    let label = &term.label.text;
+    checked(|| {
+        for x in geometries {
+            assert_all_checks(term.interaction, &term.params, x, 1e-6 * size, 1e-9);
+        }
+    })
+    .map(|()| format!("{kind} {label} custom: ok at {} geometries", geometries.len()))
+    .map_err(|e| format!("{kind} {label}: {e}"))
+}
+
+/// Runs a check that panics on failure; the panic's message, silenced.
+fn checked(check: impl FnOnce()) -> Result<(), String> {
+    let hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
+    let result = catch_unwind(AssertUnwindSafe(check));
+    std::panic::set_hook(hook);
+    result.map_err(|payload| {
+        payload.downcast_ref::<String>().cloned().or_else(|| payload.downcast_ref::<&str>().map(|s| s.to_string())).unwrap_or_default()
+    })
+}
