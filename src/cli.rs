@@ -224,7 +224,9 @@ where
                 if !selftest {
                     return ExitCode::SUCCESS;
                 }
-                let results = crate::system::check_custom_terms(&plan.model, &plan.positions, &plan.sim_box);
+                let externals: Vec<_> =
+                    plan.actions.iter().filter_map(|a| if let crate::deck::Action::External(e) = a { Some(e) } else { None }).collect();
+                let results = crate::system::check_custom_terms(&plan.model, &externals, &plan.positions, &plan.sim_box);
                 for result in &results {
                     match result {
                         Ok(line) => println!("selftest: {line}"),

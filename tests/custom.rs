@@ -115,7 +115,7 @@ fn check_selftest_runs_the_shared_checks_on_every_custom_term() {
     let out = Command::new(env!("CARGO_BIN_EXE_cellmd")).arg("check").arg("--selftest").arg(c.path("deck.in")).output().unwrap();
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{stdout}\n{}", String::from_utf8_lossy(&out.stderr));
-    for line in ["selftest: bond s custom: ok", "selftest: angle t custom: ok", "selftest: pair a-b custom: ok", "selftest: 5 custom term(s) pass"] {
+    for line in ["selftest: bond s custom: ok", "selftest: angle t custom: ok", "selftest: pair a b custom: ok", "selftest: external push custom: ok", "selftest: 6 custom term(s) pass"] {
         assert!(stdout.contains(line), "stdout lacks `{line}`:\n{stdout}");
     }
 }

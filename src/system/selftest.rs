@@ -3,8 +3,8 @@
 //! Σ r×f = 0, rigid-motion invariance, E″ against differences of E′ for
 //! radial laws) run on every `custom` term of a model, at geometries taken
 //! from the deck's initial configuration: each bond type at the length of
-//! its first bond and ±10 %, each pair rule at ¼, ½, ¾ and 0.95 of its
-//! cutoff, each angle type at its first angle and at 45°, 100° and 160°,
+//! its first bond and ±10 %, each pair rule at 0.3, 0.55, 0.8 and 0.95
+//! of its cutoff, each angle type at its first angle and at 45°, 100° and 160°,
 //! each external at its first members' positions, each body term on the
 //! first body it acts on.
 
@@ -12,13 +12,15 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 
 use glam::DVec3;
 
-use super::{Model, SimBox};
+use super::{External, Model, SimBox};
 use crate::forcefield::TermType;
 use crate::interactions::testing::{assert_all_checks, assert_surface_checks};
 
 /// One line per custom term: `Ok("bond spring: 3 geometries")` or the
 /// first check that failed.
-pub fn check_custom_terms(model: &Model, positions: &[DVec3], sim_box: &SimBox) -> Vec<Result<String, String>> {
+/// `externals` are the deck's (`external` commands), which the model gets
+/// as the run reaches them.
+pub fn check_custom_terms(model: &Model, externals: &[&External], positions: &[DVec3], sim_box: &SimBox) -> Vec<Result<String, String>> {
     let custom = |t: &TermType| t.interaction.name() == "custom";
     let images = sim_box.images();
     let mut out = Vec::new();
@@ -32,12 +34,13 @@ pub fn check_custom_terms(model: &Model, positions: &[DVec3], sim_box: &SimBox) 
             .filter(|r| *r > 0.0)
             .unwrap_or(1.0);
         let geometries = [0.9, 1.0, 1.1].map(|s| pair_at(s * length)).to_vec();
-        out.push(run("bond", term, &geometries, length));
+        out.push(run("bond", &term.label.text, term, &geometries, length));
     }
-    for term in model.pair_rules.iter().filter(|t| custom(t)) {
+    for (term, &(a, b)) in model.pair_rules.iter().zip(&model.pair_rule_types).filter(|(t, _)| custom(t)) {
         let cutoff = term.params[0];
-        let geometries = [0.25, 0.5, 0.75, 0.95].map(|s| pair_at(s * cutoff)).to_vec();
-        out.push(run("pair", term, &geometries, cutoff));
+        let geometries = [0.3, 0.55, 0.8, 0.95].map(|s| pair_at(s * cutoff)).to_vec();
+        let kind = format!("pair {} {}", model.type_names[a as usize], model.type_names[b as usize]);
+        out.push(run(&kind, "", term, &geometries, cutoff));
     }
     for (k, term) in model.angle_types.iter().enumerate().filter(|(_, t)| custom(t)) {
         let first = model.angles.iter().zip(&model.angle_type).find(|(_, &t)| t as usize == k).map(|(a, _)| *a);
@@ -49,11 +52,11 @@ pub fn check_custom_terms(model: &Model, positions: &[DVec3], sim_box: &SimBox) 
             size = u.length().max(v.length()).max(f64::MIN_POSITIVE);
             geometries.push(vec![xj + u, xj, xj + v]);
         }
-        out.push(run("angle", term, &geometries, size));
+        out.push(run("angle", &term.label.text, term, &geometries, size));
     }
-    for external in model.externals.iter().filter(|e| custom(&e.term)) {
+    for external in externals.iter().filter(|e| custom(&e.term)) {
         let geometries: Vec<Vec<DVec3>> = external.members.iter().take(3).map(|&m| vec![positions[m as usize]]).collect();
-        out.push(run("external", &external.term, &geometries, 1.0));
+        out.push(run("external", &external.term.label.text, &external.term, &geometries, 1.0));
     }
     for (term, &body_type) in model.body_rules.iter().zip(&model.body_rule_type).filter(|(t, _)| custom(t)) {
         let Some(body) = model.bodies.iter().find(|b| b.body_type == body_type) else { continue };
@@ -77,15 +80,16 @@ fn angle_at(deg: f64) -> Vec<DVec3> {
     vec![DVec3::new(0.0, 1.0, 0.2), DVec3::ZERO, DVec3::new(0.3, t.cos(), t.sin())]
 }
 
-fn run(kind: &str, term: &TermType, geometries: &[Vec<DVec3>], size: f64) -> Result<String, String> {
-    let label = &term.label.text;
+/// The checks of `term` (named `kind label`) at each geometry.
+fn run(kind: &str, label: &str, term: &TermType, geometries: &[Vec<DVec3>], size: f64) -> Result<String, String> {
+    let name = if label.is_empty() { kind.to_string() } else { format!("{kind} {label}") };
     checked(|| {
         for x in geometries {
             assert_all_checks(term.interaction, &term.params, x, 1e-6 * size, 1e-9);
         }
     })
-    .map(|()| format!("{kind} {label} custom: ok at {} geometries", geometries.len()))
-    .map_err(|e| format!("{kind} {label}: {e}"))
+    .map(|()| format!("{name} custom: ok at {} geometries", geometries.len()))
+    .map_err(|e| format!("{name}: {e}"))
 }
 
 /// Runs a check that panics on failure; the panic's message, silenced.
