@@ -4,7 +4,6 @@
 //! and the implicit step (which uses the symbolic d²E/dr²); `check
 //! --selftest` runs the shared checks on a deck's custom terms.
 
-
 mod common;
 
 use std::process::Command;
@@ -79,13 +78,7 @@ fn trajectories_agree_with_the_explicit_and_the_implicit_step() {
         let run = format!("{integrator}\nrun 20\n");
         let built_in = case(BUILT_IN, PUSH, &run).run();
         let custom = case(CUSTOM, CUSTOM_PUSH, &run).run();
-        let worst = built_in
-            .state
-            .positions
-            .iter()
-            .zip(&custom.state.positions)
-            .map(|(a, b)| (*a - *b).length())
-            .fold(0.0, f64::max);
+        let worst = built_in.state.positions.iter().zip(&custom.state.positions).map(|(a, b)| (*a - *b).length()).fold(0.0, f64::max);
         assert!(worst < 1e-12, "{integrator}: positions differ by {worst}");
         // Bit-identical across thread counts, as every law.
         let c = case(CUSTOM, CUSTOM_PUSH, &run);
@@ -107,15 +100,17 @@ fn custom_terms_are_not_cpu_only_unless_an_external_reads_time() {
 
 #[test]
 fn check_selftest_runs_the_shared_checks_on_every_custom_term() {
-    let c = case(
-        &format!("{CUSTOM}bond u custom \"k*(r>r0)*(r-r0)^3\" k 5 r0 0.4\n"),
-        CUSTOM_PUSH,
-        "run 0\n",
-    );
+    let c = case(&format!("{CUSTOM}bond u custom \"k*(r>r0)*(r-r0)^3\" k 5 r0 0.4\n"), CUSTOM_PUSH, "run 0\n");
     let out = Command::new(env!("CARGO_BIN_EXE_cellmd")).arg("check").arg("--selftest").arg(c.path("deck.in")).output().unwrap();
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{stdout}\n{}", String::from_utf8_lossy(&out.stderr));
-    for line in ["selftest: bond s custom: ok", "selftest: angle t custom: ok", "selftest: pair a b custom: ok", "selftest: external push custom: ok", "selftest: 6 custom term(s) pass"] {
+    for line in [
+        "selftest: bond s custom: ok",
+        "selftest: angle t custom: ok",
+        "selftest: pair a b custom: ok",
+        "selftest: external push custom: ok",
+        "selftest: 6 custom term(s) pass",
+    ] {
         assert!(stdout.contains(line), "stdout lacks `{line}`:\n{stdout}");
     }
 }

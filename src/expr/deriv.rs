@@ -134,7 +134,10 @@ impl Expr {
                     "atan" => div(da(), add(number(1.0, span), square(a.clone()))),
                     "atan2" => {
                         let (y, x) = (a, &args[1]);
-                        div(sub(mul(x.clone(), y.derivative(var)), mul(y.clone(), x.derivative(var))), add(square(x.clone()), square(y.clone())))
+                        div(
+                            sub(mul(x.clone(), y.derivative(var)), mul(y.clone(), x.derivative(var))),
+                            add(square(x.clone()), square(y.clone())),
+                        )
                     }
                     "abs" => {
                         let zero_e = number(0.0, span);

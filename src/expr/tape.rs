@@ -81,7 +81,10 @@ impl Emitter<'_> {
         self.depth = (self.depth as isize + by) as usize;
         self.deepest = self.deepest.max(self.depth);
         if self.depth > STACK {
-            return Err(ExprError::new(at.span(), format!("found an expression that needs more than {STACK} stack slots; expected a flatter one")));
+            return Err(ExprError::new(
+                at.span(),
+                format!("found an expression that needs more than {STACK} stack slots; expected a flatter one"),
+            ));
         }
         Ok(())
     }
@@ -107,7 +110,8 @@ impl Emitter<'_> {
                 self.emit(arg)?;
                 self.push(if *op == UnaryOp::Neg { NEG } else { NOT }, None);
             }
-            Expr::Binary { op: BinaryOp::Pow, lhs, rhs, .. } if matches!(**rhs, Expr::Number(n, _) if n.fract() == 0.0 && n.abs() <= 16.0) => {
+            Expr::Binary { op: BinaryOp::Pow, lhs, rhs, .. } if matches!(**rhs, Expr::Number(n, _) if n.fract() == 0.0 && n.abs() <= 16.0) =>
+            {
                 let Expr::Number(n, _) = **rhs else { unreachable!("matched above") };
                 self.emit(lhs)?;
                 self.push(POWI, Some(n));

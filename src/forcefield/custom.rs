@@ -58,7 +58,8 @@ fn unit(suffix: &str, units: UnitSystem) -> Option<(f64, Dim)> {
         "deg" => return Some((std::f64::consts::PI / 180.0, Dim::Dimensionless)),
         _ => {}
     }
-    if let Some(dim) = DIMS.iter().copied().filter(|d| !matches!(d, Dim::Dimensionless | Dim::Degrees)).find(|d| units.label(*d) == normal) {
+    if let Some(dim) = DIMS.iter().copied().filter(|d| !matches!(d, Dim::Dimensionless | Dim::Degrees)).find(|d| units.label(*d) == normal)
+    {
         return Some((1.0, dim));
     }
     SCALED.iter().find(|(s, _, _)| units == UnitSystem::Cell && *s == normal).map(|(_, f, d)| (*f, *d))
@@ -68,7 +69,8 @@ fn unit(suffix: &str, units: UnitSystem) -> Option<(f64, Dim)> {
 fn value_with_unit(token: &Token, name: &str, units: UnitSystem) -> Result<(f64, Dim), InputError> {
     let text = token.text.as_str();
     let split = (1..=text.len()).rev().filter(|&k| text.is_char_boundary(k)).find(|&k| text[..k].parse::<f64>().is_ok());
-    let Some(split) = split.filter(|&k| !text[..k].to_ascii_lowercase().contains("inf") && !text[..k].to_ascii_lowercase().contains("nan")) else {
+    let Some(split) = split.filter(|&k| !text[..k].to_ascii_lowercase().contains("inf") && !text[..k].to_ascii_lowercase().contains("nan"))
+    else {
         parse_f64(token, &format!("a value for `{name}`"))?;
         return Err(token.error(format!("found `{text}`, expected a value for `{name}` (a number with an optional unit)")));
     };
@@ -102,15 +104,29 @@ pub fn parse_custom(label: &Token, custom: &Token, tokens: &[Token], kind: Kind,
 /// A deck's `external NAME GROUP custom "EXPR" ...`: the term, and the
 /// parameter expressions [`crate::system::External`] evaluates at each
 /// step (the time slot, `t`, when the expression reads it).
-pub fn parse_custom_external(label: &Token, custom: &Token, tokens: &[Token], units: UnitSystem) -> Result<(TermType, Vec<(usize, Expr)>), InputError> {
+pub fn parse_custom_external(
+    label: &Token,
+    custom: &Token,
+    tokens: &[Token],
+    units: UnitSystem,
+) -> Result<(TermType, Vec<(usize, Expr)>), InputError> {
     let (term, law) = build(label, custom, tokens, Kind::External, units)?;
     let span = Span { start: 0, end: 1 };
     Ok((term, law.time_slot().map(|k| (k, Expr::Name("t".into(), span))).into_iter().collect()))
 }
 
-fn build(label: &Token, custom: &Token, tokens: &[Token], kind: Kind, units: UnitSystem) -> Result<(TermType, &'static CustomLaw), InputError> {
+fn build(
+    label: &Token,
+    custom: &Token,
+    tokens: &[Token],
+    kind: Kind,
+    units: UnitSystem,
+) -> Result<(TermType, &'static CustomLaw), InputError> {
     let Some(text) = tokens.first() else {
-        return Err(custom.error(format!("expected `custom \"EXPRESSION\" [name value]...` after `{}`; `cellmd list custom` has the grammar", custom.text)));
+        return Err(custom.error(format!(
+            "expected `custom \"EXPRESSION\" [name value]...` after `{}`; `cellmd list custom` has the grammar",
+            custom.text
+        )));
     };
     let pairs = &tokens[1..];
     let mut declared = Vec::new();

@@ -79,12 +79,17 @@ pub fn source(model: &Model) -> Result<CustomSource, String> {
             _ => specs.iter().position(|s| s.name == n).map(|i| format!("p[{i}]")),
         };
         let label = &term.label.text;
-        let code = |e: &crate::expr::Expr| wgsl(e, &name).map_err(|e| format!("{} `{label}` on the GPU: {}", kind.with_article(), e.message));
+        let code =
+            |e: &crate::expr::Expr| wgsl(e, &name).map_err(|e| format!("{} `{label}` on the GPU: {}", kind.with_article(), e.message));
         match kind {
             Kind::Bond | Kind::Pair => {
                 let (e, de) = (code(energy)?, code(&energy.derivative("r"))?);
                 let cut = if kind == Kind::Pair { "    if r >= p[0] { return RADIAL_ZERO; }\n" } else { "" };
-                writeln!(out.functions, "fn custom_{k}_radial(p: array<f32, 8>, r: f32) -> Radial {{\n{cut}    return Radial({e}, {de});\n}}").unwrap();
+                writeln!(
+                    out.functions,
+                    "fn custom_{k}_radial(p: array<f32, 8>, r: f32) -> Radial {{\n{cut}    return Radial({e}, {de});\n}}"
+                )
+                .unwrap();
                 writeln!(out.radial_cases, "        case {index}u: {{ return custom_{k}_radial(p, r); }}").unwrap();
             }
             Kind::Angle => {

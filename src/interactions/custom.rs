@@ -107,7 +107,11 @@ impl CustomLaw {
                 };
                 return Err(CustomError::Expression(ExprError::new(
                     span,
-                    format!("found unknown symbol {found}, expected a variable of {} or a declared parameter: {}", kind.with_article(), listed.join(", ")),
+                    format!(
+                        "found unknown symbol {found}, expected a variable of {} or a declared parameter: {}",
+                        kind.with_article(),
+                        listed.join(", ")
+                    ),
                 )));
             }
         }
@@ -236,7 +240,6 @@ interaction!(
     Law::Surface { eval: body_eval, hessian: body_hessian }
 );
 
-
 /// The shared checks on a set of expressions of every kind, and equality
 /// with the built-in law each one restates (to 1e-14).
 #[cfg(test)]
@@ -304,7 +307,8 @@ mod tests {
     fn shared_checks_on_body_expressions() {
         for (_, mesh, x) in deformed_icospheres(&[0, 1]) {
             let (v, a) = (mesh.volume(&x), mesh.area(&x));
-            let (body, p) = law(Kind::Body, "0.5*K*(V-V0)^2/V0 + gamma*A + c*A^2/V", &[("K", 1000.0), ("V0", 1.1 * v), ("gamma", 5.0), ("c", 0.2)]);
+            let (body, p) =
+                law(Kind::Body, "0.5*K*(V-V0)^2/V0 + gamma*A + c*A^2/V", &[("K", 1000.0), ("V0", 1.1 * v), ("gamma", 5.0), ("c", 0.2)]);
             assert_surface_checks(body, &p, &mesh, &x, 1e-6, 1e-3);
             let (rest, p) = law(Kind::Body, "0.5*K*(V-V0)^2 + 0.5*G*(A-A0)^2", &[("K", 100.0), ("V0", v), ("G", 7.0), ("A0", a)]);
             assert_surface_zero_force_at_rest(rest, &p, &mesh, &x, 100.0);
@@ -324,11 +328,22 @@ mod tests {
     #[test]
     fn expressions_of_built_in_laws_equal_the_built_ins() {
         let radial = [
-            (law(Kind::Bond, "0.5*k*(r-r0)^2", &[("k", 400.0), ("r0", 0.1)]), params_of(&harmonic::Harmonic, &[("k", 400.0), ("r0", 0.1)]), harmonic::Harmonic.law()),
-            (law(Kind::Pair, "A*(1+cos(pi*r/rc))", &[("cutoff", 1.5), ("A", 10.0), ("rc", 1.5)]), params_of(&soft::Soft, &[("A", 10.0), ("rc", 1.5)]), soft::Soft.law()),
+            (
+                law(Kind::Bond, "0.5*k*(r-r0)^2", &[("k", 400.0), ("r0", 0.1)]),
+                params_of(&harmonic::Harmonic, &[("k", 400.0), ("r0", 0.1)]),
+                harmonic::Harmonic.law(),
+            ),
+            (
+                law(Kind::Pair, "A*(1+cos(pi*r/rc))", &[("cutoff", 1.5), ("A", 10.0), ("rc", 1.5)]),
+                params_of(&soft::Soft, &[("A", 10.0), ("rc", 1.5)]),
+                soft::Soft.law(),
+            ),
         ];
         for ((custom, cp), bp, builtin) in radial {
-            let (Law::Radial { eval: ce, force: cf, range: cr }, Law::Radial { eval: be, force: bf, range: br }) = (custom.law(), builtin) else { unreachable!() };
+            let (Law::Radial { eval: ce, force: cf, range: cr }, Law::Radial { eval: be, force: bf, range: br }) = (custom.law(), builtin)
+            else {
+                unreachable!()
+            };
             assert_eq!(cr(&cp), br(&bp));
             for r in [0.05, 0.1, 0.37, 0.9, 1.49, 1.5, 2.0] {
                 let (c, b) = (ce(&cp, r), be(&bp, r));
@@ -340,7 +355,11 @@ mod tests {
             }
         }
         let angles = [
-            (law(Kind::Angle, "K*(1+cos(theta))", &[("K", 0.7)]), params_of(&cosine_angle::CosineAngle, &[("K", 0.7)]), cosine_angle::CosineAngle.law()),
+            (
+                law(Kind::Angle, "K*(1+cos(theta))", &[("K", 0.7)]),
+                params_of(&cosine_angle::CosineAngle, &[("K", 0.7)]),
+                cosine_angle::CosineAngle.law(),
+            ),
             (
                 law(Kind::Angle, "0.5*k*(theta-theta0)^2", &[("k", 3.0), ("theta0", 110f64.to_radians())]),
                 params_of(&harmonic_angle::HarmonicAngle, &[("k", 3.0), ("theta0", 110.0)]),
@@ -362,8 +381,16 @@ mod tests {
         for (_, mesh, x) in deformed_icospheres(&[1]) {
             let v = mesh.volume(&x);
             let bodies = [
-                (law(Kind::Body, "-dp0*(V-v0) + 0.5*k*(V-v0)^2/v0", &[("dp0", 40.0), ("k", 700.0), ("v0", 1.2 * v)]), params_of(&turgor::Turgor, &[("k", 700.0), ("dp0", 40.0), ("v0", 1.2 * v)]), turgor::Turgor.law()),
-                (law(Kind::Body, "gamma*A", &[("gamma", 665.0)]), params_of(&surface_tension::SurfaceTension, &[("gamma", 665.0)]), surface_tension::SurfaceTension.law()),
+                (
+                    law(Kind::Body, "-dp0*(V-v0) + 0.5*k*(V-v0)^2/v0", &[("dp0", 40.0), ("k", 700.0), ("v0", 1.2 * v)]),
+                    params_of(&turgor::Turgor, &[("k", 700.0), ("dp0", 40.0), ("v0", 1.2 * v)]),
+                    turgor::Turgor.law(),
+                ),
+                (
+                    law(Kind::Body, "gamma*A", &[("gamma", 665.0)]),
+                    params_of(&surface_tension::SurfaceTension, &[("gamma", 665.0)]),
+                    surface_tension::SurfaceTension.law(),
+                ),
             ];
             for ((custom, cp), bp, builtin) in bodies {
                 let (c, b) = (evaluate_surface(custom.law(), &cp, &mesh, &x), evaluate_surface(builtin, &bp, &mesh, &x));
@@ -399,10 +426,16 @@ mod tests {
             expression(Kind::Bond, "k*(r-q)^2", &["k"]),
             "5..6: found unknown symbol `q`, expected a variable of a bond or a declared parameter: r, k"
         );
-        assert_eq!(expression(Kind::Angle, "k*r", &["k"]), "2..3: found unknown symbol `r`, expected a variable of an angle or a declared parameter: theta, k");
+        assert_eq!(
+            expression(Kind::Angle, "k*r", &["k"]),
+            "2..3: found unknown symbol `r`, expected a variable of an angle or a declared parameter: theta, k"
+        );
         assert!(expression(Kind::Bond, "k*foo(r)", &["k"]).starts_with("2..5: found unknown function `foo`"));
         assert!(expression(Kind::Bond, "k*(r-", &["k"]).starts_with("5..5: found the end of the expression"));
-        assert_eq!(expression(Kind::Bond, "k*r", &["k", "unused"]), "parameter 1: parameter `unused` is not used in the expression; expected every declared parameter in it");
+        assert_eq!(
+            expression(Kind::Bond, "k*r", &["k", "unused"]),
+            "parameter 1: parameter `unused` is not used in the expression; expected every declared parameter in it"
+        );
         assert!(expression(Kind::Bond, "k*r", &["k", "r"]).starts_with("parameter 1: `r` is a variable of a bond expression"));
         assert!(expression(Kind::Body, "k*V", &["k", "k"]).starts_with("parameter 1: parameter `k` is declared twice"));
         assert!(expression(Kind::Contact, "d", &[]).contains("expected one of the kinds bond"));

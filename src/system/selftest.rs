@@ -65,7 +65,11 @@ pub fn check_custom_terms(model: &Model, externals: &[&External], positions: &[D
         let centre = body.mesh.centroid(&x);
         let size = x.iter().map(|p| (*p - centre).length()).fold(0.0, f64::max).max(f64::MIN_POSITIVE);
         let result = checked(|| assert_surface_checks(term.interaction, &term.params, &body.mesh, &x, 1e-6 * size, 1e-9));
-        out.push(result.map(|()| format!("body {} custom: ok on body {}", term.label.text, body.id)).map_err(|e| format!("body {}: {e}", term.label.text)));
+        out.push(
+            result
+                .map(|()| format!("body {} custom: ok on body {}", term.label.text, body.id))
+                .map_err(|e| format!("body {}: {e}", term.label.text)),
+        );
     }
     out
 }

@@ -114,4 +114,3 @@ pub(super) fn body_hessian(p: &[f64], mesh: &SurfaceMesh, x: &[DVec3], out: &mut
         }
     }
 }
-
