@@ -100,16 +100,22 @@ fn custom_terms_are_not_cpu_only_unless_an_external_reads_time() {
 
 #[test]
 fn check_selftest_runs_the_shared_checks_on_every_custom_term() {
-    let c = case(&format!("{CUSTOM}bond u custom \"k*(r>r0)*(r-r0)^3\" k 5 r0 0.4\n"), CUSTOM_PUSH, "run 0\n");
+    let c = case(
+        &format!("{CUSTOM}bond u custom \"k*(r>r0)*(r-r0)^3\" k 5 r0 0.4\npair b b custom \"A*(1-r)\" cutoff 0.5 A 1\n"),
+        CUSTOM_PUSH,
+        "run 0\n",
+    );
     let out = Command::new(env!("CARGO_BIN_EXE_cellmd")).arg("check").arg("--selftest").arg(c.path("deck.in")).output().unwrap();
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{stdout}\n{}", String::from_utf8_lossy(&out.stderr));
     for line in [
+        "selftest: pair a a custom: ok at 4 geometries; E and F continuous at the cutoff",
         "selftest: bond s custom: ok",
         "selftest: angle t custom: ok",
         "selftest: pair a b custom: ok",
         "selftest: external push custom: ok",
-        "selftest: 6 custom term(s) pass",
+        "selftest: pair b b custom: ok at 4 geometries; warning: truncated at the cutoff with E = 5.000000000005e-1, dE/dr = -1e0 just inside",
+        "selftest: 7 custom term(s) pass",
     ] {
         assert!(stdout.contains(line), "stdout lacks `{line}`:\n{stdout}");
     }

@@ -4,7 +4,8 @@
 //! radial laws) run on every `custom` term of a model, at geometries taken
 //! from the deck's initial configuration: each bond type at the length of
 //! its first bond and ±10 %, each pair rule at 0.3, 0.55, 0.8 and 0.95
-//! of its cutoff, each angle type at its first angle and at 45°, 100° and 160°,
+//! of its cutoff (and its energy and force just inside the cutoff
+//! reported), each angle type at its first angle and at 45°, 100° and 160°,
 //! each external at its first members' positions, each body term on the
 //! first body it acts on.
 
@@ -15,6 +16,7 @@ use glam::DVec3;
 use super::{External, Model, SimBox};
 use crate::forcefield::TermType;
 use crate::interactions::testing::{assert_all_checks, assert_surface_checks};
+use crate::interactions::Law;
 
 /// One line per custom term: `Ok("bond spring: 3 geometries")` or the
 /// first check that failed.
@@ -40,7 +42,7 @@ pub fn check_custom_terms(model: &Model, externals: &[&External], positions: &[D
         let cutoff = term.params[0];
         let geometries = [0.3, 0.55, 0.8, 0.95].map(|s| pair_at(s * cutoff)).to_vec();
         let kind = format!("pair {} {}", model.type_names[a as usize], model.type_names[b as usize]);
-        out.push(run(&kind, "", term, &geometries, cutoff));
+        out.push(run(&kind, "", term, &geometries, cutoff).map(|line| format!("{line}; {}", at_cutoff(term, cutoff))));
     }
     for (k, term) in model.angle_types.iter().enumerate().filter(|(_, t)| custom(t)) {
         let first = model.angles.iter().zip(&model.angle_type).find(|(_, &t)| t as usize == k).map(|(a, _)| *a);
@@ -72,6 +74,29 @@ pub fn check_custom_terms(model: &Model, externals: &[&External], positions: &[D
         );
     }
     out
+}
+
+/// Whether the energy and the force vanish just inside the cutoff (to 1e-9
+/// of the largest |E| and |dE/dr| at the checked distances): where they do
+/// not, the truncation is a jump the dynamics feel as an impulse, reported
+/// as a warning (not refused: LAMMPS' unshifted pair styles truncate alike).
+fn at_cutoff(term: &TermType, cutoff: f64) -> String {
+    let Law::Radial { eval, .. } = term.interaction.law() else { unreachable!("pair law is radial") };
+    let inside: Vec<_> = [0.3, 0.55, 0.8].iter().map(|s| eval(&term.params, s * cutoff)).collect();
+    let (e_scale, f_scale) = inside.iter().fold((0.0f64, 0.0f64), |(e, f), x| (e.max(x.energy.abs()), f.max(x.de_dr.abs())));
+    let edge = eval(&term.params, cutoff * (1.0 - 1e-12));
+    let mut notes = Vec::new();
+    if !(edge.energy.abs() <= 1e-9 * e_scale) {
+        notes.push(format!("E = {:e}", edge.energy));
+    }
+    if !(edge.de_dr.abs() <= 1e-9 * f_scale) {
+        notes.push(format!("dE/dr = {:e}", edge.de_dr));
+    }
+    if notes.is_empty() {
+        "E and F continuous at the cutoff".into()
+    } else {
+        format!("warning: truncated at the cutoff with {} just inside", notes.join(", "))
+    }
 }
 
 fn pair_at(r: f64) -> Vec<DVec3> {
