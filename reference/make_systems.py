@@ -10,6 +10,7 @@ particles (see kinetics()). Deterministic (fixed seeds); rerun only to change
 the systems, then `reference/regenerate` to record LAMMPS' answers.
 Likewise reference/per_bond_r0: bonds with their own rest lengths, which the
 export writes as one LAMMPS bond type per distinct (type, r0).
+Likewise reference/custom: `custom` expressions as LAMMPS lepton styles.
 """
 import math
 import os
@@ -359,6 +360,36 @@ def per_bond_r0():
     })
 
 
+def custom():
+    """`custom` expressions of every kind LAMMPS' lepton styles express:
+    restatements of harmonic, cosine_angle, harmonic_angle and soft, and laws
+    no built-in has, on bonded chains with angles and two particle types."""
+    rng = random.Random(sum(map(ord, "custom")))
+    ff = (TYPES
+          + 'bond s custom "0.5*k*(r-r0)^2" k 50 r0 1.0\n'
+          + 'bond t custom "k*(r-r0)^2 + c*(r-r0)^3" k 40 r0 0.9 c 5\n'
+          + 'angle s custom "K*(1+cos(theta))" K 2\n'
+          + 'angle t custom "0.5*k*(theta-theta0)^2" k 3 theta0 110deg\n'
+          + 'pair a a custom "A*(1+cos(pi*r/rc))" cutoff 1.0 A 5 rc 1.0\n'
+          + 'pair a b custom "eps*(1-r/rc)^2*exp(-r)" cutoff 1.2 eps 3 rc 1.2\n'
+          + 'pair b b custom "A*(1+cos(pi*r/rc))" cutoff 1.1 A 8 rc 1.1\n')
+    small = [[0.1, 0.2, 0.3], [1.2, 0.5, 0.1], [1.7, 1.2, 0.6], [0.9, 1.1, 0.2]]
+    top = particles_block(small, ["a", "b", "a", "b"]) + "[ bonds ]\ns 1 2\nt 2 3\n[ angles ]\nt 1 2 3\n"
+    n_chains, length, box = 12, 10, 6.0
+    pts = chains(rng, n_chains, length, 1.3, 0.7, box, bend_max=120)
+    types = ["a" if (k // length) % 3 else "b" for k in range(len(pts))]
+    rtop = f"[ box ]\nx 0 {box} p\ny 0 {box} p\nz 0 {box} p\n" + particles_block(pts, types)
+    rtop += "[ bonds ]\n" + "".join(f"{'s' if k % 2 else 't'} {c * length + k + 1} {c * length + k + 2}\n" for c in range(n_chains) for k in range(length - 1))
+    rtop += "[ angles ]\n" + "".join(f"{'t' if k % 2 else 's'} {c * length + k + 1} {c * length + k + 2} {c * length + k + 3}\n" for c in range(n_chains) for k in range(length - 2))
+    write("custom", {
+        "custom.ff": ff,
+        "small.top": top,
+        "random.top": rtop,
+        "small.in": deck("small.top", "custom.ff", "x -5 5 f y -5 5 f z -5 5 f", 1e-3),
+        "random.in": deck("random.top", "custom.ff", f"x 0 {box} p y 0 {box} p z 0 {box} p", 1e-3),
+    })
+
+
 if __name__ == "__main__":
     for name, ff in BOND_FF.items():
         bonded(name, ff, "bond")
@@ -370,3 +401,4 @@ if __name__ == "__main__":
     indenter()
     kinetics()
     per_bond_r0()
+    custom()

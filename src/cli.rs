@@ -83,6 +83,10 @@ enum Command {
         /// Accept output paths outside the output directory (absolute or with `..`).
         #[arg(long)]
         allow_outside: bool,
+        /// Also run the shared physics checks (F = −∇E, Σf = 0, rigid-motion
+        /// invariance) on every `custom` term of the deck.
+        #[arg(long)]
+        selftest: bool,
     },
     /// Write a LAMMPS data file and input script equivalent to the deck.
     ExportLammps {
@@ -236,7 +240,7 @@ where
                 }
             }
         }
-        Command::Check { deck, vars, allow_outside } => match validated(&deck, &vars, ValidateOptions { allow_outside }) {
+        Command::Check { deck, vars, allow_outside, selftest } => match validated(&deck, &vars, ValidateOptions { allow_outside }) {
             Ok(plan) => {
                 out!(
                     "{}: ok ({} particles, {} bonds, {} angles, {} actions)",
@@ -246,6 +250,22 @@ where
                     plan.model.angles.len(),
                     plan.actions.len()
                 );
+                if !selftest {
+                    return ExitCode::SUCCESS;
+                }
+                let externals: Vec<_> =
+                    plan.actions.iter().filter_map(|a| if let crate::deck::Action::External(e) = a { Some(e) } else { None }).collect();
+                let results = crate::system::check_custom_terms(&plan.model, &externals, &plan.positions, &plan.sim_box);
+                for result in &results {
+                    match result {
+                        Ok(line) => println!("selftest: {line}"),
+                        Err(e) => eprintln!("error: selftest: {e}"),
+                    }
+                }
+                if results.iter().any(Result::is_err) {
+                    return ExitCode::from(1);
+                }
+                println!("selftest: {} custom term(s) pass F = -grad E, sum f = 0 and rigid-motion checks", results.len());
                 ExitCode::SUCCESS
             }
             Err(e) => report(e),

@@ -801,9 +801,14 @@ impl Validator {
                 let units = self.units;
                 self.model(kw)?;
                 let group = self.group_named(&s[2])?.clone();
-                let (values, expressions) = self.external_expressions(&s[4..], &group)?;
-                let term = parse_params(&s[1], &s[3], &values, Kind::External, units)?;
-                let expressions = self.check_external_expressions(&term, &group, expressions)?;
+                let (term, expressions) = if s[3].text == "custom" {
+                    crate::forcefield::parse_custom_external(&s[1], &s[3], &s[4..], units)?
+                } else {
+                    let (values, expressions) = self.external_expressions(&s[4..], &group)?;
+                    let term = parse_params(&s[1], &s[3], &values, Kind::External, units)?;
+                    let expressions = self.check_external_expressions(&term, &group, expressions)?;
+                    (term, expressions)
+                };
                 let external = External { term, group: group.name.clone(), members: group.members.clone(), expressions };
                 self.externals.insert(s[1].text.clone());
                 // The working model holds the active externals for `coeff` and `ramp`.

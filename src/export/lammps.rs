@@ -403,7 +403,9 @@ impl Writer<'_> {
             }
         }
         if !self.angles.styles.is_empty() {
-            self.line(format!("angle_style hybrid {}", self.angles.styles.join(" ")));
+            // Like bonds, a lepton angle's energy is shifted to zero at θ0 unless told not to.
+            let list: Vec<&str> = self.angles.styles.iter().map(|&s| if s == "lepton" { "lepton no_offset" } else { s }).collect();
+            self.line(format!("angle_style hybrid {}", list.join(" ")));
             for (t, s) in self.angles.per_type.iter().enumerate() {
                 self.out += &format!("angle_coeff {} {} {}\n", t + 1, s.style, s.coeffs);
             }

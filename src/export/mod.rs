@@ -19,6 +19,7 @@ pub mod bond_types;
 pub mod formula;
 pub mod import_lammps;
 pub mod lammps;
+pub mod lepton;
 pub mod styles;
 
 pub use self::lammps::{export, ExportOptions, LammpsDeck};

@@ -17,6 +17,7 @@
 //! | `constant_force` | `fix addforce` | identical; its scalar is −F·x on unwrapped x |
 //! | `indenter` (K/3)(R−r)³ | `fix indent … sphere` | identical (K, centre, R) |
 //! | `field` | `fix addforce v_fx v_fy v_fz energy v_e` | one atom-style variable per parameter ([`super::formula`]) |
+//! | `custom` bond, angle, pair | `bond_style lepton` (r0 = 0), `angle_style lepton` (θ0 = 0), `pair_style lepton` | the expression, parameters as numbers ([`super::lepton`]); r0 = 0 and θ0 = 0 make Lepton's displacement variables the distance and the angle |
 
 use crate::forcefield::TermType;
 use crate::interactions::{param_index, Law};
@@ -24,6 +25,14 @@ use crate::interactions::{param_index, Law};
 /// Shortest text that reads back as exactly `x` (LAMMPS parses it with strtod).
 pub fn num(x: f64) -> String {
     format!("{x:?}")
+}
+
+/// A custom term's energy as a Lepton expression, its parameters as numbers.
+fn custom_expression(term: &TermType) -> Result<String, String> {
+    let expr = term.interaction.expression().ok_or_else(|| unsupported(term))?;
+    let names = term.interaction.params();
+    super::lepton::lepton(expr, &|n| names.iter().position(|p| p.name == n).map(|k| term.params[k]))
+        .map_err(|e| format!("{} `{}`: {e}", term.interaction.kind().with_article(), term.label.text))
 }
 
 fn param(term: &TermType, name: &str) -> f64 {
@@ -76,6 +85,7 @@ pub fn bond(term: &TermType) -> Result<Styled, String> {
             let (kt, kc) = (p("k_tension"), p("k_compression"));
             lepton(format!("0.5*({}*step(r)+{}*(1-step(r)))*r^2", num(kt), num(kc)), p("r0"))
         }
+        "custom" => lepton(custom_expression(term)?, 0.0),
         _ => return Err(unsupported(term)),
     })
 }
@@ -87,6 +97,8 @@ pub fn angle(term: &TermType) -> Result<Styled, String> {
         "harmonic_angle" => Styled { style: "harmonic", coeffs: format!("{} {}", num(0.5 * p("k")), num(p("theta0"))) },
         "cosine_angle" => Styled { style: "cosine", coeffs: num(p("K")) },
         "wlc_bending" => Styled { style: "cosine", coeffs: num(p("kappa") / p("l0")) },
+        // Lepton's angle variable is θ − θ0 in radians: θ0 = 0 makes it θ.
+        "custom" => Styled { style: "lepton", coeffs: format!("0.0 \"{}\"", custom_expression(term)?) },
         _ => return Err(unsupported(term)),
     })
 }
@@ -101,6 +113,7 @@ pub fn pair(term: &TermType) -> Result<PairStyled, String> {
         "wca" => ("lj/cut", format!("{} {} {}", num(p("epsilon")), num(p("sigma")), num(cutoff)), true),
         "soft_repulsion" => ("harmonic/cut", format!("{} {}", num(0.5 * p("k")), num(cutoff)), false),
         "soft" => ("soft", format!("{} {}", num(p("A")), num(cutoff)), false),
+        "custom" => ("lepton", format!("\"{}\" {}", custom_expression(term)?, num(cutoff)), false),
         _ => return Err(unsupported(term)),
     };
     Ok(PairStyled { style, coeffs, cutoff, shift })

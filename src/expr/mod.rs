@@ -35,9 +35,12 @@
 //! assert!(parse("sqrt(1, 2)").unwrap_err().message.contains("1 argument"));
 //! ```
 
+mod deriv;
 mod eval;
 mod functions;
 mod parse;
+pub mod tape;
+pub mod wgsl;
 
 pub use self::functions::{Function, FUNCTIONS};
 pub use self::parse::{parse, MAX_NESTING, MAX_OPERANDS};

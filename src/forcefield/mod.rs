@@ -34,9 +34,11 @@
 //! bond type during a run.
 
 mod bind;
+mod custom;
 mod params;
 mod parse;
 
 pub use self::bind::{parse_bind, BindLine, BindRule};
+pub use self::custom::{parse_custom, parse_custom_external};
 pub use self::params::{parse_kinetics, parse_params, parse_values, BondTypeKinetics, TermType};
 pub use self::parse::{check_pair_types, load_forcefield, BodyRule, ContactRule, ForceField, PairRule, ParticleType};

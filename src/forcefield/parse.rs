@@ -8,6 +8,7 @@ use crate::interactions::Kind;
 use crate::units::UnitSystem;
 
 use super::params::{parse_kinetics, parse_params, BondTypeKinetics, TermType};
+use super::parse_custom;
 
 /// A particle type: overdamped drag coefficient and radius.
 #[derive(Clone, Debug)]
@@ -140,6 +141,15 @@ fn particle(s: &Statement) -> Result<ParticleType, InputError> {
     Ok(ParticleType { name: name.clone(), drag, radius })
 }
 
+/// A term of a registered law, or a `custom` expression.
+fn term_type(label: &Token, law: &Token, tokens: &[Token], kind: Kind, units: UnitSystem) -> Result<TermType, InputError> {
+    if law.text == "custom" {
+        parse_custom(label, law, tokens, kind, units)
+    } else {
+        parse_params(label, law, tokens, kind, units)
+    }
+}
+
 /// Reads a force-field file (and its includes) into `ff`.
 ///
 /// `requested_by` is the deck token naming the file (for a missing-file error);
@@ -183,7 +193,7 @@ pub fn load_forcefield(
                 }
                 check_unique(&t[1], ff.bond_types.iter().map(|x| &x.label), "bond type")?;
                 let law_end = t.iter().position(|x| x.text == "kinetics").unwrap_or(t.len());
-                let law = parse_params(&t[1], &t[2], &t[3..law_end], Kind::Bond, units)?;
+                let law = term_type(&t[1], &t[2], &t[3..law_end], Kind::Bond, units)?;
                 ff.bond_kinetics.push(parse_kinetics(&law, &t[law_end..], units)?);
                 ff.bond_types.push(law);
             }
@@ -192,27 +202,27 @@ pub fn load_forcefield(
                     return Err(kw.error("expected `angle NAME INTERACTION [param value]...`"));
                 }
                 check_unique(&t[1], ff.angle_types.iter().map(|x| &x.label), "angle type")?;
-                ff.angle_types.push(parse_params(&t[1], &t[2], &t[3..], Kind::Angle, units)?);
+                ff.angle_types.push(term_type(&t[1], &t[2], &t[3..], Kind::Angle, units)?);
             }
             "pair" => {
                 if t.len() < 4 {
                     return Err(kw.error("expected `pair TYPE_A TYPE_B INTERACTION [param value]...`"));
                 }
-                let term = parse_params(&t[1], &t[3], &t[4..], Kind::Pair, units)?;
+                let term = term_type(&t[1], &t[3], &t[4..], Kind::Pair, units)?;
                 ff.pair_rules.push(PairRule { type_a: t[1].clone(), type_b: t[2].clone(), term });
             }
             "body" => {
                 if t.len() < 3 {
                     return Err(kw.error("expected `body TYPE INTERACTION [param value]...`"));
                 }
-                let term = parse_params(&t[1], &t[2], &t[3..], Kind::Body, units)?;
+                let term = term_type(&t[1], &t[2], &t[3..], Kind::Body, units)?;
                 ff.body_rules.push(BodyRule { body_type: t[1].clone(), term });
             }
             "contact" => {
                 if t.len() < 4 {
                     return Err(kw.error("expected `contact BODYTYPE_A BODYTYPE_B INTERACTION [param value]...`"));
                 }
-                let term = parse_params(&t[1], &t[3], &t[4..], Kind::Contact, units)?;
+                let term = term_type(&t[1], &t[3], &t[4..], Kind::Contact, units)?;
                 ff.contact_rules.push(ContactRule { type_a: t[1].clone(), type_b: t[2].clone(), term });
             }
             "bind" => ff.bind_lines.push(super::parse_bind(kw, &t[1..], units)?),

@@ -267,7 +267,7 @@ impl GpuBackend {
             layout: &args_layout,
             entries: &[wgpu::BindGroupEntry { binding: 0, resource: args.as_entire_binding() }],
         });
-        let program = shader::compose();
+        let program = shader::compose_with(&super::custom::source(model)?);
         let module = device
             .create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("cellmd"), source: wgpu::ShaderSource::Wgsl(program.into()) });
         let main_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {

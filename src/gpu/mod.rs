@@ -3,6 +3,7 @@
 //! - [`context`]: adapter choice (`device gpu|auto`), limits for ≥ 10⁶ particles.
 //! - [`shader`]: the program composed from `shaders/common/` and one
 //!   evaluator file per interaction type, validated by naga.
+//! - [`custom`]: evaluators generated from a model's `custom` expressions.
 //! - [`pack`]: the model flattened into the buffers the kernels read.
 //! - [`backend`]: buffers, pipelines and the GPU-resident step loop.
 //! - [`nlist`]: the neighbour list's buffer, bound in chunks of particles
@@ -35,6 +36,7 @@
 
 pub mod backend;
 pub mod context;
+pub mod custom;
 mod nlist;
 pub mod pack;
 pub mod shader;

@@ -1,7 +1,7 @@
 //! The model flattened into the GPU's buffers (layout: shaders/common/layout.wgsl).
 //!
 //! - `topo` (u32): particle types, then sections for each term's registry
-//!   index, the pair rules per type pair (CSR), each particle's bond ends
+//!   index (a custom term's: past the registry, [`super::custom::gpu_kinds`]), the pair rules per type pair (CSR), each particle's bond ends
 //!   `(other, term)`, its angle slots `(i, j, k, term, role)`, its external
 //!   terms, and its excluded partners (all CSR by particle, in the same order
 //!   as the CPU backend).
@@ -23,7 +23,7 @@ use bytemuck::{Pod, Zeroable};
 
 use crate::neighbor::Exclusions;
 use crate::system::BondState;
-use crate::system::{registry_index, Model, SimBox};
+use crate::system::{Model, SimBox};
 
 /// Parameter slots per term on the GPU.
 pub const PARAM_SLOTS: usize = 8;
@@ -141,13 +141,13 @@ pub fn pack(model: &Model, exclusions: &Exclusions, dt: f64, kt: f64, bonds: Opt
         Ok(())
     };
     for term in &terms {
-        push_params(&term.label.text, &term.params)?;
+        push_params(&term.label.text, super::custom::gpu_params(term))?;
     }
     let mut scales = vec![1.0f32; terms.len()];
     if let Some(state) = bonds {
         for &b in &kinetic {
             let t = model.bond_type[b] as usize;
-            let mut params = model.bond_types[t].params.clone();
+            let mut params = super::custom::gpu_params(&model.bond_types[t]).to_vec();
             if let Some(k) = model.bond_kinetics[t].rest_index {
                 params[k] = model.rest_length(b, Some(state));
             }
@@ -174,8 +174,9 @@ pub fn pack(model: &Model, exclusions: &Exclusions, dt: f64, kt: f64, bonds: Opt
     let mut topo: Vec<u32> = model.types.clone();
     let mut offsets = [0u32; 12];
     offsets[0] = topo.len() as u32;
-    topo.extend(terms.iter().map(|t| registry_index(t) as u32));
-    topo.extend(kinetic.iter().map(|&b| registry_index(&model.bond_types[model.bond_type[b] as usize]) as u32));
+    let kinds = super::custom::gpu_kinds(model);
+    topo.extend(&kinds);
+    topo.extend(kinetic.iter().map(|&b| kinds[model.bond_type[b] as usize]));
     // Pair rules per type pair.
     offsets[1] = topo.len() as u32;
     let pair_rows: Vec<Vec<u32>> =

@@ -18,6 +18,7 @@
 
 use std::fmt::Write;
 
+use super::custom::CustomSource;
 use crate::interactions::{Law, REGISTRY};
 
 mod embedded {
@@ -38,8 +39,8 @@ pub fn interaction_source(name: &str) -> Option<&'static str> {
     INTERACTION_SHADERS.iter().find(|(stem, _)| *stem == name).map(|(_, src)| *src)
 }
 
-/// The dispatch functions over the registry.
-fn dispatch() -> String {
+/// The dispatch functions over the registry (and a model's custom terms).
+fn dispatch(custom: &CustomSource) -> String {
     let mut radial = String::from("fn radial_law(kind: u32, p: array<f32, 8>, r: f32) -> Radial {\n    switch kind {\n");
     let mut three = String::from(
         "fn three_body_law(kind: u32, p: array<f32, 8>, ri: vec3<f32>, rj: vec3<f32>, rk: vec3<f32>) -> ThreeBody {\n    switch kind {\n",
@@ -55,14 +56,22 @@ fn dispatch() -> String {
         };
         writeln!(out, "        case {index}u: {{ return {call}; }}").unwrap();
     }
+    radial.push_str(&custom.radial_cases);
+    three.push_str(&custom.three_cases);
+    one.push_str(&custom.one_cases);
     radial.push_str("        default: { return RADIAL_ZERO; }\n    }\n}\n");
     three.push_str("        default: { return ThreeBody(0.0, vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0)); }\n    }\n}\n");
     one.push_str("        default: { return OneBody(0.0, vec3<f32>(0.0)); }\n    }\n}\n");
     radial + &three + &one
 }
 
-/// The whole program.
+/// The whole program for models without custom terms.
 pub fn compose() -> String {
+    compose_with(&CustomSource::default())
+}
+
+/// The whole program, with a model's generated custom evaluators.
+pub fn compose_with(custom: &CustomSource) -> String {
     let mut program = String::new();
     for name in &COMMON_ORDER[..2] {
         program.push_str(common(name));
@@ -72,7 +81,8 @@ pub fn compose() -> String {
             .unwrap_or_else(|| panic!("interaction `{}` has no shaders/interactions/{0}.wgsl", interaction.name()));
         program.push_str(source);
     }
-    program.push_str(&dispatch());
+    program.push_str(&custom.functions);
+    program.push_str(&dispatch(custom));
     for name in &COMMON_ORDER[2..] {
         program.push_str(common(name));
     }

@@ -72,6 +72,7 @@ macro_rules! radial_force {
     };
 }
 
+pub mod custom;
 mod entry;
 pub mod testing;
 
@@ -129,6 +130,7 @@ pub static REGISTRY: &[&dyn Interaction] = &[
     &helfrich_bending::HelfrichBending,
     &contact_barrier::ContactBarrier,
     &contact_adhesion::ContactAdhesion,
+    &custom::Custom,
 ];
 
 /// Looks an interaction type up by its registered name.
@@ -400,6 +402,11 @@ impl ParamSpec {
 pub trait Interaction: Entry {
     fn kind(&self) -> Kind;
     fn law(&self) -> Law;
+    /// The energy expression of a [`custom`] law (for translations to other
+    /// engines); `None` for the registered laws.
+    fn expression(&self) -> Option<&crate::expr::Expr> {
+        None
+    }
 }
 
 /// Index of a parameter in an interaction's schema.
