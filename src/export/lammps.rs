@@ -46,7 +46,8 @@ use std::fmt::Write;
 
 use super::bond_types::LammpsBondTypes;
 use super::formula;
-use super::styles::{self, num, PairStyled, Styled};
+use super::number::num;
+use super::styles::{self, PairStyled, Styled};
 use crate::deck::{Action, CoeffTarget, Plan};
 use crate::forcefield::TermType;
 use crate::integrate::Integrator;
@@ -604,7 +605,7 @@ impl Writer<'_> {
         for (k, spec) in external.term.interaction.params().iter().enumerate() {
             let formula = match external.expressions.iter().find(|(p, _)| *p == k) {
                 Some((_, expr)) => formula::lammps_formula(expr).map_err(|e| format!("external `{}`: {e}", external.term.label.text))?,
-                None => styles::num(external.term.params[k]),
+                None => num(external.term.params[k]),
             };
             let name = format!("{id}_{}", spec.name);
             self.line(format!("variable {name} atom \"{formula}\""));

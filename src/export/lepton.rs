@@ -18,7 +18,7 @@
 //!
 //! `round` has no Lepton equivalent and is an error that says so.
 
-use super::styles::num;
+use super::number::num;
 use crate::expr::{BinaryOp, Expr, UnaryOp};
 
 /// The Lepton text of `expr`; `value` gives the number of each parameter

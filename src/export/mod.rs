@@ -8,18 +8,13 @@
 //! rest lengths get one LAMMPS bond type per distinct (type, r0)
 //! ([`bond_types`]). [`import_lammps`] reads a LAMMPS data file (and script)
 //! back as a topology, force field and deck (`cellmd import-lammps`).
-//!
-//! One file-level circle remains: `formula.rs` ↔ `styles.rs` (formulas print
-//! numbers with the style table's `num`, whose documentation links the
-//! formula module for `field`). The name-keyed style table is to give way to
-//! one LAMMPS translation per interaction file (issue 14, item 4), which
-//! removes it.
 
 pub mod bond_types;
 pub mod formula;
 pub mod import_lammps;
 pub mod lammps;
 pub mod lepton;
+pub mod number;
 pub mod styles;
 
 pub use self::lammps::{export, ExportOptions, LammpsDeck};

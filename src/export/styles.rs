@@ -22,10 +22,7 @@
 use crate::forcefield::TermType;
 use crate::interactions::{param_index, Law};
 
-/// Shortest text that reads back as exactly `x` (LAMMPS parses it with strtod).
-pub fn num(x: f64) -> String {
-    format!("{x:?}")
-}
+use super::number::num;
 
 /// A custom term's energy as a Lepton expression, its parameters as numbers.
 fn custom_expression(term: &TermType) -> Result<String, String> {

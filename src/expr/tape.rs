@@ -6,7 +6,7 @@
 //! ending it with an `OUT k` instruction; [`run`] executes the words with a
 //! fixed-size stack on the machine stack. The words are plain numbers, so a
 //! tape can travel inside a parameter vector (custom interactions keep theirs
-//! behind their parameter values: [`crate::interactions`]' laws are plain
+//! behind their parameter values: the interaction laws are plain
 //! `fn` pointers that receive only that vector). An integer power `x^n`
 //! (|n| ≤ 16) becomes `powi`, as a hand-written law would multiply.
 //!

@@ -102,7 +102,7 @@ pub fn parse_custom(label: &Token, custom: &Token, tokens: &[Token], kind: Kind,
 }
 
 /// A deck's `external NAME GROUP custom "EXPR" ...`: the term, and the
-/// parameter expressions [`crate::system::External`] evaluates at each
+/// parameter expressions the system's `External` evaluates at each
 /// step (the time slot, `t`, when the expression reads it).
 pub fn parse_custom_external(
     label: &Token,

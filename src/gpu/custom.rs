@@ -5,7 +5,7 @@
 //! energy tree and the tree's symbolic derivatives by [`crate::expr::wgsl`]
 //! (parameters read from the term's slots `p[i]`, in f32 like every GPU
 //! law), and its own dispatch index past the registry's
-//! ([`gpu_kinds`]). The composed program ([`super::shader::compose_with`])
+//! ([`gpu_kinds`]). The composed program (`shader::compose_with`)
 //! holds them beside the registered evaluators; naga validates it.
 //!
 //! An external that reads `t` has an expression parameter (its time slot),

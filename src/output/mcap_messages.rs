@@ -162,7 +162,7 @@ impl From<&crate::kinetics_engine::Event> for BondEvent {
 }
 
 /// A message's JSON form: the object `encoding json` writes, described by
-/// the JSON Schemas of [`mcap_writer`](super::mcap_writer) — the protobuf
+/// the JSON Schemas of `mcap_writer` — the protobuf
 /// fields by name, with bonds, angles and triangles as nested arrays and
 /// non-finite numbers as `null`.
 pub trait JsonForm {
