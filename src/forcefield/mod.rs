@@ -34,5 +34,5 @@
 mod params;
 mod parse;
 
-pub use self::params::{parse_kinetics, parse_params, parse_values, BondTypeKinetics, TermType};
+pub use self::params::{check_param, param_position, param_value, parse_kinetics, parse_params, parse_values, BondTypeKinetics, TermType};
 pub use self::parse::{check_pair_types, load_forcefield, BodyRule, ContactRule, ForceField, PairRule, ParticleType};
