@@ -1,6 +1,7 @@
 //! Integrators and their random numbers.
 
 pub mod constraints;
+pub mod context;
 pub mod fire;
 pub mod implicit;
 pub mod overdamped;
