@@ -447,13 +447,10 @@ fn profile_gpu(plan: &crate::deck::Plan, repetitions: u32, rebuild_rate: Option<
     let sim = Simulation::before_first_run(plan, RunOptions::default()).map_err(|e| e.to_string())?;
     let context = GpuContext::open(false)?;
     let settings = StepSettings {
-        dt: sim.dt,
-        kt: sim.kt,
-        seed: sim.seed,
+        context: sim.step_context(),
         skin: sim.neighbor.skin,
         neighbor_every: sim.neighbor.every,
         neighbor_check: sim.neighbor.check,
-        integrator: *sim.integrator.common(),
     };
     let mut gpu = GpuBackend::new(&context, &sim.model, &sim.state, &sim.sim_box, &settings)?;
     let rate = match rebuild_rate {

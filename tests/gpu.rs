@@ -8,6 +8,7 @@ use cellmd::backend::{CpuBackend, Forces};
 use cellmd::deck::{Action, Plan};
 use cellmd::gpu::backend::StepSettings;
 use cellmd::gpu::{DevicePreference, GpuBackend, GpuContext};
+use cellmd::integrate::context::StepContext;
 use cellmd::integrate::overdamped::OverdampedSettings;
 use cellmd::integrate::Integrator;
 use cellmd::rng::Noise;
@@ -33,7 +34,7 @@ fn initial_state(plan: &Plan) -> State {
 }
 
 fn settings(skin: f64, dt: f64, kt: f64) -> StepSettings {
-    StepSettings { dt, kt, seed: 7, skin, neighbor_every: 1, neighbor_check: true, integrator: OverdampedSettings::default() }
+    StepSettings { context: StepContext { dt, kt, seed: 7, ..Default::default() }, skin, neighbor_every: 1, neighbor_check: true }
 }
 
 /// Every unexcluded pair closer than `range` (minimum image), by brute force.
@@ -477,7 +478,8 @@ fn thermal_statistics(device: DevicePreference, steps: u64, kt: f64, dt: f64, no
     let mut state = start.clone();
     match device {
         DevicePreference::Gpu => {
-            let settings = StepSettings { integrator, ..settings(0.5, dt, kt) };
+            let mut settings = settings(0.5, dt, kt);
+            settings.context.noise = integrator.noise;
             let mut gpu = GpuBackend::new(&context(), &plan.model, &state, &plan.sim_box, &settings).unwrap();
             assert_eq!(gpu.run(0, steps), Ok(steps));
             gpu.download(&mut state);

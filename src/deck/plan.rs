@@ -275,6 +275,13 @@ impl CoeffTarget {
             }
         }
     }
+
+    /// Sets parameter `param` of the term this target names in `model`: the
+    /// one application of a `coeff` edit or a ramp's value, in the deck's
+    /// checks and in the run.
+    pub fn set(&self, model: &mut Model, param: usize, value: f64) {
+        self.term_mut(model).params[param] = value;
+    }
 }
 
 /// A validated deck.

@@ -627,7 +627,7 @@ impl Writer<'_> {
     fn coeff(&mut self, target: &CoeffTarget, param: usize, value: f64) -> Result<(), String> {
         match target {
             CoeffTarget::BondType(k) => {
-                self.model.bond_types[*k].params[param] = value;
+                target.set(&mut self.model, param, value);
                 for l in self.bond_types.of_cellmd_type(*k).collect::<Vec<_>>() {
                     let s = styles::bond(&self.bond_types.term(&self.model, l))?;
                     self.line(format!("bond_coeff {} {} {}", l + 1, s.style, s.coeffs));
@@ -639,12 +639,12 @@ impl Writer<'_> {
                 }
             }
             CoeffTarget::AngleType(k) => {
-                self.model.angle_types[*k].params[param] = value;
+                target.set(&mut self.model, param, value);
                 let s = styles::angle(&self.model.angle_types[*k])?;
                 self.line(format!("angle_coeff {} {} {}", k + 1, s.style, s.coeffs));
             }
             CoeffTarget::PairRule(k) => {
-                self.model.pair_rules[*k].params[param] = value;
+                target.set(&mut self.model, param, value);
                 let term = self.model.pair_rules[*k].clone();
                 let line = self.pairs.coeff_line(&self.model, *k, &term)?;
                 self.line(line);

@@ -68,20 +68,14 @@ pub fn parse_values(
     let mut values: Vec<Option<f64>> = vec![None; specs.len()];
     for pair in tokens.chunks(2) {
         let name = &pair[0];
-        let index = specs.iter().position(|s| s.name == name.text).ok_or_else(|| {
-            let names: Vec<&str> = specs.iter().map(|s| s.name).collect();
-            name.error(format!("found parameter `{}`, expected one of `{owner}`'s parameters: {}", name.text, names.join(", ")))
-        })?;
+        let index = param_position(specs, owner, name)?;
         let Some(value_token) = pair.get(1) else {
             return Err(name.error(format!("parameter `{}` has no value; expected `{} VALUE`", name.text, name.text)));
         };
         if values[index].is_some() {
             return Err(name.error(format!("parameter `{}` is given twice; expected it once", name.text)));
         }
-        let spec = &specs[index];
-        let value = parse_f64(value_token, &format!("a value for `{}` in {}", spec.name, units.label(spec.dim)))?;
-        spec.check(value).map_err(|e| value_token.error(format!("expected {e}")))?;
-        values[index] = Some(value);
+        values[index] = Some(param_value(&specs[index], value_token, units)?);
     }
     specs
         .iter()
@@ -98,6 +92,28 @@ pub fn parse_values(
             })
         })
         .collect()
+}
+
+/// The index of the parameter `name` in a schema; `owner` names the
+/// interaction or rule in the message.
+pub fn param_position(specs: &[ParamSpec], owner: &str, name: &Token) -> Result<usize, InputError> {
+    specs.iter().position(|s| s.name == name.text).ok_or_else(|| {
+        let names: Vec<&str> = specs.iter().map(|s| s.name).collect();
+        name.error(format!("found parameter `{}`, expected one of `{owner}`'s parameters: {}", name.text, names.join(", ")))
+    })
+}
+
+/// A parameter's value: `token` as a number in the parameter's unit,
+/// within its schema's range.
+pub fn param_value(spec: &ParamSpec, token: &Token, units: UnitSystem) -> Result<f64, InputError> {
+    let value = parse_f64(token, &format!("a value for `{}` in {}", spec.name, units.label(spec.dim)))?;
+    check_param(spec, value, token)?;
+    Ok(value)
+}
+
+/// Checks `value` against its parameter's range (`at`: where it was given).
+pub fn check_param(spec: &ParamSpec, value: f64, at: &Token) -> Result<(), InputError> {
+    spec.check(value).map_err(|e| at.error(format!("expected {e}")))
 }
 
 /// Parses the `kinetics RULE name value ...` clauses that follow a bond

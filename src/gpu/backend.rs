@@ -20,7 +20,7 @@ use super::context::GpuContext;
 use super::nlist::NeighbourStorage;
 use super::pack::{cell_grid, pack, FixedPoint, Params};
 use super::shader;
-use crate::integrate::overdamped::OverdampedSettings;
+use crate::integrate::context::StepContext;
 use crate::neighbor::Exclusions;
 use crate::system::{Model, SimBox, State};
 
@@ -67,13 +67,12 @@ pub struct PhaseTimes {
 /// Settings the kernels need besides the model.
 #[derive(Clone, Copy, Debug)]
 pub struct StepSettings {
-    pub dt: f64,
-    pub kt: f64,
-    pub seed: u64,
+    /// The run's step context: dt, kT, seed, noise kind and displacement
+    /// bound (the steps are counted by [`GpuBackend::run`]'s caller).
+    pub context: StepContext,
     pub skin: f64,
     pub neighbor_every: u64,
     pub neighbor_check: bool,
-    pub integrator: OverdampedSettings,
 }
 
 struct Kernels {
@@ -200,16 +199,16 @@ impl GpuBackend {
             steps_wanted: 0,
             range2: (range * range) as f32,
             half_skin2: (0.25 * settings.skin * settings.skin) as f32,
-            max_disp2: (settings.integrator.max_displacement * settings.integrator.max_displacement) as f32,
+            max_disp2: (settings.context.max_displacement * settings.context.max_displacement) as f32,
             neighbor_every: settings.neighbor_every.max(1) as u32,
-            seed_lo: settings.seed as u32,
-            seed_hi: (settings.seed >> 32) as u32,
+            seed_lo: settings.context.seed as u32,
+            seed_hi: (settings.context.seed >> 32) as u32,
             step_lo: 0,
             step_hi: 0,
             neighbor_check: settings.neighbor_check as u32,
             scan_blocks,
             groups_x,
-            gaussian: (settings.integrator.noise == crate::rng::Noise::Gaussian) as u32,
+            gaussian: (settings.context.noise == crate::rng::Noise::Gaussian) as u32,
             topo_offsets: packed.topo_offsets,
             fparam_offsets: packed.fparam_offsets,
         };
@@ -750,5 +749,5 @@ fn initial_capacity(n: usize, sim_box: &SimBox, range: f64, has_pairs: bool) -> 
 fn pack_state(model: &Model, state: &State, settings: &StepSettings) -> Result<super::pack::Packed, String> {
     let bound = state.bonds.as_ref().map(|b| b.bound.as_slice());
     let exclusions = Exclusions::from_pairs(model.len(), &model.excluded_pairs(bound));
-    pack(model, &exclusions, settings.dt, settings.kt, state.bonds.as_ref())
+    pack(model, &exclusions, settings.context.dt, settings.context.kt, state.bonds.as_ref())
 }

@@ -17,6 +17,7 @@
 
 use glam::DVec3;
 
+use super::context::StepContext;
 use crate::system::{Model, SimBox, State};
 
 /// One constrained bond.
@@ -48,15 +49,16 @@ pub struct ConstraintFailure {
 
 impl Constraints {
     /// Projects `state` (just advanced from positions `before`) back onto the
-    /// constraint lengths; `dt` converts the corrections to tensions.
+    /// constraint lengths; the context's dt converts the corrections to tensions.
     pub fn project(
         &mut self,
         model: &Model,
         before: &[DVec3],
         state: &mut State,
         sim_box: &SimBox,
-        dt: f64,
+        ctx: &StepContext,
     ) -> Result<(), ConstraintFailure> {
+        let dt = ctx.dt;
         let images = sim_box.images();
         let mobility = |i: usize| {
             let gamma = model.type_drag[model.types[i] as usize];

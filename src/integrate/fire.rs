@@ -25,6 +25,7 @@
 
 use glam::DVec3;
 
+use super::context::StepContext;
 use super::overdamped::clamp_fraction;
 use crate::system::{SimBox, State};
 
@@ -62,7 +63,7 @@ pub fn fire_minimize<E>(
     state: &mut State,
     sim_box: &SimBox,
     mass: &[f64],
-    dt0: f64,
+    ctx: &StepContext,
     settings: &FireSettings,
     mut evaluate: impl FnMut(&State, &mut Vec<DVec3>, &mut Vec<f64>) -> Result<f64, E>,
 ) -> Result<FireReport, E> {
@@ -75,6 +76,7 @@ pub fn fire_minimize<E>(
     let mut v = vec![DVec3::ZERO; n];
     let mut f = Vec::with_capacity(n);
     let (mut limits, mut moves) = (Vec::new(), vec![DVec3::ZERO; n]);
+    let dt0 = ctx.dt;
     let (mut dt, dt_max, mut alpha, mut positive_steps) = (dt0, 10.0 * dt0, ALPHA0, 0u32);
     let (mut iterations, mut clamped) = (0, 0);
     loop {
@@ -127,6 +129,10 @@ pub fn fire_minimize<E>(
 mod tests {
     use super::*;
 
+    fn timestep(dt: f64) -> StepContext {
+        StepContext { dt, ..Default::default() }
+    }
+
     #[test]
     fn converges_a_stiff_anisotropic_quadratic() {
         let sim_box = SimBox::new(DVec3::splat(-10.0), DVec3::splat(10.0), [false; 3]);
@@ -136,7 +142,7 @@ mod tests {
             &mut state,
             &sim_box,
             &[1e-3, 1e-3],
-            1e-3,
+            &timestep(1e-3),
             &FireSettings { ftol: 1e-8, ..Default::default() },
             |s, f, _| {
                 f.clear();
@@ -157,7 +163,7 @@ mod tests {
         let mut state = State::new(vec![DVec3::new(3.0, 0.0, 0.0)]);
         let mut lowest = f64::INFINITY;
         let settings = FireSettings { ftol: 1e-12, max_iterations: 60, dmax: 0.5 };
-        let report = fire_minimize::<()>(&mut state, &sim_box, &[1.0], 0.1, &settings, |s, f, limits| {
+        let report = fire_minimize::<()>(&mut state, &sim_box, &[1.0], &timestep(0.1), &settings, |s, f, limits| {
             lowest = lowest.min(s.positions[0].x);
             f.clear();
             f.push(DVec3::new(-1.0, 0.0, 0.0));
@@ -178,7 +184,7 @@ mod tests {
         let mut state = State::new(vec![DVec3::ZERO, DVec3::new(1.5, 0.2, 0.0)]);
         let (k, pull) = (4.0, DVec3::new(2.0, 0.0, 0.0));
         let settings = FireSettings { ftol: 1e-10, ..Default::default() };
-        let report = fire_minimize::<()>(&mut state, &sim_box, &[f64::INFINITY, 1e-2], 1e-2, &settings, |s, f, _| {
+        let report = fire_minimize::<()>(&mut state, &sim_box, &[f64::INFINITY, 1e-2], &timestep(1e-2), &settings, |s, f, _| {
             let d = s.positions[1] - s.positions[0];
             let spring = -k * (d.length() - 1.0) * d.normalize();
             f.clear();

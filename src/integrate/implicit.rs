@@ -43,6 +43,7 @@ use faer::sparse::{SparseColMat, Triplet};
 use faer::{dyn_stack::MemBuffer, dyn_stack::MemStack, Col, Mat, Par, Side};
 use glam::DVec3;
 
+use super::context::StepContext;
 use super::overdamped::{clamp_fraction, Blowup, OverdampedSettings};
 use super::system_matrix::SystemMatrix;
 use crate::backend::Stiffness;
@@ -91,7 +92,9 @@ pub enum ImplicitError {
     Solve(String),
 }
 
-/// Advances `state` by one implicit step. On an error `state` is unchanged.
+/// Moves `state` by one implicit step of the context's dt and kT; the
+/// caller ends the step ([`StepContext::advance`]). On an error `state` is
+/// unchanged.
 #[allow(clippy::too_many_arguments)]
 pub fn implicit_step(
     model: &Model,
@@ -99,14 +102,12 @@ pub fn implicit_step(
     forces: &[DVec3],
     stiffness: &Stiffness,
     sim_box: &SimBox,
-    dt: f64,
-    kt: f64,
-    seed: u64,
-    settings: &OverdampedSettings,
+    ctx: &StepContext,
     implicit: &ImplicitSettings,
     constrained: &mut ConstrainedBonds,
     limits: Option<&[f64]>,
 ) -> Result<SolveReport, ImplicitError> {
+    let StepContext { dt, kt, seed, noise, step, .. } = *ctx;
     let n = state.len();
     let dim = 3 * n;
     let gamma = |i: usize| model.type_drag[model.types[i] as usize];
@@ -118,7 +119,7 @@ pub fn implicit_step(
     for i in (0..n).filter(|&i| !fixed(i)) {
         let mut b = forces[i];
         if kt > 0.0 {
-            b += (2.0 * kt * gamma(i) / dt).sqrt() * DVec3::from_array(noise3(seed, state.step, i as u32, settings.noise));
+            b += (2.0 * kt * gamma(i) / dt).sqrt() * DVec3::from_array(noise3(seed, step, i as u32, noise));
         }
         for a in 0..3 {
             rhs[3 * i + a] = b[a];
@@ -156,7 +157,7 @@ pub fn implicit_step(
         }
     };
     let mut step: Vec<DVec3> = (0..n).map(|i| DVec3::new(guess[(3 * i, 0)], guess[(3 * i + 1, 0)], guess[(3 * i + 2, 0)])).collect();
-    if let Some(particle) = step.iter().position(|d| !d.is_finite() || d.length() > settings.max_displacement) {
+    if let Some(particle) = step.iter().position(|d| !d.is_finite() || d.length() > ctx.max_displacement) {
         return Err(ImplicitError::Blowup(Blowup { particle, displacement: step[particle].length() }));
     }
     let fraction = limits.map_or(1.0, |limits| clamp_fraction(&step, limits));
@@ -167,8 +168,6 @@ pub fn implicit_step(
         *x += *d;
         sim_box.wrap(x, image);
     }
-    state.step += 1;
-    state.time += fraction * dt;
     Ok(SolveReport { step_fraction: fraction, ..report })
 }
 

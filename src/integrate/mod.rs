@@ -3,6 +3,7 @@
 //! leaf module `rng`.
 
 pub mod constraints;
+pub mod context;
 pub mod fire;
 pub mod implicit;
 pub mod overdamped;

@@ -31,6 +31,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
+use super::context::StepContext;
 use crate::rng::{noise3, Noise};
 use crate::system::{Model, SimBox, State};
 
@@ -73,30 +74,27 @@ pub fn clamp_fraction(moves: &[DVec3], limits: &[f64]) -> f64 {
     limits.iter().zip(moves).map(|(limit, dx)| if dx.length() > *limit { limit / dx.length() } else { 1.0 }).fold(1.0, f64::min)
 }
 
-/// Advances `state` by one step of length `dt` at temperature `kt`, shortened
-/// to s·dt when a particle would move farther than its entry of `limits`
-/// (see the module docs). Returns s (1 for a full step).
+/// Moves `state` by one step of the context's dt and kT, shortened to s·dt
+/// when a particle would move farther than its entry of `limits` (see the
+/// module docs). Returns s (1 for a full step); the caller ends the step
+/// ([`StepContext::advance`]).
 ///
 /// `scratch` (the displacements) is reused between calls. On a blow-up
 /// `state` is unchanged. Two passes over the particles: the displacements
 /// with the refusal check, then the commit; with `limits`, one more before
 /// them for s, which draws the noise again rather than storing it (the
 /// stream is counter-based, so the draw is the same).
-#[allow(clippy::too_many_arguments)]
 pub fn overdamped_step(
     model: &Model,
     state: &mut State,
     forces: &[DVec3],
     sim_box: &SimBox,
-    dt: f64,
-    kt: f64,
-    seed: u64,
-    settings: &OverdampedSettings,
+    ctx: &StepContext,
     limits: Option<&[f64]>,
     scratch: &mut Vec<DVec3>,
 ) -> Result<f64, Blowup> {
-    let step = state.step;
-    let refused = |d: &DVec3| !d.is_finite() || d.length() > settings.max_displacement;
+    let StepContext { dt, kt, seed, noise, step, .. } = *ctx;
+    let refused = |d: &DVec3| !d.is_finite() || d.length() > ctx.max_displacement;
     // Drift a = dt·F/γ and noise b = √(2kT·dt/γ)·ξ of particle i; a `fixed`
     // particle never moves (and draws no noise).
     let drift_and_noise = |i: usize| {
@@ -104,11 +102,8 @@ pub fn overdamped_step(
         if gamma.is_infinite() {
             return (DVec3::ZERO, DVec3::ZERO);
         }
-        let noise = if kt > 0.0 {
-            (2.0 * kt * dt / gamma).sqrt() * DVec3::from_array(noise3(seed, step, i as u32, settings.noise))
-        } else {
-            DVec3::ZERO
-        };
+        let noise =
+            if kt > 0.0 { (2.0 * kt * dt / gamma).sqrt() * DVec3::from_array(noise3(seed, step, i as u32, noise)) } else { DVec3::ZERO };
         (forces[i] * (dt / gamma), noise)
     };
     // The minimum is exact, so s does not depend on the thread count.
@@ -148,8 +143,6 @@ pub fn overdamped_step(
             sim_box.wrap(x, image);
         },
     );
-    state.step += 1;
-    state.time += fraction * dt;
     Ok(fraction)
 }
 

@@ -104,23 +104,13 @@ impl Kinetics {
     /// step whose forces produced `tension` and `length`), which `clock`
     /// describes: rates act over its actual length and events are stamped
     /// with its start time.
-    #[allow(clippy::too_many_arguments)]
-    pub fn step(
-        &mut self,
-        model: &Model,
-        state: &mut State,
-        tension: &[f64],
-        length: &[f64],
-        clock: StepClock,
-        kt: f64,
-        seed: u64,
-    ) -> KineticsReport {
+    pub fn step(&mut self, model: &Model, state: &mut State, tension: &[f64], length: &[f64], clock: StepClock) -> KineticsReport {
         let step = clock.step;
         let mut report = KineticsReport::default();
         let Some(bonds) = state.bonds.as_mut() else { return report };
         self.warned.resize(model.bond_types.len(), false);
         let outcomes: Vec<Outcome> =
-            (0..bonds.len()).into_par_iter().map(|b| decide(model, bonds, b, tension[b], length[b], clock, kt, seed)).collect();
+            (0..bonds.len()).into_par_iter().map(|b| decide(model, bonds, b, tension[b], length[b], clock)).collect();
         for (b, o) in outcomes.iter().enumerate() {
             let t = model.bond_type[b] as usize;
             if o.rate_dt > COARSE_RATE_DT && !self.warned[t] {
@@ -215,9 +205,8 @@ impl Kinetics {
 }
 
 /// One bond's decision: a pure function of its state, force and random numbers.
-#[allow(clippy::too_many_arguments)]
-fn decide(model: &Model, bonds: &BondState, b: usize, force: f64, length: f64, clock: StepClock, kt: f64, seed: u64) -> Outcome {
-    let (step, dt) = (clock.step, clock.length);
+fn decide(model: &Model, bonds: &BondState, b: usize, force: f64, length: f64, clock: StepClock) -> Outcome {
+    let StepClock { step, length: dt, kt, seed, .. } = clock;
     let t = model.bond_type[b] as usize;
     let mut out = Outcome { event: None, rest: bonds.rest[b], scale: bonds.scale[b], age: bonds.age[b], rate_dt: 0.0 };
     let rules = &model.bond_kinetics[t].rules;

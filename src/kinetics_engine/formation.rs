@@ -88,8 +88,8 @@ impl Formation {
 
     /// The bindings decided at the step `clock` describes, over its actual
     /// length, from the positions of `state`.
-    pub fn decide(&mut self, model: &Model, state: &State, sim_box: &SimBox, clock: StepClock, seed: u64) -> Result<Vec<Binding>, String> {
-        let (step, dt) = (clock.step, clock.length);
+    pub fn decide(&mut self, model: &Model, state: &State, sim_box: &SimBox, clock: StepClock) -> Result<Vec<Binding>, String> {
+        let StepClock { step, length: dt, seed, .. } = clock;
         if model.bind_rules.is_empty() {
             return Ok(Vec::new());
         }

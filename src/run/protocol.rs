@@ -8,6 +8,7 @@
 use glam::DVec3;
 
 use crate::deck::{Protocol, Ramp};
+use crate::integrate::context::StepContext;
 use crate::interactions::{param_index, Law};
 use crate::system::{Model, SimBox, State};
 
@@ -113,13 +114,13 @@ impl Protocols {
     }
 
     /// Moves every driven indenter that has not reached its load by v·dt.
-    pub(super) fn advance_drives(&self, model: &mut Model, dt: f64) {
+    pub(super) fn advance_drives(&self, model: &mut Model, ctx: &StepContext) {
         for drive in self.drives.iter().filter(|d| !d.holding) {
             let Some(external) = model.externals.iter_mut().find(|e| e.term.label.text == drive.external) else { continue };
             let term = &mut external.term;
             for (a, name) in ["x", "y", "z"].into_iter().enumerate() {
                 let k = param_index(term.interaction, name).expect("the deck checked the indenter has a centre");
-                term.params[k] += drive.velocity[a] * dt;
+                term.params[k] += drive.velocity[a] * ctx.dt;
             }
         }
     }
@@ -145,7 +146,7 @@ impl Protocols {
         let (first, last) = self.span;
         let fraction = if last > first { (step - first) as f64 / (last - first) as f64 } else { 1.0 };
         for ramp in &self.ramps {
-            ramp.target.term_mut(model).params[ramp.param] = ramp.value(fraction);
+            ramp.target.set(model, ramp.param, ramp.value(fraction));
         }
         !self.ramps.is_empty()
     }
@@ -182,10 +183,10 @@ impl Protocols {
         }
     }
 
-    /// Puts the held particles on their prescription after a step of `dt`:
-    /// held axes back where they were, moved particles advanced by v·dt
-    /// (wrapped into the box, image counters kept).
-    pub(super) fn after_step(&self, state: &mut State, sim_box: &SimBox, dt: f64) {
+    /// Puts the held particles on their prescription after a step of the
+    /// context's dt: held axes back where they were, moved particles advanced
+    /// by v·dt (wrapped into the box, image counters kept).
+    pub(super) fn after_step(&self, state: &mut State, sim_box: &SimBox, ctx: &StepContext) {
         for (h, (x0, image0, _)) in self.held.iter().zip(&self.before) {
             let i = h.particle as usize;
             let (x, image) = (&mut state.positions[i], &mut state.images[i]);
@@ -194,7 +195,7 @@ impl Protocols {
                 image[a] = image0[a];
             }
             if h.velocity != DVec3::ZERO {
-                *x += h.velocity * dt;
+                *x += h.velocity * ctx.dt;
                 sim_box.wrap(x, image);
             }
         }

@@ -1,37 +1,47 @@
-//! The run loop: actions of a plan applied to a live system.
+//! A live simulation: the actions of a plan applied to a system.
+//!
+//! [`Simulation`] orchestrates; each responsibility has its own file:
+//! `step_loop` (the one loop of a `run` over a `Stepper`), `cpu_steps` and
+//! `gpu_steps` (the two steppers), `reference` (the CPU backend as the
+//! reference for forces, thermo and measurements), `outputs`, `restarts`
+//! (checkpoints, stops, blow-ups) and `stepping` (driving a run from outside
+//! a deck).
 
 use std::path::{Path, PathBuf};
 
 use glam::DVec3;
-use indicatif::{ProgressBar, ProgressStyle};
-use rayon::prelude::*;
 
-use super::blowup::{culprit, RunError};
+use super::blowup::RunError;
 use super::protocol::{reset_rest, Protocols};
 use super::stop::StopSignal;
-use super::thermo::{column_value, Thermo, ThermoInputs};
-use crate::backend::{CpuBackend, Forces};
-use crate::deck::{Action, CheckpointSpec, CoeffTarget, DumpSpec, NeighborSettings, Plan, Protocol, ThermoColumn};
-use crate::gpu::backend::StepSettings;
-use crate::gpu::{DevicePreference, GpuBackend, GpuContext, GpuHalt};
+use super::thermo::Thermo;
+use crate::backend::Forces;
+use crate::deck::{Action, CoeffTarget, NeighborSettings, Plan, Protocol};
+use crate::gpu::{DevicePreference, GpuContext};
 use crate::input::DeckInputs;
 use crate::integrate::constraints::{Constraint, Constraints};
-use crate::integrate::fire::{fire_minimize, FireReport, FireSettings};
-use crate::integrate::implicit::{implicit_step, ConstrainedBonds, ImplicitError, ImplicitSettings, SolveReport};
-use crate::integrate::overdamped::{overdamped_step, Blowup};
+use crate::integrate::fire::FireReport;
+use crate::integrate::implicit::SolveReport;
 use crate::integrate::Integrator;
-use crate::kinetics_engine::{initial_bond_state, Binding, Formation, Kinetics};
-use crate::output::restart::{read_state, write_state, Counters, RestartData, Resume};
-use crate::output::run_log::{model_parameters, LogHeader, Phase, PhaseTimes, RunLog};
-use crate::output::{open_writer_with, EventLog, FrameView, LifetimeTable, Measures, TopologyView, TrajectoryWriter, WallPlane};
-use crate::system::{Model, SimBox, State, StepClock};
+use crate::kinetics_engine::{initial_bond_state, Formation, Kinetics};
+use crate::output::{EventLog, LifetimeTable};
+use crate::output::open_writer_with;
+use crate::output::restart::{read_state, write_state, RestartData};
+use crate::output::run_log::{LogHeader, PhaseTimes, RunLog};
+use crate::system::{Model, SimBox, State};
 
+mod cpu_steps;
+mod gpu_steps;
+mod outputs;
+mod reference;
+mod restarts;
+mod step_loop;
 mod stepping;
 
+use self::outputs::ActiveDump;
+use self::reference::Reference;
+use self::restarts::{with_step, Checkpoints};
 pub use self::stepping::{ActiveRun, BondTable};
-
-/// The longest GPU segment between read-backs when no output is due.
-const GPU_SYNC_STEPS: u64 = 1000;
 
 /// How to run: where outputs go and how to report progress.
 #[derive(Clone, Debug)]
@@ -57,29 +67,6 @@ impl Default for RunOptions {
     }
 }
 
-/// Periodic checkpoints in force, the step of the last one and the files
-/// written with a `*` name (oldest first).
-struct Checkpoints {
-    spec: CheckpointSpec,
-    last_step: Option<u64>,
-    written: std::collections::VecDeque<PathBuf>,
-}
-
-/// `path` with a `*` in its file name replaced by the step (LAMMPS' `write_restart file.*`).
-fn with_step(path: &Path, step: u64) -> PathBuf {
-    match path.file_name().map(|n| n.to_string_lossy()) {
-        Some(name) if name.contains('*') => path.with_file_name(name.replace('*', &step.to_string())),
-        _ => path.to_path_buf(),
-    }
-}
-
-struct ActiveDump {
-    spec: DumpSpec,
-    path: PathBuf,
-    writer: Box<dyn TrajectoryWriter>,
-    last_step: Option<u64>,
-}
-
 /// A live simulation.
 pub struct Simulation {
     pub model: Model,
@@ -91,7 +78,8 @@ pub struct Simulation {
     pub seed: u64,
     pub integrator: Integrator,
     pub neighbor: NeighborSettings,
-    backend: Option<CpuBackend>,
+    /// The CPU backend (the reference for thermo and measurements).
+    cpu: Reference,
     forces_current: bool,
     /// Whether `forces` also holds the energies and virial of the current state.
     energies_current: bool,
@@ -168,7 +156,7 @@ impl Simulation {
             seed: 1,
             integrator: Integrator::default(),
             neighbor: NeighborSettings::default(),
-            backend: None,
+            cpu: Reference::default(),
             forces_current: false,
             energies_current: false,
             dumps: Vec::new(),
@@ -301,57 +289,6 @@ impl Simulation {
         Ok(self)
     }
 
-    /// Creates the run log when the options ask for one.
-    fn open_log(&mut self) -> Result<(), RunError> {
-        let Some(header) = &self.options.log else { return Ok(()) };
-        let path = self.output_path(Path::new(&format!("{}.log", self.deck_stem)));
-        let log = RunLog::create(&path, header, &self.inputs).map_err(|e| self.output_error(&path, e))?;
-        self.log = Some(log);
-        Ok(())
-    }
-
-    /// Logs the resolved settings and parameters a `run` starts with.
-    fn log_run(&mut self, steps: u64, device: &str) -> Result<(), RunError> {
-        let Some(log) = &mut self.log else { return Ok(()) };
-        let text = format!(
-            "\nrun {steps} from step {} on {device}: units {:?}, {} particles, box {:?} to {:?} periodic {:?}\n\
-             timestep {:e}, temperature (kT) {:e}, seed {}, integrator {:?}, neighbor {:?}\n{}",
-            self.state.step,
-            self.model.units,
-            self.model.len(),
-            self.sim_box.lo.to_array(),
-            self.sim_box.hi.to_array(),
-            self.sim_box.periodic,
-            self.dt,
-            self.kt,
-            self.seed,
-            self.integrator,
-            self.neighbor,
-            model_parameters(&self.model)
-        );
-        if let Err(e) = log.section(&text) {
-            let path = log.path.clone();
-            return Err(self.output_error(&path, e));
-        }
-        Ok(())
-    }
-
-    /// When a stop was requested: writes `NAME.restart` (with the deck and
-    /// where the run stands in it) and the lifetime table, and returns
-    /// [`RunError::Stopped`]; the caller's error path closes the outputs.
-    fn stop_if_requested(&mut self) -> Result<(), RunError> {
-        let Some(reason) = self.options.stop.requested() else { return Ok(()) };
-        let restart = self.output_path(Path::new(&format!("{}.restart", self.deck_stem)));
-        self.write_lifetimes()?;
-        write_state(&restart, &self.restart_data()).map_err(|e| self.output_error(&restart, e))?;
-        Err(RunError::Stopped { step: self.state.step, reason: reason.to_string(), restart: restart.display().to_string() })
-    }
-
-    /// An output that could not be written, with the step it happened at.
-    fn output_error(&self, path: &Path, e: impl std::fmt::Display) -> RunError {
-        RunError::Io(format!("{}: {e} (at step {})", path.display(), self.state.step))
-    }
-
     /// The simulation as the deck sets it up before its first `run`,
     /// `minimize` or `if` decided during the run: settings, externals, coefficient edits and restarts are
     /// applied; outputs are not opened. For tools that inspect or time the
@@ -364,20 +301,6 @@ impl Simulation {
             }
         }
         Ok(sim)
-    }
-
-    fn say(&self, message: &str) {
-        if self.options.echo {
-            self.options.stop.say(message);
-        }
-    }
-
-    fn output_path(&self, path: &Path) -> PathBuf {
-        if path.is_absolute() {
-            path.to_path_buf()
-        } else {
-            self.options.output_dir.join(path)
-        }
     }
 
     /// Applies one action (jumps only make sense within their plan: see
@@ -394,7 +317,7 @@ impl Simulation {
             Action::Integrator(settings) => self.integrator = *settings,
             Action::Neighbor(settings) => {
                 self.neighbor = *settings;
-                self.backend = None;
+                self.cpu.invalidate();
             }
             Action::Thermo { every, columns } => {
                 self.thermo.every = *every;
@@ -439,14 +362,14 @@ impl Simulation {
             Action::Displace { group, delta } => self.displace(&group.members, *delta)?,
             Action::Coeff { target, param, value } => {
                 if let CoeffTarget::PairRule(_) = target {
-                    self.backend = None; // the cutoff may change
+                    self.cpu.invalidate(); // the cutoff may change
                 }
-                target.term_mut(&mut self.model).params[*param] = *value;
+                target.set(&mut self.model, *param, *value);
                 self.forces_current = false;
             }
             Action::Protocol(Protocol::ResetRest(bond_types)) => {
                 reset_rest(&mut self.model, &mut self.state, &self.sim_box, bond_types);
-                self.backend = None; // bonds now carry state
+                self.cpu.invalidate(); // bonds now carry state
                 self.forces_current = false;
             }
             Action::Protocol(protocol) => self.protocols.apply(protocol),
@@ -495,782 +418,10 @@ impl Simulation {
             self.sim_box.wrap(&mut self.state.positions[i], &mut self.state.images[i]);
         }
         self.check_in_box()?;
-        if let Some(backend) = self.backend.as_mut() {
+        if let Some(backend) = self.cpu.built_mut() {
             backend.update_neighbors(&self.state, &self.sim_box, true).map_err(RunError::Setup)?;
         }
         self.forces_current = false;
         Ok(())
     }
-
-    fn topology_view(&self) -> TopologyView<'_> {
-        TopologyView {
-            units: self.model.units,
-            ids: &self.model.ids,
-            types: &self.model.types,
-            type_names: &self.model.type_names,
-            type_radius: &self.model.type_radius,
-            bonds: &self.model.bonds,
-            angles: &self.model.angles,
-            triangles: &self.model.triangles,
-            bond_types: &self.model.bond_type,
-            bond_type_names: &self.bond_type_names,
-        }
-    }
-
-    /// The restart of the current state: with the counters, the deck and
-    /// where the run stands in it.
-    fn restart_data(&self) -> RestartData {
-        let mut data = RestartData::from_state(self.model.units, &self.state, &self.sim_box, &self.model.ids);
-        data.counters = Counters {
-            breaks: self.kinetics.breaks,
-            rebinds: self.kinetics.rebinds,
-            forms: self.kinetics.forms,
-            resets: self.kinetics.resets,
-            contact_clamps: self.contact_clamps,
-        };
-        data.resume = Some(Resume { inputs: self.inputs.clone(), action: self.action, run_end: self.run_end });
-        data
-    }
-
-    /// A periodic checkpoint when one is due at this step.
-    fn checkpoint(&mut self) -> Result<(), RunError> {
-        let step = self.state.step;
-        let Some(due) = self.checkpoints.as_ref().filter(|c| step.is_multiple_of(c.spec.every) && c.last_step != Some(step)) else {
-            return Ok(());
-        };
-        let path = self.output_path(&with_step(&due.spec.path, step));
-        write_state(&path, &self.restart_data()).map_err(|e| self.output_error(&path, e))?;
-        let checkpoints = self.checkpoints.as_mut().expect("due above");
-        checkpoints.last_step = Some(step);
-        let mut stale = Vec::new();
-        if let Some(keep) = checkpoints.spec.keep {
-            checkpoints.written.push_back(path);
-            while checkpoints.written.len() > keep {
-                stale.extend(checkpoints.written.pop_front());
-            }
-        }
-        for old in stale {
-            std::fs::remove_file(&old).map_err(|e| self.output_error(&old, e))?;
-        }
-        Ok(())
-    }
-
-    fn load_restart(&mut self, data: RestartData, path: &Path) -> Result<(), RunError> {
-        data.check_ids(&self.model.ids).map_err(|e| RunError::Setup(format!("{}: {e}", path.display())))?;
-        if data.units != self.model.units {
-            return Err(RunError::Setup(format!(
-                "{}: the restart was written in {:?} units, the deck uses {:?}",
-                path.display(),
-                data.units,
-                self.model.units
-            )));
-        }
-        let counters = data.counters;
-        self.kinetics.breaks = counters.breaks;
-        self.kinetics.rebinds = counters.rebinds;
-        self.kinetics.forms = counters.forms;
-        self.kinetics.resets = counters.resets;
-        self.contact_clamps = counters.contact_clamps;
-        self.sim_box = data.sim_box;
-        if self.formation.is_some() {
-            self.formation = Some(Formation::new(&self.model, &self.sim_box));
-        }
-        self.state = data.to_state();
-        match &self.state.bonds {
-            Some(bonds) => self.model.set_formed_bonds(&bonds.formed),
-            None => self.state.bonds = initial_bond_state(&self.model),
-        }
-        self.backend = None;
-        self.forces_current = false;
-        self.check_in_box()
-    }
-
-    /// Stops the run, as a blow-up (step, particle id, last good frame), if a
-    /// particle left a fixed box or cannot be wrapped into a periodic one:
-    /// LAMMPS' "Lost atoms". Checked after every CPU step and at every GPU
-    /// read-back.
-    fn check_in_box(&mut self) -> Result<(), RunError> {
-        let sim_box = self.sim_box;
-        let lost = self.state.positions.par_iter().with_min_len(4096).position_first(|&x| sim_box.misplaced_axis(x).is_some());
-        match lost {
-            Some(i) => {
-                let x = self.state.positions[i];
-                let axis = sim_box.misplaced_axis(x).expect("found above");
-                Err(self.blowup(i, format!("lost: {} (LAMMPS: lost atoms)", sim_box.misplacement(x, axis))))
-            }
-            None => Ok(()),
-        }
-    }
-
-    /// The smallest node–face distance between different bodies at the last
-    /// force evaluation (∞ without `contact` lines or before the first one).
-    pub fn min_contact_distance(&self) -> f64 {
-        self.backend.as_ref().map_or(f64::INFINITY, |b| b.min_contact_distance())
-    }
-
-    /// Forces, energies by interaction and virial at the current state
-    /// (computed now if stale).
-    pub fn current_forces(&mut self) -> Result<&Forces, RunError> {
-        self.ensure_forces()?;
-        Ok(&self.forces)
-    }
-
-    /// What thermo columns read, at the current state (backend built).
-    fn thermo_inputs(&self) -> ThermoInputs<'_> {
-        let (bond_tension, _) = self.backend.as_ref().expect("backend built").bond_tension_and_length();
-        ThermoInputs {
-            model: &self.model,
-            bonds: self.state.bonds.as_ref(),
-            bond_tension,
-            kinetics: &self.kinetics,
-            step: self.state.step,
-            time: self.state.time,
-            forces: &self.forces,
-            n_particles: self.model.len(),
-            kt: self.kt,
-            volume: self.sim_box.volume(),
-            neighbor_builds: self.backend.as_ref().map_or(0, |b| b.neighbor_builds()),
-            solve: self.last_solve,
-            constraints: &self.constraints,
-            positions: &self.state.positions,
-            images: self.sim_box.images(),
-            backend: self.backend.as_ref().expect("backend built"),
-            state: &self.state,
-            sim_box: &self.sim_box,
-            min_contact_distance: self.min_contact_distance(),
-            contact_clamps: self.contact_clamps,
-        }
-    }
-
-    /// The value of a thermo column at the current state (forces, energies
-    /// and virial computed now if stale), as a thermo row would print it.
-    pub fn thermo_value(&mut self, column: &ThermoColumn) -> Result<f64, RunError> {
-        self.ensure_forces()?;
-        Ok(column_value(column, &self.thermo_inputs()))
-    }
-
-    /// The per-particle virial W_i at the current state (see [`crate::measure::stress`]).
-    pub fn particle_virial(&mut self) -> Result<Vec<[f64; 6]>, RunError> {
-        self.ensure_forces()?;
-        Ok(crate::measure::per_particle_virial(self.backend.as_ref().expect("backend built"), &self.model, &self.state, &self.sim_box))
-    }
-
-    /// Tension (dE/dr, positive when stretched) and length of every bond at the current state.
-    pub fn bond_tensions(&mut self) -> Result<(Vec<f64>, Vec<f64>), RunError> {
-        self.ensure_forces()?;
-        Ok(self.backend.as_ref().expect("backend built").bond_tensions_at(&self.model, &self.state, &self.sim_box))
-    }
-
-    /// Ensures a backend with a fresh neighbour list and forces at the current state.
-    fn ensure_forces(&mut self) -> Result<(), RunError> {
-        if self.backend.is_none() {
-            let backend = CpuBackend::new(&self.model, &self.state, &self.sim_box, self.neighbor.skin).map_err(RunError::Setup)?;
-            self.backend = Some(backend);
-            self.forces_current = false;
-        }
-        if !self.forces_current || !self.energies_current {
-            self.compute_forces(true)?;
-        }
-        Ok(())
-    }
-
-    /// Forces at the current state, with energies and virial if `energies`.
-    fn compute_forces(&mut self, energies: bool) -> Result<(), RunError> {
-        let backend = self.backend.as_mut().expect("backend built");
-        backend.update_contacts(&self.model, &self.state, &self.sim_box).map_err(RunError::Setup)?;
-        if energies {
-            backend.compute(&self.model, &self.state, &self.sim_box, &mut self.forces);
-        } else {
-            backend.compute_forces(&self.model, &self.state, &self.sim_box, &mut self.forces);
-        }
-        self.forces_current = true;
-        self.energies_current = energies;
-        if let Some(i) = self.forces.forces.par_iter().with_min_len(4096).position_first(|f| !finite_force(*f)) {
-            return Err(self.blowup(i, "non-finite force".into()));
-        }
-        Ok(())
-    }
-
-    /// Builds the blow-up report and writes the last good frame.
-    fn blowup(&mut self, particle: usize, what: String) -> RunError {
-        let parts = match &self.backend {
-            Some(b) => b.breakdown(&self.model, &self.state, &self.sim_box, particle),
-            None => Vec::new(),
-        };
-        let mut last_good = Vec::new();
-        let step = self.state.step;
-        for i in 0..self.dumps.len() {
-            if self.dumps[i].last_step != Some(step) && self.write_dump(i).is_ok() {
-                last_good.push(self.dumps[i].path.display().to_string());
-            }
-        }
-        let restart = self.output_path(Path::new(&format!("{}.lastgood.restart", self.deck_stem)));
-        if write_state(&restart, &self.restart_data()).is_ok() {
-            last_good.push(restart.display().to_string());
-        }
-        RunError::Blowup { step, particle_id: self.model.ids[particle], what, culprit: culprit(parts), last_good }
-    }
-
-    fn write_dump(&mut self, i: usize) -> Result<(), RunError> {
-        let needs = self.dumps[i].writer.needs();
-        let (mut virial, mut tension, mut length) = (Vec::new(), Vec::new(), Vec::new());
-        if needs.any() {
-            // Measurements read the CPU backend's terms at these positions.
-            if self.backend.is_none() {
-                self.ensure_forces()?;
-            } else if !self.forces_current {
-                self.refresh_cpu_forces(false)?;
-            }
-            let backend = self.backend.as_ref().expect("backend built");
-            if needs.virial {
-                virial = crate::measure::per_particle_virial(backend, &self.model, &self.state, &self.sim_box);
-            }
-            if needs.bonds {
-                (tension, length) = backend.bond_tensions_at(&self.model, &self.state, &self.sim_box);
-            }
-        }
-        let forces: &[DVec3] = if needs.forces { &self.forces.forces } else { &[] };
-        let walls: Vec<WallPlane> = (self.model.externals.iter())
-            .filter(|e| e.term.interaction.name() == "wall")
-            .filter_map(|e| crate::interactions::wall_plane(&e.term.params))
-            .map(|(normal, offset)| WallPlane { normal, offset })
-            .collect();
-        let frame = FrameView {
-            step: self.state.step,
-            time: self.state.time,
-            sim_box: &self.sim_box,
-            positions: &self.state.positions,
-            images: &self.state.images,
-            measures: Measures { forces, virial: &virial, bond_tension: &tension, bond_length: &length },
-            bound: self.state.bonds.as_ref().map_or(&[], |b| &b.bound),
-            walls: &walls,
-        };
-        if let Err(e) = self.dumps[i].writer.write_frame(&frame) {
-            return Err(self.output_error(&self.dumps[i].path, e));
-        }
-        self.dumps[i].last_step = Some(self.state.step);
-        Ok(())
-    }
-
-    fn outputs_at_step(&mut self, bar: &Option<ProgressBar>, force_thermo: bool) -> Result<(), RunError> {
-        let step = self.state.step;
-        for i in 0..self.dumps.len() {
-            if step.is_multiple_of(self.dumps[i].spec.every) && self.dumps[i].last_step != Some(step) {
-                self.write_dump(i)?;
-            }
-        }
-        let due = self.thermo.every > 0 && step.is_multiple_of(self.thermo.every);
-        if due || force_thermo {
-            let values = self.thermo.values(&self.thermo_inputs());
-            let line = self.thermo.row(&values).map_err(|(path, e)| self.output_error(&path, e))?;
-            match bar {
-                Some(bar) => bar.println(line),
-                None => self.say(&line),
-            }
-        }
-        self.checkpoint()
-    }
-
-    /// The lifetime table, rewritten after every `run` (and when stopped).
-    fn write_lifetimes(&self) -> Result<(), RunError> {
-        match &self.lifetime_file {
-            Some(path) => self.lifetimes.write(path, &self.model, self.state.bonds.as_ref()).map_err(|e| self.output_error(path, e)),
-            None => Ok(()),
-        }
-    }
-
-    /// `run N`: N overdamped steps, on the CPU backend or the GPU.
-    pub fn run(&mut self, steps: u64) -> Result<(), RunError> {
-        let run = self.begin_run(steps)?;
-        self.advance(&run, run.last)?;
-        self.end_run(run)
-    }
-
-    /// The start of a `run N`: checks, forces, the backend, the thermo
-    /// header and the outputs of the first step.
-    pub fn begin_run(&mut self, steps: u64) -> Result<ActiveRun, RunError> {
-        self.check_kinetics_temperature()?;
-        self.protocols.begin_run(self.state.step, self.state.step + steps);
-        if self.protocols.set_ramps(&mut self.model, self.state.step) {
-            self.forces_current = false;
-        }
-        self.ensure_forces()?;
-        self.protocols.check_drives(&self.model, &self.state, &self.sim_box);
-        let gpu = self.gpu_for_run()?;
-        let bar = (self.options.progress && steps >= 1000).then(|| {
-            let bar = ProgressBar::new(steps);
-            bar.set_style(ProgressStyle::with_template("{bar:40} {pos}/{len} steps  {per_sec}  ETA {eta}").expect("valid template"));
-            bar
-        });
-        let header = self.thermo.header();
-        match &bar {
-            Some(b) => b.println(header),
-            None => self.say(&header),
-        }
-        let last = self.state.step + steps;
-        self.run_end = Some(last);
-        self.log_run(steps, if gpu.is_some() { "the GPU" } else { "the CPU" })?;
-        self.outputs_at_step(&bar, true)?;
-        Ok(ActiveRun { steps, last, gpu, bar, started: std::time::Instant::now() })
-    }
-
-    /// Steps of `run` up to step `until` (at most the run's last): on the
-    /// CPU the same steps, bit for bit, however the run is cut into
-    /// segments; forces are recomputed first if the system changed since.
-    pub fn advance(&mut self, run: &ActiveRun, until: u64) -> Result<(), RunError> {
-        let until = until.min(run.last);
-        if self.backend.is_none() || !self.forces_current {
-            self.ensure_forces()?;
-        }
-        let started = std::time::Instant::now();
-        let looped = match &run.gpu {
-            Some(context) => self.run_gpu(context, until, run.last, &run.bar),
-            None => self.run_cpu(until, run.last, &run.bar),
-        };
-        self.times.total += started.elapsed();
-        looped
-    }
-
-    /// The end of a run: writes the lifetime table and reports the loop time.
-    pub fn end_run(&mut self, run: ActiveRun) -> Result<(), RunError> {
-        if let Some(b) = run.bar {
-            b.finish_and_clear();
-        }
-        self.run_end = None;
-        self.protocols.end_run();
-        self.write_lifetimes()?;
-        let seconds = run.started.elapsed().as_secs_f64();
-        self.say(&format!(
-            "loop time {seconds:.6} s for {} steps with {} particles: {:.6e} particle-steps/s",
-            run.steps,
-            self.model.len(),
-            (run.steps as f64 * self.model.len() as f64) / seconds
-        ));
-        Ok(())
-    }
-
-    /// CPU steps up to `until` of a run that ends at `last`.
-    fn run_cpu(&mut self, until: u64, last: u64, bar: &Option<ProgressBar>) -> Result<(), RunError> {
-        let mut before = Vec::new();
-        while self.state.step < until {
-            self.stop_if_requested()?;
-            let mut clock = self.times.clock();
-            let (step, start) = (self.state.step, self.state.time);
-            if !self.constraints.list.is_empty() {
-                before.clone_from(&self.state.positions);
-            }
-            self.protocols.before_step(&mut self.forces.forces, &self.state);
-            let moved = match self.integrator {
-                Integrator::Implicit(_, implicit) => self.implicit_step(&implicit)?,
-                Integrator::Overdamped(_) => {
-                    let n = self.model.len();
-                    let limited = self.backend.as_ref().is_some_and(|b| b.contact_step_limits(n, &mut self.step_limits));
-                    overdamped_step(
-                        &self.model,
-                        &mut self.state,
-                        &self.forces.forces,
-                        &self.sim_box,
-                        self.dt,
-                        self.kt,
-                        self.seed,
-                        self.integrator.common(),
-                        limited.then_some(self.step_limits.as_slice()),
-                        &mut self.scratch,
-                    )
-                    .inspect(|&fraction| self.contact_clamps += u64::from(fraction < 1.0))
-                }
-            };
-            self.protocols.restore_forces(&mut self.forces.forces);
-            let fraction = match moved {
-                Ok(fraction) => fraction,
-                Err(Blowup { particle, displacement }) => return Err(self.blowup(particle, self.displacement_message(displacement))),
-            };
-            if !self.constraints.list.is_empty() {
-                let projected = self.constraints.project(&self.model, &before, &mut self.state, &self.sim_box, self.dt);
-                if self.implicit_tension.len() == self.constraints.tension.len() {
-                    self.constraints.tension.iter_mut().zip(&self.implicit_tension).for_each(|(t, extra)| *t += extra);
-                }
-                if let Err(failure) = projected {
-                    let [i, j] = self.model.bonds[failure.bond];
-                    return Err(RunError::Setup(format!(
-                        "constraint of bond {}-{} not met after {} sweeps at step {}: |r − r0|/r0 = {:e} > tolerance {:e}",
-                        self.model.ids[i as usize],
-                        self.model.ids[j as usize],
-                        self.constraints.max_iterations,
-                        self.state.step,
-                        failure.relative_error,
-                        self.constraints.tolerance
-                    )));
-                }
-            }
-            self.protocols.after_step(&mut self.state, &self.sim_box, self.dt);
-            clock.lap(&mut self.times, Phase::Integrate);
-            self.check_in_box()?;
-            if self.model.has_kinetics() {
-                self.kinetics_step(StepClock { step, start, length: fraction * self.dt })?;
-                clock.lap(&mut self.times, Phase::Kinetics);
-            }
-            self.protocols.advance_drives(&mut self.model, self.dt);
-            self.protocols.set_ramps(&mut self.model, self.state.step);
-            let final_step = self.state.step == last;
-            let thermo_due = self.thermo.every > 0 && self.state.step.is_multiple_of(self.thermo.every);
-            match self.backend.as_mut() {
-                Some(backend) => {
-                    if self.state.step.is_multiple_of(self.neighbor.every) {
-                        backend.update_neighbors(&self.state, &self.sim_box, self.neighbor.check).map_err(RunError::Setup)?;
-                        clock.lap(&mut self.times, Phase::Neighbor);
-                    }
-                    self.compute_forces(thermo_due || final_step)?;
-                }
-                // Bonds formed: the backend is rebuilt for the new bond list.
-                None => self.ensure_forces()?,
-            }
-            self.protocols.check_drives(&self.model, &self.state, &self.sim_box);
-            clock.lap(&mut self.times, Phase::Force);
-            self.outputs_at_step(bar, final_step && !thermo_due)?;
-            clock.lap(&mut self.times, Phase::Output);
-            if let Some(b) = bar {
-                b.inc(1);
-            }
-        }
-        Ok(())
-    }
-
-    /// One linearly implicit step from the current forces; a failed solve
-    /// stops the run, a refused displacement is returned like the explicit one.
-    /// One implicit step; returns the fraction of dt it took (below 1 where
-    /// the contact clamp shortened it).
-    fn implicit_step(&mut self, implicit: &ImplicitSettings) -> Result<Result<f64, Blowup>, RunError> {
-        let backend = self.backend.as_ref().expect("backend built");
-        let stiffness = backend.stiffness(&self.model, &self.state, &self.sim_box);
-        let limited = backend.contact_step_limits(self.model.len(), &mut self.step_limits);
-        let (model, forces, sim_box) = (&self.model, &self.forces.forces, &self.sim_box);
-        let mut constrained =
-            ConstrainedBonds { pairs: self.constraints.list.iter().map(|c| model.bonds[c.bond]).collect(), tension: Vec::new() };
-        let outcome = implicit_step(
-            model,
-            &mut self.state,
-            forces,
-            &stiffness,
-            sim_box,
-            self.dt,
-            self.kt,
-            self.seed,
-            self.integrator.common(),
-            implicit,
-            &mut constrained,
-            limited.then_some(self.step_limits.as_slice()),
-        );
-        self.implicit_tension = constrained.tension;
-        match outcome {
-            Ok(report) => {
-                let fraction = report.step_fraction;
-                self.contact_clamps += u64::from(fraction < 1.0);
-                self.last_solve = report;
-                Ok(Ok(fraction))
-            }
-            Err(ImplicitError::Blowup(blowup)) => Ok(Err(blowup)),
-            Err(ImplicitError::Solve(why)) => Err(RunError::Setup(format!("integrator implicit at step {}: {why}", self.state.step))),
-        }
-    }
-
-    fn displacement_message(&self, displacement: f64) -> String {
-        format!("displacement {displacement:e} in one step exceeds max_displacement {:e}", self.integrator.common().max_displacement)
-    }
-
-    /// Why the next `run` cannot use the GPU backend: the first feature in
-    /// use that only the CPU backend has (None when the GPU can run it).
-    pub fn cpu_only_feature(&self) -> Option<&'static str> {
-        if let Some(why) = self.protocols.cpu_only() {
-            Some(why)
-        } else if matches!(self.integrator, Integrator::Implicit(..)) {
-            Some("`integrator implicit` runs on the CPU backend only")
-        } else if !self.constraints.list.is_empty() {
-            Some("constrained bonds (`constrain`) run on the CPU backend only")
-        } else if self.model.has_surface_terms() {
-            Some("surface terms of bodies (`body` lines) run on the CPU backend only")
-        } else if self.model.has_contact_terms() {
-            Some("contact terms between bodies (`contact` lines) run on the CPU backend only")
-        } else if self.model.special_bonds.is_fractional() && !self.model.pair_rules.is_empty() {
-            Some("fractional `special_bonds` weights run on the CPU backend only")
-        } else if self.model.externals.iter().any(|e| !e.expressions.is_empty()) {
-            Some("externals with expression parameters (`field`, or a quoted formula of x, y, z, t) run on the CPU backend only")
-        } else {
-            None
-        }
-    }
-
-    /// The GPU to run on, per the effective `device` setting (None: the CPU).
-    /// The adapter is opened once and announced.
-    fn gpu_for_run(&mut self) -> Result<Option<GpuContext>, RunError> {
-        let device = self.options.device.unwrap_or(self.device);
-        if device == DevicePreference::Cpu {
-            return Ok(None);
-        }
-        if let Some(why) = self.cpu_only_feature() {
-            return match device {
-                DevicePreference::Gpu => Err(RunError::Setup(format!("device gpu: {why}; use `device cpu` or `device auto`"))),
-                _ => {
-                    self.say(&format!("device auto: {why}; running on the CPU"));
-                    Ok(None)
-                }
-            };
-        }
-        if self.gpu.is_none() {
-            let opened = GpuContext::open(device == DevicePreference::Auto);
-            match &opened {
-                Ok(context) => self.say(&format!("device: GPU {}", context.describe())),
-                Err(e) if device == DevicePreference::Auto => self.say(&format!("device auto: {e}; running on the CPU")),
-                Err(_) => {}
-            }
-            self.gpu = Some(opened);
-        }
-        match self.gpu.as_ref().expect("opened above") {
-            Ok(context) => Ok(Some(context.clone())),
-            Err(_) if device == DevicePreference::Auto => Ok(None),
-            Err(e) => Err(RunError::Setup(format!("device gpu: {e}"))),
-        }
-    }
-
-    /// The steps up to `last` on the GPU. The host synchronises where an
-    /// output is due (thermo, dump, the end) and at least every
-    /// [`GPU_SYNC_STEPS`] steps (progress, blow-up checks), reading back the
-    /// positions only where an output needs them; thermo quantities are then
-    /// computed by the CPU backend at the read-back positions. With bond
-    /// kinetics the host synchronises every step: it reads the positions back,
-    /// measures every bond's tension and length in f64, decides the step's
-    /// events exactly as on the CPU, and uploads the changed bond state as one
-    /// batch (a new GPU backend when bonds formed). A segment that ends at
-    /// `until` before `last` reads the positions back and leaves the CPU
-    /// forces current there.
-    fn run_gpu(&mut self, context: &GpuContext, until: u64, last: u64, bar: &Option<ProgressBar>) -> Result<(), RunError> {
-        let settings = StepSettings {
-            dt: self.dt,
-            kt: self.kt,
-            seed: self.seed,
-            skin: self.neighbor.skin,
-            neighbor_every: self.neighbor.every,
-            neighbor_check: self.neighbor.check,
-            integrator: *self.integrator.common(),
-        };
-        let mut gpu = GpuBackend::new(context, &self.model, &self.state, &self.sim_box, &settings).map_err(RunError::Setup)?;
-        let kinetics = self.model.has_kinetics();
-        let evolving = self.model.bond_kinetics.iter().flat_map(|k| &k.rules).any(|r| r.rule.evolves_every_step());
-        while self.state.step < until {
-            let (step, start) = (self.state.step, self.state.time);
-            let next_output = self.next_output_step(last).min(self.state.step + GPU_SYNC_STEPS).min(until);
-            let steps = if kinetics { 1 } else { next_output - self.state.step };
-            let outcome = gpu.run(self.state.step, steps);
-            let done = match &outcome {
-                Ok(done) => *done,
-                Err(GpuHalt::Blowup { step, .. } | GpuHalt::Capacity { step, .. }) => step - self.state.step,
-            };
-            for _ in 0..done {
-                self.state.step += 1;
-                self.state.time += self.dt;
-            }
-            self.forces_current = false;
-            let final_step = self.state.step == last;
-            let segment_end = self.state.step == until;
-            let thermo_due = self.thermo.every > 0 && self.state.step.is_multiple_of(self.thermo.every);
-            let dump_due = self.dumps.iter().any(|d| self.state.step.is_multiple_of(d.spec.every));
-            // Positions come back only when something reads them; between
-            // outputs the sync only reads the GPU's status words.
-            let checkpoint_due = self.checkpoints.as_ref().is_some_and(|c| self.state.step.is_multiple_of(c.spec.every));
-            let stopping = self.options.stop.requested().is_some();
-            let read_back = segment_end || thermo_due || dump_due || checkpoint_due || stopping || outcome.is_err() || kinetics;
-            if read_back {
-                gpu.download(&mut self.state);
-            }
-            if let Err(GpuHalt::Capacity { message, .. }) = outcome {
-                return Err(RunError::Setup(format!("device gpu at step {}: {message}", self.state.step)));
-            }
-            if let Err(GpuHalt::Blowup { particle, .. }) = outcome {
-                self.refresh_cpu_forces(false)?;
-                let what = format!(
-                    "its GPU step was non-finite or longer than max_displacement {:e} (force here {:e})",
-                    self.integrator.common().max_displacement,
-                    self.forces.forces[particle].length()
-                );
-                return Err(self.blowup(particle, what));
-            }
-            if read_back {
-                self.check_in_box()?;
-            }
-            if kinetics {
-                // As on the CPU: decided from the tensions before the step
-                // (measured at the end of the previous one), then measured
-                // again at the new positions with the new bond state.
-                let resets = self.kinetics.resets;
-                // One step per segment with kinetics, never clamped on the GPU.
-                let changed = self.kinetics_step(StepClock { step, start, length: self.dt })?;
-                if self.backend.is_none() {
-                    // Bonds formed: both backends are rebuilt for the new bond list.
-                    self.ensure_forces()?;
-                    gpu = GpuBackend::new(context, &self.model, &self.state, &self.sim_box, &settings).map_err(RunError::Setup)?;
-                } else if changed || evolving || self.kinetics.resets != resets {
-                    gpu.update_bonds(&self.model, &self.state, changed).map_err(RunError::Setup)?;
-                }
-                let backend = self.backend.as_mut().expect("backend built");
-                backend.measure_bonds(&self.model, &self.state, &self.sim_box);
-            }
-            if thermo_due || segment_end {
-                self.refresh_cpu_forces(thermo_due || final_step)?;
-            }
-            self.outputs_at_step(bar, final_step && !thermo_due)?;
-            if let Some(b) = bar {
-                b.inc(done);
-            }
-            if stopping {
-                // The positions of this sync were read back above.
-                self.stop_if_requested()?;
-            }
-        }
-        Ok(())
-    }
-
-    /// The first step after the current one at which thermo or a dump is due (or `last`).
-    fn next_output_step(&self, last: u64) -> u64 {
-        let after = |every: u64| (self.state.step / every + 1) * every;
-        let mut next = last;
-        if self.thermo.every > 0 {
-            next = next.min(after(self.thermo.every));
-        }
-        for dump in &self.dumps {
-            next = next.min(after(dump.spec.every));
-        }
-        if let Some(c) = &self.checkpoints {
-            next = next.min(after(c.spec.every));
-        }
-        next
-    }
-
-    /// CPU forces (and energies) at the current state, after a GPU segment.
-    fn refresh_cpu_forces(&mut self, energies: bool) -> Result<(), RunError> {
-        let backend = self.backend.as_mut().expect("backend built");
-        backend.update_neighbors(&self.state, &self.sim_box, true).map_err(RunError::Setup)?;
-        self.compute_forces(energies)
-    }
-
-    /// Bond kinetics of the step just integrated, decided from the tensions of
-    /// its force pass; a break or rebind updates the pair exclusions.
-    /// Returns whether a bond broke, bound or formed.
-    fn kinetics_step(&mut self, clock: StepClock) -> Result<bool, RunError> {
-        let backend = self.backend.as_ref().expect("backend built");
-        let (tension, length) = backend.bond_tension_and_length();
-        let mut report = self.kinetics.step(&self.model, &mut self.state, tension, length, clock, self.kt, self.seed);
-        for warning in &report.warnings {
-            eprintln!("{warning}");
-        }
-        let mut formed_any = false;
-        if let Some(formation) = &mut self.formation {
-            let bindings = formation.decide(&self.model, &self.state, &self.sim_box, clock, self.seed).map_err(RunError::Setup)?;
-            formed_any = bindings.iter().any(|b| matches!(b, Binding::New(..)));
-            report.bonds_changed |= !bindings.is_empty();
-            report.events.extend(self.kinetics.apply_bindings(&mut self.model, &mut self.state, &self.sim_box, bindings, clock));
-        }
-        if !report.events.is_empty() {
-            self.lifetimes.record(&self.model, &report.events, clock.length);
-            if let Some((log, path)) = &mut self.event_log {
-                if let Err(e) = log.write(&report.events) {
-                    let path = path.clone();
-                    return Err(self.output_error(&path, e));
-                }
-            }
-            let bound = &self.state.bonds.as_ref().expect("kinetics has bond state").bound;
-            let failed =
-                self.dumps.iter_mut().find_map(|d| d.writer.write_bond_events(&report.events, bound).err().map(|e| (d.path.clone(), e)));
-            if let Some((path, e)) = failed {
-                return Err(self.output_error(&path, e));
-            }
-        }
-        if formed_any {
-            // New bonds change every per-bond buffer: rebuild the backend.
-            self.backend = None;
-        } else if report.bonds_changed {
-            let backend = self.backend.as_mut().expect("backend built");
-            backend.bonds_changed(&self.model, &self.state, &self.sim_box).map_err(RunError::Setup)?;
-        }
-        Ok(report.bonds_changed)
-    }
-
-    /// Rules whose rates depend on kT refuse to run at T = 0.
-    fn check_kinetics_temperature(&self) -> Result<(), RunError> {
-        if self.kt > 0.0 {
-            return Ok(());
-        }
-        for (t, kinetics) in self.model.bond_kinetics.iter().enumerate() {
-            if let Some(rule) = kinetics.rules.iter().find(|r| r.rule.needs_temperature()) {
-                return Err(RunError::Setup(format!(
-                    "bond type `{}`: kinetic rule `{}` has rates that depend on kT; expected a `temperature` > 0",
-                    self.model.bond_types[t].label.text,
-                    rule.rule.name()
-                )));
-            }
-        }
-        Ok(())
-    }
-
-    /// `minimize`: FIRE to max |F| < ftol. The step counter does not advance.
-    pub fn minimize(&mut self, settings: &FireSettings) -> Result<(), RunError> {
-        self.ensure_forces()?;
-        let mass: Vec<f64> = self.model.types.iter().map(|&t| self.model.type_drag[t as usize] * self.dt).collect();
-        let mut state = self.state.clone();
-        let backend = self.backend.as_mut().expect("backend built");
-        let (model, sim_box, forces, protocols) = (&self.model, &self.sim_box, &mut self.forces, &self.protocols);
-        let report = fire_minimize(&mut state, sim_box, &mass, self.dt, settings, |s, f, limits| {
-            backend.update_neighbors(s, sim_box, true).map_err(RunError::Setup)?;
-            backend.update_contacts(model, s, sim_box).map_err(RunError::Setup)?;
-            backend.compute(model, s, sim_box, forces);
-            backend.contact_step_limits(s.len(), limits);
-            f.clone_from(&forces.forces);
-            protocols.mask(f);
-            Ok::<f64, RunError>(forces.total_energy())
-        })?;
-        self.state = state;
-        self.forces_current = true;
-        self.energies_current = true;
-        if let Some(i) = self.forces.forces.iter().position(|f| !finite_force(*f)) {
-            return Err(self.blowup(i, "non-finite force during minimisation".into()));
-        }
-        self.check_in_box()?;
-        let verdict = if report.converged { "converged" } else { "stopped at maxiter without converging" };
-        self.say(&format!(
-            "minimize (FIRE): {verdict} after {} iterations: max |F| = {:e} (ftol {:e}), pe = {:e}{}",
-            report.iterations,
-            report.max_force,
-            settings.ftol,
-            report.energy,
-            if report.clamped > 0 { format!(", {} moves shortened by the contact step clamp", report.clamped) } else { String::new() }
-        ));
-        self.contact_clamps += report.clamped;
-        self.last_minimize = Some(report);
-        Ok(())
-    }
-
-    /// Finishes every output file (called at the end and on errors).
-    pub fn close_outputs(&mut self) -> Result<(), RunError> {
-        let mut first_error = None;
-        for dump in std::mem::take(&mut self.dumps) {
-            if let Err(e) = dump.writer.finish() {
-                first_error.get_or_insert(self.output_error(&dump.path, e));
-            }
-        }
-        if let Err((path, e)) = self.thermo.close() {
-            first_error.get_or_insert(self.output_error(&path, e));
-        }
-        if let Some((log, path)) = self.event_log.take() {
-            if let Err(e) = log.finish() {
-                first_error.get_or_insert(self.output_error(&path, e));
-            }
-        }
-        first_error.map_or(Ok(()), Err)
-    }
-}
-
-/// Whether a force and its squared magnitude are finite: `turgor dp0 1e308`
-/// gave finite components whose |F| overflowed, and every later step was
-/// clamped to nothing instead of stopping.
-fn finite_force(f: DVec3) -> bool {
-    f.length_squared().is_finite()
 }

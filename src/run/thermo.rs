@@ -50,11 +50,11 @@ pub struct ThermoInputs<'a> {
     /// Per-bond tension of the last force pass.
     pub bond_tension: &'a [f64],
     pub kinetics: &'a crate::kinetics_engine::Kinetics,
-    pub step: u64,
-    pub time: f64,
+    /// The context of the next step: its index and start time are the
+    /// current state's, with the kT in force.
+    pub context: crate::integrate::context::StepContext,
     pub forces: &'a Forces,
     pub n_particles: usize,
-    pub kt: f64,
     pub volume: f64,
     pub neighbor_builds: u64,
     /// The last implicit step's linear solve.
@@ -150,11 +150,11 @@ fn body_sum(t: &ThermoInputs, body_type: usize, pick: impl Fn((f64, f64)) -> f64
 
 /// A column's value; integers are returned as exact f64.
 pub fn column_value(c: &ThermoColumn, t: &ThermoInputs) -> f64 {
-    let ideal = t.n_particles as f64 * t.kt / t.volume;
+    let ideal = t.n_particles as f64 * t.context.kt / t.volume;
     let w = &t.forces.virial;
     match c {
-        ThermoColumn::Step => t.step as f64,
-        ThermoColumn::Time => t.time,
+        ThermoColumn::Step => t.context.step as f64,
+        ThermoColumn::Time => t.context.time,
         ThermoColumn::Pe => t.forces.total_energy() + constant_force_work(t),
         ThermoColumn::Work => constant_force_work(t),
         ThermoColumn::ExternalForce { name, axis } => external_sums(t, name).0[*axis],

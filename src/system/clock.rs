@@ -5,9 +5,10 @@
 //! `integrate::overdamped`), and a deck may change `timestep` between runs.
 //! Everything that stamps or ages with time — kinetic event times, bond ages,
 //! the rates' per-step probabilities 1 − exp(−k·Δt), the lifetime
-//! correction — reads it from one [`StepClock`], which the run builds from
-//! the state's time before the step and the fraction of dt the integrator
-//! took, so event times always equal thermo times.
+//! correction — reads it from one [`StepClock`], which the run's step
+//! context (`integrate::context`) returns as it advances the state's time by
+//! the fraction of dt the integrator took, so event times always equal
+//! thermo times.
 
 /// The step just integrated: its index, when it started and how long it took.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -18,4 +19,8 @@ pub struct StepClock {
     pub start: f64,
     /// The step's actual length Δt: the fraction of dt the integrator took × dt.
     pub length: f64,
+    /// The thermal energy kT the step ran at (the rates of kinetic rules read it).
+    pub kt: f64,
+    /// Seed of the step's random streams.
+    pub seed: u64,
 }

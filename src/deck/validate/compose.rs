@@ -5,12 +5,10 @@ use super::{expect_len, options, Validator};
 use crate::input::{parse_u64, InputError, SourceFile, Token};
 use crate::topology::parse_topology;
 
-const USAGE: &str = "topology FILE [offset auto|N]";
-
 impl Validator {
-    pub(super) fn topology_command(&mut self, s: &[Token]) -> Result<(), InputError> {
-        expect_len(s, 1..=3, USAGE)?;
-        let opts = options(&s[2..], &["offset"], USAGE)?;
+    pub(super) fn topology_command(&mut self, s: &[Token], usage: &str) -> Result<(), InputError> {
+        expect_len(s, 1..=3, usage)?;
+        let opts = options(&s[2..], &["offset"], usage)?;
         let offset = match opts.get("offset") {
             Some(t) if t.text != "auto" => Some(parse_u64(t, "a particle id offset (a whole number, or `auto`)")?),
             _ => None,

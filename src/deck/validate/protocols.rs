@@ -11,12 +11,6 @@ use crate::deck::protocol::{Protocol, Ramp};
 use crate::input::{parse_f64, InputError, Token};
 use crate::interactions::param_index;
 
-const RAMP_USAGE: &str =
-    "ramp bond|angle NAME PARAM FROM TO | ramp pair A B PARAM FROM TO | ramp body TYPE LAW PARAM FROM TO | ramp external NAME PARAM FROM TO";
-const MOVE_USAGE: &str = "move GROUP linear VX VY VZ";
-const FREEZE_USAGE: &str = "freeze GROUP x|y|z ...";
-const INDENT_USAGE: &str = "indent NAME velocity VX VY VZ [until LOAD] | indent NAME stop";
-
 /// The interaction types whose centre `indent` drives and whose load and
 /// depth thermo reports (laws E = (K/3)δ³ with a centre `x y z` and a `k`).
 const INDENTERS: [&str; 2] = ["indenter", "flat_punch"];
@@ -78,46 +72,39 @@ impl Protocols {
 }
 
 impl Validator {
-    pub(super) fn protocol_command(&mut self, s: &[Token]) -> Result<(), InputError> {
-        let protocol = match s[0].text.as_str() {
-            "ramp" => self.ramp(s)?,
-            "move" => self.move_group(s)?,
-            "unmove" | "unfreeze" => {
-                expect_len(s, 1..=1, &format!("{} GROUP", s[0].text))?;
-                let (active, what) = if s[0].text == "unmove" {
-                    (self.protocols.moving.remove(&s[1].text).is_some(), "moved")
-                } else {
-                    (self.protocols.frozen.remove(&s[1].text), "frozen")
-                };
-                if !active {
-                    return Err(s[1].error(format!(
-                        "found `{}`, expected a group {what} by a `{}` command before",
-                        s[1].text,
-                        &s[0].text[2..]
-                    )));
-                }
-                if s[0].text == "unmove" {
-                    Protocol::Unmove(s[1].text.clone())
-                } else {
-                    Protocol::Unfreeze(s[1].text.clone())
-                }
-            }
-            "freeze" => self.freeze(s)?,
-            "reset_rest" => self.reset_rest(s)?,
-            "indent" => self.indent(s)?,
-            _ => unreachable!("dispatched by keyword"),
-        };
+    /// A protocol command: its parser's protocol becomes the plan's action.
+    pub(super) fn protocol(
+        &mut self,
+        s: &[Token],
+        usage: &str,
+        parse: fn(&mut Validator, &[Token], &str) -> Result<Protocol, InputError>,
+    ) -> Result<(), InputError> {
+        let protocol = parse(self, s, usage)?;
         self.actions.push(Action::Protocol(protocol));
         Ok(())
+    }
+
+    /// `unmove GROUP`, `unfreeze GROUP`: ends the group's protocol.
+    pub(super) fn release(&mut self, s: &[Token], usage: &str) -> Result<Protocol, InputError> {
+        expect_len(s, 1..=1, usage)?;
+        let (active, what) = if s[0].text == "unmove" {
+            (self.protocols.moving.remove(&s[1].text).is_some(), "moved")
+        } else {
+            (self.protocols.frozen.remove(&s[1].text), "frozen")
+        };
+        if !active {
+            return Err(s[1].error(format!("found `{}`, expected a group {what} by a `{}` command before", s[1].text, &s[0].text[2..])));
+        }
+        Ok(if s[0].text == "unmove" { Protocol::Unmove(s[1].text.clone()) } else { Protocol::Unfreeze(s[1].text.clone()) })
     }
 
     /// `ramp TARGET PARAM FROM TO`: both ends and [`RAMP_SAMPLES`] values
     /// between them must pass the law's checks; a pair rule's cutoff must
     /// not change (the neighbour list is built for one cutoff per run).
-    fn ramp(&mut self, s: &[Token]) -> Result<Protocol, InputError> {
-        expect_len(s, 5..=usize::MAX, RAMP_USAGE)?;
-        let (targets, start) = self.coeff_targets(s, RAMP_USAGE)?;
-        expect_len(s, start + 2..=start + 2, RAMP_USAGE)?;
+    pub(super) fn ramp(&mut self, s: &[Token], usage: &str) -> Result<Protocol, InputError> {
+        expect_len(s, 5..=usize::MAX, usage)?;
+        let (targets, start) = self.coeff_targets(s, usage)?;
+        expect_len(s, start + 2..=start + 2, usage)?;
         let [name, from_token, to_token] = [&s[start], &s[start + 1], &s[start + 2]];
         let mut ramps = Vec::new();
         for target in targets {
@@ -156,12 +143,12 @@ impl Validator {
     }
 
     /// `move GROUP linear VX VY VZ` (velocity in length/time units).
-    fn move_group(&mut self, s: &[Token]) -> Result<Protocol, InputError> {
-        expect_len(s, 5..=5, MOVE_USAGE)?;
+    pub(super) fn move_group(&mut self, s: &[Token], usage: &str) -> Result<Protocol, InputError> {
+        expect_len(s, 5..=5, usage)?;
         self.model(&s[0])?;
         let group = self.group_named(&s[1])?.clone();
         if s[2].text != "linear" {
-            return Err(s[2].error(format!("found style `{}`, expected `linear` (`{MOVE_USAGE}`)", s[2].text)));
+            return Err(s[2].error(format!("found style `{}`, expected `linear` (`{usage}`)", s[2].text)));
         }
         let mut velocity = DVec3::ZERO;
         let unit = self.units.label(crate::units::Dim::Velocity);
@@ -186,8 +173,8 @@ impl Validator {
     }
 
     /// `freeze GROUP x|y|z ...`.
-    fn freeze(&mut self, s: &[Token]) -> Result<Protocol, InputError> {
-        expect_len(s, 2..=4, FREEZE_USAGE)?;
+    pub(super) fn freeze(&mut self, s: &[Token], usage: &str) -> Result<Protocol, InputError> {
+        expect_len(s, 2..=4, usage)?;
         self.model(&s[0])?;
         let group = self.group_named(&s[1])?.clone();
         let mut axes = [false; 3];
@@ -195,7 +182,7 @@ impl Validator {
             let a = ["x", "y", "z"]
                 .iter()
                 .position(|a| *a == t.text)
-                .ok_or_else(|| t.error(format!("found `{}`, expected an axis `x`, `y` or `z` (`{FREEZE_USAGE}`)", t.text)))?;
+                .ok_or_else(|| t.error(format!("found `{}`, expected an axis `x`, `y` or `z` (`{usage}`)", t.text)))?;
             if std::mem::replace(&mut axes[a], true) {
                 return Err(t.error(format!("axis `{}` is given twice; expected each axis once", t.text)));
             }
@@ -205,8 +192,8 @@ impl Validator {
     }
 
     /// `reset_rest BONDTYPE|all`: bond types whose law has a rest length `r0`.
-    fn reset_rest(&mut self, s: &[Token]) -> Result<Protocol, InputError> {
-        expect_len(s, 1..=1, "reset_rest BONDTYPE|all")?;
+    pub(super) fn reset_rest(&mut self, s: &[Token], usage: &str) -> Result<Protocol, InputError> {
+        expect_len(s, 1..=1, usage)?;
         let model = self.model(&s[0])?;
         let with_rest: Vec<usize> =
             (0..model.bond_types.len()).filter(|&t| param_index(model.bond_types[t].interaction, "r0").is_some()).collect();
@@ -261,8 +248,8 @@ impl Validator {
     }
 
     /// `indent NAME velocity VX VY VZ [until LOAD]` / `indent NAME stop`.
-    fn indent(&mut self, s: &[Token]) -> Result<Protocol, InputError> {
-        expect_len(s, 2..=7, INDENT_USAGE)?;
+    pub(super) fn indent(&mut self, s: &[Token], usage: &str) -> Result<Protocol, InputError> {
+        expect_len(s, 2..=7, usage)?;
         self.model(&s[0])?;
         self.indenter_named(&s[1], &s[1].text)?;
         if self.protocols.pending.iter().any(|(t, _, _)| *t == CoeffTarget::External(s[1].text.clone())) {
@@ -272,12 +259,12 @@ impl Validator {
         let external = s[1].text.clone();
         match s[2].text.as_str() {
             "stop" => {
-                expect_len(s, 2..=2, INDENT_USAGE)?;
+                expect_len(s, 2..=2, usage)?;
                 Ok(Protocol::Indent { external, velocity: DVec3::ZERO, until: None })
             }
             "velocity" => {
                 if s.len() != 6 && s.len() != 8 {
-                    expect_len(s, 5..=5, INDENT_USAGE)?;
+                    expect_len(s, 5..=5, usage)?;
                 }
                 let unit = self.units.label(crate::units::Dim::Velocity);
                 let mut velocity = DVec3::ZERO;
@@ -290,13 +277,11 @@ impl Validator {
                         let load = positive(&s[7], &format!("a load in {}", self.units.label(crate::units::Dim::Force)))?;
                         Some(load)
                     }
-                    Some(t) => {
-                        return Err(t.error(format!("found `{}`, expected `until` or the end of the line (`{INDENT_USAGE}`)", t.text)))
-                    }
+                    Some(t) => return Err(t.error(format!("found `{}`, expected `until` or the end of the line (`{usage}`)", t.text))),
                 };
                 Ok(Protocol::Indent { external, velocity, until })
             }
-            other => Err(s[2].error(format!("found `{other}`, expected `velocity` or `stop` (`{INDENT_USAGE}`)"))),
+            other => Err(s[2].error(format!("found `{other}`, expected `velocity` or `stop` (`{usage}`)"))),
         }
     }
 }

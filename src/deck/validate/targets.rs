@@ -4,8 +4,9 @@
 
 use super::{expect_len, Validator};
 use crate::deck::plan::CoeffTarget;
+use crate::forcefield::{check_param, param_position};
 use crate::input::{InputError, Token};
-use crate::interactions::{param_index, Law};
+use crate::interactions::Law;
 
 impl Validator {
     /// The terms `s[1..]` names and the index of the first token after the
@@ -89,15 +90,7 @@ impl Validator {
         }
         let term = target.term_mut(model);
         let (label, interaction) = (term.label.text.clone(), term.interaction);
-        let index = param_index(interaction, &name.text).ok_or_else(|| {
-            let names: Vec<&str> = interaction.params().iter().map(|p| p.name).collect();
-            name.error(format!(
-                "found parameter `{}`, expected one of `{}`'s parameters: {}",
-                name.text,
-                interaction.name(),
-                names.join(", ")
-            ))
-        })?;
+        let index = param_position(interaction.params(), interaction.name(), name)?;
         if rest_index == Some(index) {
             if let Some(reset) = self.protocols.reset_by(target) {
                 return Err(name.error(format!(
@@ -124,10 +117,10 @@ impl Validator {
     /// and the law's own checks with the other parameters in force) and sets
     /// it in the working model. `at` is the value's token.
     pub(super) fn set_target_param(&mut self, target: &CoeffTarget, param: usize, value: f64, at: &Token) -> Result<(), InputError> {
-        let term = target.term_mut(self.model(at)?);
-        let spec = &term.interaction.params()[param];
-        spec.check(value).map_err(|e| at.error(format!("expected {e}")))?;
-        term.params[param] = value;
+        let model = self.model(at)?;
+        check_param(&target.term_mut(model).interaction.params()[param], value, at)?;
+        target.set(model, param, value);
+        let term = target.term_mut(model);
         term.interaction
             .validate(&term.params)
             .map_err(|e| at.error(format!("invalid `{}` parameters: expected {e}", term.interaction.name())))

@@ -101,7 +101,7 @@ impl Simulation {
             *x = *new;
             self.sim_box.wrap(x, image);
         }
-        if let Some(backend) = self.backend.as_mut() {
+        if let Some(backend) = self.cpu.built_mut() {
             backend.update_neighbors(&self.state, &self.sim_box, true).map_err(RunError::Setup)?;
         }
         self.forces_current = false;

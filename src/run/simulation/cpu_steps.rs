@@ -1,0 +1,199 @@
+//! The CPU backend's steps: the explicit or implicit step of the reference
+//! backend, with the protocols' held particles, the constraints' projection
+//! and the contact step clamp, and FIRE minimisation.
+
+use glam::DVec3;
+
+use super::reference::finite_force;
+use super::step_loop::{Stepper, Taken};
+use super::Simulation;
+use crate::integrate::context::StepContext;
+use crate::integrate::fire::{fire_minimize, FireSettings};
+use crate::integrate::implicit::{implicit_step, ConstrainedBonds, ImplicitError, ImplicitSettings};
+use crate::integrate::overdamped::{overdamped_step, Blowup};
+use crate::integrate::Integrator;
+use crate::output::run_log::{Clock, Phase};
+use crate::run::RunError;
+
+/// The CPU backend as a [`Stepper`]: one step per call, timed by phase
+/// for the run log.
+#[derive(Default)]
+pub(super) struct CpuSteps {
+    /// Positions before the step (the constraints project from them).
+    before: Vec<DVec3>,
+    /// The phase clock of the step in progress.
+    clock: Option<Clock>,
+}
+
+impl CpuSteps {
+    fn lap(&mut self, sim: &mut Simulation, phase: Phase) {
+        if let Some(clock) = &mut self.clock {
+            clock.lap(&mut sim.times, phase);
+        }
+    }
+}
+
+impl Stepper for CpuSteps {
+    fn take(&mut self, sim: &mut Simulation, _until: u64, _last: u64) -> Result<Taken, RunError> {
+        sim.stop_if_requested()?;
+        self.clock = Some(sim.times.clock());
+        let ctx = sim.step_context();
+        if !sim.constraints.list.is_empty() {
+            self.before.clone_from(&sim.state.positions);
+        }
+        sim.protocols.before_step(&mut sim.forces.forces, &sim.state);
+        let moved = match sim.integrator {
+            Integrator::Implicit(_, implicit) => sim.implicit_step(&ctx, &implicit)?,
+            Integrator::Overdamped(_) => {
+                let n = sim.model.len();
+                let limited = sim.cpu.built().is_some_and(|b| b.contact_step_limits(n, &mut sim.step_limits));
+                overdamped_step(
+                    &sim.model,
+                    &mut sim.state,
+                    &sim.forces.forces,
+                    &sim.sim_box,
+                    &ctx,
+                    limited.then_some(sim.step_limits.as_slice()),
+                    &mut sim.scratch,
+                )
+                .inspect(|&fraction| sim.contact_clamps += u64::from(fraction < 1.0))
+            }
+        };
+        sim.protocols.restore_forces(&mut sim.forces.forces);
+        let clock = match moved {
+            Ok(fraction) => ctx.advance(&mut sim.state, fraction),
+            Err(Blowup { particle, displacement }) => return Err(sim.blowup(particle, sim.displacement_message(displacement))),
+        };
+        if !sim.constraints.list.is_empty() {
+            let projected = sim.constraints.project(&sim.model, &self.before, &mut sim.state, &sim.sim_box, &ctx);
+            if sim.implicit_tension.len() == sim.constraints.tension.len() {
+                sim.constraints.tension.iter_mut().zip(&sim.implicit_tension).for_each(|(t, extra)| *t += extra);
+            }
+            if let Err(failure) = projected {
+                let [i, j] = sim.model.bonds[failure.bond];
+                return Err(RunError::Setup(format!(
+                    "constraint of bond {}-{} not met after {} sweeps at step {}: |r − r0|/r0 = {:e} > tolerance {:e}",
+                    sim.model.ids[i as usize],
+                    sim.model.ids[j as usize],
+                    sim.constraints.max_iterations,
+                    sim.state.step,
+                    failure.relative_error,
+                    sim.constraints.tolerance
+                )));
+            }
+        }
+        sim.protocols.after_step(&mut sim.state, &sim.sim_box, &ctx);
+        self.lap(sim, Phase::Integrate);
+        sim.check_in_box()?;
+        Ok(Taken { steps: 1, last: Some(clock) })
+    }
+
+    fn bonds_changed(&mut self, sim: &mut Simulation, _changed: bool) -> Result<(), RunError> {
+        // The kinetics step updated (or dropped, when bonds formed) the CPU backend.
+        self.lap(sim, Phase::Kinetics);
+        Ok(())
+    }
+
+    fn before_outputs(&mut self, sim: &mut Simulation, _until: u64, last: u64, due: bool) -> Result<(), RunError> {
+        let ctx = sim.step_context();
+        sim.protocols.advance_drives(&mut sim.model, &ctx);
+        sim.protocols.set_ramps(&mut sim.model, sim.state.step);
+        let final_step = sim.state.step == last;
+        if sim.cpu.is_built() {
+            if sim.state.step.is_multiple_of(sim.neighbor.every) {
+                let backend = sim.cpu.get(&sim.model, &sim.state, &sim.sim_box, sim.neighbor.skin)?;
+                backend.update_neighbors(&sim.state, &sim.sim_box, sim.neighbor.check).map_err(RunError::Setup)?;
+                self.lap(sim, Phase::Neighbor);
+            }
+            sim.compute_forces(due || final_step)?;
+        } else {
+            // Bonds formed: the backend is rebuilt for the new bond list.
+            sim.ensure_forces()?;
+        }
+        sim.protocols.check_drives(&sim.model, &sim.state, &sim.sim_box);
+        self.lap(sim, Phase::Force);
+        Ok(())
+    }
+
+    fn after_outputs(&mut self, sim: &mut Simulation) -> Result<(), RunError> {
+        self.lap(sim, Phase::Output);
+        Ok(())
+    }
+}
+
+impl Simulation {
+    /// One implicit step; returns the fraction of dt it took (below 1 where
+    /// the contact clamp shortened it).
+    fn implicit_step(&mut self, ctx: &StepContext, implicit: &ImplicitSettings) -> Result<Result<f64, Blowup>, RunError> {
+        let backend = self.cpu.get(&self.model, &self.state, &self.sim_box, self.neighbor.skin)?;
+        let stiffness = backend.stiffness(&self.model, &self.state, &self.sim_box);
+        let limited = backend.contact_step_limits(self.model.len(), &mut self.step_limits);
+        let (model, forces, sim_box) = (&self.model, &self.forces.forces, &self.sim_box);
+        let mut constrained =
+            ConstrainedBonds { pairs: self.constraints.list.iter().map(|c| model.bonds[c.bond]).collect(), tension: Vec::new() };
+        let outcome = implicit_step(
+            model,
+            &mut self.state,
+            forces,
+            &stiffness,
+            sim_box,
+            ctx,
+            implicit,
+            &mut constrained,
+            limited.then_some(self.step_limits.as_slice()),
+        );
+        self.implicit_tension = constrained.tension;
+        match outcome {
+            Ok(report) => {
+                let fraction = report.step_fraction;
+                self.contact_clamps += u64::from(fraction < 1.0);
+                self.last_solve = report;
+                Ok(Ok(fraction))
+            }
+            Err(ImplicitError::Blowup(blowup)) => Ok(Err(blowup)),
+            Err(ImplicitError::Solve(why)) => Err(RunError::Setup(format!("integrator implicit at step {}: {why}", self.state.step))),
+        }
+    }
+
+    fn displacement_message(&self, displacement: f64) -> String {
+        format!("displacement {displacement:e} in one step exceeds max_displacement {:e}", self.integrator.common().max_displacement)
+    }
+
+    /// `minimize`: FIRE to max |F| < ftol. The step counter does not advance.
+    pub fn minimize(&mut self, settings: &FireSettings) -> Result<(), RunError> {
+        self.ensure_forces()?;
+        let ctx = self.step_context();
+        let mass: Vec<f64> = self.model.types.iter().map(|&t| self.model.type_drag[t as usize] * ctx.dt).collect();
+        let mut state = self.state.clone();
+        let backend = self.cpu.get(&self.model, &self.state, &self.sim_box, self.neighbor.skin)?;
+        let (model, sim_box, forces, protocols) = (&self.model, &self.sim_box, &mut self.forces, &self.protocols);
+        let report = fire_minimize(&mut state, sim_box, &mass, &ctx, settings, |s, f, limits| {
+            backend.update_neighbors(s, sim_box, true).map_err(RunError::Setup)?;
+            backend.update_contacts(model, s, sim_box).map_err(RunError::Setup)?;
+            backend.compute(model, s, sim_box, forces);
+            backend.contact_step_limits(s.len(), limits);
+            f.clone_from(&forces.forces);
+            protocols.mask(f);
+            Ok::<f64, RunError>(forces.total_energy())
+        })?;
+        self.state = state;
+        self.forces_current = true;
+        self.energies_current = true;
+        if let Some(i) = self.forces.forces.iter().position(|f| !finite_force(*f)) {
+            return Err(self.blowup(i, "non-finite force during minimisation".into()));
+        }
+        self.check_in_box()?;
+        let verdict = if report.converged { "converged" } else { "stopped at maxiter without converging" };
+        self.say(&format!(
+            "minimize (FIRE): {verdict} after {} iterations: max |F| = {:e} (ftol {:e}), pe = {:e}{}",
+            report.iterations,
+            report.max_force,
+            settings.ftol,
+            report.energy,
+            if report.clamped > 0 { format!(", {} moves shortened by the contact step clamp", report.clamped) } else { String::new() }
+        ));
+        self.contact_clamps += report.clamped;
+        self.last_minimize = Some(report);
+        Ok(())
+    }
+}

@@ -1,0 +1,187 @@
+//! The GPU backend's steps: which runs it can take, the adapter, and the
+//! GPU as a [`Stepper`].
+
+use super::step_loop::{Stepper, Taken};
+use super::Simulation;
+use crate::gpu::backend::StepSettings;
+use crate::gpu::{DevicePreference, GpuBackend, GpuContext, GpuHalt};
+use crate::integrate::Integrator;
+use crate::run::RunError;
+
+/// The longest GPU segment between read-backs when no output is due.
+const GPU_SYNC_STEPS: u64 = 1000;
+
+/// The GPU as a [`Stepper`]. The host synchronises where an output is due
+/// (thermo, dump, checkpoint, the end) and at least every
+/// [`GPU_SYNC_STEPS`] steps (progress, blow-up checks), reading back the
+/// positions only where an output needs them; thermo quantities are then
+/// computed by the CPU backend at the read-back positions. With bond
+/// kinetics the host synchronises every step: it reads the positions back,
+/// measures every bond's tension and length in f64, decides the step's
+/// events exactly as on the CPU, and uploads the changed bond state as one
+/// batch (a new GPU backend when bonds formed). A segment that ends at
+/// `until` before `last` reads the positions back and leaves the CPU
+/// forces current there.
+pub(super) struct GpuSteps {
+    context: GpuContext,
+    settings: StepSettings,
+    gpu: GpuBackend,
+    /// Some kinetic rule changes the bond state every step.
+    evolving: bool,
+    /// The reset count before the kinetics of the step just taken.
+    resets: u64,
+    /// A stop was requested when the last segment synchronised.
+    stopping: bool,
+}
+
+impl GpuSteps {
+    /// The GPU backend for the steps of a run from the current state.
+    pub(super) fn new(sim: &Simulation, context: &GpuContext) -> Result<Self, RunError> {
+        let settings = StepSettings {
+            context: sim.step_context(),
+            skin: sim.neighbor.skin,
+            neighbor_every: sim.neighbor.every,
+            neighbor_check: sim.neighbor.check,
+        };
+        let gpu = GpuBackend::new(context, &sim.model, &sim.state, &sim.sim_box, &settings).map_err(RunError::Setup)?;
+        let evolving = sim.model.bond_kinetics.iter().flat_map(|k| &k.rules).any(|r| r.rule.evolves_every_step());
+        Ok(Self { context: context.clone(), settings, gpu, evolving, resets: 0, stopping: false })
+    }
+}
+
+impl Stepper for GpuSteps {
+    fn take(&mut self, sim: &mut Simulation, until: u64, last: u64) -> Result<Taken, RunError> {
+        let kinetics = sim.model.has_kinetics();
+        let next_output = sim.next_output_step(last).min(sim.state.step + GPU_SYNC_STEPS).min(until);
+        let steps = if kinetics { 1 } else { next_output - sim.state.step };
+        let outcome = self.gpu.run(sim.state.step, steps);
+        let done = match &outcome {
+            Ok(done) => *done,
+            Err(GpuHalt::Blowup { step, .. } | GpuHalt::Capacity { step, .. }) => step - sim.state.step,
+        };
+        // Every GPU step takes the full dt (no contact clamp on the GPU).
+        let mut taken = Taken { steps: done, last: None };
+        for _ in 0..done {
+            taken.last = Some(sim.step_context().advance(&mut sim.state, 1.0));
+        }
+        sim.forces_current = false;
+        let segment_end = sim.state.step == until;
+        let thermo_due = sim.thermo.every > 0 && sim.state.step.is_multiple_of(sim.thermo.every);
+        let dump_due = sim.dumps.iter().any(|d| sim.state.step.is_multiple_of(d.spec.every));
+        // Positions come back only when something reads them; between
+        // outputs the sync only reads the GPU's status words.
+        let checkpoint_due = sim.checkpoints.as_ref().is_some_and(|c| sim.state.step.is_multiple_of(c.spec.every));
+        self.stopping = sim.options.stop.requested().is_some();
+        let read_back = segment_end || thermo_due || dump_due || checkpoint_due || self.stopping || outcome.is_err() || kinetics;
+        if read_back {
+            self.gpu.download(&mut sim.state);
+        }
+        if let Err(GpuHalt::Capacity { message, .. }) = outcome {
+            return Err(RunError::Setup(format!("device gpu at step {}: {message}", sim.state.step)));
+        }
+        if let Err(GpuHalt::Blowup { particle, .. }) = outcome {
+            sim.refresh_cpu_forces(false)?;
+            let what = format!(
+                "its GPU step was non-finite or longer than max_displacement {:e} (force here {:e})",
+                sim.integrator.common().max_displacement,
+                sim.forces.forces[particle].length()
+            );
+            return Err(sim.blowup(particle, what));
+        }
+        if read_back {
+            sim.check_in_box()?;
+        }
+        // As on the CPU, bond kinetics (one step per segment) are decided from
+        // the tensions before the step (measured at the end of the previous
+        // one), then measured again at the new positions with the new bond state.
+        self.resets = sim.kinetics.resets;
+        Ok(taken)
+    }
+
+    fn bonds_changed(&mut self, sim: &mut Simulation, changed: bool) -> Result<(), RunError> {
+        if !sim.cpu.is_built() {
+            // Bonds formed: both backends are rebuilt for the new bond list.
+            sim.ensure_forces()?;
+            self.gpu = GpuBackend::new(&self.context, &sim.model, &sim.state, &sim.sim_box, &self.settings).map_err(RunError::Setup)?;
+        } else if changed || self.evolving || sim.kinetics.resets != self.resets {
+            self.gpu.update_bonds(&sim.model, &sim.state, changed).map_err(RunError::Setup)?;
+        }
+        let backend = sim.cpu.get(&sim.model, &sim.state, &sim.sim_box, sim.neighbor.skin)?;
+        backend.measure_bonds(&sim.model, &sim.state, &sim.sim_box);
+        Ok(())
+    }
+
+    fn before_outputs(&mut self, sim: &mut Simulation, until: u64, last: u64, due: bool) -> Result<(), RunError> {
+        if due || sim.state.step == until {
+            sim.refresh_cpu_forces(due || sim.state.step == last)?;
+        }
+        Ok(())
+    }
+
+    fn after_outputs(&mut self, sim: &mut Simulation) -> Result<(), RunError> {
+        if self.stopping {
+            // The positions of this sync were read back above.
+            sim.stop_if_requested()?;
+        }
+        Ok(())
+    }
+}
+
+impl Simulation {
+    /// Why the next `run` cannot use the GPU backend: the first feature in
+    /// use that only the CPU backend has (None when the GPU can run it).
+    pub fn cpu_only_feature(&self) -> Option<&'static str> {
+        if let Some(why) = self.protocols.cpu_only() {
+            Some(why)
+        } else if matches!(self.integrator, Integrator::Implicit(..)) {
+            Some("`integrator implicit` runs on the CPU backend only")
+        } else if !self.constraints.list.is_empty() {
+            Some("constrained bonds (`constrain`) run on the CPU backend only")
+        } else if self.model.has_surface_terms() {
+            Some("surface terms of bodies (`body` lines) run on the CPU backend only")
+        } else if self.model.has_contact_terms() {
+            Some("contact terms between bodies (`contact` lines) run on the CPU backend only")
+        } else if self.model.special_bonds.is_fractional() && !self.model.pair_rules.is_empty() {
+            Some("fractional `special_bonds` weights run on the CPU backend only")
+        } else if self.model.externals.iter().any(|e| !e.expressions.is_empty()) {
+            Some("externals with expression parameters (`field`, or a quoted formula of x, y, z, t) run on the CPU backend only")
+        } else {
+            None
+        }
+    }
+
+    /// The GPU to run on, per the effective `device` setting (None: the CPU).
+    /// The adapter is opened once and announced.
+    pub(super) fn gpu_for_run(&mut self) -> Result<Option<GpuContext>, RunError> {
+        let device = self.options.device.unwrap_or(self.device);
+        if device == DevicePreference::Cpu {
+            return Ok(None);
+        }
+        if let Some(why) = self.cpu_only_feature() {
+            return match device {
+                DevicePreference::Gpu => Err(RunError::Setup(format!("device gpu: {why}; use `device cpu` or `device auto`"))),
+                _ => {
+                    self.say(&format!("device auto: {why}; running on the CPU"));
+                    Ok(None)
+                }
+            };
+        }
+        let opened = match self.gpu.take() {
+            Some(opened) => opened,
+            None => {
+                let opened = GpuContext::open(device == DevicePreference::Auto);
+                match &opened {
+                    Ok(context) => self.say(&format!("device: GPU {}", context.describe())),
+                    Err(e) if device == DevicePreference::Auto => self.say(&format!("device auto: {e}; running on the CPU")),
+                    Err(_) => {}
+                }
+                opened
+            }
+        };
+        match self.gpu.insert(opened) {
+            Ok(context) => Ok(Some(context.clone())),
+            Err(_) if device == DevicePreference::Auto => Ok(None),
+            Err(e) => Err(RunError::Setup(format!("device gpu: {e}"))),
+        }
+    }
+}

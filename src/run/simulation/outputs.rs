@@ -1,0 +1,180 @@
+//! The outputs of a run: the run log, messages, dumps, thermo rows, the
+//! lifetime table, and closing them all.
+
+use std::path::{Path, PathBuf};
+
+use glam::DVec3;
+use indicatif::ProgressBar;
+
+use super::Simulation;
+use crate::deck::DumpSpec;
+use crate::output::run_log::{model_parameters, RunLog};
+use crate::output::{FrameView, Measures, TopologyView, TrajectoryWriter, WallPlane};
+use crate::run::RunError;
+
+/// An open dump and the step of its last frame.
+pub(super) struct ActiveDump {
+    pub(super) spec: DumpSpec,
+    pub(super) path: PathBuf,
+    pub(super) writer: Box<dyn TrajectoryWriter>,
+    pub(super) last_step: Option<u64>,
+}
+
+impl Simulation {
+    /// Creates the run log when the options ask for one.
+    pub(super) fn open_log(&mut self) -> Result<(), RunError> {
+        let Some(header) = &self.options.log else { return Ok(()) };
+        let path = self.output_path(Path::new(&format!("{}.log", self.deck_stem)));
+        let log = RunLog::create(&path, header, &self.inputs).map_err(|e| self.output_error(&path, e))?;
+        self.log = Some(log);
+        Ok(())
+    }
+
+    /// Logs the resolved settings and parameters a `run` starts with.
+    pub(super) fn log_run(&mut self, steps: u64, device: &str) -> Result<(), RunError> {
+        let Some(log) = &mut self.log else { return Ok(()) };
+        let text = format!(
+            "\nrun {steps} from step {} on {device}: units {:?}, {} particles, box {:?} to {:?} periodic {:?}\n\
+             timestep {:e}, temperature (kT) {:e}, seed {}, integrator {:?}, neighbor {:?}\n{}",
+            self.state.step,
+            self.model.units,
+            self.model.len(),
+            self.sim_box.lo.to_array(),
+            self.sim_box.hi.to_array(),
+            self.sim_box.periodic,
+            self.dt,
+            self.kt,
+            self.seed,
+            self.integrator,
+            self.neighbor,
+            model_parameters(&self.model)
+        );
+        if let Err(e) = log.section(&text) {
+            let path = log.path.clone();
+            return Err(self.output_error(&path, e));
+        }
+        Ok(())
+    }
+
+    pub(super) fn say(&self, message: &str) {
+        if self.options.echo {
+            self.options.stop.say(message);
+        }
+    }
+
+    pub(super) fn output_path(&self, path: &Path) -> PathBuf {
+        if path.is_absolute() {
+            path.to_path_buf()
+        } else {
+            self.options.output_dir.join(path)
+        }
+    }
+
+    /// An output that could not be written, with the step it happened at.
+    pub(super) fn output_error(&self, path: &Path, e: impl std::fmt::Display) -> RunError {
+        RunError::Io(format!("{}: {e} (at step {})", path.display(), self.state.step))
+    }
+
+    pub(super) fn topology_view(&self) -> TopologyView<'_> {
+        TopologyView {
+            units: self.model.units,
+            ids: &self.model.ids,
+            types: &self.model.types,
+            type_names: &self.model.type_names,
+            type_radius: &self.model.type_radius,
+            bonds: &self.model.bonds,
+            angles: &self.model.angles,
+            triangles: &self.model.triangles,
+            bond_types: &self.model.bond_type,
+            bond_type_names: &self.bond_type_names,
+        }
+    }
+
+    pub(super) fn write_dump(&mut self, i: usize) -> Result<(), RunError> {
+        let needs = self.dumps[i].writer.needs();
+        let (mut virial, mut tension, mut length) = (Vec::new(), Vec::new(), Vec::new());
+        if needs.any() {
+            // Measurements read the CPU backend's terms at these positions.
+            if !self.cpu.is_built() {
+                self.ensure_forces()?;
+            } else if !self.forces_current {
+                self.refresh_cpu_forces(false)?;
+            }
+            let backend = self.cpu.get(&self.model, &self.state, &self.sim_box, self.neighbor.skin)?;
+            if needs.virial {
+                virial = crate::measure::per_particle_virial(backend, &self.model, &self.state, &self.sim_box);
+            }
+            if needs.bonds {
+                (tension, length) = backend.bond_tensions_at(&self.model, &self.state, &self.sim_box);
+            }
+        }
+        let forces: &[DVec3] = if needs.forces { &self.forces.forces } else { &[] };
+        let walls: Vec<WallPlane> = (self.model.externals.iter())
+            .filter(|e| e.term.interaction.name() == "wall")
+            .filter_map(|e| crate::interactions::wall_plane(&e.term.params))
+            .map(|(normal, offset)| WallPlane { normal, offset })
+            .collect();
+        let clock = self.step_context();
+        let frame = FrameView {
+            step: clock.step,
+            time: clock.time,
+            sim_box: &self.sim_box,
+            positions: &self.state.positions,
+            images: &self.state.images,
+            measures: Measures { forces, virial: &virial, bond_tension: &tension, bond_length: &length },
+            bound: self.state.bonds.as_ref().map_or(&[], |b| &b.bound),
+            walls: &walls,
+        };
+        if let Err(e) = self.dumps[i].writer.write_frame(&frame) {
+            return Err(self.output_error(&self.dumps[i].path, e));
+        }
+        self.dumps[i].last_step = Some(self.state.step);
+        Ok(())
+    }
+
+    pub(super) fn outputs_at_step(&mut self, bar: &Option<ProgressBar>, force_thermo: bool) -> Result<(), RunError> {
+        let step = self.state.step;
+        for i in 0..self.dumps.len() {
+            if step.is_multiple_of(self.dumps[i].spec.every) && self.dumps[i].last_step != Some(step) {
+                self.write_dump(i)?;
+            }
+        }
+        let due = self.thermo.every > 0 && step.is_multiple_of(self.thermo.every);
+        if due || force_thermo {
+            let values = self.with_thermo_inputs(|thermo, inputs| thermo.values(inputs))?;
+            let line = self.thermo.row(&values).map_err(|(path, e)| self.output_error(&path, e))?;
+            match bar {
+                Some(bar) => bar.println(line),
+                None => self.say(&line),
+            }
+        }
+        self.checkpoint()
+    }
+
+    /// The lifetime table, rewritten after every `run` (and when stopped).
+    pub(super) fn write_lifetimes(&self) -> Result<(), RunError> {
+        match &self.lifetime_file {
+            Some(path) => self.lifetimes.write(path, &self.model, self.state.bonds.as_ref()).map_err(|e| self.output_error(path, e)),
+            None => Ok(()),
+        }
+    }
+
+    /// Finishes every output file (called at the end and on errors).
+    pub fn close_outputs(&mut self) -> Result<(), RunError> {
+        let mut first_error = None;
+        for dump in std::mem::take(&mut self.dumps) {
+            if let Err(e) = dump.writer.finish() {
+                first_error.get_or_insert(self.output_error(&dump.path, e));
+            }
+        }
+        if let Err((path, e)) = self.thermo.close() {
+            first_error.get_or_insert(self.output_error(&path, e));
+        }
+        if let Some((log, path)) = self.event_log.take() {
+            if let Err(e) = log.finish() {
+                first_error.get_or_insert(self.output_error(&path, e));
+            }
+        }
+        first_error.map_or(Ok(()), Err)
+    }
+}

@@ -1,0 +1,237 @@
+//! The step loop of a `run`: one loop over a [`Stepper`], the backend that
+//! takes the steps — the CPU backend (`cpu_steps`, the reference for thermo
+//! and measurements) or the GPU (`gpu_steps`).
+//!
+//! A stepper takes the steps up to the next point where the host must look
+//! (one step on the CPU; on the GPU up to the next output, sync or bond
+//! kinetics decision), ending each with the step context
+//! ([`StepContext::advance`], the one place simulated time advances). The
+//! loop does the rest once for both: bond kinetics of the step just taken
+//! (decided on the host from the CPU backend's tensions), the outputs due,
+//! progress and stop requests. What is resident where stays the stepper's
+//! business: a GPU that keeps shells, contact, constraints, the implicit
+//! step or bond kinetics on the device implements the same hooks.
+
+use indicatif::{ProgressBar, ProgressStyle};
+
+use super::cpu_steps::CpuSteps;
+use super::gpu_steps::GpuSteps;
+use super::stepping::ActiveRun;
+use super::Simulation;
+use crate::integrate::context::StepContext;
+use crate::kinetics_engine::Binding;
+use crate::run::RunError;
+use crate::system::StepClock;
+
+/// What a stepper's call took.
+pub(super) struct Taken {
+    /// Steps taken (each ended with [`StepContext::advance`]).
+    pub(super) steps: u64,
+    /// The clock of the last of them (None when none was taken).
+    pub(super) last: Option<StepClock>,
+}
+
+/// A backend that takes the steps of a run (see the module docs).
+pub(super) trait Stepper {
+    /// Takes the steps from the current one up to the next point where the
+    /// host must look, never beyond `until` (`last`: the run's last step),
+    /// and leaves the positions the outputs due there read on the host.
+    fn take(&mut self, sim: &mut Simulation, until: u64, last: u64) -> Result<Taken, RunError>;
+
+    /// After bond kinetics of the step just taken (`changed`: a bond broke,
+    /// bound or formed): the stepper's copy of the bonds follows.
+    fn bonds_changed(&mut self, sim: &mut Simulation, changed: bool) -> Result<(), RunError>;
+
+    /// Before the outputs of the step reached: the CPU forces the outputs
+    /// read are brought to the new state (with energies where thermo is
+    /// `due` or the run ends at `last`), and the next step is prepared.
+    fn before_outputs(&mut self, sim: &mut Simulation, until: u64, last: u64, due: bool) -> Result<(), RunError>;
+
+    /// After the outputs of the step reached: a requested stop is honoured
+    /// where the stepper has the state to write.
+    fn after_outputs(&mut self, sim: &mut Simulation) -> Result<(), RunError>;
+}
+
+impl Simulation {
+    /// `run N`: N overdamped steps, on the CPU backend or the GPU.
+    pub fn run(&mut self, steps: u64) -> Result<(), RunError> {
+        let run = self.begin_run(steps)?;
+        self.advance(&run, run.last)?;
+        self.end_run(run)
+    }
+
+    /// The start of a `run N`: checks, forces, the backend, the thermo
+    /// header and the outputs of the first step.
+    pub fn begin_run(&mut self, steps: u64) -> Result<ActiveRun, RunError> {
+        self.check_kinetics_temperature()?;
+        self.protocols.begin_run(self.state.step, self.state.step + steps);
+        if self.protocols.set_ramps(&mut self.model, self.state.step) {
+            self.forces_current = false;
+        }
+        self.ensure_forces()?;
+        self.protocols.check_drives(&self.model, &self.state, &self.sim_box);
+        let gpu = self.gpu_for_run()?;
+        let bar = (self.options.progress && steps >= 1000).then(|| {
+            let bar = ProgressBar::new(steps);
+            bar.set_style(ProgressStyle::with_template("{bar:40} {pos}/{len} steps  {per_sec}  ETA {eta}").expect("valid template"));
+            bar
+        });
+        let header = self.thermo.header();
+        match &bar {
+            Some(b) => b.println(header),
+            None => self.say(&header),
+        }
+        let last = self.state.step + steps;
+        self.run_end = Some(last);
+        self.log_run(steps, if gpu.is_some() { "the GPU" } else { "the CPU" })?;
+        self.outputs_at_step(&bar, true)?;
+        Ok(ActiveRun { steps, last, gpu, bar, started: std::time::Instant::now() })
+    }
+
+    /// Steps of `run` up to step `until` (at most the run's last): on the
+    /// CPU the same steps, bit for bit, however the run is cut into
+    /// segments; forces are recomputed first if the system changed since.
+    pub fn advance(&mut self, run: &ActiveRun, until: u64) -> Result<(), RunError> {
+        let until = until.min(run.last);
+        if !self.cpu.is_built() || !self.forces_current {
+            self.ensure_forces()?;
+        }
+        let started = std::time::Instant::now();
+        let looped = match &run.gpu {
+            Some(context) => GpuSteps::new(self, context).and_then(|mut gpu| self.step_loop(&mut gpu, until, run.last, &run.bar)),
+            None => self.step_loop(&mut CpuSteps::default(), until, run.last, &run.bar),
+        };
+        self.times.total += started.elapsed();
+        looped
+    }
+
+    /// The steps up to `until` of a run that ends at `last`, on `stepper`.
+    fn step_loop(&mut self, stepper: &mut dyn Stepper, until: u64, last: u64, bar: &Option<ProgressBar>) -> Result<(), RunError> {
+        while self.state.step < until {
+            let taken = stepper.take(self, until, last)?;
+            if self.model.has_kinetics() {
+                // Decided from the tensions of the step's force pass.
+                let changed = match taken.last {
+                    Some(clock) => self.kinetics_step(clock)?,
+                    None => false,
+                };
+                stepper.bonds_changed(self, changed)?;
+            }
+            let final_step = self.state.step == last;
+            let thermo_due = self.thermo.every > 0 && self.state.step.is_multiple_of(self.thermo.every);
+            stepper.before_outputs(self, until, last, thermo_due)?;
+            self.outputs_at_step(bar, final_step && !thermo_due)?;
+            stepper.after_outputs(self)?;
+            if let Some(b) = bar {
+                b.inc(taken.steps);
+            }
+        }
+        Ok(())
+    }
+
+    /// The end of a run: writes the lifetime table and reports the loop time.
+    pub fn end_run(&mut self, run: ActiveRun) -> Result<(), RunError> {
+        if let Some(b) = run.bar {
+            b.finish_and_clear();
+        }
+        self.run_end = None;
+        self.protocols.end_run();
+        self.write_lifetimes()?;
+        let seconds = run.started.elapsed().as_secs_f64();
+        self.say(&format!(
+            "loop time {seconds:.6} s for {} steps with {} particles: {:.6e} particle-steps/s",
+            run.steps,
+            self.model.len(),
+            (run.steps as f64 * self.model.len() as f64) / seconds
+        ));
+        Ok(())
+    }
+
+    /// The context of the next step: the deck's settings in force and the state's clock.
+    pub fn step_context(&self) -> StepContext {
+        StepContext {
+            dt: self.dt,
+            kt: self.kt,
+            seed: self.seed,
+            noise: self.integrator.common().noise,
+            max_displacement: self.integrator.common().max_displacement,
+            step: self.state.step,
+            time: self.state.time,
+        }
+    }
+
+    /// The first step after the current one at which thermo or a dump is due (or `last`).
+    pub(super) fn next_output_step(&self, last: u64) -> u64 {
+        let after = |every: u64| (self.state.step / every + 1) * every;
+        let mut next = last;
+        if self.thermo.every > 0 {
+            next = next.min(after(self.thermo.every));
+        }
+        for dump in &self.dumps {
+            next = next.min(after(dump.spec.every));
+        }
+        if let Some(c) = &self.checkpoints {
+            next = next.min(after(c.spec.every));
+        }
+        next
+    }
+
+    /// Bond kinetics of the step just integrated, decided from the tensions of
+    /// its force pass; a break or rebind updates the pair exclusions.
+    /// Returns whether a bond broke, bound or formed.
+    pub(super) fn kinetics_step(&mut self, clock: StepClock) -> Result<bool, RunError> {
+        let backend = self.cpu.get(&self.model, &self.state, &self.sim_box, self.neighbor.skin)?;
+        let (tension, length) = backend.bond_tension_and_length();
+        let mut report = self.kinetics.step(&self.model, &mut self.state, tension, length, clock);
+        for warning in &report.warnings {
+            eprintln!("{warning}");
+        }
+        let mut formed_any = false;
+        if let Some(formation) = &mut self.formation {
+            let bindings = formation.decide(&self.model, &self.state, &self.sim_box, clock).map_err(RunError::Setup)?;
+            formed_any = bindings.iter().any(|b| matches!(b, Binding::New(..)));
+            report.bonds_changed |= !bindings.is_empty();
+            report.events.extend(self.kinetics.apply_bindings(&mut self.model, &mut self.state, &self.sim_box, bindings, clock));
+        }
+        if !report.events.is_empty() {
+            self.lifetimes.record(&self.model, &report.events, clock.length);
+            if let Some((log, path)) = &mut self.event_log {
+                if let Err(e) = log.write(&report.events) {
+                    let path = path.clone();
+                    return Err(self.output_error(&path, e));
+                }
+            }
+            let bound = &self.state.bonds.as_ref().expect("kinetics has bond state").bound;
+            let failed =
+                self.dumps.iter_mut().find_map(|d| d.writer.write_bond_events(&report.events, bound).err().map(|e| (d.path.clone(), e)));
+            if let Some((path, e)) = failed {
+                return Err(self.output_error(&path, e));
+            }
+        }
+        if formed_any {
+            // New bonds change every per-bond buffer: rebuild the backend.
+            self.cpu.invalidate();
+        } else if report.bonds_changed {
+            let backend = self.cpu.get(&self.model, &self.state, &self.sim_box, self.neighbor.skin)?;
+            backend.bonds_changed(&self.model, &self.state, &self.sim_box).map_err(RunError::Setup)?;
+        }
+        Ok(report.bonds_changed)
+    }
+
+    /// Rules whose rates depend on kT refuse to run at T = 0.
+    fn check_kinetics_temperature(&self) -> Result<(), RunError> {
+        if self.kt > 0.0 {
+            return Ok(());
+        }
+        for (t, kinetics) in self.model.bond_kinetics.iter().enumerate() {
+            if let Some(rule) = kinetics.rules.iter().find(|r| r.rule.needs_temperature()) {
+                return Err(RunError::Setup(format!(
+                    "bond type `{}`: kinetic rule `{}` has rates that depend on kT; expected a `temperature` > 0",
+                    self.model.bond_types[t].label.text,
+                    rule.rule.name()
+                )));
+            }
+        }
+        Ok(())
+    }
+}
