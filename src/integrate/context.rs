@@ -9,7 +9,7 @@
 //! less where the contact clamp shortened it). The [`StepClock`] it returns
 //! is what the consumers after the step (bond kinetics, lifetimes) read.
 
-use super::rng::Noise;
+use crate::rng::Noise;
 use crate::system::{State, StepClock};
 
 /// The settings and clock of the step about to be taken.

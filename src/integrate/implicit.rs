@@ -44,7 +44,7 @@ use faer::{dyn_stack::MemBuffer, dyn_stack::MemStack, Col, Mat, Par, Side};
 use glam::DVec3;
 
 use super::context::StepContext;
-use super::overdamped::{clamp_fraction, Blowup, OverdampedSettings};
+use super::overdamped::{clamp_fraction, Blowup};
 use super::system_matrix::SystemMatrix;
 use crate::backend::Stiffness;
 use crate::rng::noise3;

@@ -24,10 +24,10 @@ use crate::integrate::fire::FireReport;
 use crate::integrate::implicit::SolveReport;
 use crate::integrate::Integrator;
 use crate::kinetics_engine::{initial_bond_state, Formation, Kinetics};
-use crate::output::{EventLog, LifetimeTable};
 use crate::output::open_writer_with;
 use crate::output::restart::{read_state, write_state, RestartData};
 use crate::output::run_log::{LogHeader, PhaseTimes, RunLog};
+use crate::output::{EventLog, LifetimeTable};
 use crate::system::{Model, SimBox, State};
 
 mod cpu_steps;
