@@ -361,9 +361,10 @@ def per_bond_r0():
 
 
 def custom():
-    """`custom` expressions of every kind LAMMPS' lepton styles express:
-    restatements of harmonic, cosine_angle, harmonic_angle and soft, and laws
-    no built-in has, on bonded chains with angles and two particle types."""
+    """`custom` expressions of every kind LAMMPS expresses (lepton bond,
+    angle and pair styles; fix addforce for an external): restatements of
+    harmonic, cosine_angle, harmonic_angle and soft, and laws no built-in has,
+    on bonded chains with angles and two particle types."""
     rng = random.Random(sum(map(ord, "custom")))
     ff = (TYPES
           + 'bond s custom "0.5*k*(r-r0)^2" k 50 r0 1.0\n'
@@ -385,7 +386,9 @@ def custom():
         "custom.ff": ff,
         "small.top": top,
         "random.top": rtop,
-        "small.in": deck("small.top", "custom.ff", "x -5 5 f y -5 5 f z -5 5 f", 1e-3),
+        # A custom external (fix addforce with −∇E from the symbolic derivatives).
+        "small.in": deck("small.top", "custom.ff", "x -5 5 f y -5 5 f z -5 5 f", 1e-3,
+                         extra='external trap all custom "0.5*k*((x-x0)^2+y^2)+f*z*exp(-z^2)" k 3 x0 0.5 f 0.7\n'),
         "random.in": deck("random.top", "custom.ff", f"x 0 {box} p y 0 {box} p z 0 {box} p", 1e-3),
     })
 

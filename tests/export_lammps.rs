@@ -180,3 +180,18 @@ fn per_bond_rest_lengths_become_bond_types_of_their_own() {
     let plain = Case::new(&[("t.top", &top.replace(" 1.2\n", "\n").replace(" 0.7\n", "\n")), ("f.ff", ff), ("deck.in", deck)]);
     assert!(export(&plain.plan(), ExportOptions::default()).unwrap().data.contains("\n2 bond types\n"));
 }
+
+/// A `custom` external becomes `fix addforce` with −∇E from the symbolic
+/// derivatives (its agreement with LAMMPS is the golden case
+/// reference/custom/small.in); an energy that reads a periodic coordinate is
+/// refused, since LAMMPS' atom-style `x` is wrapped.
+#[test]
+fn a_custom_external_exports_as_addforce_with_its_gradient() {
+    let trap = "external trap all custom \"0.5*k*(x-x0)^2 + f*z\" k 3 x0 0.5 f 0.7\n";
+    let out = export(&deck(&trap.replace("(x-x0)^2", "(z-x0)^2")).plan(), ExportOptions::default()).unwrap();
+    for line in ["variable x_trap_fx atom \"(-0.0)\"", "fix x_trap g_trap addforce v_x_trap_fx v_x_trap_fy v_x_trap_fz energy v_x_trap_e"] {
+        assert!(out.input.lines().any(|l| l == line), "in.lammps lacks `{line}`:\n{}", out.input);
+    }
+    let periodic = export(&deck(trap).plan(), ExportOptions::default()).unwrap_err();
+    assert!(periodic.contains("external `trap` reads `x` on a periodic axis"), "{periodic}");
+}

@@ -49,6 +49,7 @@ use super::formula;
 use super::number::num;
 use super::styles::{self, PairStyled, Styled};
 use crate::deck::{Action, CoeffTarget, Plan};
+use crate::expr::{Expr, UnaryOp};
 use crate::forcefield::TermType;
 use crate::integrate::Integrator;
 use crate::kinetics::deterministic_strain;
@@ -575,6 +576,8 @@ impl Writer<'_> {
         let id = ident("x_", &external.term.label.text);
         let args = if external.term.interaction.name() == "field" {
             self.field_variables(external, &id)?
+        } else if external.term.interaction.name() == "custom" {
+            self.custom_variables(external, &id, b.periodic)?
         } else {
             let d = moving_wall_offset(external).map_err(|e| format!("external `{}`: {e}", external.term.label.text))?;
             let variable = format!("{id}_face");
@@ -608,6 +611,41 @@ impl Writer<'_> {
                 None => num(external.term.params[k]),
             };
             let name = format!("{id}_{}", spec.name);
+            self.line(format!("variable {name} atom \"{formula}\""));
+            names.push(name);
+        }
+        Ok(format!("addforce v_{} v_{} v_{} energy v_{}", names[0], names[1], names[2], names[3]))
+    }
+
+    /// A `custom` external as `fix addforce` with atom-style variables: the
+    /// components of −∇E from the expression's symbolic derivatives and the
+    /// energy E, its parameters written as numbers and `t` as LAMMPS' `time`.
+    /// LAMMPS' `x`, `y`, `z` are wrapped into the box, so an energy that reads
+    /// the coordinate of a periodic axis is refused.
+    fn custom_variables(&mut self, external: &External, id: &str, periodic: [bool; 3]) -> Result<String, String> {
+        let term = &external.term;
+        let label = &term.label.text;
+        let energy = term.interaction.expression().ok_or_else(|| format!("external `{label}` has no expression"))?;
+        for (axis, name) in ["x", "y", "z"].into_iter().enumerate() {
+            if periodic[axis] && energy.depends_on(name) {
+                return Err(format!(
+                    "external `{label}` reads `{name}` on a periodic axis: LAMMPS' atom-style `{name}` is wrapped into the box where cellmd's is unwrapped"
+                ));
+            }
+        }
+        let specs = term.interaction.params();
+        let energy =
+            energy.substitute(&|name| (name != "t").then(|| specs.iter().position(|p| p.name == name)).flatten().map(|k| term.params[k]));
+        let minus = |e: Expr| Expr::Unary { op: UnaryOp::Neg, span: e.span(), arg: Box::new(e) };
+        let mut names = Vec::new();
+        for (suffix, expr) in [
+            ("fx", minus(energy.derivative("x"))),
+            ("fy", minus(energy.derivative("y"))),
+            ("fz", minus(energy.derivative("z"))),
+            ("e", energy),
+        ] {
+            let formula = formula::lammps_formula(&expr).map_err(|e| format!("external `{label}`: {e}"))?;
+            let name = format!("{id}_{suffix}");
             self.line(format!("variable {name} atom \"{formula}\""));
             names.push(name);
         }

@@ -18,6 +18,7 @@
 //! | `indenter` (K/3)(R−r)³ | `fix indent … sphere` | identical (K, centre, R) |
 //! | `field` | `fix addforce v_fx v_fy v_fz energy v_e` | one atom-style variable per parameter ([`super::formula`]) |
 //! | `custom` bond, angle, pair | `bond_style lepton` (r0 = 0), `angle_style lepton` (θ0 = 0), `pair_style lepton` | the expression, parameters as numbers ([`super::lepton`]); r0 = 0 and θ0 = 0 make Lepton's displacement variables the distance and the angle |
+//! | `custom` external | `fix addforce v_fx v_fy v_fz energy v_e` | atom-style variables of −∇E (symbolic derivatives) and E ([`super::formula`]); refused when E reads a periodic axis's coordinate |
 
 use crate::forcefield::TermType;
 use crate::interactions::{param_index, Law};
