@@ -182,13 +182,7 @@ fn builders_with_rest_lengths_from_geometry_start_force_free() {
 /// per such bond), a pair repulsion and bending angles; `constrain h` in
 /// `deck_body` constrains every `h` bond. Returns the case.
 fn chains(per_type: bool, deck_body: &str) -> Case {
-    let mut seed = 0x2545F4914F6CDD1Du64;
-    let mut next = || {
-        seed ^= seed << 13;
-        seed ^= seed >> 7;
-        seed ^= seed << 17;
-        (seed >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut next = common::uniform(0x2545F4914F6CDD1D);
     let laws = [
         ("h", "harmonic k 50 r0 1.0"),
         ("c", "cable k 40 r0 1.0 tau 0.05"),

@@ -16,13 +16,7 @@ use glam::DVec3;
 /// an external push; `ff_laws` gives the bond, angle and pair lines and
 /// `external` the push.
 fn case(ff_laws: &str, external: &str, run: &str) -> Case {
-    let mut seed = 0x2545F4914F6CDD1Du64;
-    let mut next = || {
-        seed ^= seed << 13;
-        seed ^= seed >> 7;
-        seed ^= seed << 17;
-        (seed >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut next = common::uniform(0x2545F4914F6CDD1D);
     let (n, l) = (300, 6.0);
     let mut top = String::from("[ particles ]\n");
     for id in 1..=n {

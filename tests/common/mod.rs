@@ -63,16 +63,21 @@ pub fn grid_topology(n_side: usize, a: f64) -> String {
     top
 }
 
-/// 400 particles of two types in a box of edge 8 (some right at the faces),
-/// with bonds, angles and three pair rules; `special` is inserted into the deck.
-pub fn random_case(periodic: bool, special: &str) -> Case {
-    let mut seed = 0x9E3779B97F4A7C15u64;
-    let mut next = || {
+/// A xorshift64 generator of uniform numbers in [0, 1) from `seed`: test
+/// geometries that are random-looking but the same on every machine.
+pub fn uniform(mut seed: u64) -> impl FnMut() -> f64 {
+    move || {
         seed ^= seed << 13;
         seed ^= seed >> 7;
         seed ^= seed << 17;
         (seed >> 11) as f64 / (1u64 << 53) as f64
-    };
+    }
+}
+
+/// 400 particles of two types in a box of edge 8 (some right at the faces),
+/// with bonds, angles and three pair rules; `special` is inserted into the deck.
+pub fn random_case(periodic: bool, special: &str) -> Case {
+    let mut next = uniform(0x9E3779B97F4A7C15);
     let (n, l) = (400, 8.0);
     let mut top = String::from("[ particles ]\n");
     for id in 1..=n {
