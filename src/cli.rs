@@ -258,14 +258,14 @@ where
                 let results = crate::system::check_custom_terms(&plan.model, &externals, &plan.positions, &plan.sim_box);
                 for result in &results {
                     match result {
-                        Ok(line) => println!("selftest: {line}"),
+                        Ok(line) => out!("selftest: {line}"),
                         Err(e) => eprintln!("error: selftest: {e}"),
                     }
                 }
                 if results.iter().any(Result::is_err) {
                     return ExitCode::from(1);
                 }
-                println!("selftest: {} custom term(s) pass F = -grad E, sum f = 0 and rigid-motion checks", results.len());
+                out!("selftest: {} custom term(s) pass F = -grad E, sum f = 0 and rigid-motion checks", results.len());
                 ExitCode::SUCCESS
             }
             Err(e) => report(e),

@@ -114,3 +114,26 @@ fn check_selftest_runs_the_shared_checks_on_every_custom_term() {
         assert!(stdout.contains(line), "stdout lacks `{line}`:\n{stdout}");
     }
 }
+
+/// Every `check` (and `run`) warns, at the law's label, of a custom law that
+/// is not finite where the deck starts or at its declared rest value, and of
+/// a pair law truncated at its cutoff; a law that is fine says nothing.
+#[test]
+fn custom_laws_not_finite_where_the_deck_starts_or_truncated_at_the_cutoff_warn() {
+    let laws = "bond s custom \"k*ln(r-r0)\" k 1 r0 0.5\nangle t custom \"K*ln(1-cos(theta-theta0))\" K 1 theta0 90deg\n\
+                pair a a custom \"A*(1+cos(pi*r/rc))\" cutoff 0.8 A 2 rc 0.8\npair b b custom \"A*(1-r)\" cutoff 0.5 A 1\n";
+    let c = case(laws, "external sink all custom \"f*sqrt(x-3)\" f 1", "run 0\n");
+    let out = Command::new(env!("CARGO_BIN_EXE_cellmd")).arg("check").arg(c.path("deck.in")).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    for warning in [
+        "f.ff:3:6: warning: bond `s` (custom): E = -inf, dE/dr = inf at its rest length r0 (r = 5e-1)",
+        "f.ff:4:7: warning: angle `t` (custom): not finite at its rest angle theta0 = 90.000000°",
+        "warning: external `sink` (custom): not finite at the initial position of particle",
+        "f.ff:6:6: warning: pair b b (custom): truncated at the cutoff with E = 5.000000000005e-1, dE/dr = -1e0 just inside; \
+         the dynamics feel the jump",
+    ] {
+        assert!(stderr.contains(warning), "stderr lacks `{warning}`:\n{stderr}");
+    }
+    assert_eq!(stderr.matches("warning").count(), 4, "{stderr}");
+}

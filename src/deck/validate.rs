@@ -225,6 +225,10 @@ pub(super) fn validate_in(v: &mut Validator, file: &std::sync::Arc<SourceFile>) 
     };
     v.model(&last)?;
     v.protocols.finish()?;
+    let model = v.initial_model.as_ref().expect("built above");
+    let externals: Vec<_> = v.actions.iter().filter_map(|a| if let Action::External(e) = a { Some(e) } else { None }).collect();
+    let sim_box = v.sim_box.as_ref().expect("built with the model");
+    v.warnings.extend(crate::system::custom_warnings(model, &externals, &v.positions, sim_box));
     Ok(Plan {
         deck_path: PathBuf::from(&file.path),
         model: v.initial_model.take().expect("built above"),

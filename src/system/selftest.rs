@@ -8,6 +8,12 @@
 //! reported), each angle type at its first angle and at 45°, 100° and 160°,
 //! each external at its first members' positions, each body term on the
 //! first body it acts on.
+//!
+//! [`custom_warnings`] is the cheap part every `check` and `run` prints: a
+//! custom law that is not finite where the deck starts (each bond and angle
+//! at its initial geometry, at its `r0`/`theta0` if it declares one, each
+//! external at its members' positions), and a pair law truncated at its
+//! cutoff.
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
@@ -74,6 +80,88 @@ pub fn check_custom_terms(model: &Model, externals: &[&External], positions: &[D
         );
     }
     out
+}
+
+/// Warnings (`file:line:col: warning: …`, at the law's label) for the
+/// custom terms of `model` whose energy or force is not finite at the
+/// deck's initial geometry or at a declared rest value (`r0`, `theta0`), and
+/// for custom pair laws truncated at their cutoff (see [`at_cutoff`]).
+/// `externals` are the deck's `external` commands.
+pub fn custom_warnings(model: &Model, externals: &[&External], positions: &[DVec3], sim_box: &SimBox) -> Vec<String> {
+    let custom = |t: &TermType| t.interaction.name() == "custom";
+    let images = sim_box.images();
+    let warn = |term: &TermType, what: &str, message: String| {
+        let l = &term.label;
+        format!("{}:{}:{}: warning: {what} (custom): {message}", l.file.path, l.line, l.col)
+    };
+    let named = |what: &str, term: &TermType| format!("{what} `{}`", term.label.text);
+    let declared = |term: &TermType, name: &str| term.interaction.params().iter().position(|p| p.name == name).map(|k| term.params[k]);
+    let mut out = Vec::new();
+    for (k, term) in model.bond_types.iter().enumerate().filter(|(_, t)| custom(t)) {
+        let Law::Radial { eval, .. } = term.interaction.law() else { continue };
+        let lengths = model.bonds.iter().zip(&model.bond_type).filter(|(_, &t)| t as usize == k).map(|([i, j], _)| {
+            (
+                format!("at the initial length of bond {}–{}", model.ids[*i as usize], model.ids[*j as usize]),
+                images.minimum_image(positions[*j as usize] - positions[*i as usize]).length(),
+            )
+        });
+        let rest = declared(term, "r0").map(|r0| ("at its rest length r0".to_string(), r0));
+        if let Some((place, r)) = rest.into_iter().chain(lengths).find(|(_, r)| !finite_radial(eval(&term.params, *r))) {
+            let e = eval(&term.params, r);
+            out.push(warn(term, &named("bond", term), format!("E = {:e}, dE/dr = {:e} {place} (r = {r:e})", e.energy, e.de_dr)));
+        }
+    }
+    for (k, term) in model.angle_types.iter().enumerate().filter(|(_, t)| custom(t)) {
+        let Law::ThreeBody(eval) = term.interaction.law() else { continue };
+        let finite = |x: [DVec3; 3]| {
+            let e = eval(&term.params, x);
+            e.energy.is_finite() && e.forces.iter().all(|f| f.is_finite())
+        };
+        let rest = declared(term, "theta0").filter(|t| !finite([DVec3::X, DVec3::ZERO, DVec3::new(t.cos(), t.sin(), 0.0)]));
+        if let Some(theta0) = rest {
+            out.push(warn(term, &named("angle", term), format!("not finite at its rest angle theta0 = {:.6}°", theta0.to_degrees())));
+        }
+        let bad = model.angles.iter().zip(&model.angle_type).filter(|(_, &t)| t as usize == k).find(|([i, j, l], _)| {
+            let xj = positions[*j as usize];
+            let (u, v) = (images.minimum_image(positions[*i as usize] - xj), images.minimum_image(positions[*l as usize] - xj));
+            !finite([xj + u, xj, xj + v])
+        });
+        if let Some(([i, j, l], _)) = bad {
+            let ids = [i, j, l].map(|&p| model.ids[p as usize]);
+            out.push(warn(
+                term,
+                &named("angle", term),
+                format!("not finite at the initial geometry of angle {}–{}–{}", ids[0], ids[1], ids[2]),
+            ));
+        }
+    }
+    for external in externals.iter().filter(|e| custom(&e.term)) {
+        let term = &external.term;
+        let Law::OneBody(eval) = term.interaction.law() else { continue };
+        let bad = external.members.iter().find(|&&m| {
+            let e = eval(&term.params, positions[m as usize]);
+            !(e.energy.is_finite() && e.force.is_finite())
+        });
+        if let Some(&m) = bad {
+            out.push(warn(
+                term,
+                &named("external", term),
+                format!("not finite at the initial position of particle {}", model.ids[m as usize]),
+            ));
+        }
+    }
+    for (term, &(a, b)) in model.pair_rules.iter().zip(&model.pair_rule_types).filter(|(t, _)| custom(t)) {
+        let note = at_cutoff(term, term.params[0]);
+        if note.starts_with("warning: ") {
+            let what = format!("pair {} {}", model.type_names[a as usize], model.type_names[b as usize]);
+            out.push(warn(term, &what, format!("{}; the dynamics feel the jump (`cellmd check --selftest` runs every check)", &note[9..])));
+        }
+    }
+    out
+}
+
+fn finite_radial(e: crate::interactions::Radial) -> bool {
+    e.energy.is_finite() && e.de_dr.is_finite()
 }
 
 /// Whether the energy and the force vanish just inside the cutoff (to 1e-9
