@@ -32,7 +32,9 @@ pub fn parse_params(
     units: UnitSystem,
 ) -> Result<TermType, InputError> {
     let interaction = lookup(&interaction_token.text).ok_or_else(|| {
-        let names: Vec<&str> = REGISTRY.iter().filter(|i| i.kind() == kind).map(|i| i.name()).collect();
+        // `custom` (registered as a body term) takes every kind but contact.
+        let offered = |i: &&&dyn Interaction| i.kind() == kind || (i.name() == "custom" && kind != Kind::Contact);
+        let names: Vec<&str> = REGISTRY.iter().filter(offered).map(|i| i.name()).collect();
         interaction_token.error(format!(
             "found `{}`, expected a registered {} interaction: {}",
             interaction_token.text,

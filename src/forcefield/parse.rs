@@ -192,7 +192,9 @@ pub fn load_forcefield(
                     return Err(kw.error("expected `bond NAME INTERACTION [param value]... [kinetics RULE [param value]...]...`"));
                 }
                 check_unique(&t[1], ff.bond_types.iter().map(|x| &x.label), "bond type")?;
-                let law_end = t.iter().position(|x| x.text == "kinetics").unwrap_or(t.len());
+                // Kinetic rules follow the interaction and its parameters (a
+                // bond named or typed `kinetics` is not one).
+                let law_end = t[3..].iter().position(|x| x.text == "kinetics").map_or(t.len(), |k| k + 3);
                 let law = term_type(&t[1], &t[2], &t[3..law_end], Kind::Bond, units)?;
                 ff.bond_kinetics.push(parse_kinetics(&law, &t[law_end..], units)?);
                 ff.bond_types.push(law);
