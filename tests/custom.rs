@@ -23,14 +23,7 @@ fn case(ff_laws: &str, external: &str, run: &str) -> Case {
         let ty = if id % 3 == 0 { "b" } else { "a" };
         top += &format!("{id} {ty} {} {} {}\n", next() * l, next() * l, next() * l);
     }
-    top += "[ bonds ]\n";
-    for id in (1..n).step_by(2) {
-        top += &format!("s {id} {}\n", id + 1);
-    }
-    top += "[ angles ]\n";
-    for id in (1..n - 2).step_by(4) {
-        top += &format!("t {id} {} {}\n", id + 1, id + 2);
-    }
+    top += &common::pairs_and_triples(n);
     let ff = format!("particle a drag 1\nparticle b drag 2\n{ff_laws}");
     let deck = format!(
         "units lj\ntopology t.top\nforcefield f.ff\nbox x 0 {l} p y 0 {l} p z 0 {l} p\nneighbor skin 0.3\ntimestep 1e-3\n{external}\n{run}"

@@ -604,17 +604,26 @@ impl Writer<'_> {
     /// A `field` as `fix addforce` with one atom-style variable per parameter
     /// (its arguments after the group).
     fn field_variables(&mut self, external: &External, id: &str) -> Result<String, String> {
-        let mut names = Vec::new();
+        let mut variables = Vec::new();
         for (k, spec) in external.term.interaction.params().iter().enumerate() {
             let formula = match external.expressions.iter().find(|(p, _)| *p == k) {
                 Some((_, expr)) => formula::lammps_formula(expr).map_err(|e| format!("external `{}`: {e}", external.term.label.text))?,
                 None => num(external.term.params[k]),
             };
-            let name = format!("{id}_{}", spec.name);
-            self.line(format!("variable {name} atom \"{formula}\""));
-            names.push(name);
+            variables.push((spec.name, formula));
         }
-        Ok(format!("addforce v_{} v_{} v_{} energy v_{}", names[0], names[1], names[2], names[3]))
+        Ok(self.addforce(id, &variables))
+    }
+
+    /// Writes one atom-style variable `ID_NAME` per (name, formula) — the
+    /// force components, then the energy — and returns the `fix addforce`
+    /// arguments that read them.
+    fn addforce(&mut self, id: &str, variables: &[(&str, String)]) -> String {
+        let names: Vec<String> = variables.iter().map(|(name, _)| format!("{id}_{name}")).collect();
+        for (name, (_, formula)) in names.iter().zip(variables) {
+            self.line(format!("variable {name} atom \"{formula}\""));
+        }
+        format!("addforce v_{} v_{} v_{} energy v_{}", names[0], names[1], names[2], names[3])
     }
 
     /// A `custom` external as `fix addforce` with atom-style variables: the
@@ -637,19 +646,16 @@ impl Writer<'_> {
         let energy =
             energy.substitute(&|name| (name != "t").then(|| specs.iter().position(|p| p.name == name)).flatten().map(|k| term.params[k]));
         let minus = |e: Expr| Expr::Unary { op: UnaryOp::Neg, span: e.span(), arg: Box::new(e) };
-        let mut names = Vec::new();
+        let mut variables = Vec::new();
         for (suffix, expr) in [
             ("fx", minus(energy.derivative("x"))),
             ("fy", minus(energy.derivative("y"))),
             ("fz", minus(energy.derivative("z"))),
             ("e", energy),
         ] {
-            let formula = formula::lammps_formula(&expr).map_err(|e| format!("external `{label}`: {e}"))?;
-            let name = format!("{id}_{suffix}");
-            self.line(format!("variable {name} atom \"{formula}\""));
-            names.push(name);
+            variables.push((suffix, formula::lammps_formula(&expr).map_err(|e| format!("external `{label}`: {e}"))?));
         }
-        Ok(format!("addforce v_{} v_{} v_{} energy v_{}", names[0], names[1], names[2], names[3]))
+        Ok(self.addforce(id, &variables))
     }
 
     fn unexternal(&mut self, name: &str) {

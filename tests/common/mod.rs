@@ -74,6 +74,20 @@ pub fn uniform(mut seed: u64) -> impl FnMut() -> f64 {
     }
 }
 
+/// Topology sections over particles 1..=n: `s` bonds (1 2), (3 4), … and
+/// `t` angles (1 2 3), (5 6 7), ….
+pub fn pairs_and_triples(n: u64) -> String {
+    let mut top = String::from("[ bonds ]\n");
+    for id in (1..n).step_by(2) {
+        top += &format!("s {id} {}\n", id + 1);
+    }
+    top += "[ angles ]\n";
+    for id in (1..n - 2).step_by(4) {
+        top += &format!("t {id} {} {}\n", id + 1, id + 2);
+    }
+    top
+}
+
 /// 400 particles of two types in a box of edge 8 (some right at the faces),
 /// with bonds, angles and three pair rules; `special` is inserted into the deck.
 pub fn random_case(periodic: bool, special: &str) -> Case {
@@ -86,14 +100,7 @@ pub fn random_case(periodic: bool, special: &str) -> Case {
         let x = if id % 50 == 0 { l - 1e-9 } else { next() * l };
         top += &format!("{id} {ty} {x} {} {}\n", next() * l, next() * l);
     }
-    top += "[ bonds ]\n";
-    for id in (1..n).step_by(2) {
-        top += &format!("s {id} {}\n", id + 1);
-    }
-    top += "[ angles ]\n";
-    for id in (1..n - 2).step_by(4) {
-        top += &format!("t {id} {} {}\n", id + 1, id + 2);
-    }
+    top += &pairs_and_triples(n);
     let ff = "particle a drag 1\nparticle b drag 2\nbond s harmonic k 2 r0 0.5\nangle t cosine_angle K 0.3\n\
               pair a a lj epsilon 1 sigma 0.3 rc 0.9\npair a b soft A 1 rc 0.7\npair a b soft_repulsion k 5 sigma 0.5\n";
     let b = if periodic { "p" } else { "f" };
