@@ -6,7 +6,7 @@
 
 mod common;
 
-use cellmd::deck::{Group, ThermoColumn};
+use cellmd::deck::{Group, GroupQuantity, ThermoColumn};
 use common::Case;
 
 const TOP: &str = "[ particles ]\n1 p 0 0 0\n2 p 1.5 0 0\n3 q 5 5 5\n4 q 6 5 5\n[ bonds ]\ns 1 2\n";
@@ -84,8 +84,47 @@ fn a_moved_group_moves_at_its_velocity_and_reports_the_drag_it_pulls() {
     assert_eq!(sim.state.positions[1].y, 0.0);
     let r = sim.state.positions[1].x - sim.state.positions[0].x;
     assert!((r - (1.0 + 2.0 * 0.3 / 3.0)).abs() < 1e-9, "stretch {r}");
-    let reaction = sim.thermo_value(&ThermoColumn::GroupForce { group: Group { name: "drv".into(), members: vec![1] }, axis: 0 }).unwrap();
+    let reaction = sim.thermo_value(&ThermoColumn::Group { group: Group { name: "drv".into(), members: vec![1] }, quantity: GroupQuantity::Force(0) }).unwrap();
     assert!((reaction + 2.0 * 0.3).abs() < 1e-9, "reaction {reaction}");
+}
+
+#[test]
+fn a_velocity_field_moves_each_particle_by_explicit_euler_steps_of_its_own_velocity() {
+    // Particles 3 and 4 turn about the z axis (v = ω ẑ × x) while drifting up
+    // at a speed that grows with time; each step is x += dt·v(x, t), t the
+    // step's start, which this recursion repeats exactly.
+    let body = "variable w equal 2\ngroup qs type q\nmove qs velocity \"-w*y\" \"w*x\" \"0.5*t\"\nrun 300\n";
+    let sim = deck(body).run();
+    for (k, start) in [(2, [5.0, 5.0, 5.0]), (3, [6.0, 5.0, 5.0])] {
+        let mut x = glam::DVec3::from_array(start);
+        for n in 0..300 {
+            let t = n as f64 * DT;
+            x += DT * glam::DVec3::new(-2.0 * x.y, 2.0 * x.x, 0.5 * t);
+        }
+        assert!((sim.state.positions[k] - x).length() < 1e-12, "particle {k}: {} vs {x}", sim.state.positions[k]);
+    }
+    // Turning by explicit Euler grows the radius by √(1 + (ω·dt)²) per step.
+    let radius = sim.state.positions[2].truncate().length();
+    let expected = 50f64.sqrt() * (1.0 + (2.0 * DT) * (2.0 * DT)).powf(150.0);
+    assert!((radius - expected).abs() < 1e-9, "{radius} vs {expected}");
+}
+
+#[test]
+fn group_extent_force_magnitudes_and_footprint_columns() {
+    let mut sim = deck("group ends id 1 2 3\nrun 0\n").run();
+    let mut column = |name: &str, quantity| {
+        let members = vec![0, 1, 2];
+        sim.thermo_value(&ThermoColumn::Group { group: Group { name: name.into(), members }, quantity }).unwrap()
+    };
+    // Particles at (0,0,0), (1.5,0,0), (5,5,5): x spans 5, z spans 5.
+    assert_eq!(column("ends", GroupQuantity::Span(0)), 5.0);
+    assert_eq!(column("ends", GroupQuantity::Span(2)), 5.0);
+    // The xy footprint is the triangle (0,0), (1.5,0), (5,5): area 3.75.
+    assert!((column("ends", GroupQuantity::HullArea) - 3.75).abs() < 1e-12);
+    // The bond pulls 1 and 2 together with k(r − r0) = 1.5 each: Σ|f| = 3
+    // while the summed vector force fx is 0.
+    assert!((column("ends", GroupQuantity::ForceMagnitudes) - 3.0).abs() < 1e-12);
+    assert!(column("ends", GroupQuantity::Force(0)).abs() < 1e-12);
 }
 
 #[test]
@@ -153,7 +192,7 @@ fn an_indenter_driven_to_a_load_stops_there_and_reports_load_and_depth() {
     assert!((load - 10.0 * depth * depth).abs() < 1e-12, "load {load} at depth {depth}");
     assert!((0.9..=10.0 * 0.301 * 0.301 + 1e-9).contains(&load), "load {load}: reached within one step");
     // The anchor's reaction is the load.
-    let reaction = sim.thermo_value(&ThermoColumn::GroupForce { group: Group { name: "a".into(), members: vec![0] }, axis: 2 }).unwrap();
+    let reaction = sim.thermo_value(&ThermoColumn::Group { group: Group { name: "a".into(), members: vec![0] }, quantity: GroupQuantity::Force(2) }).unwrap();
     assert!((reaction + load).abs() < 1e-12, "reaction {reaction}");
     // Without `until` it keeps going; `indent tip stop` holds it.
     let body = "group a id 1\nexternal tip a indenter z 1.5 r 1 k 10\nindent tip velocity 0 0 -1\nrun 300\nindent tip stop\nrun 300\n";

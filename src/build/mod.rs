@@ -77,6 +77,7 @@ mod icosphere;
 mod merge;
 mod network;
 mod sheet;
+mod substrate;
 mod tensegrity;
 
 use std::f64::consts::TAU;

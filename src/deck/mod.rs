@@ -38,7 +38,7 @@ mod variables;
 
 pub use self::expression::Condition;
 pub use self::open::OpenDeck;
-pub use self::plan::{Action, CheckpointSpec, CoeffTarget, DumpSpec, Group, NeighborSettings, Plan, ThermoColumn};
-pub use self::protocol::{Protocol, Ramp};
+pub use self::plan::{Action, CheckpointSpec, CoeffTarget, DumpSpec, Group, GroupQuantity, NeighborSettings, Plan, ThermoColumn};
+pub use self::protocol::{Protocol, Ramp, Velocity};
 pub use self::validate::{validate, validate_file, validate_file_with, validate_with, ValidateOptions};
 pub use self::variables::Variables;

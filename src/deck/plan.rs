@@ -97,23 +97,74 @@ pub enum ThermoColumn {
         bond_type: usize,
         quantity: crate::measure::fracture::FractureQuantity,
     },
-    /// Summed force on a group's particles along an axis (`fx/GROUP`,
-    /// `fy/GROUP`, `fz/GROUP`); on `fixed` particles, the reaction of their anchors.
-    GroupForce {
+    /// A quantity of a group's particles (`fx/GROUP`, `xu/GROUP`,
+    /// `xspan/GROUP`, `fabs/GROUP`, …).
+    Group {
         group: Group,
-        axis: usize,
-    },
-    /// Mean unwrapped coordinate of a group's particles along an axis
-    /// (`xu/GROUP`, `yu/GROUP`, `zu/GROUP`).
-    GroupPosition {
-        group: Group,
-        axis: usize,
+        quantity: GroupQuantity,
     },
     /// Magnitude of the summed force an indenter external exerts on its
     /// group, its reaction (`load/NAME`).
     IndenterLoad(String),
     /// Deepest penetration δ of a particle into an indenter external (`depth/NAME`).
     IndenterDepth(String),
+}
+
+/// What a group thermo column measures over the group's particles.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum GroupQuantity {
+    /// Summed force along an axis (`fx/`, `fy/`, `fz/`), pN; on `fixed` and
+    /// moved particles the reaction of what holds them.
+    Force(usize),
+    /// Mean unwrapped coordinate along an axis (`xu/`, `yu/`, `zu/`), µm.
+    Position(usize),
+    /// Extent, largest minus smallest unwrapped coordinate along an axis
+    /// (`xspan/`, `yspan/`, `zspan/`), µm: e.g. a nucleus' height.
+    Span(usize),
+    /// Σ|f_i|, the summed magnitudes of the particles' forces (`fabs/`), pN:
+    /// Vassaux & Milan's (2017) "total resultant force at the focal
+    /// adhesions", which the vector sum `fx/` … would cancel.
+    ForceMagnitudes,
+    /// Area of the convex hull of the particles' (x, y) projection
+    /// (`hullarea/`), µm²: a cell's footprint, its spread area on a substrate.
+    HullArea,
+}
+
+impl GroupQuantity {
+    /// The quantity a column prefix names (`fx`, `xu`, `zspan`, `fabs`).
+    pub fn from_prefix(prefix: &str) -> Option<Self> {
+        let axis = |c: u8| usize::from(c - b'x');
+        match prefix {
+            "fx" | "fy" | "fz" => Some(Self::Force(axis(prefix.as_bytes()[1]))),
+            "xu" | "yu" | "zu" => Some(Self::Position(axis(prefix.as_bytes()[0]))),
+            "xspan" | "yspan" | "zspan" => Some(Self::Span(axis(prefix.as_bytes()[0]))),
+            "fabs" => Some(Self::ForceMagnitudes),
+            "hullarea" => Some(Self::HullArea),
+            _ => None,
+        }
+    }
+
+    /// The column prefix (inverse of [`Self::from_prefix`]).
+    pub fn prefix(self) -> String {
+        let axis = |a: usize| ["x", "y", "z"][a];
+        match self {
+            Self::Force(a) => format!("f{}", axis(a)),
+            Self::Position(a) => format!("{}u", axis(a)),
+            Self::Span(a) => format!("{}span", axis(a)),
+            Self::ForceMagnitudes => "fabs".into(),
+            Self::HullArea => "hullarea".into(),
+        }
+    }
+
+    /// The quantity's dimension.
+    pub fn dim(self) -> crate::units::Dim {
+        use crate::units::Dim;
+        match self {
+            Self::Force(_) | Self::ForceMagnitudes => Dim::Force,
+            Self::Position(_) | Self::Span(_) => Dim::Length,
+            Self::HullArea => Dim::Area,
+        }
+    }
 }
 
 /// A named trajectory output.

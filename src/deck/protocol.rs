@@ -33,15 +33,44 @@ impl Ramp {
     }
 }
 
+/// The velocity of a moved group.
+#[derive(Clone, Debug)]
+pub enum Velocity {
+    /// `linear VX VY VZ`: one constant velocity (LAMMPS `fix move linear`).
+    Constant(DVec3),
+    /// `velocity "VX" "VY" "VZ"`: a velocity field, each component an
+    /// expression of the particle's unwrapped position `x`, `y`, `z` and the
+    /// simulated time `t` (deck variables folded in), evaluated for every
+    /// particle at the start of every step (LAMMPS `fix move variable` with
+    /// velocity variables): a step moves a particle by v(x, t)·dt, explicit
+    /// Euler along the field's streamlines.
+    Field(Box<[crate::expr::Expr; 3]>),
+}
+
+impl Velocity {
+    /// The velocity of a particle at unwrapped position `x` at time `t`
+    /// (NaN components where an expression leaves its domain).
+    pub fn at(&self, x: DVec3, t: f64) -> DVec3 {
+        match self {
+            Self::Constant(v) => *v,
+            Self::Field(components) => {
+                let value = |e: &crate::expr::Expr| e.eval(&mut |r| crate::system::position_or_time(r, x, t)).unwrap_or(f64::NAN);
+                DVec3::new(value(&components[0]), value(&components[1]), value(&components[2]))
+            }
+        }
+    }
+}
+
 /// A protocol command, in deck order.
 #[derive(Clone, Debug)]
 pub enum Protocol {
     /// `ramp …`: applies over the next `run`.
     Ramp(Ramp),
-    /// `move GROUP linear VX VY VZ`: the group's particles move at this
-    /// velocity every step whatever the forces on them (which thermo's
-    /// `fx/GROUP` … still reports: the reaction of the driven group).
-    Move { group: Group, velocity: DVec3 },
+    /// `move GROUP linear VX VY VZ` / `move GROUP velocity "VX" "VY" "VZ"`:
+    /// the group's particles move at this velocity every step whatever the
+    /// forces on them (which thermo's `fx/GROUP` … still reports: the
+    /// reaction of the driven group).
+    Move { group: Group, velocity: Velocity },
     /// `unmove GROUP`.
     Unmove(String),
     /// `freeze GROUP x|y|z…`: the group's coordinates along these axes stay

@@ -7,18 +7,18 @@
 
 use glam::DVec3;
 
-use crate::deck::{Protocol, Ramp};
+use crate::deck::{Protocol, Ramp, Velocity};
 use crate::integrate::context::StepContext;
 use crate::interactions::{param_index, Law};
 use crate::system::{Model, SimBox, State};
 
 /// One prescribed particle: which axes the protocol holds and, for a moved
-/// particle, its velocity (zero for a freeze).
+/// particle, its moving group (index into `Protocols::moves`; None for a freeze).
 #[derive(Clone, Copy, Debug)]
 struct Held {
     particle: u32,
     axes: [bool; 3],
-    velocity: DVec3,
+    mover: Option<usize>,
 }
 
 /// An indenter driven by `indent`.
@@ -40,7 +40,7 @@ pub(super) struct Protocols {
     /// First and last step of the run the ramps span.
     span: (u64, u64),
     /// Moving groups (name, members, velocity) and frozen groups (name, members, axes), in deck order.
-    moves: Vec<(String, Vec<u32>, DVec3)>,
+    moves: Vec<(String, Vec<u32>, Velocity)>,
     freezes: Vec<(String, Vec<u32>, [bool; 3])>,
     /// Every held particle, by ascending index (a moved particle ignores freezes).
     held: Vec<Held>,
@@ -57,7 +57,7 @@ impl Protocols {
             Protocol::Ramp(ramp) => self.ramps.push(ramp.clone()),
             Protocol::Move { group, velocity } => {
                 self.moves.retain(|m| m.0 != group.name);
-                self.moves.push((group.name.clone(), group.members.clone(), *velocity));
+                self.moves.push((group.name.clone(), group.members.clone(), velocity.clone()));
             }
             Protocol::Unmove(name) => self.moves.retain(|m| m.0 != *name),
             Protocol::Freeze { group, axes } => {
@@ -78,15 +78,15 @@ impl Protocols {
 
     fn collect_held(&mut self) {
         let mut held: Vec<Held> = Vec::new();
-        for (_, members, velocity) in &self.moves {
-            held.extend(members.iter().map(|&particle| Held { particle, axes: [true; 3], velocity: *velocity }));
+        for (m, (_, members, _)) in self.moves.iter().enumerate() {
+            held.extend(members.iter().map(|&particle| Held { particle, axes: [true; 3], mover: Some(m) }));
         }
         held.sort_by_key(|h| h.particle);
         let moved = held.len();
         for (_, members, axes) in &self.freezes {
             for &particle in members {
                 if held[..moved].binary_search_by_key(&particle, |h| h.particle).is_err() {
-                    held.push(Held { particle, axes: *axes, velocity: DVec3::ZERO });
+                    held.push(Held { particle, axes: *axes, mover: None });
                 }
             }
         }
@@ -185,20 +185,37 @@ impl Protocols {
 
     /// Puts the held particles on their prescription after a step of the
     /// context's dt: held axes back where they were, moved particles advanced
-    /// by v·dt (wrapped into the box, image counters kept).
-    pub(super) fn after_step(&self, state: &mut State, sim_box: &SimBox, ctx: &StepContext) {
+    /// by v·dt (wrapped into the box, image counters kept), v their group's
+    /// velocity at their position before the step and the step's start time.
+    /// A velocity field that is not finite there stops the step before any
+    /// held particle moves: `Err((particle, why))`.
+    pub(super) fn after_step(&self, state: &mut State, sim_box: &SimBox, ctx: &StepContext) -> Result<(), (usize, String)> {
+        let mut velocities = Vec::with_capacity(self.held.len());
         for (h, (x0, image0, _)) in self.held.iter().zip(&self.before) {
+            let Some(m) = h.mover else {
+                velocities.push(DVec3::ZERO);
+                continue;
+            };
+            let (group, _, velocity) = &self.moves[m];
+            let v = velocity.at(sim_box.unwrap(*x0, *image0), ctx.time);
+            if !v.is_finite() {
+                return Err((h.particle as usize, format!("velocity {v} of moving group `{group}` is not finite")));
+            }
+            velocities.push(v);
+        }
+        for ((h, (x0, image0, _)), v) in self.held.iter().zip(&self.before).zip(velocities) {
             let i = h.particle as usize;
             let (x, image) = (&mut state.positions[i], &mut state.images[i]);
             for a in (0..3).filter(|&a| h.axes[a]) {
                 x[a] = x0[a];
                 image[a] = image0[a];
             }
-            if h.velocity != DVec3::ZERO {
-                *x += h.velocity * ctx.dt;
+            if v != DVec3::ZERO {
+                *x += v * ctx.dt;
                 sim_box.wrap(x, image);
             }
         }
+        Ok(())
     }
 }
 

@@ -38,7 +38,8 @@ use std::path::PathBuf;
 
 use super::protocol::indenter_load;
 use crate::backend::Forces;
-use crate::deck::ThermoColumn;
+use crate::deck::{GroupQuantity, ThermoColumn};
+use glam::DVec2;
 use crate::interactions::REGISTRY;
 use crate::measure::{filaments, fracture, planes};
 use crate::units::{Dim, UnitSystem};
@@ -107,8 +108,7 @@ pub fn column_label(c: &ThermoColumn, model: &crate::system::Model) -> String {
         ThermoColumn::Fracture { bond_type, quantity } => {
             format!("fracture/{}/{}", model.bond_types[*bond_type].label.text, quantity.name())
         }
-        ThermoColumn::GroupForce { group, axis } => format!("f{}/{}", ["x", "y", "z"][*axis], group.name),
-        ThermoColumn::GroupPosition { group, axis } => format!("{}u/{}", ["x", "y", "z"][*axis], group.name),
+        ThermoColumn::Group { group, quantity } => format!("{}/{}", quantity.prefix(), group.name),
         ThermoColumn::IndenterLoad(name) => format!("load/{name}"),
         ThermoColumn::IndenterDepth(name) => format!("depth/{name}"),
     }
@@ -128,8 +128,9 @@ pub fn column_unit(c: &ThermoColumn, units: UnitSystem) -> &'static str {
         ThermoColumn::MinDistance => units.label(Dim::Length),
         ThermoColumn::Tension(_) | ThermoColumn::ConstraintTension(_) | ThermoColumn::PlaneTension { .. } => units.label(Dim::Force),
         ThermoColumn::CorticalTension(_) => units.label(Dim::Tension),
-        ThermoColumn::EndToEnd(_) | ThermoColumn::GroupPosition { .. } => units.label(Dim::Length),
-        ThermoColumn::GroupForce { .. } | ThermoColumn::ExternalForce { .. } | ThermoColumn::IndenterLoad(_) => units.label(Dim::Force),
+        ThermoColumn::Group { quantity, .. } => units.label(quantity.dim()),
+        ThermoColumn::EndToEnd(_) => units.label(Dim::Length),
+        ThermoColumn::ExternalForce { .. } | ThermoColumn::IndenterLoad(_) => units.label(Dim::Force),
         ThermoColumn::IndenterDepth(_) => units.label(Dim::Length),
         ThermoColumn::Time => units.label(Dim::Time),
         ThermoColumn::Pe | ThermoColumn::PeOf(_) | ThermoColumn::Work | ThermoColumn::ExternalEnergy(_) => units.label(Dim::Energy),
@@ -195,14 +196,55 @@ pub fn column_value(c: &ThermoColumn, t: &ThermoInputs) -> f64 {
         ThermoColumn::Fracture { bond_type, quantity } => {
             fracture::fracture(t.model, t.bonds.map(|s| s.bound.as_slice()), *bond_type).value(*quantity)
         }
-        ThermoColumn::GroupForce { group, axis } => group.members.iter().map(|&i| t.forces.forces[i as usize][*axis]).sum(),
+        ThermoColumn::Group { group, quantity } => group_value(t, &group.members, *quantity),
         ThermoColumn::IndenterLoad(name) => indenter_load(t.model, t.state, t.sim_box, name).map_or(f64::NAN, |(load, _)| load),
         ThermoColumn::IndenterDepth(name) => indenter_load(t.model, t.state, t.sim_box, name).map_or(f64::NAN, |(_, depth)| depth),
-        ThermoColumn::GroupPosition { group, axis } => {
-            let unwrapped = |i: usize| t.sim_box.unwrap(t.state.positions[i], t.state.images[i])[*axis];
-            group.members.iter().map(|&i| unwrapped(i as usize)).sum::<f64>() / group.members.len() as f64
+    }
+}
+
+/// A group column's value over the particles `members`.
+fn group_value(t: &ThermoInputs, members: &[u32], quantity: GroupQuantity) -> f64 {
+    let unwrapped = |i: u32, axis: usize| t.sim_box.unwrap(t.state.positions[i as usize], t.state.images[i as usize])[axis];
+    match quantity {
+        GroupQuantity::Force(axis) => members.iter().map(|&i| t.forces.forces[i as usize][axis]).sum(),
+        GroupQuantity::Position(axis) => members.iter().map(|&i| unwrapped(i, axis)).sum::<f64>() / members.len() as f64,
+        GroupQuantity::Span(axis) => {
+            let (low, high) = members.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(low, high), &i| {
+                let x = unwrapped(i, axis);
+                (low.min(x), high.max(x))
+            });
+            high - low
+        }
+        GroupQuantity::ForceMagnitudes => members.iter().map(|&i| t.forces.forces[i as usize].length()).sum(),
+        GroupQuantity::HullArea => {
+            let points: Vec<glam::DVec2> = members.iter().map(|&i| DVec2::new(unwrapped(i, 0), unwrapped(i, 1))).collect();
+            hull_area(points)
         }
     }
+}
+
+/// Area of the convex hull of `points` (Andrew's monotone chain, then the
+/// shoelace formula); 0 for fewer than three points or collinear ones.
+fn hull_area(mut points: Vec<DVec2>) -> f64 {
+    points.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+    points.dedup();
+    if points.len() < 3 {
+        return 0.0;
+    }
+    let turn = |o: DVec2, a: DVec2, b: DVec2| (a - o).perp_dot(b - o);
+    let mut hull: Vec<DVec2> = Vec::with_capacity(2 * points.len());
+    for pass in [points.as_slice(), &points.iter().rev().copied().collect::<Vec<_>>()] {
+        let start = hull.len();
+        for &p in pass {
+            while hull.len() >= start + 2 && turn(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0.0 {
+                hull.pop();
+            }
+            hull.push(p);
+        }
+        hull.pop();
+    }
+    let n = hull.len();
+    (0..n).map(|k| hull[k].perp_dot(hull[(k + 1) % n])).sum::<f64>().abs() / 2.0
 }
 
 /// Σ F·x of the `constant_force` externals: minus their energy.
@@ -356,5 +398,21 @@ impl Thermo {
             file.flush().map_err(|e| (path, e))?;
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hull_area_of_points_inside_and_on_the_edges_of_a_rectangle_is_the_rectangle() {
+        let mut points: Vec<DVec2> = (0..=6).flat_map(|i| (0..=4).map(move |j| DVec2::new(i as f64 * 0.5, j as f64 * 0.25))).collect();
+        points.reverse();
+        assert!((hull_area(points) - 3.0).abs() < 1e-12);
+        let disc: Vec<DVec2> = (0..1000).map(|k| DVec2::from_angle(k as f64 * 0.001 * std::f64::consts::TAU) * 2.0).collect();
+        assert!((hull_area(disc) / (std::f64::consts::PI * 4.0) - 1.0).abs() < 1e-4);
+        assert_eq!(hull_area(vec![DVec2::ZERO, DVec2::X, DVec2::X * 2.0]), 0.0);
+        assert_eq!(hull_area(vec![DVec2::ZERO, DVec2::Y]), 0.0);
     }
 }

@@ -90,7 +90,7 @@ const COMMANDS: &[Command] = &[
         "ramp bond|angle NAME PARAM FROM TO | ramp pair A B PARAM FROM TO | ramp body TYPE LAW PARAM FROM TO | ramp external NAME PARAM FROM TO",
         |v, s, usage| v.protocol(s, usage, Validator::ramp),
     ),
-    line("move", "move GROUP linear VX VY VZ", |v, s, usage| v.protocol(s, usage, Validator::move_group)),
+    line("move", "move GROUP linear VX VY VZ | move GROUP velocity \"VX\" \"VY\" \"VZ\"", |v, s, usage| v.protocol(s, usage, Validator::move_group)),
     line("unmove", "unmove GROUP", |v, s, usage| v.protocol(s, usage, Validator::release)),
     line("freeze", "freeze GROUP x|y|z ...", |v, s, usage| v.protocol(s, usage, Validator::freeze)),
     line("unfreeze", "unfreeze GROUP", |v, s, usage| v.protocol(s, usage, Validator::release)),

@@ -192,14 +192,7 @@ impl Validator {
             if parse_f64(&pairs[k], "").is_ok() {
                 continue;
             }
-            let mut expr = DeckExpr::parse(std::slice::from_ref(&pairs[k]))?;
-            for (r, span) in expr.expr.refs() {
-                let known = matches!(r, Ref::Name("x" | "y" | "z" | "t"));
-                if let (Ref::Name(name), false) = (r, known) {
-                    self.vars.number(name).map_err(|message| expr.error(&ExprError { span, message }))?;
-                }
-            }
-            expr.expr = expr.expr.substitute(&|name| self.vars.number(name).ok().filter(|_| !matches!(name, "x" | "y" | "z" | "t")));
+            let expr = self.position_expression(&pairs[k])?;
             let first = group.members.first().copied().unwrap_or(0);
             let x = self.positions[first as usize];
             let value = expr.expr.eval(&mut |r| position_or_time(r, x, 0.0)).map_err(|e| self.at_particle(&expr, &e, first))?;
@@ -207,6 +200,21 @@ impl Validator {
             expressions.push((pairs[k - 1].clone(), expr));
         }
         Ok((values, expressions))
+    }
+
+    /// An expression of the position `x`, `y`, `z` and the time `t` (an
+    /// external's parameter, a moved group's velocity) with the numeric deck
+    /// variables it names folded in; any other name is an error at it.
+    pub(super) fn position_expression(&self, token: &Token) -> Result<DeckExpr, InputError> {
+        let mut expr = DeckExpr::parse(std::slice::from_ref(token))?;
+        for (r, span) in expr.expr.refs() {
+            let known = matches!(r, Ref::Name("x" | "y" | "z" | "t"));
+            if let (Ref::Name(name), false) = (r, known) {
+                self.vars.number(name).map_err(|message| expr.error(&ExprError { span, message }))?;
+            }
+        }
+        expr.expr = expr.expr.substitute(&|name| self.vars.number(name).ok().filter(|_| !matches!(name, "x" | "y" | "z" | "t")));
+        Ok(expr)
     }
 
     /// Checks each expression parameter at every member's initial position
@@ -240,7 +248,7 @@ impl Validator {
     }
 
     /// An error of an external's expression evaluated at particle `m`'s initial position.
-    fn at_particle(&self, expr: &DeckExpr, e: &ExprError, m: u32) -> InputError {
+    pub(super) fn at_particle(&self, expr: &DeckExpr, e: &ExprError, m: u32) -> InputError {
         let mut located = expr.error(e);
         let id = self.model.as_ref().expect("built").ids[m as usize];
         located.message = format!("at particle {id} (x = {}) and t = 0: {}", self.positions[m as usize], located.message);

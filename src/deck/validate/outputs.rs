@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use super::{expect_len, Validator};
-use crate::deck::plan::{Action, CheckpointSpec, DumpSpec, ThermoColumn};
+use crate::deck::plan::{Action, CheckpointSpec, DumpSpec, GroupQuantity, ThermoColumn};
 use crate::input::{check_input_file, is_replaying, parse_u64, InputError, Token};
 use crate::interactions::REGISTRY;
 use crate::kinetics_engine::EventKind;
@@ -13,13 +13,6 @@ use crate::output::{AtomColumn, DumpFormat, Encoding, WriterOptions};
 
 /// Whether a thermo column prefix names a group measurement: (force (`fx`,
 /// `fy`, `fz`) or mean unwrapped position (`xu`, `yu`, `zu`), axis).
-fn group_column(prefix: &str) -> Option<(bool, usize)> {
-    match prefix {
-        "fx" | "fy" | "fz" => Some((true, usize::from(prefix.as_bytes()[1] - b'x'))),
-        "xu" | "yu" | "zu" => Some((false, usize::from(prefix.as_bytes()[0] - b'x'))),
-        _ => None,
-    }
-}
 
 impl Validator {
     pub(super) fn thermo(&mut self, s: &[Token], usage: &str) -> Result<(), InputError> {
@@ -27,7 +20,7 @@ impl Validator {
         let every = parse_u64(&s[1], "a thermo interval in steps")?;
         let columns = if s.len() > 2 {
             // Group columns name groups, which exist once the system does.
-            if let Some(t) = s[2..].iter().find(|t| t.text.split_once('/').is_some_and(|(p, _)| group_column(p).is_some())) {
+            if let Some(t) = s[2..].iter().find(|t| t.text.split_once('/').is_some_and(|(p, _)| GroupQuantity::from_prefix(p).is_some())) {
                 self.model(t)?;
             }
             self.thermo_columns(&s[2..])?
@@ -155,7 +148,7 @@ impl Validator {
 
     pub(in crate::deck) fn thermo_columns(&self, tokens: &[Token]) -> Result<Vec<ThermoColumn>, InputError> {
         const FIXED: &str =
-            "step, time, pe, work, pe/NAME, pe/EXTERNAL, fmax, fnorm, press, pxx, pyy, pzz, pxy, pxz, pyz, nbuild, solver_iterations, solver_residual, ctension/BONDTYPE, breaks, rebinds, forms, resets, nbound/BONDTYPE, tension/BONDTYPE, volume/BODYTYPE, area/BODYTYPE, planetension/AXIS/POS, gamma/BODYTYPE, e2e/BONDTYPE, tcorr/BONDTYPE/LAG, fracture/BONDTYPE/QUANTITY, fx/GROUP, fy/GROUP, fz/GROUP, fx/EXTERNAL, fy/EXTERNAL, fz/EXTERNAL, xu/GROUP, yu/GROUP, zu/GROUP, load/INDENTER, depth/INDENTER, mindist, nclamp";
+            "step, time, pe, work, pe/NAME, pe/EXTERNAL, fmax, fnorm, press, pxx, pyy, pzz, pxy, pxz, pyz, nbuild, solver_iterations, solver_residual, ctension/BONDTYPE, breaks, rebinds, forms, resets, nbound/BONDTYPE, tension/BONDTYPE, volume/BODYTYPE, area/BODYTYPE, planetension/AXIS/POS, gamma/BODYTYPE, e2e/BONDTYPE, tcorr/BONDTYPE/LAG, fracture/BONDTYPE/QUANTITY, fx/GROUP, fy/GROUP, fz/GROUP, fx/EXTERNAL, fy/EXTERNAL, fz/EXTERNAL, xu/GROUP, yu/GROUP, zu/GROUP, xspan/GROUP, yspan/GROUP, zspan/GROUP, fabs/GROUP, hullarea/GROUP, load/INDENTER, depth/INDENTER, mindist, nclamp";
         let bond_type = |t: &Token, name: &str| {
             self.forcefield.bond_types.iter().position(|b| b.label.text == name).ok_or_else(|| {
                 let names: Vec<&str> = self.forcefield.bond_types.iter().map(|b| b.label.text.as_str()).collect();
@@ -217,14 +210,14 @@ impl Validator {
                                 )))
                             }
                         },
-                        Some((prefix, name)) if self.externals.contains(name) && group_column(prefix).is_some_and(|(force, _)| force) => {
+                        Some((prefix @ ("fx" | "fy" | "fz"), name)) if self.externals.contains(name) => {
                             if self.groups.contains_key(name) {
                                 return Err(t.error(format!(
                                     "found `{other}`, where `{name}` names both a group and an active external; expected an external \
                                      named otherwise than every group"
                                 )));
                             }
-                            ThermoColumn::ExternalForce { name: name.to_string(), axis: group_column(prefix).expect("matched").1 }
+                            ThermoColumn::ExternalForce { name: name.to_string(), axis: usize::from(prefix.as_bytes()[1] - b'x') }
                         }
                         Some(("nbound", name)) => ThermoColumn::Bound(bond_type(t, name)?),
                         Some(("tension", name)) => ThermoColumn::Tension(bond_type(t, name)?),
@@ -233,14 +226,10 @@ impl Validator {
                         Some(("area", name)) => ThermoColumn::BodyArea(body_type(t, name)?),
                         Some(("gamma", name)) => ThermoColumn::CorticalTension(body_type(t, name)?),
                         Some(("e2e", name)) => ThermoColumn::EndToEnd(bond_type(t, name)?),
-                        Some((prefix, name)) if group_column(prefix).is_some() => {
-                            let (force, axis) = group_column(prefix).expect("matched");
+                        Some((prefix, name)) if GroupQuantity::from_prefix(prefix).is_some() => {
+                            let quantity = GroupQuantity::from_prefix(prefix).expect("matched");
                             let group = self.group_named(&t.with_text(name.to_string()))?.clone();
-                            if force {
-                                ThermoColumn::GroupForce { group, axis }
-                            } else {
-                                ThermoColumn::GroupPosition { group, axis }
-                            }
+                            ThermoColumn::Group { group, quantity }
                         }
                         Some((kind @ ("load" | "depth"), name)) => self.indenter_column(t, kind, name)?,
                         Some(("planetension", rest)) => {

@@ -7,7 +7,9 @@ use glam::DVec3;
 
 use super::{expect_len, positive, Validator};
 use crate::deck::plan::{Action, CoeffTarget, ThermoColumn};
-use crate::deck::protocol::{Protocol, Ramp};
+use crate::deck::protocol::{Protocol, Ramp, Velocity};
+use crate::expr::ExprError;
+use crate::system::position_or_time;
 use crate::input::{parse_f64, InputError, Token};
 use crate::interactions::param_index;
 
@@ -142,19 +144,40 @@ impl Validator {
         Ok(Protocol::Ramp(last))
     }
 
-    /// `move GROUP linear VX VY VZ` (velocity in length/time units).
+    /// `move GROUP linear VX VY VZ` (velocity in length/time units) or
+    /// `move GROUP velocity "VX" "VY" "VZ"` (expressions of x, y, z, t,
+    /// checked at every member's initial position at t = 0).
     pub(super) fn move_group(&mut self, s: &[Token], usage: &str) -> Result<Protocol, InputError> {
         expect_len(s, 5..=5, usage)?;
         self.model(&s[0])?;
         let group = self.group_named(&s[1])?.clone();
-        if s[2].text != "linear" {
-            return Err(s[2].error(format!("found style `{}`, expected `linear` (`{usage}`)", s[2].text)));
-        }
-        let mut velocity = DVec3::ZERO;
         let unit = self.units.label(crate::units::Dim::Velocity);
-        for (a, (t, name)) in s[3..].iter().zip(["VX", "VY", "VZ"]).enumerate() {
-            velocity[a] = parse_f64(t, &format!("a velocity {name} in {unit}"))?;
-        }
+        let components = s[3..].iter().zip(["VX", "VY", "VZ"]);
+        let velocity = match s[2].text.as_str() {
+            "linear" => {
+                let mut velocity = DVec3::ZERO;
+                for (a, (t, name)) in components.enumerate() {
+                    velocity[a] = parse_f64(t, &format!("a velocity {name} in {unit}"))?;
+                }
+                Velocity::Constant(velocity)
+            }
+            "velocity" => {
+                let exprs = components.map(|(t, _)| self.position_expression(t)).collect::<Result<Vec<_>, _>>()?;
+                for &m in &group.members {
+                    let x = self.positions[m as usize];
+                    for expr in &exprs {
+                        let value = expr.expr.eval(&mut |r| position_or_time(r, x, 0.0)).map_err(|e| self.at_particle(expr, &e, m))?;
+                        if !value.is_finite() {
+                            let message = format!("found velocity {value}, expected a finite velocity in {unit}");
+                            return Err(self.at_particle(expr, &ExprError { span: expr.expr.span(), message }, m));
+                        }
+                    }
+                }
+                let field: [crate::expr::Expr; 3] = exprs.into_iter().map(|e| e.expr).collect::<Vec<_>>().try_into().expect("three tokens");
+                Velocity::Field(Box::new(field))
+            }
+            other => return Err(s[2].error(format!("found style `{other}`, expected `linear` or `velocity` (`{usage}`)"))),
+        };
         let clash = self
             .protocols
             .moving

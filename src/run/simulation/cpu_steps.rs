@@ -82,7 +82,9 @@ impl Stepper for CpuSteps {
                 )));
             }
         }
-        sim.protocols.after_step(&mut sim.state, &sim.sim_box, &ctx);
+        if let Err((particle, why)) = sim.protocols.after_step(&mut sim.state, &sim.sim_box, &ctx) {
+            return Err(sim.blowup(particle, why));
+        }
         self.lap(sim, Phase::Integrate);
         sim.check_in_box()?;
         Ok(Taken { steps: 1, last: Some(clock) })

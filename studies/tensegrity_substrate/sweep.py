@@ -1,0 +1,171 @@
+#!/usr/bin/env python3
+"""Tensegrity cell on curved substrates and nano-indentation (seed 003,
+Vassaux & Milan 2017), with inputs/tensegrity_substrate.in.
+
+1. Calibration: on a flat substrate, spread the cell (unit stiffness scale)
+   until its footprint passes 962 µm², interpolate the total adhesion force
+   Σ|f| at 962 µm² between the last two stages, and scale every stiffness by
+   47 150 pN / that force (quasi-static: at given adhesion positions every
+   force is proportional to the common stiffness scale).
+2. Check and indent: the calibrated cell spread on the flat substrate to
+   F_sprd = 47.15 nN (its footprint at F_sprd is reported), contracted, then
+   indented by a rigid 2.5 µm sphere; the relaxed load against the travel
+   since contact is the force-depth curve.
+3. Curvature sweep: the calibrated cell spread to F_sprd on substrates of
+   curvature radius ±75, ±150, ±500 µm and flat, then contracted; nucleus
+   volumetric and vertical strain, summed stress-fibre tension (per fibre,
+   the mean over its cables, summed over fibres) and mean cortex-cable
+   tension against 1/R.
+
+Writes OUT/calibration.csv, OUT/indentation.csv, OUT/curvature.csv and, with
+plot.py, the PNGs. Not part of CI (tests/tensegrity_substrate.rs runs a
+reduced case).
+
+    python3 studies/tensegrity_substrate/sweep.py --cellmd target/release/cellmd --out out/tensegrity_substrate [--level 2]
+"""
+
+import argparse
+import csv
+import re
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+DECK = ROOT / "inputs" / "tensegrity_substrate.in"
+F_SPRD = 47150.0  # pN, Vassaux & Milan's total adhesion force at 962 µm²
+AREA = 962.0  # µm²
+CURVATURES = ["-75", "-150", "-500", "flat", "500", "150", "75"]
+FIBRE_SEGMENTS = 3
+CENTRE_Z = 11.5  # the cell's centre: its lowest node 1.5 µm above z = 0
+GAP = 1.0
+
+
+def build(cellmd, level, curvature, path):
+    """Builds the cell on one substrate; returns the cortex's and the nucleus' volumes and the bottom z."""
+    out = subprocess.run(
+        [cellmd, "build", "tensegrity", "--radius", "10", "--level", str(level), "--nucleus", "5",
+         "--centre", "0", "0", str(CENTRE_Z), "--focal-adhesions", "30", "--fibre-segments", str(FIBRE_SEGMENTS),
+         "--bodies", "--seed", "3", "--rest-from-geometry", "--substrate", curvature, "--substrate-extent", "30",
+         "-o", str(path)],
+        check=True, capture_output=True, text=True).stdout
+    volumes = [float(v) for v in re.findall(r"enclosed volume ([0-9.eE+-]+)", out)]
+    bottom = float(re.search(r"touching z = ([0-9.eE+-]+)", out).group(1))
+    return volumes[0], volumes[1], bottom
+
+
+def run(cellmd, top, out, curvature, volumes, **variables):
+    """Runs the deck on one topology; returns the rows of its thermo files, by phase."""
+    v_cell, v_nucleus, bottom = volumes
+    flat = curvature == "flat"
+    values = {"topology": top, "v0_cell": v_cell, "v0_nucleus": v_nucleus, "c": 0 if flat else 1,
+              "curvature": 0 if flat else float(curvature), "zc": 0 if flat else bottom + float(curvature)}
+    values.update(variables)
+    out.mkdir(parents=True, exist_ok=True)
+    command = [cellmd, "run", str(DECK), "-o", str(out), "--threads", "1"]
+    for key, value in values.items():
+        command += ["--var", f"{key}={value}"]
+    subprocess.run(command, check=True, capture_output=True, text=True)
+    phases = {}
+    for phase in ["spread", "contract", "indentation"]:
+        path = out / f"tensegrity_{phase}.thermo.csv"
+        if path.exists():
+            rows = [{k.split("[")[0]: float(v) for k, v in r.items()} for r in csv.DictReader(open(path))]
+            # A stage's run and its minimize both end on the same step: keep the relaxed (last) row.
+            last = {}
+            for r in rows:
+                last[r["step"]] = r
+            phases[phase] = list(last.values())
+    return phases
+
+
+def at_area(rows, area):
+    """Σ|f| at the adhesions interpolated to the footprint `area` between the two stages around it."""
+    for a, b in zip(rows, rows[1:]):
+        if a["hullarea/cortex"] < area <= b["hullarea/cortex"]:
+            w = (area - a["hullarea/cortex"]) / (b["hullarea/cortex"] - a["hullarea/cortex"])
+            return a["fabs/fa"] + w * (b["fabs/fa"] - a["fabs/fa"])
+    raise SystemExit(f"the footprint never crossed {area} µm²")
+
+
+def area_at_force(rows, force):
+    for a, b in zip(rows, rows[1:]):
+        if a["fabs/fa"] < force <= b["fabs/fa"]:
+            w = (force - a["fabs/fa"]) / (b["fabs/fa"] - a["fabs/fa"])
+            return a["hullarea/cortex"] + w * (b["hullarea/cortex"] - a["hullarea/cortex"])
+    raise SystemExit(f"the adhesion force never crossed {force} pN")
+
+
+def readouts(phases):
+    spread, contract = phases["spread"], phases["contract"]
+    first, last = spread[0], contract[-1]
+    return {
+        "footprint_um2": spread[-1]["hullarea/cortex"],
+        "adhesion_force_pN": spread[-1]["fabs/fa"],
+        "nucleus_volumetric_strain": last["volume/nucleus"] / first["volume/nucleus"] - 1,
+        "nucleus_vertical_strain": last["zspan/nucleus"] / first["zspan/nucleus"] - 1,
+        "stress_fibre_force_pN": last["tension/stress_fibre"] / FIBRE_SEGMENTS,
+        "cortex_tension_sum_pN": last["tension/edge"],
+    }
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("--cellmd", default=str(ROOT / "target" / "release" / "cellmd"))
+    p.add_argument("--out", default="out/tensegrity_substrate")
+    p.add_argument("--level", type=int, default=2)
+    p.add_argument("--indent-stages", type=int, default=10)
+    args = p.parse_args()
+    out = Path(args.out).resolve()
+    out.mkdir(parents=True, exist_ok=True)
+    started = time.time()
+    tops = {}
+    for curvature in CURVATURES:
+        top = out / f"cell_{curvature}.top"
+        tops[curvature] = (top, build(args.cellmd, args.level, curvature, top))
+
+    top, volumes = tops["flat"]
+    raw = run(args.cellmd, top, out / "calibrate", "flat", volumes, spread_area=AREA, contract_steps=0)
+    force = at_area(raw["spread"], AREA)
+    scale = F_SPRD / force
+    print(f"calibration: Σ|f| = {force:.1f} pN at {AREA} µm² with unit stiffnesses; scale {scale:.4f}", file=sys.stderr)
+
+    checked = run(args.cellmd, top, out / "indent", "flat", volumes, scale=scale, f_sprd=F_SPRD,
+                  indent_stages=args.indent_stages)
+    area = area_at_force(checked["spread"], F_SPRD)
+    with open(out / "calibration.csv", "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["level", "force_at_962_unit_scale_pN", "scale", "footprint_at_F_sprd_um2", "target_um2"])
+        w.writerow([args.level, f"{force:.6g}", f"{scale:.6g}", f"{area:.6g}", AREA])
+    print(f"check: the calibrated cell reaches {F_SPRD} pN at a footprint of {area:.1f} µm²", file=sys.stderr)
+
+    rows = checked["indentation"]
+    # The approach ends on the first row loaded to 1 pN; after it the
+    # indenter moves only during the stage runs, at indent_step/(stage·dt).
+    t_contact = next(r["time"] for r in rows if r["load/tip"] >= 1.0)
+    speed = 0.2 / (50 * 2e-3)  # µm/s, the deck's indent_step/(stage·dt)
+    with open(out / "indentation.csv", "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["travel_um", "load_pN", "depth_um"])
+        for r in rows:
+            if r["time"] >= t_contact:
+                w.writerow([f"{(r['time'] - t_contact) * speed:.4f}", f"{r['load/tip']:.6g}", f"{r['depth/tip']:.6g}"])
+
+    with open(out / "curvature.csv", "w", newline="") as f:
+        w = None
+        for curvature in CURVATURES:
+            top, volumes = tops[curvature]
+            phases = run(args.cellmd, top, out / f"R_{curvature}", curvature, volumes, scale=scale, f_sprd=F_SPRD)
+            result = {"curvature_um": curvature, "inverse_radius_per_um": 0.0 if curvature == "flat" else 1 / float(curvature)}
+            result.update({k: f"{v:.6g}" for k, v in readouts(phases).items()})
+            if w is None:
+                w = csv.DictWriter(f, fieldnames=list(result))
+                w.writeheader()
+            w.writerow(result)
+            print(f"R = {curvature}: {result}", file=sys.stderr)
+    print(f"done in {time.time() - started:.0f} s", file=sys.stderr)
+
+
+if __name__ == "__main__":
+    main()
