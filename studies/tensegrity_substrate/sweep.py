@@ -60,7 +60,7 @@ def run(cellmd, top, out, curvature, volumes, **variables):
     v_cell, v_nucleus, bottom = volumes
     flat = curvature == "flat"
     values = {"topology": top, "v0_cell": v_cell, "v0_nucleus": v_nucleus, "c": 0 if flat else 1,
-              "curvature": 0 if flat else float(curvature), "zc": 0 if flat else bottom + float(curvature)}
+              "curvature": 0 if flat else float(curvature), "zc": -1000 if flat else bottom + float(curvature)}
     values.update(variables)
     out.mkdir(parents=True, exist_ok=True)
     command = [cellmd, "run", str(DECK), "-o", str(out), "--threads", "1"]
@@ -141,16 +141,15 @@ def main():
     print(f"check: the calibrated cell reaches {F_SPRD} pN at a footprint of {area:.1f} µm²", file=sys.stderr)
 
     rows = checked["indentation"]
-    # The approach ends on the first row loaded to 1 pN; after it the
-    # indenter moves only during the stage runs, at indent_step/(stage·dt).
+    # The approach ends on the first row loaded to 1 pN; after it every
+    # (relaxed) row ends one stage of the deck's indent_step.
     t_contact = next(r["time"] for r in rows if r["load/tip"] >= 1.0)
-    speed = 0.2 / (50 * 2e-3)  # µm/s, the deck's indent_step/(stage·dt)
+    indent_step = 0.2  # µm, the deck's default
     with open(out / "indentation.csv", "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(["travel_um", "load_pN", "depth_um"])
-        for r in rows:
-            if r["time"] >= t_contact:
-                w.writerow([f"{(r['time'] - t_contact) * speed:.4f}", f"{r['load/tip']:.6g}", f"{r['depth/tip']:.6g}"])
+        for n, r in enumerate(r for r in rows if r["time"] >= t_contact):
+            w.writerow([f"{n * indent_step:.3f}", f"{r['load/tip']:.6g}", f"{r['depth/tip']:.6g}"])
 
     with open(out / "curvature.csv", "w", newline="") as f:
         w = None
