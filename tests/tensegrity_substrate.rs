@@ -85,7 +85,9 @@ fn adhesions_after(s: &Spread) -> Vec<DVec3> {
 #[test]
 fn adhesions_slide_along_the_substrate_sphere_until_the_force_target() {
     let target = 3000.0;
-    let s = spread("75", &[("f_sprd", target.to_string())]);
+    // One step size throughout (the deck's coarse passes to half the target,
+    // then the fine one to the target), so the arc is FA_STEP per stage.
+    let s = spread("75", &[("f_sprd", target.to_string()), ("approach", "0.5".into()), ("fine_step", FA_STEP.to_string())]);
     let centre = DVec3::new(0.0, 0.0, s.bottom + 75.0);
     let rows = &s.spread;
     let last = rows.last().unwrap();
