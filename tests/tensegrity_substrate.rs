@@ -56,9 +56,13 @@ fn spread(curvature: &str, vars: &[(&str, String)]) -> Spread {
         ("v0_nucleus".into(), number_after("enclosed volume ", 1).to_string()),
         ("c".into(), if flat { "0" } else { "1" }.into()),
         ("zc".into(), if flat { "-1000".into() } else { (bottom + curvature.parse::<f64>().unwrap()).to_string() }),
-        ("contract_steps".into(), "0".into()),
+        ("steps".into(), "0".into()),
+        ("scale".into(), "1".into()),
     ];
-    all.extend(vars.iter().map(|(k, v)| (k.to_string(), v.clone())));
+    for (k, v) in vars {
+        all.retain(|(name, _)| name != k);
+        all.push((k.to_string(), v.clone()));
+    }
     let plan = validate_file(Path::new("inputs/tensegrity_substrate.in"), &all).unwrap_or_else(|e| panic!("{e}"));
     let adhesion_type = plan.model.type_names.iter().position(|n| n == "focal_adhesion").unwrap() as u32;
     let adhesions_before: Vec<DVec3> =

@@ -126,7 +126,7 @@ def main():
         tops[curvature] = (top, build(args.cellmd, args.level, curvature, top))
 
     top, volumes = tops["flat"]
-    raw = run(args.cellmd, top, out / "calibrate", "flat", volumes, spread_area=AREA, contract_steps=0)
+    raw = run(args.cellmd, top, out / "calibrate", "flat", volumes, scale=1, spread_area=AREA, steps=0)
     force = at_area(raw["spread"], AREA)
     scale = F_SPRD / force
     print(f"calibration: Σ|f| = {force:.1f} pN at {AREA} µm² with unit stiffnesses; scale {scale:.4f}", file=sys.stderr)
