@@ -1,7 +1,9 @@
-//! The README stays true: its interaction table is the registry, its worked
-//! example is the files in the repository, and its test command is CI's.
+//! The README stays true: its tables of interaction types and of kinetic
+//! rules are the registries, its worked example is the files in the
+//! repository, and its test command is CI's.
 
 use cellmd::interactions::REGISTRY;
+use cellmd::kinetics::RULES;
 
 fn readme() -> String {
     std::fs::read_to_string("README.md").unwrap()
@@ -17,6 +19,17 @@ fn interaction_table_matches_the_registry() {
     }
     let listed = rows.iter().filter(|r| REGISTRY.iter().any(|i| r.starts_with(&format!("| `{}` |", i.name())))).count();
     assert_eq!(listed, REGISTRY.len(), "README lists interactions that are not registered");
+}
+
+#[test]
+fn kinetic_rule_table_matches_the_registry() {
+    let text = readme();
+    let rows: Vec<&str> = text.lines().filter(|l| l.starts_with("| `") && l.replace("\\|", "").matches('|').count() == 3).collect();
+    let expected: Vec<String> = RULES.iter().map(|r| format!("| `{}` | {} |", r.name(), r.summary().replace('|', "\\|"))).collect();
+    let missing: Vec<&String> = expected.iter().filter(|row| !rows.contains(&row.as_str())).collect();
+    assert!(missing.is_empty(), "README lacks the rows\n{}", missing.iter().map(|r| r.as_str()).collect::<Vec<_>>().join("\n"));
+    let listed = rows.iter().filter(|r| RULES.iter().any(|k| r.starts_with(&format!("| `{}` |", k.name())))).count();
+    assert_eq!(listed, RULES.len(), "README lists kinetic rules that are not registered");
 }
 
 #[test]
