@@ -80,21 +80,14 @@ def run(cellmd, top, out, curvature, volumes, **variables):
     return phases
 
 
-def at_area(rows, area):
-    """Σ|f| at the adhesions interpolated to the footprint `area` between the two stages around it."""
+def crossing(rows, key, value, other):
+    """`other` interpolated linearly to where `key` first passes `value`
+    between two consecutive (relaxed) stages."""
     for a, b in zip(rows, rows[1:]):
-        if a["hullarea/cortex"] < area <= b["hullarea/cortex"]:
-            w = (area - a["hullarea/cortex"]) / (b["hullarea/cortex"] - a["hullarea/cortex"])
-            return a["fabs/fa"] + w * (b["fabs/fa"] - a["fabs/fa"])
-    raise SystemExit(f"the footprint never crossed {area} µm²")
-
-
-def area_at_force(rows, force):
-    for a, b in zip(rows, rows[1:]):
-        if a["fabs/fa"] < force <= b["fabs/fa"]:
-            w = (force - a["fabs/fa"]) / (b["fabs/fa"] - a["fabs/fa"])
-            return a["hullarea/cortex"] + w * (b["hullarea/cortex"] - a["hullarea/cortex"])
-    raise SystemExit(f"the adhesion force never crossed {force} pN")
+        if a[key] < value <= b[key]:
+            w = (value - a[key]) / (b[key] - a[key])
+            return a[other] + w * (b[other] - a[other])
+    raise SystemExit(f"{key} never crossed {value}")
 
 
 def readouts(phases):
@@ -127,13 +120,13 @@ def main():
 
     top, volumes = tops["flat"]
     raw = run(args.cellmd, top, out / "calibrate", "flat", volumes, scale=1, spread_area=AREA, steps=0)
-    force = at_area(raw["spread"], AREA)
+    force = crossing(raw["spread"], "hullarea/cortex", AREA, "fabs/fa")
     scale = F_SPRD / force
     print(f"calibration: Σ|f| = {force:.1f} pN at {AREA} µm² with unit stiffnesses; scale {scale:.4f}", file=sys.stderr)
 
     checked = run(args.cellmd, top, out / "indent", "flat", volumes, scale=scale, f_sprd=F_SPRD,
                   indent_stages=args.indent_stages)
-    area = area_at_force(checked["spread"], F_SPRD)
+    area = crossing(checked["spread"], "fabs/fa", F_SPRD, "hullarea/cortex")
     with open(out / "calibration.csv", "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(["level", "force_at_962_unit_scale_pN", "scale", "footprint_at_F_sprd_um2", "target_um2"])
