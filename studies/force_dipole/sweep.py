@@ -6,7 +6,7 @@ a contractile bond at its centre (`cellmd build lattice --radius R
 --bond-probability p --bending --dipole --seed S`), relaxes it with
 inputs/force_dipole.in (FIRE at T = 0, clamped rim) and reads the dump's
 per-node `sxx` (stress × area) over the area per node √3/2 (a = 1). |σ_xx| is
-averaged over rings logarithmically spaced between 3a and R/2 and the log-log
+averaged over rings logarithmically spaced between 4a and R/2 and the log-log
 slope fitted by least squares, per seed and for the seeds' mean profile;
 seed 000's window is [−2.5, −1.5], the 2D continuum's r⁻² its centre. The full
 lattice without bending (p = 1, an isotropic elastic sheet) is the reference.
@@ -29,7 +29,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[2]
 DECK = ROOT / "inputs" / "force_dipole.in"
 RINGS = 6
-R_IN = 3.0
+R_IN = 4.0
 
 
 def run(cmd):
