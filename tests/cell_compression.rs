@@ -51,10 +51,11 @@ fn compress(level: u32, stages: u32, dstrain: f64) -> Vec<Stage> {
     let v0 = cell.shells[0].volume;
     let top = out.path().join("cell.top");
     std::fs::write(&top, &cell.text).unwrap();
-    let vars: Vec<(String, String)> = [("topology", top.display().to_string()), ("v0", v0.to_string()), ("stages", stages.to_string()), ("dstrain", dstrain.to_string())]
-        .into_iter()
-        .map(|(k, v)| (k.to_string(), v))
-        .collect();
+    let vars: Vec<(String, String)> =
+        [("topology", top.display().to_string()), ("v0", v0.to_string()), ("stages", stages.to_string()), ("dstrain", dstrain.to_string())]
+            .into_iter()
+            .map(|(k, v)| (k.to_string(), v))
+            .collect();
     let plan = validate_file(Path::new(DECK), &vars).unwrap_or_else(|e| panic!("{e}"));
     let mut sim = Simulation::new(&plan, RunOptions { output_dir: out.path().to_path_buf(), ..Default::default() });
     let columns: Vec<ThermoColumn> =
