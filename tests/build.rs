@@ -234,6 +234,16 @@ fn bad_options_exit_with_status_2_and_say_what_was_expected() {
         (&["sheet", "--rows", "2", "--columns", "2", "--cell-size", "3", "--jitter", "0.49", "--gap", "1"][..], "convex hexagon"),
         (&["tensegrity", "--radius", "5", "--level", "1", "--microtubules", "50"][..], "expected --microtubules <= 42"),
         (&["tensegrity", "--radius", "5", "--nucleus", "6"][..], "expected 0 < --nucleus RADIUS < --radius 5, found 6"),
+        (
+            &["lattice", "--radius", "10", "--spacing", "1", "--bond-probability", "1.5"][..],
+            "expected --bond-probability in [0, 1], found 1.5",
+        ),
+        (
+            &["lattice", "--radius", "10", "--spacing", "1", "--bond-probability", "nan"][..],
+            "expected --bond-probability in [0, 1], found NaN",
+        ),
+        (&["lattice", "--radius", "2", "--spacing", "1"][..], "expected --radius at least 3 spacings"),
+        (&["lattice", "--radius", "1", "--spacing", "1e-300"][..], "expected --radius at most 2000 spacings"),
     ] {
         let mut all = vec!["build"];
         all.extend_from_slice(args);

@@ -23,6 +23,7 @@
 //! | [`cells()`] | `cells` | many icosphere cells packed in a spheroid or a confluent layer |
 //! | [`sheet()`] | `sheet` | a 2D epithelial sheet (Prakash et al. 2022): hexagonal cells as rings of nodes (or single particles) joined by junction bonds |
 //! | [`tensegrity()`] | `tensegrity` | a tensegrity cell (Vassaux & Milan 2017): cortex and nucleus shells, radial microtubule struts, actin cables and stress fibres from focal adhesions |
+//! | [`lattice()`] | `lattice` | a diluted triangular lattice of fibres in a disc with a clamped rim (Broedersz et al. 2011), optionally with a contractile force dipole |
 //! | [`merge()`] | `merge` | several topology files composed into one by the deck's rule for several `topology` lines |
 //!
 //! **Rest lengths** (`--rest-from-geometry`, every generator): by default a
@@ -74,6 +75,7 @@ mod cortex;
 mod filament;
 mod filopodium;
 mod icosphere;
+mod lattice;
 mod merge;
 mod network;
 mod sheet;
@@ -96,6 +98,7 @@ pub use self::cortex::{cortex, CortexArgs};
 pub use self::filament::{filament, FilamentArgs};
 pub use self::filopodium::{filopodium, FilopodiumArgs};
 pub use self::icosphere::{icosphere, icosphere_cell, IcosphereArgs, IcosphereCell, Nucleus, ShellOptions};
+pub use self::lattice::{lattice, LatticeArgs};
 pub use self::merge::{merge, MergeArgs};
 pub use self::network::{network, NetworkArgs, SlabAxis};
 pub use self::sheet::{sheet, SheetArgs};
@@ -133,6 +136,10 @@ pub enum Generator {
     /// centrosome node), radial microtubule struts, actin cables from the
     /// cortex to the nucleus and stress fibres from focal adhesions.
     Tensegrity(TensegrityArgs),
+    /// A diluted triangular lattice of fibres in a disc with a clamped rim
+    /// (Broedersz et al. 2011): each bond present with a probability,
+    /// optionally bending-stiff lattice lines and a contractile force dipole.
+    Lattice(LatticeArgs),
     /// Several topology files composed into one by the rule of a deck with
     /// several `topology` lines (ids shifted by --offset, by default the
     /// largest so far; body ids follow; shared type names; the first box).
@@ -153,6 +160,7 @@ impl Generator {
             Self::Cells(a) => cells(a),
             Self::Sheet(a) => sheet(a),
             Self::Tensegrity(a) => tensegrity(a),
+            Self::Lattice(a) => lattice(a),
             Self::Merge(a) => merge(a),
         }
     }
@@ -170,6 +178,7 @@ impl Generator {
             Self::Cells(a) => a.common.output.as_path(),
             Self::Sheet(a) => a.common.output.as_path(),
             Self::Tensegrity(a) => a.common.output.as_path(),
+            Self::Lattice(a) => a.common.output.as_path(),
             Self::Merge(a) => a.output.as_path(),
         }
     }
@@ -470,6 +479,7 @@ pub(crate) mod stream {
     pub const CELLS: u32 = 0x6275_0007;
     pub const SHEET: u32 = 0x6275_0008;
     pub const TENSEGRITY: u32 = 0x6275_0009;
+    pub const LATTICE: u32 = 0x6275_000a;
 }
 
 impl Draws {

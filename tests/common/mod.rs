@@ -206,3 +206,23 @@ pub fn kinetic_sites() -> (String, &'static str) {
               bond x harmonic k 5 r0 1.5 kinetics slip k0 1 x_beta 0.1\nbind a bead x k_on 0.5 capture 2.2 max_bonds 2\npair bead bead wca epsilon 1 sigma 0.3\n";
     (top + &bonds, ff)
 }
+
+/// Runs the repository deck `deck` (e.g. `inputs/force_dipole.in`) on the
+/// lattice of `args`, built into a temporary directory and passed as the
+/// deck's `topology` variable, with further `--var` overrides `vars`.
+/// Returns the finished simulation and what the builder wrote.
+pub fn run_deck_on_lattice(deck: &str, args: &cellmd::build::LatticeArgs, vars: &[(&str, String)]) -> (Simulation, cellmd::build::Built) {
+    let built = cellmd::build::lattice(args).unwrap_or_else(|e| panic!("{e}"));
+    let dir = tempfile::tempdir().unwrap();
+    let top = dir.path().join("lattice.top");
+    std::fs::write(&top, &built.text).unwrap();
+    let mut all = vec![("topology".to_string(), top.display().to_string())];
+    all.extend(vars.iter().map(|(k, v)| (k.to_string(), v.clone())));
+    let plan = validate_file(Path::new(deck), &all).unwrap_or_else(|e| panic!("{e}"));
+    let sim = Simulation::execute(plan, RunOptions { output_dir: dir.path().to_path_buf(), ..Default::default() })
+        .unwrap_or_else(|e| panic!("{e}"));
+    if let Some(report) = &sim.last_minimize {
+        assert!(report.converged, "FIRE did not converge: {report:?}");
+    }
+    (sim, built)
+}
