@@ -8,8 +8,13 @@
 //! - [`backend`]: buffers, pipelines and the GPU-resident step loop.
 //! - [`nlist`]: the neighbour list's buffer, bound in chunks of particles
 //!   where it exceeds the adapter's largest storage binding.
-//! - [`surface`]: per-face surface (body) terms: face, body and corner
-//!   passes, deterministic (no float atomics).
+//! - [`surface`]: surface (body) terms: face, body, edge and node passes,
+//!   deterministic (no float atomics).
+//!
+//! One file-level circle, on purpose: `pack.rs` ↔ `surface.rs`. `pack.rs`
+//! lays out the whole topology, the surface sections included, and
+//! `surface.rs` builds those sections' CSR lists with pack's `push_csr`, the
+//! one CSR builder of the GPU buffers.
 //!
 //! What runs where: each step — neighbour-list check and (when due) rebuild,
 //! forces, overdamped integration — runs on the GPU without reading anything
