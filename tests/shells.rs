@@ -7,7 +7,7 @@
 //! - **Volume conservation at kT = 0**: an ellipsoidal cell rounds up under
 //!   surface tension while stiff turgor holds its volume.
 //! - the `body` terms through the engine: thread-count independence, the
-//!   GPU refusal, the `cellmd build icosphere` command.
+//!   `cellmd build icosphere` command (the GPU's surface kernels: tests/gpu.rs).
 //!
 //! Each table is printed (`cargo test --release --test shells -- --nocapture`)
 //! and reported in the README.
@@ -18,7 +18,6 @@ use std::f64::consts::PI;
 
 use cellmd::build::{icosphere_cell, IcosphereCell};
 use cellmd::deck::validate_file;
-use cellmd::gpu::DevicePreference;
 use cellmd::run::{RunOptions, Simulation};
 use common::{merge_topologies, position_bits, stretch_particles, Case};
 use glam::DVec3;
@@ -203,21 +202,15 @@ fn volume_is_conserved_at_zero_temperature_while_the_cell_rounds_up() {
 }
 
 /// Surface terms keep runs bit-identical on 1 and 2 threads (per-body slots
-/// gathered in a fixed order) and are refused by the GPU backend.
+/// gathered in a fixed order). (On the GPU: `tests/gpu.rs`.)
 #[test]
-fn body_terms_are_deterministic_and_refused_on_the_gpu() {
+fn body_terms_are_deterministic_on_any_thread_count() {
     let ff = "body cell turgor k 500 dp0 50 v0 400\nbody cell surface_tension gamma 100\nbody cell helfrich_bending kappa 0.5\nbody cell area_conservation kl 200 a0 300\n";
     let case = cell_case(3, 5.0, ff, "temperature 300\ntimestep 1e-4\nseed 5\nrun 200\n");
     let plan = case.plan();
     let (one, two) = (case.run_with_threads(1), case.run_with_threads(2));
     assert_eq!(position_bits(&one), position_bits(&two));
     assert!(one.state.positions.iter().zip(&plan.positions).any(|(a, b)| (*a - *b).length() > 1e-3));
-    let gpu = Simulation::execute(
-        plan,
-        RunOptions { output_dir: case.output_dir().to_path_buf(), device: Some(DevicePreference::Gpu), ..Default::default() },
-    );
-    let refusal = gpu.err().map(|e| e.to_string()).unwrap_or_default();
-    assert!(refusal.contains("surface terms of bodies"), "expected the GPU to refuse body terms, got {refusal:?}");
 }
 
 /// A cell may straddle a periodic boundary: its terms see it whole.

@@ -18,6 +18,7 @@ REPO = Path(__file__).resolve().parents[2]
 DIMER = REPO / "inputs" / "dimer.in"
 SINGLE_CELL = REPO / "inputs" / "single_cell.in"
 CATCH_SLIP = REPO / "inputs" / "catch_slip_sweep.in"
+CELL_DOUBLET = REPO / "inputs" / "cell_doublet.in"
 NO_GPU = os.environ.get("CELLMD_NO_GPU") == "1"
 
 
@@ -217,8 +218,8 @@ def test_gpu_device_runs_the_same_system(tmp_path):
 
 
 def test_device_gpu_refuses_cpu_only_features(tmp_path):
-    sim = cellmd.Simulation(SINGLE_CELL, output_dir=tmp_path, device="gpu")
-    with pytest.raises(cellmd.RunError, match="surface terms of bodies"):
+    sim = cellmd.Simulation(CELL_DOUBLET, output_dir=tmp_path, device="gpu")
+    with pytest.raises(cellmd.RunError, match="contact terms between bodies"):
         sim.run(1)
 
 

@@ -1,9 +1,10 @@
 // Force on each particle as the sum of its own terms (no float atomics, no
 // write conflicts; the order is fixed by the data, so a run repeats bit for
 // bit): pairs from the neighbour list, its bonds from its own side, its
-// angle slots, and the external fields acting on it. `force[i].w` is the
+// angle slots, the external fields acting on it, and its slots of the
+// surface terms (shaders/common/surface.wgsl). `force[i].w` is the
 // particle's share of the potential energy (half of each pair and bond,
-// a third of each angle, all of its externals).
+// a third of each angle, all of its externals, its surface slots' shares).
 //
 // `radial_law`, `three_body_law` and `one_body_law` dispatch on the
 // registry index of the term's interaction type; they are generated from the
@@ -84,6 +85,13 @@ fn forces(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index)
             f += one.force;
             e += one.energy;
         }
+    }
+    // Surface terms: this particle's slots (face corners, edge stencils, node energies) in a fixed order.
+    let slots_end = topo[P.off_node_slot_offsets + i + 1u];
+    for (var s = topo[P.off_node_slot_offsets + i]; s < slots_end; s++) {
+        let slot = surf[topo[P.off_node_slots + s]];
+        f += slot.xyz;
+        e += slot.w;
     }
     force[i] = vec4<f32>(f, e);
 }

@@ -33,6 +33,11 @@ struct Params {
     off_ext_terms: u32, off_excl_offsets: u32, off_excl: u32, off_term_scale: u32,
     // offsets of the sections of `fparams`
     off_params: u32, off_skip2: u32, off_mobility: u32, off_amplitude: u32,
+    // surface sections of `topo` (src/gpu/surface.rs), then their sizes
+    off_faces: u32, off_body_faces: u32, off_body_term_start: u32, off_body_terms: u32,
+    off_node_slot_offsets: u32, off_node_slots: u32, off_edges: u32, off_node_body: u32,
+    off_node_edge_offsets: u32, off_node_edges: u32, off_node_face_offsets: u32, off_node_faces: u32,
+    n_faces: u32, n_bodies: u32, n_edges: u32, n_body_nodes: u32,
 }
 
 @group(0) @binding(0) var<uniform> P: Params;
@@ -49,6 +54,8 @@ struct Params {
 @group(0) @binding(8) var<storage, read_write> nlist: array<u32>;
 @group(0) @binding(9) var<storage, read_write> force: array<vec4<f32>>;
 @group(0) @binding(10) var<storage, read_write> status: array<atomic<u32>>;
+// Surface terms (shaders/common/surface.wgsl; regions in src/gpu/surface.rs).
+@group(0) @binding(12) var<storage, read_write> surf: array<vec4<f32>>;
 
 struct Chunk {
     first: u32,  // first particle of the chunk
@@ -81,8 +88,10 @@ const ST_BUILDS: u32 = 3u;        // neighbour-list builds so far
 const ST_STEPS_DONE: u32 = 4u;    // steps completed in this call
 const ST_BLOWUP_PARTICLE: u32 = 5u; // lowest particle index whose step was refused
 const ST_FORCE_REBUILD: u32 = 6u; // host request: rebuild before the next step
+const ST_SPAN_BODY: u32 = 7u;     // lowest packed body wider than half the periodic box
 const HALT_OVERFLOW: u32 = 1u;
 const HALT_BLOWUP: u32 = 2u;
+const HALT_SPAN: u32 = 4u;
 
 const WORKGROUP: u32 = 256u;
 
@@ -202,6 +211,43 @@ struct OneBody {
 }
 
 const RADIAL_ZERO: Radial = Radial(0.0, 0.0);
+
+// A body's totals for its per-face surface laws.
+struct BodyTotals {
+    volume: f32,
+    area: f32,
+    faces: f32,
+}
+
+// One face of a body: its corners relative to corner 0 (x0 = 0), its area,
+// the area's gradient at each corner, and each corner's share of the
+// volume's gradient, A·n̂/3 (the same for all three corners; summed over the
+// faces around a node it is the node's ∂V/∂x on a closed surface).
+struct FaceGeometry {
+    x1: vec3<f32>,
+    x2: vec3<f32>,
+    area: f32,
+    ga0: vec3<f32>,
+    ga1: vec3<f32>,
+    ga2: vec3<f32>,
+    gv: vec3<f32>,
+}
+
+// What a curvature law gives for one node: its energy, ∂E/∂M_i, ∂E/∂A_i.
+struct NodeCurvature {
+    energy: f32,
+    de_dm: f32,
+    de_da: f32,
+}
+
+// What a per-face surface law gives: the face's share of the body's energy
+// and the forces on its corners.
+struct SurfaceFace {
+    energy: f32,
+    f0: vec3<f32>,
+    f1: vec3<f32>,
+    f2: vec3<f32>,
+}
 
 // (dE/dr)·d/r, exactly zero for a term that exerts no force (also at r = 0).
 fn force_along(radial: Radial, d: vec3<f32>, r: f32) -> vec3<f32> {

@@ -8,6 +8,10 @@
 //! large enough list. A refused step (blow-up) halts too, leaving the state
 //! of the last completed step in place.
 //!
+//! Surface (body) terms run in their own passes before the force pass
+//! ([`super::surface`]); a body wider than half the periodic box halts the
+//! run ([`GpuHalt::Capacity`], with the body named).
+//!
 //! Bond kinetics are decided on the host from the read-back positions;
 //! [`GpuBackend::update_bonds`] then uploads the new bond state (bound bonds,
 //! their rest lengths and scales, the exclusions of the bound bonds) as one
@@ -32,8 +36,10 @@ const ST_BUILDS: usize = 3;
 const ST_STEPS_DONE: usize = 4;
 const ST_BLOWUP_PARTICLE: usize = 5;
 const ST_FORCE_REBUILD: usize = 6;
+const ST_SPAN_BODY: usize = 7;
 const HALT_OVERFLOW: u32 = 1;
 const HALT_BLOWUP: u32 = 2;
+const HALT_SPAN: u32 = 4;
 /// Steps per command buffer.
 const STEPS_PER_SUBMIT: u64 = 64;
 
@@ -43,8 +49,8 @@ pub enum GpuHalt {
     /// The step of `particle` (internal index) was refused at `step`; the
     /// state is that of `step`.
     Blowup { step: u64, particle: usize },
-    /// The neighbour list had to grow beyond what the adapter can bind; the
-    /// state is that of `step`.
+    /// The neighbour list had to grow beyond what the adapter can bind, or a
+    /// body spans more than half the periodic box; the state is that of `step`.
     Capacity { step: u64, message: String },
 }
 
@@ -56,7 +62,7 @@ pub struct PhaseTimes {
     pub check: f64,
     /// A full neighbour-list rebuild (binning, scan, scatter, sort, list).
     pub neighbor_build: f64,
-    /// Pair, bonded and external forces.
+    /// Pair, bonded, external and surface forces (the surface passes included).
     pub forces: f64,
     /// Integration, commit and step counter.
     pub integrate: f64,
@@ -86,6 +92,12 @@ struct Kernels {
     scatter: wgpu::ComputePipeline,
     sort: wgpu::ComputePipeline,
     build: wgpu::ComputePipeline,
+    surface_faces: wgpu::ComputePipeline,
+    surface_bodies: wgpu::ComputePipeline,
+    surface_edges: wgpu::ComputePipeline,
+    surface_nodes: wgpu::ComputePipeline,
+    surface_edge_forces: wgpu::ComputePipeline,
+    surface_forces: wgpu::ComputePipeline,
     forces: wgpu::ComputePipeline,
     integrate: wgpu::ComputePipeline,
     commit: wgpu::ComputePipeline,
@@ -112,6 +124,10 @@ pub struct GpuBackend {
     nlist_binding_limit: u64,
     force: wgpu::Buffer,
     status: wgpu::Buffer,
+    /// Face, body and corner-slot values of the surface terms.
+    surf: wgpu::Buffer,
+    /// The user id of each packed body (for the span halt's message).
+    body_ids: Vec<u64>,
     args: wgpu::Buffer,
     layout: wgpu::BindGroupLayout,
     main_group: wgpu::BindGroup,
@@ -159,10 +175,8 @@ fn words<T: bytemuck::Pod>(data: &[T]) -> &[u8] {
 impl GpuBackend {
     /// Uploads the model and state and compiles the kernels.
     pub fn new(ctx: &GpuContext, model: &Model, state: &State, sim_box: &SimBox, settings: &StepSettings) -> Result<Self, String> {
-        if model.has_surface_terms() {
-            return Err(
-                "the GPU backend has no kernels for surface terms of bodies yet; use `device cpu` for decks with `body` lines".into()
-            );
+        if model.has_cpu_only_surface_terms() {
+            return Err("the GPU backend has no kernels for custom surface terms of bodies (`custom` body lines) yet; use `device cpu`".into());
         }
         if model.has_contact_terms() {
             return Err(
@@ -211,6 +225,7 @@ impl GpuBackend {
             gaussian: (settings.context.noise == crate::rng::Noise::Gaussian) as u32,
             topo_offsets: packed.topo_offsets,
             fparam_offsets: packed.fparam_offsets,
+            surface_offsets: packed.surface_offsets,
         };
         let device = &ctx.device;
         let init = |label: &str, contents: &[u8], usage: wgpu::BufferUsages| {
@@ -237,6 +252,9 @@ impl GpuBackend {
         let nlist = NeighbourStorage::new(ctx, n as u32, params.nlist_cap, nlist_binding_limit)?;
         let force = zeros("force", 16 * n as u64, rw);
         let status = zeros("status", 4 * STATUS_WORDS as u64, rw);
+        let surf_bytes = 16 * packed.surf_entries;
+        check_binding(ctx, "the surface terms' face and body values", surf_bytes)?;
+        let surf = zeros("surf", surf_bytes, rw);
         let args = zeros("dispatch_args", 4 * 12, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT);
 
         let mut entries = vec![wgpu::BindGroupLayoutEntry {
@@ -258,6 +276,7 @@ impl GpuBackend {
             ty: wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Uniform, has_dynamic_offset: true, min_binding_size: None },
             count: None,
         });
+        entries.push(storage_entry(12, false));
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("cellmd main"), entries: &entries });
         let args_layout = device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("cellmd args"), entries: &[storage_entry(0, false)] });
@@ -300,6 +319,12 @@ impl GpuBackend {
             scatter: pipeline("nb_scatter", &main_layout),
             sort: pipeline("nb_sort", &main_layout),
             build: pipeline("nb_build", &main_layout),
+            surface_faces: pipeline("surface_faces", &main_layout),
+            surface_bodies: pipeline("surface_bodies", &main_layout),
+            surface_edges: pipeline("surface_edges", &main_layout),
+            surface_nodes: pipeline("surface_nodes", &main_layout),
+            surface_edge_forces: pipeline("surface_edge_forces", &main_layout),
+            surface_forces: pipeline("surface_forces", &main_layout),
             forces: pipeline("forces", &main_layout),
             integrate: pipeline("integrate", &main_layout),
             commit: pipeline("commit", &main_layout),
@@ -308,7 +333,7 @@ impl GpuBackend {
         let main_group = bind_main(
             device,
             &layout,
-            [&uniform, &state_buffer, &next, &reference, &topo, &fparams, &cell_count, &cell_data, &force, &status],
+            [&uniform, &state_buffer, &next, &reference, &topo, &fparams, &cell_count, &cell_data, &force, &status, &surf],
             &nlist,
         );
         let mut backend = Self {
@@ -328,6 +353,8 @@ impl GpuBackend {
             nlist_binding_limit,
             force,
             status,
+            surf,
+            body_ids: packed.body_ids,
             args,
             layout,
             main_group,
@@ -345,7 +372,8 @@ impl GpuBackend {
 
     fn bind_main(&self) -> wgpu::BindGroup {
         let s = self;
-        let buffers = [&s.uniform, &s.state, &s.next, &s.reference, &s.topo, &s.fparams, &s.cell_count, &s.cell_data, &s.force, &s.status];
+        let buffers =
+            [&s.uniform, &s.state, &s.next, &s.reference, &s.topo, &s.fparams, &s.cell_count, &s.cell_data, &s.force, &s.status, &s.surf];
         bind_main(&self.ctx.device, &self.layout, buffers, &s.nlist)
     }
 
@@ -431,6 +459,7 @@ impl GpuBackend {
         }
         self.params.topo_offsets = packed.topo_offsets;
         self.params.fparam_offsets = packed.fparam_offsets;
+        self.params.surface_offsets = packed.surface_offsets;
         self.pending_rebuild |= rebuild;
         Ok(())
     }
@@ -438,6 +467,7 @@ impl GpuBackend {
     fn reset_status(&self, force_rebuild: bool) {
         let mut status = [0u32; STATUS_WORDS];
         status[ST_BLOWUP_PARTICLE] = u32::MAX;
+        status[ST_SPAN_BODY] = u32::MAX;
         status[ST_FORCE_REBUILD] = force_rebuild as u32;
         self.ctx.queue.write_buffer(&self.status, 0, words(&status));
     }
@@ -552,7 +582,9 @@ impl GpuBackend {
         };
         let check = if self.has_pairs { time(self, &[(&k.displacement, particles), (&k.decide, Over::Groups(1))], true) } else { 0.0 };
         let neighbor_build = if self.has_pairs { time(self, &build, false) } else { 0.0 };
-        let forces = time(self, &[(&k.forces, Over::Chunks)], false);
+        let mut force_pass = self.surface_passes();
+        force_pass.push((&k.forces, Over::Chunks));
+        let forces = time(self, &force_pass, false);
         let integrate = time(self, &[(&k.integrate, particles), (&k.commit, particles), (&k.advance, Over::Groups(1))], false);
         let started = std::time::Instant::now();
         for _ in 0..repetitions {
@@ -614,6 +646,9 @@ impl GpuBackend {
             indirect(pass, &k.sort, 1);
             self.per_chunk(pass, |pass| indirect(pass, &k.build, 3));
         }
+        for (pipeline, over) in self.surface_passes() {
+            self.dispatch(pass, pipeline, over);
+        }
         self.dispatch(pass, &k.forces, Over::Chunks);
         if integrate {
             self.dispatch(pass, &k.integrate, Over::Particles);
@@ -624,6 +659,28 @@ impl GpuBackend {
 
     fn status(&self) -> [u32; STATUS_WORDS] {
         bytemuck::cast_slice(&self.read(&self.status, 4 * STATUS_WORDS as u64)).try_into().expect("status words")
+    }
+
+    /// The surface kernels in order (none without surface terms; the
+    /// curvature passes only with a curvature law), see [`super::surface`].
+    fn surface_passes(&self) -> Vec<(&wgpu::ComputePipeline, Over)> {
+        let k = &self.kernels;
+        let [faces, bodies, edges, nodes] = [12, 13, 14, 15].map(|c| self.params.surface_offsets[c]);
+        let over = |count: u32| Over::Groups(count.div_ceil(WORKGROUP));
+        let mut passes = Vec::new();
+        if faces > 0 {
+            passes.extend([(&k.surface_faces, over(faces)), (&k.surface_bodies, Over::Groups(bodies))]);
+            if edges > 0 {
+                passes.extend([(&k.surface_edges, over(edges)), (&k.surface_nodes, over(nodes)), (&k.surface_edge_forces, over(edges))]);
+            }
+            passes.push((&k.surface_forces, over(faces)));
+        }
+        passes
+    }
+
+    /// The message of a body-span halt (see [`super::surface`]), if there was one.
+    fn span_halt(&self, status: &[u32; STATUS_WORDS]) -> Option<String> {
+        (status[ST_HALTED] & HALT_SPAN != 0).then(|| super::surface::span_message(self.body_ids[status[ST_SPAN_BODY] as usize]))
     }
 
     /// Handles an overflow: grows the list and clears the halt. Returns
@@ -656,6 +713,9 @@ impl GpuBackend {
             self.ctx.queue.submit([encoder.finish()]);
             let status = self.status();
             self.builds += status[ST_BUILDS] as u64;
+            if let Some(message) = self.span_halt(&status) {
+                return Err(message);
+            }
             if !self.grow_if_overflowed(&status)? {
                 return Ok(());
             }
@@ -694,6 +754,9 @@ impl GpuBackend {
             if status[ST_HALTED] & HALT_BLOWUP != 0 {
                 return Err(GpuHalt::Blowup { step: first_step + done, particle: status[ST_BLOWUP_PARTICLE] as usize });
             }
+            if let Some(message) = self.span_halt(&status) {
+                return Err(GpuHalt::Capacity { step: first_step + done, message });
+            }
             force_rebuild = self.grow_if_overflowed(&status).map_err(|message| GpuHalt::Capacity { step: first_step + done, message })?;
         }
         Ok(done)
@@ -715,12 +778,12 @@ enum Over {
 fn bind_main(
     device: &wgpu::Device,
     layout: &wgpu::BindGroupLayout,
-    buffers: [&wgpu::Buffer; 10],
+    buffers: [&wgpu::Buffer; 11],
     nlist: &NeighbourStorage,
 ) -> wgpu::BindGroup {
     let mut entries: Vec<wgpu::BindGroupEntry> = buffers
         .iter()
-        .zip((0..8).chain(9..11))
+        .zip((0..8).chain(9..11).chain(12..13))
         .map(|(buf, b)| wgpu::BindGroupEntry { binding: b, resource: buf.as_entire_binding() })
         .collect();
     entries.extend(nlist.entries());

@@ -4,7 +4,7 @@
 //! rasteriser (llvmpipe/lavapipe) included; `device auto` takes a hardware
 //! adapter when there is one and otherwise leaves the run on the CPU backend.
 //! The device is opened with the adapter's own limits (not WebGPU's
-//! defaults), so that buffers for ≥ 10⁶ particles and all eleven storage
+//! defaults), so that buffers for ≥ 10⁶ particles and all twelve storage
 //! bindings fit.
 
 /// The deck's `device` setting.
@@ -31,7 +31,7 @@ impl DevicePreference {
 }
 
 /// Storage buffers bound by the kernels at once (see shaders/common/layout.wgsl).
-pub const STORAGE_BINDINGS: u32 = 11;
+pub const STORAGE_BINDINGS: u32 = 12;
 
 /// An open device and its queue (cheap to clone: handles are shared).
 #[derive(Clone)]

@@ -8,6 +8,13 @@
 //! - [`backend`]: buffers, pipelines and the GPU-resident step loop.
 //! - [`nlist`]: the neighbour list's buffer, bound in chunks of particles
 //!   where it exceeds the adapter's largest storage binding.
+//! - [`surface`]: surface (body) terms: face, body, edge and node passes,
+//!   deterministic (no float atomics).
+//!
+//! One file-level circle, on purpose: `pack.rs` ↔ `surface.rs`. `pack.rs`
+//! lays out the whole topology, the surface sections included, and
+//! `surface.rs` builds those sections' CSR lists with pack's `push_csr`, the
+//! one CSR builder of the GPU buffers.
 //!
 //! What runs where: each step — neighbour-list check and (when due) rebuild,
 //! forces, overdamped integration — runs on the GPU without reading anything
@@ -16,9 +23,10 @@
 //! evaluated by the f64 CPU backend at the read-back positions.
 //!
 //! Not on the GPU (refused by [`GpuBackend::new`], and by `device gpu`
-//! before a run; `device auto` falls back to the CPU): bond kinetics, the
-//! surface terms of bodies (`Law::Surface`) and contact terms between bodies
-//! (`Law::Contact`, `Law::ContactArea`), which have no kernel yet.
+//! before a run; `device auto` falls back to the CPU): custom surface terms
+//! of bodies and contact
+//! terms between bodies (`Law::Contact`, `Law::ContactArea`), which have no
+//! kernel yet. Bond kinetics are decided on the host (see [`backend`]).
 //!
 //! # Precision
 //!
@@ -40,6 +48,7 @@ pub mod custom;
 mod nlist;
 pub mod pack;
 pub mod shader;
+pub mod surface;
 
 pub use backend::{GpuBackend, GpuHalt};
 pub use context::{DevicePreference, GpuContext};

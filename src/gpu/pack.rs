@@ -8,9 +8,12 @@
 //! - `fparams` (f32): eight parameter slots per term, the squared reach of
 //!   each type pair, and per particle type the mobility dt/γ and the noise
 //!   amplitude √(2kT·dt/γ) (computed in f64; both 0 for a `fixed` type).
+//! - `topo` also holds the surface sections of [`super::surface::SurfacePack`]
+//!   (faces, bodies' faces and terms, each particle's slots, edges and body
+//!   nodes), at `surface_offsets`.
 //!
 //! Terms are numbered bond types, then angle types, then pair rules, then
-//! externals, then — with bond state — one term per bound bond of a type
+//! externals, then surface (body) terms, then — with bond state — one term per bound bond of a type
 //! with kinetic rules or with a rest length of its own (the topology's
 //! per-bond r0), holding that bond's own rest length. Each term also has
 //! a force scale (`fparams`, at `topo_offsets[11]`): a kinetic bond's
@@ -61,6 +64,10 @@ pub struct Params {
     pub topo_offsets: [u32; 12],
     /// Offsets of the `fparams` sections: params, skip2, mobility, amplitude.
     pub fparam_offsets: [u32; 4],
+    /// Offsets of the surface sections of `topo`
+    /// ([`super::surface::SurfacePack::sections`]), then the numbers of
+    /// faces, bodies, edges and body nodes.
+    pub surface_offsets: [u32; 16],
 }
 
 /// The GPU's 64-bit fixed point (layout.wgsl): a length x is the integer
@@ -95,10 +102,15 @@ pub struct Packed {
     pub fparams: Vec<f32>,
     pub topo_offsets: [u32; 12],
     pub fparam_offsets: [u32; 4],
+    pub surface_offsets: [u32; 16],
+    /// Entries of the `surf` buffer.
+    pub surf_entries: u64,
+    /// The user id of each packed body (in packing order).
+    pub body_ids: Vec<u64>,
 }
 
 /// Appends a CSR section (`offsets` for n + 1 entries, then rows flattened).
-fn push_csr<T: Copy>(rows: &[Vec<T>], offsets: &mut Vec<u32>, flat: &mut Vec<T>) {
+pub(super) fn push_csr<T: Copy>(rows: &[Vec<T>], offsets: &mut Vec<u32>, flat: &mut Vec<T>) {
     offsets.push(flat.len() as u32);
     for row in rows {
         flat.extend_from_slice(row);
@@ -112,11 +124,18 @@ fn push_csr<T: Copy>(rows: &[Vec<T>], offsets: &mut Vec<u32>, flat: &mut Vec<T>)
 pub fn pack(model: &Model, exclusions: &Exclusions, dt: f64, kt: f64, bonds: Option<&BondState>) -> Result<Packed, String> {
     let n = model.len();
     let nt = model.type_names.len();
-    let terms: Vec<_> =
-        model.bond_types.iter().chain(&model.angle_types).chain(&model.pair_rules).chain(model.externals.iter().map(|e| &e.term)).collect();
+    let terms: Vec<_> = model
+        .bond_types
+        .iter()
+        .chain(&model.angle_types)
+        .chain(&model.pair_rules)
+        .chain(model.externals.iter().map(|e| &e.term))
+        .chain(&model.body_rules)
+        .collect();
     let angle_base = model.bond_types.len();
     let pair_base = angle_base + model.angle_types.len();
     let external_base = pair_base + model.pair_rules.len();
+    let body_base = external_base + model.externals.len();
     // Bonds with their own parameters (bound, and of a type with kinetic
     // rules or with a rest length of their own): (bond, own term).
     let kinetic: Vec<usize> = match bonds {
@@ -174,7 +193,8 @@ pub fn pack(model: &Model, exclusions: &Exclusions, dt: f64, kt: f64, bonds: Opt
     let mut topo: Vec<u32> = model.types.clone();
     let mut offsets = [0u32; 12];
     offsets[0] = topo.len() as u32;
-    let kinds = super::custom::gpu_kinds(model);
+    let mut kinds = super::custom::gpu_kinds(model);
+    kinds.extend(model.body_rules.iter().map(|t| crate::system::registry_index(t) as u32));
     topo.extend(&kinds);
     topo.extend(kinetic.iter().map(|&b| kinds[model.bond_type[b] as usize]));
     // Pair rules per type pair.
@@ -223,6 +243,13 @@ pub fn pack(model: &Model, exclusions: &Exclusions, dt: f64, kt: f64, bonds: Opt
         topo.extend(&flat);
     }
     offsets[11] = scale_offset as u32;
+    let surfaces = super::surface::pack_surfaces(model, body_base);
+    let mut surface_offsets = [0u32; 16];
+    for (k, section) in surfaces.sections().into_iter().enumerate() {
+        surface_offsets[k] = topo.len() as u32;
+        topo.extend(section);
+    }
+    surface_offsets[12..].copy_from_slice(&surfaces.counts());
     if topo.len() > u32::MAX as usize / 2 {
         return Err(format!("the model needs {} words of GPU topology, more than the u32 index range", topo.len()));
     }
@@ -231,6 +258,9 @@ pub fn pack(model: &Model, exclusions: &Exclusions, dt: f64, kt: f64, bonds: Opt
         fparams,
         topo_offsets: offsets,
         fparam_offsets: [0, skip2_offset as u32, mobility_offset as u32, amplitude_offset as u32],
+        surface_offsets,
+        surf_entries: surfaces.surf_entries(),
+        body_ids: surfaces.body_ids,
     })
 }
 

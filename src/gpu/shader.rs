@@ -6,20 +6,22 @@
 //! generated dispatch functions `radial_law`, `three_body_law` and
 //! `one_body_law` (a `switch` on the registry index), and the kernels
 //! (neighbour list, forces, integrator). One module holds every entry point.
+//! Surface laws define `NAME_face` or `NAME_node` by their [`SurfaceGpu`]
+//! form, dispatched by `surface_law` and `node_law` from the surface
+//! kernels (src/gpu/surface.rs).
 //!
-//! Only law families with a GPU kernel take part ([`Law::runs_on_gpu`]).
-//! Surface laws ([`Law::Surface`]: turgor, surface tension, bending of closed
-//! bodies) and contact laws ([`Law::Contact`], [`Law::ContactArea`]: node–face
-//! barriers and adhesion between bodies) have none yet: they have no evaluator file, no dispatch case, and
-//! the GPU backend refuses decks that use them, so such a deck never runs on
-//! the GPU without its surface forces. A surface-law WGSL file without the
-//! kernel to call it is refused by a test, so a shader cannot pretend to
-//! cover one.
+//! Only laws with a GPU kernel take part ([`Law::runs_on_gpu`]). Custom
+//! body terms and contact laws ([`Law::Contact`], [`Law::ContactArea`]:
+//! node–face barriers and adhesion between bodies) have none yet: they have
+//! no evaluator file, no dispatch case, and the GPU backend refuses decks
+//! that use them, so such a deck never runs on the GPU without those
+//! forces. A WGSL file for a law without the kernel to call it is refused
+//! by a test, so a shader cannot pretend to cover one.
 
 use std::fmt::Write;
 
 use super::custom::CustomSource;
-use crate::interactions::{Law, REGISTRY};
+use crate::interactions::{Law, SurfaceGpu, REGISTRY};
 
 mod embedded {
     include!(concat!(env!("OUT_DIR"), "/shaders.rs"));
@@ -28,7 +30,7 @@ mod embedded {
 pub use embedded::{COMMON_SHADERS, INTERACTION_SHADERS};
 
 /// The common files in the order they must appear (declarations first).
-const COMMON_ORDER: [&str; 5] = ["layout", "philox", "neighbor", "forces", "integrate"];
+const COMMON_ORDER: [&str; 6] = ["layout", "philox", "neighbor", "forces", "surface", "integrate"];
 
 fn common(name: &str) -> &'static str {
     COMMON_SHADERS.iter().find(|(stem, _)| *stem == name).map(|(_, src)| *src).unwrap_or_else(|| panic!("shaders/common/{name}.wgsl"))
@@ -46,12 +48,17 @@ fn dispatch(custom: &CustomSource) -> String {
         "fn three_body_law(kind: u32, p: array<f32, 8>, ri: vec3<f32>, rj: vec3<f32>, rk: vec3<f32>) -> ThreeBody {\n    switch kind {\n",
     );
     let mut one = String::from("fn one_body_law(kind: u32, p: array<f32, 8>, x: vec3<f32>) -> OneBody {\n    switch kind {\n");
+    let mut surface =
+        String::from("fn surface_law(kind: u32, p: array<f32, 8>, body: BodyTotals, g: FaceGeometry) -> SurfaceFace {\n    switch kind {\n");
+    let mut node = String::from("fn node_law(kind: u32, p: array<f32, 8>, m: f32, a: f32) -> NodeCurvature {\n    switch kind {\n");
     for (index, interaction) in REGISTRY.iter().enumerate() {
         let name = interaction.name();
         let (out, call) = match interaction.law() {
             Law::Radial { .. } => (&mut radial, format!("{name}_radial(p, r)")),
             Law::ThreeBody(_) => (&mut three, format!("{name}_three(p, ri, rj, rk)")),
             Law::OneBody(_) => (&mut one, format!("{name}_one(p, x)")),
+            Law::Surface { gpu: SurfaceGpu::PerFace, .. } => (&mut surface, format!("{name}_face(p, body, g)")),
+            Law::Surface { gpu: SurfaceGpu::NodeCurvature, .. } => (&mut node, format!("{name}_node(p, m, a)")),
             Law::Surface { .. } | Law::Contact { .. } | Law::ContactArea { .. } => continue,
         };
         writeln!(out, "        case {index}u: {{ return {call}; }}").unwrap();
@@ -62,7 +69,9 @@ fn dispatch(custom: &CustomSource) -> String {
     radial.push_str("        default: { return RADIAL_ZERO; }\n    }\n}\n");
     three.push_str("        default: { return ThreeBody(0.0, vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0)); }\n    }\n}\n");
     one.push_str("        default: { return OneBody(0.0, vec3<f32>(0.0)); }\n    }\n}\n");
-    radial + &three + &one
+    surface.push_str("        default: { return SurfaceFace(0.0, vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0)); }\n    }\n}\n");
+    node.push_str("        default: { return NodeCurvature(0.0, 0.0, 0.0); }\n    }\n}\n");
+    radial + &three + &one + &surface + &node
 }
 
 /// The whole program for models without custom terms.
@@ -102,8 +111,9 @@ pub fn validate(program: &str) -> Result<(), String> {
 mod tests {
     use super::*;
 
-    /// One evaluator file per interaction type whose law family runs on the
-    /// GPU, and none for the others (surface laws: refused by the GPU backend).
+    /// One evaluator file per interaction type whose law runs on the GPU,
+    /// and none for the others (refused by the GPU backend); every surface
+    /// law with a GPU form is dispatched by `surface_law` or `node_law`.
     #[test]
     fn every_gpu_interaction_has_exactly_one_shader_file_and_no_other_has_one() {
         for interaction in REGISTRY {
@@ -121,8 +131,19 @@ mod tests {
         for (stem, _) in INTERACTION_SHADERS {
             assert!(crate::interactions::lookup(stem).is_some(), "shaders/interactions/{stem}.wgsl names no registered interaction");
         }
-        let surface: Vec<&str> = REGISTRY.iter().filter(|i| !i.law().runs_on_gpu()).map(|i| i.name()).collect();
-        assert!(surface.iter().all(|n| !compose().contains(&format!("fn {n}_"))), "{surface:?} appear in the composed program");
+        let cpu_only: Vec<&str> = REGISTRY.iter().filter(|i| !i.law().runs_on_gpu()).map(|i| i.name()).collect();
+        assert!(cpu_only.iter().all(|n| !compose().contains(&format!("fn {n}_"))), "{cpu_only:?} appear in the composed program");
+        let form = |want: SurfaceGpu| -> Vec<&str> {
+            REGISTRY.iter().filter(|i| matches!(i.law(), Law::Surface { gpu, .. } if gpu == want)).map(|i| i.name()).collect()
+        };
+        assert_eq!(form(SurfaceGpu::PerFace), ["turgor", "turgor_log", "surface_tension", "area_conservation", "surface_shear"]);
+        assert_eq!(form(SurfaceGpu::NodeCurvature), ["helfrich_bending"]);
+        for name in form(SurfaceGpu::PerFace) {
+            assert!(compose().contains(&format!("return {name}_face(p, body, g);")), "{name} has no `surface_law` case");
+        }
+        for name in form(SurfaceGpu::NodeCurvature) {
+            assert!(compose().contains(&format!("return {name}_node(p, m, a);")), "{name} has no `node_law` case");
+        }
     }
 
     #[test]

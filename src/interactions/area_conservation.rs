@@ -2,7 +2,7 @@
 
 use glam::DVec3;
 
-use super::{Kind, Law, ParamSpec, SurfaceHessian, SurfaceMesh};
+use super::{Kind, Law, ParamSpec, SurfaceGpu, SurfaceHessian, SurfaceMesh};
 use crate::hessian::RankOne;
 use crate::mesh::{triangle_area, triangle_area_gradient};
 use crate::units::Dim;
@@ -80,7 +80,7 @@ interaction!(
     "area_conservation",
     Kind::Body,
     "Area elasticity of a closed body, global ½k_a(A − A0)²/A0 and per face ½k_l Σ(A_t − A0/N)²/(A0/N)",
-    Law::Surface { eval, hessian },
+    Law::Surface { eval, hessian, gpu: SurfaceGpu::PerFace },
     validate = validate
 );
 

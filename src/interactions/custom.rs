@@ -19,7 +19,7 @@
 mod laws;
 
 use self::laws::{angle_eval, body_eval, body_hessian, external_eval, pair_eval, pair_force, radial_eval, radial_force};
-use super::{Entry, Interaction, Kind, Law, ParamSpec};
+use super::{Entry, Interaction, Kind, Law, ParamSpec, SurfaceGpu};
 use crate::expr::tape::{compile, Slot};
 use crate::expr::{parse, Expr, ExprError, Span};
 use crate::units::Dim;
@@ -231,7 +231,7 @@ impl Interaction for CustomLaw {
             Kind::Pair => Law::Radial { eval: pair_eval, force: pair_force, range: |p| p[0] },
             Kind::Angle => Law::ThreeBody(angle_eval),
             Kind::External => Law::OneBody(external_eval),
-            Kind::Body | Kind::Contact => Law::Surface { eval: body_eval, hessian: body_hessian },
+            Kind::Body | Kind::Contact => Law::Surface { eval: body_eval, hessian: body_hessian, gpu: SurfaceGpu::None },
         }
     }
 }
@@ -243,7 +243,7 @@ interaction!(
     "custom",
     Kind::Body,
     "Any bond, angle, pair, external or body law given as an energy expression, with exact derivatives (see `cellmd list custom`)",
-    Law::Surface { eval: body_eval, hessian: body_hessian }
+    Law::Surface { eval: body_eval, hessian: body_hessian, gpu: SurfaceGpu::None }
 );
 
 /// The shared checks on a set of expressions of every kind, and equality

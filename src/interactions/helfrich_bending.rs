@@ -2,7 +2,7 @@
 
 use glam::DVec3;
 
-use super::{Kind, Law, ParamSpec, SurfaceHessian, SurfaceMesh};
+use super::{Kind, Law, ParamSpec, SurfaceGpu, SurfaceHessian, SurfaceMesh};
 use crate::hessian::LocalRankOne;
 use crate::mesh::{bending_angle, triangle_area_gradient, MeshEdge};
 use crate::units::Dim;
@@ -155,7 +155,7 @@ interaction!(
     "helfrich_bending",
     Kind::Body,
     "Helfrich bending (κ/2)∮(2H − C0)² dA, Jülicher's discretisation: Σ_i 2κ(M_i − C0·A_i/2)²/A_i",
-    Law::Surface { eval, hessian }
+    Law::Surface { eval, hessian, gpu: SurfaceGpu::NodeCurvature }
 );
 
 #[cfg(test)]

@@ -254,14 +254,15 @@ pub enum Law {
     /// E(r_1 … r_n) of one closed surface: the evaluator gets the body's mesh
     /// and its node positions (image-consistent, local numbering), adds the
     /// force on each node to `forces` and returns the energy. The CPU backend
-    /// evaluates it; the GPU backend has no kernel for this family yet and
-    /// refuses decks that use it ([`Law::runs_on_gpu`]). `hessian` gives the
+    /// evaluates it; `gpu` says how the GPU backend does ([`SurfaceGpu`],
+    /// [`Law::runs_on_gpu`]). `hessian` gives the
     /// term's second-order model at x for the implicit step: local stencil
     /// Hessians (projected onto their PSD part by the backend) and
     /// Gauss–Newton rank-one terms ([`SurfaceHessian`]).
     Surface {
         eval: fn(params: &[f64], mesh: &SurfaceMesh, x: &[DVec3], forces: &mut [DVec3]) -> f64,
         hessian: fn(params: &[f64], mesh: &SurfaceMesh, x: &[DVec3], out: &mut SurfaceHessian),
+        gpu: SurfaceGpu,
     },
     /// b(d) of the distance d from a node of one body to a face of another
     /// (E ≡ 0 for d ≥ `range`); the CPU backend finds the node–face pairs
@@ -279,10 +280,15 @@ pub enum Law {
 }
 
 impl Law {
-    /// Whether the GPU backend has a kernel for this law family (and so each
-    /// interaction of the family a `shaders/interactions/NAME.wgsl` evaluator).
+    /// Whether the GPU backend has a kernel for this law (and so its
+    /// interaction a `shaders/interactions/NAME.wgsl` evaluator): every law
+    /// but the surface laws without a GPU form and the contact laws.
     pub fn runs_on_gpu(&self) -> bool {
-        !matches!(self, Law::Surface { .. } | Law::Contact { .. } | Law::ContactArea { .. })
+        match self {
+            Law::Surface { gpu, .. } => *gpu != SurfaceGpu::None,
+            Law::Contact { .. } | Law::ContactArea { .. } => false,
+            _ => true,
+        }
     }
 
     /// The range of a contact law (node–face or area-weighted): beyond it E ≡ 0.
@@ -292,6 +298,20 @@ impl Law {
             _ => None,
         }
     }
+}
+
+/// How the GPU backend evaluates a surface law (src/gpu/surface.rs); the
+/// law's `shaders/interactions/NAME.wgsl` defines the function named.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SurfaceGpu {
+    /// No kernel: the GPU backend refuses decks that use it (custom body terms).
+    None,
+    /// `NAME_face`: the forces on a face's corners from that face's corners
+    /// and the body's totals (volume, area, face count).
+    PerFace,
+    /// `NAME_node`: an energy of each node's integrated mean curvature M_i
+    /// and area A_i (sums over its edges and faces), with ∂E/∂M_i and ∂E/∂A_i.
+    NodeCurvature,
 }
 
 /// Forces [node, corner 0, corner 1, corner 2] of a node–face energy b(d) with

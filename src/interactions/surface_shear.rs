@@ -3,7 +3,7 @@
 use faer::Mat;
 use glam::DVec3;
 
-use super::{Kind, Law, ParamSpec, SurfaceHessian, SurfaceMesh};
+use super::{Kind, Law, ParamSpec, SurfaceGpu, SurfaceHessian, SurfaceMesh};
 use crate::hessian::LocalHessian;
 use crate::mesh::{triangle_area_gradient, triangle_area_hessian};
 use crate::units::Dim;
@@ -66,7 +66,7 @@ interaction!(
     "surface_shear",
     Kind::Body,
     "In-plane shear (shape) elasticity of a closed body's faces, E = k·Σ_t (Σℓ²/(4√3·A_t) − 1): no tension, no bending",
-    Law::Surface { eval, hessian }
+    Law::Surface { eval, hessian, gpu: SurfaceGpu::PerFace }
 );
 
 #[cfg(test)]

@@ -2,7 +2,7 @@
 
 use glam::DVec3;
 
-use super::{Kind, Law, ParamSpec, SurfaceHessian, SurfaceMesh};
+use super::{Kind, Law, ParamSpec, SurfaceGpu, SurfaceHessian, SurfaceMesh};
 use crate::mesh::triangle_area_gradient;
 use crate::units::Dim;
 
@@ -30,7 +30,7 @@ fn hessian(p: &[f64], mesh: &SurfaceMesh, x: &[DVec3], out: &mut SurfaceHessian)
     }
 }
 
-interaction!(SurfaceTension, "surface_tension", Kind::Body, "Surface tension of a closed body, E = γ·A", Law::Surface { eval, hessian });
+interaction!(SurfaceTension, "surface_tension", Kind::Body, "Surface tension of a closed body, E = γ·A", Law::Surface { eval, hessian, gpu: SurfaceGpu::PerFace });
 
 #[cfg(test)]
 mod tests {

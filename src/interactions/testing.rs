@@ -230,7 +230,7 @@ pub fn assert_surface_hessian(
     tolerance: f64,
 ) -> f64 {
     let name = interaction.name();
-    let Law::Surface { eval, hessian } = interaction.law() else { panic!("{name}: not a surface law") };
+    let Law::Surface { eval, hessian, .. } = interaction.law() else { panic!("{name}: not a surface law") };
     let energy = |x: &[DVec3]| {
         let mut forces = vec![DVec3::ZERO; x.len()];
         eval(params, mesh, x, &mut forces) - dropped(x)

@@ -2,7 +2,7 @@
 
 use glam::DVec3;
 
-use super::{Kind, Law, ParamSpec, SurfaceHessian, SurfaceMesh};
+use super::{Kind, Law, ParamSpec, SurfaceGpu, SurfaceHessian, SurfaceMesh};
 use crate::hessian::RankOne;
 use crate::units::Dim;
 
@@ -49,7 +49,7 @@ interaction!(
     "turgor",
     Kind::Body,
     "Pressure of the enclosed volume, ΔP = ΔP0 + K(V0 − V)/V0, E = −ΔP0(V − V0) + K(V − V0)²/(2V0)",
-    Law::Surface { eval, hessian }
+    Law::Surface { eval, hessian, gpu: SurfaceGpu::PerFace }
 );
 
 #[cfg(test)]

@@ -2,7 +2,7 @@
 
 use glam::DVec3;
 
-use super::{Kind, Law, ParamSpec, SurfaceHessian, SurfaceMesh};
+use super::{Kind, Law, ParamSpec, SurfaceGpu, SurfaceHessian, SurfaceMesh};
 use crate::hessian::RankOne;
 use crate::units::Dim;
 
@@ -53,7 +53,7 @@ interaction!(
     "turgor_log",
     Kind::Body,
     "Pressure of the enclosed volume by the log law, ΔP = ΔP0 − K·ln(V/V0) (SimuCell3D)",
-    Law::Surface { eval, hessian }
+    Law::Surface { eval, hessian, gpu: SurfaceGpu::PerFace }
 );
 
 #[cfg(test)]

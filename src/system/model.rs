@@ -340,10 +340,14 @@ impl Model {
         bonds.and_then(|s| s.rest[b]).or_else(|| self.bond_kinetics[t].rest_index.map(|k| self.bond_types[t].params[k])).unwrap_or(f64::NAN)
     }
 
-    /// Whether any body has surface terms (the CPU backend evaluates them;
-    /// the GPU backend does not).
+    /// Whether any body has surface terms.
     pub fn has_surface_terms(&self) -> bool {
         self.bodies.iter().any(|b| self.body_rule_type.contains(&b.body_type))
+    }
+
+    /// Whether any body has a surface term without a GPU kernel (custom body terms).
+    pub fn has_cpu_only_surface_terms(&self) -> bool {
+        (0..self.bodies.len()).any(|b| self.rules_of_body(b).any(|r| !self.body_rules[r].interaction.law().runs_on_gpu()))
     }
 
     /// Whether any contact term acts between bodies (CPU only, explicit steps only).
