@@ -234,6 +234,10 @@ fn bad_options_exit_with_status_2_and_say_what_was_expected() {
         (&["sheet", "--rows", "2", "--columns", "2", "--cell-size", "3", "--jitter", "0.49", "--gap", "1"][..], "convex hexagon"),
         (&["tensegrity", "--radius", "5", "--level", "1", "--microtubules", "50"][..], "expected --microtubules <= 42"),
         (&["tensegrity", "--radius", "5", "--nucleus", "6"][..], "expected 0 < --nucleus RADIUS < --radius 5, found 6"),
+        (&["collagen", "--separation", "15", "--cell-radius", "10", "--size", "120", "80", "--density", "0.5", "--fibre-length", "20", "--node-spacing", "3"][..], "expected --separation > 2 × --cell-radius + --node-spacing"),
+        (&["collagen", "--layout", "random", "--separation", "60", "--cell-radius", "10", "--size", "120", "80", "--density", "0.5", "--fibre-length", "20", "--node-spacing", "3"][..], "expected --cells N with --layout random"),
+        (&["collagen", "--separation", "60", "--cell-radius", "10", "--size", "120", "80", "--density", "-0.5", "--fibre-length", "20", "--node-spacing", "3"][..], "expected --density > 0, found -0.5"),
+        (&["collagen", "--separation", "60", "--cell-radius", "10", "--size", "60", "80", "--density", "0.5", "--fibre-length", "20", "--node-spacing", "3"][..], "expected --size to hold every cell"),
     ] {
         let mut all = vec!["build"];
         all.extend_from_slice(args);

@@ -97,6 +97,14 @@ pub enum ThermoColumn {
         bond_type: usize,
         quantity: crate::measure::fracture::FractureQuantity,
     },
+    /// Fibre clustering S_max/S_min of a bond type across the band between
+    /// two groups (`clustering/BONDTYPE/GROUP_A/GROUP_B`; see
+    /// [`crate::measure::clustering`]).
+    Clustering {
+        bond_type: usize,
+        a: Group,
+        b: Group,
+    },
     /// Summed force on a group's particles along an axis (`fx/GROUP`,
     /// `fy/GROUP`, `fz/GROUP`); on `fixed` particles, the reaction of their anchors.
     GroupForce {
