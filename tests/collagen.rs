@@ -1,6 +1,6 @@
 //! Collagen clustering (seed 002, Ouyang et al. 2022; issue #19): the study
-//! deck `inputs/collagen_two_cells.in` on a reduced network (see the README
-//! section *Collagen clustering study*), and the thermo column
+//! deck `inputs/collagen_two_cells.in` on its two-cell network with shorter
+//! stages (see the README section *Collagen clustering study*), and the thermo column
 //! `clustering/BONDTYPE/GROUP_A/GROUP_B` on a configuration whose profile is
 //! known exactly.
 //!
@@ -12,11 +12,11 @@ use std::process::Command;
 use cellmd::deck::validate_file;
 use cellmd::run::{RunOptions, Simulation};
 
-/// The reduced network of the CI test: the study's geometry (cells of radius
-/// 100 µm, 600 µm apart, 83 ring nodes, fibres 200 µm long), a smaller
-/// rectangle (1000 × 600 µm against 1400 × 1000) and a coarser mesh (density
-/// 0.04 µm⁻¹, node spacing 40 µm, against 0.0628 and 25).
-const REDUCED: [&str; 16] = [
+/// The network of the CI test: the study's two-cell topology
+/// (`topologies/collagen_two_cells.top`: cells of radius 100 µm, 600 µm
+/// apart, 83 ring nodes, fibres 200 µm long at 0.1 µm⁻¹, node spacing 10 µm,
+/// in 1000 × 600 µm), built anew by the builder.
+const NETWORK: [&str; 17] = [
     "--layout",
     "pair",
     "--separation",
@@ -27,23 +27,26 @@ const REDUCED: [&str; 16] = [
     "1000",
     "600",
     "--density",
-    "0.04",
+    "0.1",
     "--fibre-length",
     "200",
     "--node-spacing",
-    "40",
-    "--seed=1",
+    "10",
+    "--seed",
+    "1",
 ];
 
-/// Stages and steps per stage of the CI runs (the study: 10 × 5000).
+/// Stages and steps per stage of the CI runs (the study: 10 × 1000; the paper: 50 000 steps per stage).
 const STAGES: u32 = 8;
-const STEPS: u32 = 1000;
+const STEPS: u32 = 500;
 
-/// Builds the reduced network into `dir` and returns the topology's path.
-fn reduced_network(dir: &Path) -> std::path::PathBuf {
+/// Builds the network into `dir` and returns the topology's path; it is the committed one.
+fn network(dir: &Path) -> std::path::PathBuf {
     let top = dir.join("collagen.top");
-    let out = Command::new(env!("CARGO_BIN_EXE_cellmd")).arg("build").arg("collagen").args(REDUCED).arg("-o").arg(&top).output().unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_cellmd")).arg("build").arg("collagen").args(NETWORK).arg("-o").arg(&top).output().unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let committed = std::fs::read_to_string("topologies/collagen_two_cells.top").unwrap();
+    assert_eq!(std::fs::read_to_string(&top).unwrap(), committed, "topologies/collagen_two_cells.top is not what the builder writes");
     top
 }
 
@@ -81,26 +84,29 @@ fn ratios(top: &Path, kc: f64) -> Vec<f64> {
 }
 
 #[test]
-fn asymmetric_fibres_cluster_between_contracting_cells_and_symmetric_ones_much_less() {
+fn fibres_cluster_between_contracting_cells_whether_or_not_they_are_asymmetric() {
     let dir = tempfile::tempdir().unwrap();
-    let top = reduced_network(dir.path());
+    let top = network(dir.path());
     let asymmetric = ratios(&top, 1.0);
     let symmetric = ratios(&top, 100.0);
     println!("stage  S_max/S_min asymmetric (k_t = 100 k_c)  symmetric (k_t = k_c)");
     for (s, (a, b)) in asymmetric.iter().zip(&symmetric).enumerate() {
         println!("{s:>5}  {a:.4}  {b:.4}");
     }
-    // The same network as built: the same ratio (a random network's noise, above 1).
+    // The same network as built: the same ratio, near 1 (a random network's noise).
     assert_eq!(asymmetric[0], symmetric[0]);
-    let last = STAGES as usize;
-    // Asymmetric fibres gather between the cells, more with every few stages.
-    assert!(asymmetric[last] > 1.0, "{asymmetric:?}");
-    assert!(asymmetric[last] > asymmetric[last / 2] && asymmetric[last / 2] > asymmetric[0], "{asymmetric:?}");
-    assert!(asymmetric[last] - asymmetric[0] > 0.2, "clustering grew by less than 0.2: {asymmetric:?}");
-    // Symmetric fibres (compression as stiff as tension): the growth is at
-    // most half of it — the asymmetry drives the clustering.
-    let grown = |r: &[f64]| r[last] - r[0];
-    assert!(grown(&symmetric) < 0.5 * grown(&asymmetric), "asymmetric {asymmetric:?}, symmetric {symmetric:?}");
+    assert!((asymmetric[0] - 1.0).abs() < 0.1, "{asymmetric:?}");
+    // Fibres gather between the contracting cells: the ratio exceeds 1 and
+    // grows with every stage.
+    for r in [&asymmetric, &symmetric] {
+        assert!(r.windows(2).all(|w| w[1] > w[0]), "not growing at every stage: {r:?}");
+        assert!(r[STAGES as usize] > r[0] + 0.2, "grew by less than 0.2: {r:?}");
+    }
+    // The paper's claim that the asymmetry drives it is NOT what this model
+    // gives: with compression as stiff as tension the ratio grows as much
+    // (within 5 % of the asymmetric growth; README, *Collagen clustering study*).
+    let grown = |r: &[f64]| r[STAGES as usize] - r[0];
+    assert!((grown(&symmetric) - grown(&asymmetric)).abs() < 0.05 * grown(&asymmetric), "asymmetric {asymmetric:?}, symmetric {symmetric:?}");
 }
 
 /// Two square "cells" of radius 1 at (±5, 0), rotated by `angle` about the

@@ -32,11 +32,11 @@ COLUMNS = "clustering/fibre/cell1/cell2 xu/hub1 yu/hub1 xu/hub2 yu/hub2"
 
 # The paper's geometry (µm): cells 200 µm across, 600 µm apart (the random
 # array: 600–1000 µm between neighbours); the mesh is ours.
-COMMON = ["--cell-radius", "100", "--density", "0.0628", "--fibre-length", "200", "--node-spacing", "25", "--seed", "1"]
+COMMON = ["--cell-radius", "100", "--density", "0.1", "--fibre-length", "200", "--node-spacing", "10", "--seed", "1"]
 LAYOUTS = {
-    "pair": ["--layout", "pair", "--separation", "600", "--size", "1400", "1000"],
-    "square": ["--layout", "square", "--separation", "600", "--size", "1400", "1400"],
-    "random": ["--layout", "random", "--cells", "6", "--separation", "600", "--size", "2000", "1600"],
+    "pair": ["--layout", "pair", "--separation", "600", "--size", "1000", "600"],
+    "square": ["--layout", "square", "--separation", "600", "--size", "1000", "1000"],
+    "random": ["--layout", "random", "--cells", "5", "--separation", "600", "--size", "1600", "1200"],
 }
 NEIGHBOUR = 1000.0  # µm: cells this close are a pair whose band is measured (random array)
 FIBRES = {"asymmetric": 1.0, "symmetric": 100.0}  # k_compression, pN/µm (k_tension 100)
