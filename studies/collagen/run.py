@@ -36,7 +36,7 @@ COMMON = ["--cell-radius", "100", "--density", "0.1", "--fibre-length", "200", "
 LAYOUTS = {
     "pair": ["--layout", "pair", "--separation", "600", "--size", "1000", "600"],
     "square": ["--layout", "square", "--separation", "600", "--size", "1000", "1000"],
-    "random": ["--layout", "random", "--cells", "5", "--separation", "600", "--size", "1600", "1200"],
+    "random": ["--layout", "random", "--cells", "5", "--separation", "600", "--size", "1800", "1400"],
 }
 NEIGHBOUR = 1000.0  # µm: cells this close are a pair whose band is measured (random array)
 FIBRES = {"asymmetric": 1.0, "symmetric": 100.0}  # k_compression, pN/µm (k_tension 100)
