@@ -54,15 +54,11 @@ fn network(dir: &Path) -> std::path::PathBuf {
 /// clustering ratio at the end of each stage (stage 0: as built).
 fn ratios(top: &Path, kc: f64) -> Vec<f64> {
     let dir = tempfile::tempdir().unwrap();
-    let vars: Vec<(String, String)> = [
-        ("kc", kc.to_string()),
-        ("stages", STAGES.to_string()),
-        ("steps", STEPS.to_string()),
-        ("top", top.display().to_string()),
-    ]
-    .into_iter()
-    .map(|(k, v)| (k.to_string(), v))
-    .collect();
+    let vars: Vec<(String, String)> =
+        [("kc", kc.to_string()), ("stages", STAGES.to_string()), ("steps", STEPS.to_string()), ("top", top.display().to_string())]
+            .into_iter()
+            .map(|(k, v)| (k.to_string(), v))
+            .collect();
     let plan = validate_file(Path::new("inputs/collagen_two_cells.in"), &vars).unwrap_or_else(|e| panic!("{e}"));
     Simulation::execute(plan, RunOptions { output_dir: dir.path().to_path_buf(), ..Default::default() }).unwrap_or_else(|e| panic!("{e}"));
     let thermo = std::fs::read_to_string(dir.path().join("collagen_two_cells.thermo.csv")).unwrap();
@@ -106,7 +102,10 @@ fn fibres_cluster_between_contracting_cells_whether_or_not_they_are_asymmetric()
     // gives: with compression as stiff as tension the ratio grows as much
     // (within 5 % of the asymmetric growth; README, *Collagen clustering study*).
     let grown = |r: &[f64]| r[STAGES as usize] - r[0];
-    assert!((grown(&symmetric) - grown(&asymmetric)).abs() < 0.05 * grown(&asymmetric), "asymmetric {asymmetric:?}, symmetric {symmetric:?}");
+    assert!(
+        (grown(&symmetric) - grown(&asymmetric)).abs() < 0.05 * grown(&asymmetric),
+        "asymmetric {asymmetric:?}, symmetric {symmetric:?}"
+    );
 }
 
 /// Two square "cells" of radius 1 at (±5, 0), rotated by `angle` about the

@@ -409,7 +409,10 @@ pub fn collagen(a: &CollagenArgs) -> Result<Built, String> {
         return Err(format!("expected at most {MAX_FIBRES} fibres (ρ·(W + L)(H + L)/L), found {n_fibres}: lower --density or --size"));
     }
     if (w * h / (ell * ell)) > 1e7 {
-        return Err(format!("expected at most 10 000 000 nodes' worth of area (W·H/ℓ²), found {:.3e}: raise --node-spacing", w * h / (ell * ell)));
+        return Err(format!(
+            "expected at most 10 000 000 nodes' worth of area (W·H/ℓ²), found {:.3e}: raise --node-spacing",
+            w * h / (ell * ell)
+        ));
     }
 
     let mut g = Graph::default();
@@ -602,7 +605,8 @@ pub fn collagen(a: &CollagenArgs) -> Result<Built, String> {
         format!("fibre bond length min {lo:.6e} mean {mean:.6e} max {hi:.6e} (node spacing {ell:?}); each fibre bond line ends with its own r0"),
         format!("{angles} angles `{}` along the fibres, at every node where a fibre runs straight on (θ = 180° as built)", a.angle_type),
     ];
-    let title = format!("Collagen network: {} cells, fibres of length {len:?} at density {rho:?} µm⁻¹, seed {}", cells.len(), a.common.seed);
+    let title =
+        format!("Collagen network: {} cells, fibres of length {len:?} at density {rho:?} µm⁻¹, seed {}", cells.len(), a.common.seed);
     Ok(wr.finish(&title, "collagen", lines))
 }
 
@@ -639,9 +643,14 @@ mod tests {
         assert!(fibres.len() > 500, "{}", fibres.len());
         assert!(fibres.iter().all(|[x, y]| (*x - *y).length() <= 3.0 + 1e-9));
         assert!(built.text.lines().filter(|l| l.starts_with("fibre ")).all(|l| l.split_whitespace().count() == 4));
-        assert!(built.text.lines().filter(|l| l.starts_with("cortex ") || l.starts_with("spoke ")).all(|l| l.split_whitespace().count() == 3));
+        assert!(built
+            .text
+            .lines()
+            .filter(|l| l.starts_with("cortex ") || l.starts_with("spoke "))
+            .all(|l| l.split_whitespace().count() == 3));
         for x in [-30.0, 30.0] {
-            let touching = fibres.iter().filter(|b| b.iter().any(|p| ((p.truncate() - DVec2::new(x, 0.0)).length() - 10.0).abs() < 1e-9)).count();
+            let touching =
+                fibres.iter().filter(|b| b.iter().any(|p| ((p.truncate() - DVec2::new(x, 0.0)).length() - 10.0).abs() < 1e-9)).count();
             assert!(touching >= 10, "{touching} fibres reach the cell at x = {x}");
         }
         // Every network node has at least two bonds or is an anchor at the edge.
@@ -676,7 +685,8 @@ mod tests {
 
     #[test]
     fn square_and_random_layouts_place_their_cells() {
-        let square = parse(&collagen(&CollagenArgs { layout: CellLayout::Square, size: vec![120.0, 120.0], ..CollagenArgs::default() }).unwrap());
+        let square =
+            parse(&collagen(&CollagenArgs { layout: CellLayout::Square, size: vec![120.0, 120.0], ..CollagenArgs::default() }).unwrap());
         let hubs: Vec<DVec3> = (0..4).map(|c| square.positions[c * 84]).collect();
         assert_eq!(hubs[0], DVec3::new(-30.0, -30.0, 0.0));
         assert_eq!(hubs[2], DVec3::new(30.0, 30.0, 0.0));
@@ -704,10 +714,15 @@ mod tests {
         let err = |b: CollagenArgs| collagen(&b).unwrap_err();
         assert_eq!(err(CollagenArgs { density: 0.0, ..a.clone() }), "expected --density > 0, found 0");
         assert_eq!(err(CollagenArgs { node_spacing: f64::NAN, ..a.clone() }), "expected --node-spacing > 0, found NaN");
-        assert!(err(CollagenArgs { separation: 20.0, ..a.clone() }).starts_with("expected --separation > 2 × --cell-radius + --node-spacing"));
+        assert!(
+            err(CollagenArgs { separation: 20.0, ..a.clone() }).starts_with("expected --separation > 2 × --cell-radius + --node-spacing")
+        );
         assert!(err(CollagenArgs { size: vec![70.0, 80.0], ..a.clone() }).starts_with("expected --size to hold every cell"));
         assert_eq!(err(CollagenArgs { ring_nodes: 2, ..a.clone() }), "expected 3 <= --ring-nodes <= 100000, found 2");
-        assert_eq!(err(CollagenArgs { cells: Some(3), ..a.clone() }), "expected --cells only with --layout random (--layout pair places its own)");
+        assert_eq!(
+            err(CollagenArgs { cells: Some(3), ..a.clone() }),
+            "expected --cells only with --layout random (--layout pair places its own)"
+        );
         assert_eq!(err(CollagenArgs { layout: CellLayout::Random, ..a.clone() }), "expected --cells N with --layout random");
         assert!(err(CollagenArgs { layout: CellLayout::Random, cells: Some(50), ..a.clone() }).starts_with("expected room for 50 cells"));
         assert!(err(CollagenArgs { density: 100.0, ..a.clone() }).starts_with("expected at most 20000 fibres"));

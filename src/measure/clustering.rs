@@ -59,7 +59,15 @@ fn within(lo: f64, hi: f64, v0: f64, dv: f64, (l0, l1): (f64, f64)) -> (f64, f64
 }
 
 /// The fibre length in each strip of the ROI between groups `a` and `b`.
-pub fn profile(model: &Model, bound: Option<&[bool]>, state: &State, sim_box: &SimBox, bond_type: usize, a: &[u32], b: &[u32]) -> [f64; STRIPS] {
+pub fn profile(
+    model: &Model,
+    bound: Option<&[bool]>,
+    state: &State,
+    sim_box: &SimBox,
+    bond_type: usize,
+    a: &[u32],
+    b: &[u32],
+) -> [f64; STRIPS] {
     let ((ca, ra), (cb, rb)) = (centre_and_radius(a, state, sim_box), centre_and_radius(b, state, sim_box));
     let axis = cb - ca;
     let u = axis.normalize_or_zero();

@@ -108,7 +108,9 @@ pub fn column_label(c: &ThermoColumn, model: &crate::system::Model) -> String {
         ThermoColumn::Fracture { bond_type, quantity } => {
             format!("fracture/{}/{}", model.bond_types[*bond_type].label.text, quantity.name())
         }
-        ThermoColumn::Clustering { bond_type, a, b } => format!("clustering/{}/{}/{}", model.bond_types[*bond_type].label.text, a.name, b.name),
+        ThermoColumn::Clustering { bond_type, a, b } => {
+            format!("clustering/{}/{}/{}", model.bond_types[*bond_type].label.text, a.name, b.name)
+        }
         ThermoColumn::GroupForce { group, axis } => format!("f{}/{}", ["x", "y", "z"][*axis], group.name),
         ThermoColumn::GroupPosition { group, axis } => format!("{}u/{}", ["x", "y", "z"][*axis], group.name),
         ThermoColumn::IndenterLoad(name) => format!("load/{name}"),

@@ -275,7 +275,10 @@ impl Validator {
                             let [a, b] = [a, b].map(|g| self.group_named(&t.with_text(g.to_string())).cloned());
                             let (a, b) = (a?, b?);
                             if let Some(empty) = [&a, &b].into_iter().find(|g| g.members.is_empty()) {
-                                return Err(t.error(format!("found `{other}`, whose group `{}` is empty; expected groups with members", empty.name)));
+                                return Err(t.error(format!(
+                                    "found `{other}`, whose group `{}` is empty; expected groups with members",
+                                    empty.name
+                                )));
                             }
                             ThermoColumn::Clustering { bond_type, a, b }
                         }
