@@ -24,6 +24,7 @@
 //! | [`sheet()`] | `sheet` | a 2D epithelial sheet (Prakash et al. 2022): hexagonal cells as rings of nodes (or single particles) joined by junction bonds |
 //! | [`tensegrity()`] | `tensegrity` | a tensegrity cell (Vassaux & Milan 2017): cortex and nucleus shells, radial microtubule struts, actin cables and stress fibres from focal adhesions |
 //! | [`lattice()`] | `lattice` | a diluted triangular lattice of fibres in a disc with a clamped rim (Broedersz et al. 2011), optionally with a contractile force dipole |
+//! | [`collagen()`] | `collagen` | a planar collagen fibre network (Ouyang et al. 2022): crosslinks as shared nodes, holes under cells that are rings of nodes with a hub |
 //! | [`merge()`] | `merge` | several topology files composed into one by the deck's rule for several `topology` lines |
 //!
 //! **Rest lengths** (`--rest-from-geometry`, every generator): by default a
@@ -71,6 +72,7 @@
 mod aster;
 mod branched;
 mod cells;
+mod collagen;
 mod cortex;
 mod filament;
 mod filopodium;
@@ -94,6 +96,7 @@ use crate::units::BOLTZMANN_PN_UM_PER_K;
 pub use self::aster::{aster, AsterArgs};
 pub use self::branched::{branched, BranchedArgs};
 pub use self::cells::{cells, CellsArgs, Layout};
+pub use self::collagen::{collagen, CellLayout, CollagenArgs};
 pub use self::cortex::{cortex, CortexArgs};
 pub use self::filament::{filament, FilamentArgs};
 pub use self::filopodium::{filopodium, FilopodiumArgs};
@@ -140,6 +143,11 @@ pub enum Generator {
     /// (Broedersz et al. 2011): each bond present with a probability,
     /// optionally bending-stiff lattice lines and a contractile force dipole.
     Lattice(LatticeArgs),
+    /// A planar collagen fibre network (Ouyang et al. 2022): random straight
+    /// fibres crosslinked where they cross (shared nodes), holes under the
+    /// cells, each cell a ring of nodes (83 by default) with a hub and spokes;
+    /// cells in a pair, a square or at random.
+    Collagen(CollagenArgs),
     /// Several topology files composed into one by the rule of a deck with
     /// several `topology` lines (ids shifted by --offset, by default the
     /// largest so far; body ids follow; shared type names; the first box).
@@ -161,6 +169,7 @@ impl Generator {
             Self::Sheet(a) => sheet(a),
             Self::Tensegrity(a) => tensegrity(a),
             Self::Lattice(a) => lattice(a),
+            Self::Collagen(a) => collagen(a),
             Self::Merge(a) => merge(a),
         }
     }
@@ -179,6 +188,7 @@ impl Generator {
             Self::Sheet(a) => a.common.output.as_path(),
             Self::Tensegrity(a) => a.common.output.as_path(),
             Self::Lattice(a) => a.common.output.as_path(),
+            Self::Collagen(a) => a.common.output.as_path(),
             Self::Merge(a) => a.output.as_path(),
         }
     }
@@ -259,6 +269,8 @@ pub(crate) struct Writer {
     bonds_comment: String,
     /// Write each bond's length as built as its rest length (`type i j r0`).
     rest_from_geometry: bool,
+    /// Bond types whose bonds always carry their length as built as r0.
+    own_rest: Vec<String>,
     angles: Vec<(String, [u64; 3])>,
     bodies: Vec<(u64, String)>,
     triangles: Vec<(u64, [u64; 3])>,
@@ -274,6 +286,7 @@ impl Writer {
             bonds: Vec::new(),
             bonds_comment: "# type  i  j".into(),
             rest_from_geometry: false,
+            own_rest: Vec::new(),
             angles: Vec::new(),
             bodies: Vec::new(),
             triangles: Vec::new(),
@@ -327,6 +340,17 @@ impl Writer {
     /// Whether each bond's line ends with its length as built, its own rest length.
     pub fn set_rest_from_geometry(&mut self, on: bool) {
         self.rest_from_geometry = on;
+    }
+
+    /// Bonds of `type_name` carry their length as built as r0 whatever
+    /// `set_rest_from_geometry` says (a network whose bonds differ by construction).
+    pub fn set_own_rest(&mut self, type_name: &str) {
+        self.own_rest.push(type_name.to_string());
+    }
+
+    /// Whether a bond of `type_name` is written with its own r0.
+    fn writes_rest(&self, type_name: &str) -> bool {
+        self.rest_from_geometry || self.own_rest.iter().any(|t| t == type_name)
     }
 
     /// The length of the bond between `i` and `j` as written: the minimum
@@ -404,10 +428,11 @@ impl Writer {
             }
         }
         if !self.bonds.is_empty() {
-            let r0 = if self.rest_from_geometry { "  r0" } else { "" };
+            let r0 = if self.bonds.iter().any(|b| self.writes_rest(&b.0)) { "  [r0]" } else { "" };
+            let r0 = if self.rest_from_geometry { "  r0" } else { r0 };
             writeln!(t, "[ bonds ]\n{}{r0}", self.bonds_comment).unwrap();
             for (type_name, i, j) in &self.bonds {
-                if self.rest_from_geometry {
+                if self.writes_rest(type_name) {
                     writeln!(t, "{type_name} {i} {j} {:?}", self.bond_length(*i, *j)).unwrap();
                 } else {
                     writeln!(t, "{type_name} {i} {j}").unwrap();
@@ -480,6 +505,7 @@ pub(crate) mod stream {
     pub const SHEET: u32 = 0x6275_0008;
     pub const TENSEGRITY: u32 = 0x6275_0009;
     pub const LATTICE: u32 = 0x6275_000a;
+    pub const COLLAGEN: u32 = 0x6275_000b;
 }
 
 impl Draws {

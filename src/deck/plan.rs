@@ -103,6 +103,14 @@ pub enum ThermoColumn {
         group: Group,
         quantity: GroupQuantity,
     },
+    /// Fibre clustering S_max/S_min of a bond type across the band between
+    /// two groups (`clustering/BONDTYPE/GROUP_A/GROUP_B`; see
+    /// [`crate::measure::clustering`]).
+    Clustering {
+        bond_type: usize,
+        a: Group,
+        b: Group,
+    },
     /// Magnitude of the summed force an indenter external exerts on its
     /// group, its reaction (`load/NAME`).
     IndenterLoad(String),

@@ -1,5 +1,6 @@
 //! Measurements read from a configuration and its force terms: per-particle
-//! stress, plane and cortical tension, filament statistics, sheet fracture.
+//! stress, plane and cortical tension, filament statistics, sheet fracture,
+//! fibre clustering.
 //!
 //! They are computed by the CPU reference backend at output steps only (on
 //! GPU runs after the positions come back), from the decomposition of every
@@ -13,8 +14,10 @@
 //! | force across a plane | thermo `planetension/AXIS/POS` | [`planes`] |
 //! | cortical tension γ (method of planes) | thermo `gamma/BODYTYPE` | [`planes`] |
 //! | end-to-end distance, tangent correlation | thermo `e2e/BONDTYPE`, `tcorr/BONDTYPE/LAG` | [`filaments`] |
+//! | fibre clustering between two cells, S_max/S_min | thermo `clustering/BONDTYPE/GROUP_A/GROUP_B` | [`clustering`] |
 //! | sheet fracture: broken junctions, rearrangements, crack, pieces, ductile/brittle | thermo `fracture/BONDTYPE/QUANTITY` | [`fracture`] |
 
+pub mod clustering;
 pub mod filaments;
 pub mod fracture;
 pub mod planes;

@@ -28,6 +28,7 @@
 //! | `e2e/BONDTYPE` | mean end-to-end distance of the chains of bonds of the type ([`filaments`](crate::measure::filaments)) | µm |
 //! | `tcorr/BONDTYPE/LAG` | tangent correlation ⟨t_s·t_{s+LAG}⟩ along those chains, LAG in bonds | – |
 //! | `fracture/BONDTYPE/QUANTITY` | a sheet's junctions: `broken` original junctions, `rearranged` (bound junctions to new neighbours), `ratio` (rearranged per broken), largest `crack` (broken junctions), `pieces`, `label` (0 elastic, 1 ductile, 2 brittle) ([`fracture`](crate::measure::fracture)) | – |
+//! | `clustering/BONDTYPE/GROUP_A/GROUP_B` | fibre clustering S_max/S_min: the densest 7 of 21 strips across the band between two cells against the 3 outermost at each end ([`clustering`](crate::measure::clustering)) | – |
 //! | `fx/GROUP`, `fy/GROUP`, `fz/GROUP` | Σ_{i∈GROUP} F_i along the axis; on `fixed` particles the reaction of their anchors (a sheared plate's load) | pN |
 //! | `xu/GROUP`, `yu/GROUP`, `zu/GROUP` | mean unwrapped coordinate (1/N)Σ_{i∈GROUP} (x_i + n_i·L) along the axis | µm |
 //! | `load/NAME`, `depth/NAME` | an indenter external's load \|Σ F\| on its group (its reaction) and its deepest penetration δ = (3E/K)^{1/3} | pN, µm |
@@ -41,7 +42,7 @@ use crate::backend::Forces;
 use crate::deck::{GroupQuantity, ThermoColumn};
 use glam::DVec2;
 use crate::interactions::REGISTRY;
-use crate::measure::{filaments, fracture, planes};
+use crate::measure::{clustering, filaments, fracture, planes};
 use crate::units::{Dim, UnitSystem};
 
 /// Values a thermo row is made from.
@@ -109,6 +110,9 @@ pub fn column_label(c: &ThermoColumn, model: &crate::system::Model) -> String {
             format!("fracture/{}/{}", model.bond_types[*bond_type].label.text, quantity.name())
         }
         ThermoColumn::Group { group, quantity } => format!("{}/{}", quantity.prefix(), group.name),
+        ThermoColumn::Clustering { bond_type, a, b } => {
+            format!("clustering/{}/{}/{}", model.bond_types[*bond_type].label.text, a.name, b.name)
+        }
         ThermoColumn::IndenterLoad(name) => format!("load/{name}"),
         ThermoColumn::IndenterDepth(name) => format!("depth/{name}"),
     }
@@ -124,7 +128,8 @@ pub fn column_unit(c: &ThermoColumn, units: UnitSystem) -> &'static str {
         | ThermoColumn::SolverResidual
         | ThermoColumn::ContactClamps
         | ThermoColumn::TangentCorrelation { .. }
-        | ThermoColumn::Fracture { .. } => "-",
+        | ThermoColumn::Fracture { .. }
+        | ThermoColumn::Clustering { .. } => "-",
         ThermoColumn::MinDistance => units.label(Dim::Length),
         ThermoColumn::Tension(_) | ThermoColumn::ConstraintTension(_) | ThermoColumn::PlaneTension { .. } => units.label(Dim::Force),
         ThermoColumn::CorticalTension(_) => units.label(Dim::Tension),
@@ -197,6 +202,15 @@ pub fn column_value(c: &ThermoColumn, t: &ThermoInputs) -> f64 {
             fracture::fracture(t.model, t.bonds.map(|s| s.bound.as_slice()), *bond_type).value(*quantity)
         }
         ThermoColumn::Group { group, quantity } => group_value(t, &group.members, *quantity),
+        ThermoColumn::Clustering { bond_type, a, b } => clustering::ratio(&clustering::profile(
+            t.model,
+            t.bonds.map(|s| s.bound.as_slice()),
+            t.state,
+            t.sim_box,
+            *bond_type,
+            &a.members,
+            &b.members,
+        )),
         ThermoColumn::IndenterLoad(name) => indenter_load(t.model, t.state, t.sim_box, name).map_or(f64::NAN, |(load, _)| load),
         ThermoColumn::IndenterDepth(name) => indenter_load(t.model, t.state, t.sim_box, name).map_or(f64::NAN, |(_, depth)| depth),
     }

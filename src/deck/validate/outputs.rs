@@ -148,7 +148,7 @@ impl Validator {
 
     pub(in crate::deck) fn thermo_columns(&self, tokens: &[Token]) -> Result<Vec<ThermoColumn>, InputError> {
         const FIXED: &str =
-            "step, time, pe, work, pe/NAME, pe/EXTERNAL, fmax, fnorm, press, pxx, pyy, pzz, pxy, pxz, pyz, nbuild, solver_iterations, solver_residual, ctension/BONDTYPE, breaks, rebinds, forms, resets, nbound/BONDTYPE, tension/BONDTYPE, volume/BODYTYPE, area/BODYTYPE, planetension/AXIS/POS, gamma/BODYTYPE, e2e/BONDTYPE, tcorr/BONDTYPE/LAG, fracture/BONDTYPE/QUANTITY, fx/GROUP, fy/GROUP, fz/GROUP, fx/EXTERNAL, fy/EXTERNAL, fz/EXTERNAL, xu/GROUP, yu/GROUP, zu/GROUP, xspan/GROUP, yspan/GROUP, zspan/GROUP, fabs/GROUP, hullarea/GROUP, load/INDENTER, depth/INDENTER, mindist, nclamp";
+            "step, time, pe, work, pe/NAME, pe/EXTERNAL, fmax, fnorm, press, pxx, pyy, pzz, pxy, pxz, pyz, nbuild, solver_iterations, solver_residual, ctension/BONDTYPE, breaks, rebinds, forms, resets, nbound/BONDTYPE, tension/BONDTYPE, volume/BODYTYPE, area/BODYTYPE, planetension/AXIS/POS, gamma/BODYTYPE, e2e/BONDTYPE, tcorr/BONDTYPE/LAG, fracture/BONDTYPE/QUANTITY, clustering/BONDTYPE/GROUP_A/GROUP_B, fx/GROUP, fy/GROUP, fz/GROUP, fx/EXTERNAL, fy/EXTERNAL, fz/EXTERNAL, xu/GROUP, yu/GROUP, zu/GROUP, xspan/GROUP, yspan/GROUP, zspan/GROUP, fabs/GROUP, hullarea/GROUP, load/INDENTER, depth/INDENTER, mindist, nclamp";
         let bond_type = |t: &Token, name: &str| {
             self.forcefield.bond_types.iter().position(|b| b.label.text == name).ok_or_else(|| {
                 let names: Vec<&str> = self.forcefield.bond_types.iter().map(|b| b.label.text.as_str()).collect();
@@ -253,6 +253,23 @@ impl Validator {
                             let (name, quantity) = rest.rsplit_once('/').ok_or_else(|| t.error(usage.clone()))?;
                             let quantity = FractureQuantity::from_name(quantity).ok_or_else(|| t.error(usage))?;
                             ThermoColumn::Fracture { bond_type: bond_type(t, name)?, quantity }
+                        }
+                        Some(("clustering", rest)) => {
+                            let usage = || t.error(format!("found `{other}`, expected clustering/BONDTYPE/GROUP_A/GROUP_B"));
+                            let [name, a, b] = rest.split('/').collect::<Vec<_>>()[..] else { return Err(usage()) };
+                            if a == b {
+                                return Err(t.error(format!("found `{other}`, expected two different groups (the two cells)")));
+                            }
+                            let bond_type = bond_type(t, name)?;
+                            let [a, b] = [a, b].map(|g| self.group_named(&t.with_text(g.to_string())).cloned());
+                            let (a, b) = (a?, b?);
+                            if let Some(empty) = [&a, &b].into_iter().find(|g| g.members.is_empty()) {
+                                return Err(t.error(format!(
+                                    "found `{other}`, whose group `{}` is empty; expected groups with members",
+                                    empty.name
+                                )));
+                            }
+                            ThermoColumn::Clustering { bond_type, a, b }
                         }
                         _ => return Err(t.error(format!("found thermo column `{other}`, expected one of: {FIXED}"))),
                     },
