@@ -505,7 +505,10 @@ pub(crate) mod stream {
     pub const SHEET: u32 = 0x6275_0008;
     pub const TENSEGRITY: u32 = 0x6275_0009;
     pub const LATTICE: u32 = 0x6275_000a;
-    pub const COLLAGEN: u32 = 0x6275_000b;
+    /// The same number as LATTICE (two branches took it at once): the
+    /// collagen study's committed network and its measured ratios are drawn
+    /// from it, and no system combines the two generators' draws.
+    pub const COLLAGEN: u32 = 0x6275_000a;
 }
 
 impl Draws {
