@@ -23,6 +23,7 @@
 //! | [`cells()`] | `cells` | many icosphere cells packed in a spheroid or a confluent layer |
 //! | [`sheet()`] | `sheet` | a 2D epithelial sheet (Prakash et al. 2022): hexagonal cells as rings of nodes (or single particles) joined by junction bonds |
 //! | [`tensegrity()`] | `tensegrity` | a tensegrity cell (Vassaux & Milan 2017): cortex and nucleus shells, radial microtubule struts, actin cables and stress fibres from focal adhesions |
+//! | [`ball()`] | `ball` | an elastic ball meshed with linear tetrahedra (`[ tetrahedra ]`, for `neo_hookean`/`linear_elastic`) |
 //! | [`merge()`] | `merge` | several topology files composed into one by the deck's rule for several `topology` lines |
 //!
 //! **Rest lengths** (`--rest-from-geometry`, every generator): by default a
@@ -68,6 +69,7 @@
 //! ```
 
 mod aster;
+mod ball;
 mod branched;
 mod cells;
 mod cortex;
@@ -89,6 +91,7 @@ use crate::rng::{block, open_unit_52};
 use crate::units::BOLTZMANN_PN_UM_PER_K;
 
 pub use self::aster::{aster, AsterArgs};
+pub use self::ball::{ball, BallArgs};
 pub use self::branched::{branched, BranchedArgs};
 pub use self::cells::{cells, CellsArgs, Layout};
 pub use self::cortex::{cortex, CortexArgs};
@@ -132,6 +135,9 @@ pub enum Generator {
     /// centrosome node), radial microtubule struts, actin cables from the
     /// cortex to the nucleus and stress fibres from focal adhesions.
     Tensegrity(TensegrityArgs),
+    /// An elastic ball of radius RADIUS meshed with linear tetrahedra (a cubed-sphere
+    /// map of a lattice of CELLS³ cubes, six tetrahedra each), for `tetra` volume laws.
+    Ball(BallArgs),
     /// Several topology files composed into one by the rule of a deck with
     /// several `topology` lines (ids shifted by --offset, by default the
     /// largest so far; body ids follow; shared type names; the first box).
@@ -152,6 +158,7 @@ impl Generator {
             Self::Cells(a) => cells(a),
             Self::Sheet(a) => sheet(a),
             Self::Tensegrity(a) => tensegrity(a),
+            Self::Ball(a) => ball(a),
             Self::Merge(a) => merge(a),
         }
     }
@@ -169,6 +176,7 @@ impl Generator {
             Self::Cells(a) => a.common.output.as_path(),
             Self::Sheet(a) => a.common.output.as_path(),
             Self::Tensegrity(a) => a.common.output.as_path(),
+            Self::Ball(a) => a.output.as_path(),
             Self::Merge(a) => a.output.as_path(),
         }
     }
@@ -227,6 +235,7 @@ pub struct Built {
     pub angles: usize,
     pub bodies: usize,
     pub triangles: usize,
+    pub tetrahedra: usize,
     /// The closed shells written (cells, nuclei), in body order.
     pub shells: Vec<Shell>,
 }
@@ -252,6 +261,7 @@ pub(crate) struct Writer {
     angles: Vec<(String, [u64; 3])>,
     bodies: Vec<(u64, String)>,
     triangles: Vec<(u64, [u64; 3])>,
+    tetrahedra: Vec<(String, [u64; 4])>,
     pub shells: Vec<Shell>,
 }
 
@@ -267,6 +277,7 @@ impl Writer {
             angles: Vec::new(),
             bodies: Vec::new(),
             triangles: Vec::new(),
+            tetrahedra: Vec::new(),
             shells: Vec::new(),
         }
     }
@@ -312,6 +323,11 @@ impl Writer {
 
     pub fn triangle(&mut self, body: u64, ids: [u64; 3]) {
         self.triangles.push((body, ids));
+    }
+
+    /// A volume element of type `type_name` on particles `ids`.
+    pub fn tetra(&mut self, type_name: &str, ids: [u64; 4]) {
+        self.tetrahedra.push((type_name.to_string(), ids));
     }
 
     /// Whether each bond's line ends with its length as built, its own rest length.
@@ -422,6 +438,12 @@ impl Writer {
                 writeln!(t, "{body} {i} {j} {k}").unwrap();
             }
         }
+        if !self.tetrahedra.is_empty() {
+            writeln!(t, "[ tetrahedra ]\n# type  i  j  k  l").unwrap();
+            for (type_name, [i, j, k, l]) in &self.tetrahedra {
+                writeln!(t, "{type_name} {i} {j} {k} {l}").unwrap();
+            }
+        }
         Built {
             text: t,
             lines,
@@ -430,6 +452,7 @@ impl Writer {
             angles: self.angles.len(),
             bodies: self.bodies.len(),
             triangles: self.triangles.len(),
+            tetrahedra: self.tetrahedra.len(),
             shells: self.shells,
         }
     }
