@@ -36,6 +36,8 @@ import random
 import numpy as np
 import openmm as mm
 
+from openmm_surfaces import document, fmt, snapshot  # the golden format, shared
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 STEPS = 100
 PARAMS = {"neo_hookean": dict(e=40.0, nu=0.3), "linear_elastic": dict(e=25.0, nu=0.4)}
@@ -120,10 +122,6 @@ def displacements(rest, centre, rng, amplitude):
     return out
 
 
-def fmt(v):
-    return repr(float(v))
-
-
 def write_case(name, case, rest, moves, elements, dt, box, periodic):
     d = os.path.join(HERE, name)
     lines = [f"# {case} case of {name}: written by reference/openmm_solids.py (positions: the rest shape)", "[ particles ]"]
@@ -158,27 +156,6 @@ def system_of(name, p, rest, elements):
     force.setForceGroup(1)
     system.addForce(force)
     return system
-
-
-def snapshot(context, name, step):
-    s = context.getState(getEnergy=True, getForces=True, getPositions=True, groups={1})
-    x = s.getPositions(asNumpy=True).value_in_unit(mm.unit.nanometer)
-    f = s.getForces(asNumpy=True).value_in_unit(mm.unit.kilojoule_per_mole / mm.unit.nanometer)
-    e = s.getPotentialEnergy().value_in_unit(mm.unit.kilojoule_per_mole)
-    w = [sum(x[:, a] * f[:, b]) for a, b in [(0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)]]
-    return dict(step=step, energy=e, energies={name: e}, stress=w, forces=f, positions=x)
-
-
-def document(header, probes):
-    block = lambda rows: "".join(f"  {r}\n" for r in rows)
-    out = "---\n" + "".join(f"{k}: {v}\n" for k, v in header)
-    for prefix, s in probes:
-        out += f"{prefix}_step: {s['step']}\n{prefix}_energy: {fmt(s['energy'])}\n"
-        out += f"{prefix}_energies: ! |\n" + block(f"{k} {fmt(v)}" for k, v in s["energies"].items())
-        out += f"{prefix}_stress: ! |\n" + block([" ".join(fmt(w) for w in s["stress"])])
-        for key in ("forces", "positions"):
-            out += f"{prefix}_{key}: ! |\n" + block(f"{k + 1} {fmt(v[0])} {fmt(v[1])} {fmt(v[2])}" for k, v in enumerate(s[key]))
-    return out
 
 
 def main():

@@ -2,8 +2,10 @@
 //! the volume laws (`neo_hookean`, `linear_elastic`).
 //!
 //! The cube [−1, 1]³ is cut into n³ lattice cells (n = `--cells`, even),
-//! each split into the six Kuhn tetrahedra around its (+,+,+) diagonal (the
-//! same diagonal in every cell, so faces match), and mapped onto the ball of
+//! each split into the six Kuhn tetrahedra around its diagonal from the
+//! corner nearest the centre to the farthest (the split mirrored into each
+//! octant: a mirror keeps the diagonals of the faces on the mirror planes,
+//! so faces still match), and mapped onto the ball of
 //! radius R by the cubed-sphere map: a point p with s = max|p_a| on the face
 //! of dominant axis a, face coordinates u = p_b/s, v = p_c/s, goes to
 //! R·s·d/|d| with d_a = sign(p_a), d_b = tan(πu/4), d_c = tan(πv/4). The map
@@ -11,7 +13,9 @@
 //! cube's surface onto the sphere (nodes *on* it, equal-angle spacing), and is
 //! monotone along every ray, so no element is inverted. The summary prints
 //! the mesh quality q = 6√2·V/ℓ_rms³ (1 for a regular tetrahedron, 0.66
-//! for a Kuhn tetrahedron of a cube; distorted most near the cube's corners),
+//! for a Kuhn tetrahedron of a cube; distorted most near the cube's corners,
+//! where three faces of a cell map onto one patch of the sphere: every
+//! element there keeps the cell's inner corner, so none lies flat on it),
 //! the element volumes and the total volume against 4πR³/3.
 
 use std::f64::consts::{FRAC_PI_4, PI};
@@ -59,8 +63,8 @@ fn cube_to_ball(p: DVec3) -> DVec3 {
     s * d.normalize()
 }
 
-/// The six Kuhn tetrahedra of the unit cube around its (0,0,0)–(1,1,1)
-/// diagonal, as corner offsets: one per order in which the path takes the axes.
+/// The six Kuhn tetrahedra of a cube around one of its diagonals: one per
+/// order in which the path along the diagonal takes the axes.
 const KUHN: [[usize; 3]; 6] = [[0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]];
 
 /// Mesh quality 6√2·V/ℓ_rms³ of a tetrahedron (1: regular).
@@ -95,11 +99,14 @@ pub fn ball(args: &BallArgs) -> Result<Built, String> {
     for i in 0..n {
         for j in 0..n {
             for k in 0..n {
+                // Along each axis, from the cell's side nearer the centre outwards.
+                let outward = [i, j, k].map(|c| 2 * c >= n);
+                let start = [i, j, k].map(|c| if 2 * c >= n { c } else { c + 1 });
                 for order in KUHN {
-                    let mut corner = [i, j, k];
-                    let mut nodes = [index(i, j, k); 4];
+                    let mut corner = start;
+                    let mut nodes = [index(start[0], start[1], start[2]); 4];
                     for (step, &axis) in order.iter().enumerate() {
-                        corner[axis] += 1;
+                        corner[axis] = if outward[axis] { corner[axis] + 1 } else { corner[axis] - 1 };
                         nodes[step + 1] = index(corner[0], corner[1], corner[2]);
                     }
                     let mut at = nodes.map(|v| x[v]);
@@ -174,7 +181,7 @@ mod tests {
                 }
             }
             let sphere = 4.0 / 3.0 * PI * 8.0;
-            assert!(total < sphere && total > 0.8 * sphere, "{cells}: volume {total} vs {sphere}");
+            assert!(total < sphere && total > 0.75 * sphere, "{cells}: volume {total} vs {sphere}");
         }
     }
 

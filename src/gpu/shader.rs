@@ -52,7 +52,7 @@ fn dispatch(custom: &CustomSource) -> String {
             Law::Radial { .. } => (&mut radial, format!("{name}_radial(p, r)")),
             Law::ThreeBody(_) => (&mut three, format!("{name}_three(p, ri, rj, rk)")),
             Law::OneBody(_) => (&mut one, format!("{name}_one(p, x)")),
-            Law::Surface { .. } | Law::Contact { .. } | Law::ContactArea { .. } => continue,
+            Law::Surface { .. } | Law::Contact { .. } | Law::ContactArea { .. } | Law::Tetra(_) => continue,
         };
         writeln!(out, "        case {index}u: {{ return {call}; }}").unwrap();
     }

@@ -444,3 +444,16 @@ pub fn assert_small_strain_moduli(interaction: &dyn Interaction, params: &[f64])
     assert!((young - e).abs() < 1e-3 * e, "{}: Young's modulus {young}, expected {e}", interaction.name());
     assert!((poisson - nu).abs() < 1e-3, "{}: Poisson's ratio {poisson}, expected {nu}", interaction.name());
 }
+
+/// Every shared check of a volume law (parameters `e`, `nu`) at a stiff, a
+/// nearly incompressible and an auxetic material: [`assert_tetra_checks`]
+/// on [`deformed_tetrahedra`] and [`assert_small_strain_moduli`].
+pub fn assert_volume_law_checks(interaction: &dyn Interaction) {
+    for (e, nu) in [(1000.0, 0.3), (250.0, 0.49), (40.0, -0.2)] {
+        let p = params_of(interaction, &[("e", e), ("nu", nu)]);
+        for (rest, x) in deformed_tetrahedra() {
+            assert_tetra_checks(interaction, &p, rest, x, 1e-6, 1e-3 * e);
+        }
+        assert_small_strain_moduli(interaction, &p);
+    }
+}

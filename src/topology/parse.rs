@@ -331,7 +331,7 @@ mod tests {
             parse("[ particles ]\n1 a 0 0 0\n[ bonds ]\ns 1 2\n").unwrap_err(),
             "t.top:4:5: found particle id 2, expected the id of a particle listed in [ particles ] before it"
         );
-        assert_eq!(parse("1 a 0 0 0\n").unwrap_err(), "t.top:1:1: found `1` before any section, expected a section header [ box ], [ particles ], [ bonds ], [ angles ], [ bodies ] or [ triangles ]");
+        assert_eq!(parse("1 a 0 0 0\n").unwrap_err(), "t.top:1:1: found `1` before any section, expected a section header [ box ], [ particles ], [ bonds ], [ angles ], [ bodies ], [ triangles ] or [ tetrahedra ]");
         assert!(parse("[ atoms ]\n").unwrap_err().starts_with("t.top:1:1: found section `[atoms]`"));
         assert!(parse("[ particles ]\n1 a 0 0 0\n1 a 1 0 0\n").unwrap_err().contains("already used at line 2"));
         assert!(parse("[ particles ]\n1 a 0 zero 0\n").unwrap_err().starts_with("t.top:2:7: found `zero`, expected the y coordinate"));
