@@ -11,10 +11,10 @@
 //! sink into it by F/k per node, ≤ 0.1 % of δ here.
 //!
 //! Measured (README, *Solid bodies*): the load follows δ^{3/2} but lies
-//! 20–25 % above Hertz at n = 8, 12 and 16 alike (`--cells n`), so the
-//! excess is not the mesh's resolution: a ball between plates is no
-//! half-space (its centre, pinned by symmetry, lies only R below each
-//! contact). The 5 % is not met, and this test does not claim it:
+//! 14–27 % above Hertz at n = 8, 12 and 16 alike (`--cells n`), so
+//! resolution explains little of the excess; the suspect is the oracle: a
+//! ball between plates is no half-space (its centre, pinned by symmetry,
+//! lies only R below each contact). The 5 % is not met, and this test does not claim it:
 //! it checks the exponent. The refinement study prints the whole table:
 //! `cargo test --release --test hertz -- --ignored --nocapture`.
 
