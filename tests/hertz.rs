@@ -97,7 +97,13 @@ fn report(cells: u32, stages: &[Stage]) -> (f64, f64) {
     let mut worst: f64 = 0.0;
     for s in stages {
         let (f, h) = (s.bottom, hertz(s.delta));
-        println!("  {:.2}  {f:10.3}  {h:10.3}  {:+.4}  {:.2}  {:.1e}", s.delta / RADIUS, f / h - 1.0, (RADIUS * s.delta).sqrt() / spacing, s.drift);
+        println!(
+            "  {:.2}  {f:10.3}  {h:10.3}  {:+.4}  {:.2}  {:.1e}",
+            s.delta / RADIUS,
+            f / h - 1.0,
+            (RADIUS * s.delta).sqrt() / spacing,
+            s.drift
+        );
         worst = worst.max((f / h - 1.0).abs());
     }
     let points: Vec<(f64, f64)> = stages.iter().map(|s| (s.delta.ln(), s.bottom.ln())).collect();
@@ -130,4 +136,20 @@ fn hertz_refinement_study() {
     for cells in [8, 12, 16] {
         report(cells, &sweep(cells));
     }
+}
+
+#[test]
+fn the_gpu_refuses_volume_elements() {
+    let dir = tempfile::tempdir().unwrap();
+    let files = [
+        ("t.top", "[ particles ]\n1 p 0 0 0\n2 p 1 0 0\n3 p 0 1 0\n4 p 0 0 1\n[ tetrahedra ]\nsolid 1 2 3 4\n"),
+        ("f.ff", "particle p drag 1\ntetra solid neo_hookean e 10 nu 0.3\n"),
+        ("deck.in", "units cell\ntopology t.top\nforcefield f.ff\nbox x -5 5 f y -5 5 f z -5 5 f\ntimestep 1e-3\nrun 1\n"),
+    ];
+    for (name, text) in files {
+        std::fs::write(dir.path().join(name), text).unwrap();
+    }
+    let plan = validate_file(&dir.path().join("deck.in"), &[]).unwrap_or_else(|e| panic!("{e}"));
+    let sim = Simulation::before_first_run(&plan, RunOptions::default()).unwrap();
+    assert_eq!(sim.cpu_only_feature(), Some("volume elements (`[ tetrahedra ]`, `tetra` lines) run on the CPU backend only"));
 }

@@ -122,7 +122,12 @@ impl CpuBackend {
             let term = &model.tetra_types[model.tetra_type[e] as usize];
             let Law::Tetra(eval) = term.interaction.law() else { unreachable!("tetra law is a volume law") };
             let rest = &model.tetra_rest[e];
-            projected_term_blocks(&model.tetras[e], &at, |p| eval(&term.params, rest, [p[0], p[1], p[2], p[3]]).forces.to_vec(), &mut blocks);
+            projected_term_blocks(
+                &model.tetras[e],
+                &at,
+                |p| eval(&term.params, rest, [p[0], p[1], p[2], p[3]]).forces.to_vec(),
+                &mut blocks,
+            );
         }
         if let Some(list) = self.neighbor_list() {
             for i in 0..model.len() {

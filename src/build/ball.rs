@@ -55,7 +55,13 @@ fn cube_to_ball(p: DVec3) -> DVec3 {
     if s == 0.0 {
         return DVec3::ZERO;
     }
-    let a = if p.x.abs() == s { 0 } else if p.y.abs() == s { 1 } else { 2 };
+    let a = if p.x.abs() == s {
+        0
+    } else if p.y.abs() == s {
+        1
+    } else {
+        2
+    };
     let mut d = DVec3::ZERO;
     for b in 0..3 {
         d[b] = if b == a { p[b].signum() } else { (FRAC_PI_4 * p[b] / s).tan() };
