@@ -1,5 +1,6 @@
 //! Closed triangulated surfaces (cell shells): connectivity, the geometry the
-//! surface interactions share, and the icosphere.
+//! surface interactions share, and the icosphere; and the rest shape of a
+//! linear tetrahedron ([`TetraRest`]), which the volume elements share.
 //!
 //! A [`SurfaceMesh`] holds one body's faces in local node numbering
 //! (`0..nodes`), each face wound counter-clockwise seen from outside, so its
@@ -377,6 +378,54 @@ pub fn icosphere(level: u32, radius: f64) -> (Vec<DVec3>, Vec<[u32; 3]>) {
         faces = next;
     }
     (x.into_iter().map(|p| p * radius).collect(), faces)
+}
+
+/// The rest shape of a linear (constant-strain) tetrahedron with corners
+/// x_0 … x_3: D_m⁻¹ and the rest volume V_0 = |det D_m|/6, where
+/// D_m = [X_1 − X_0, X_2 − X_0, X_3 − X_0] (columns) at rest.
+///
+/// The deformation gradient of the current corners x is
+/// F = D_s·D_m⁻¹ with D_s = [x_1 − x_0, x_2 − x_0, x_3 − x_0]; it is the same
+/// for either winding of the corners (det F > 0 unless the element turned
+/// inside out). An energy V_0·W(F) with first Piola stress P = ∂W/∂F exerts
+/// the forces [f_1 f_2 f_3] = −V_0·P·D_m⁻ᵀ (columns) and f_0 = −(f_1 + f_2 + f_3)
+/// ([`TetraRest::forces`]; Sifakis and Barbič, SIGGRAPH course 2012).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TetraRest {
+    pub dm_inv: DMat3,
+    pub volume: f64,
+}
+
+/// The edge matrix [x_1 − x_0, x_2 − x_0, x_3 − x_0] of a tetrahedron.
+pub fn tetra_edges(x: [DVec3; 4]) -> DMat3 {
+    DMat3::from_cols(x[1] - x[0], x[2] - x[0], x[3] - x[0])
+}
+
+impl TetraRest {
+    /// The rest shape of corners `x`; an error (for the caller to place)
+    /// when they are degenerate: a rest volume below 10⁻¹² of the cube of
+    /// the longest edge, where D_m⁻¹ would be meaningless.
+    pub fn new(x: [DVec3; 4]) -> Result<Self, String> {
+        let dm = tetra_edges(x);
+        let signed = dm.determinant() / 6.0;
+        let longest = (0..4).flat_map(|a| (a + 1..4).map(move |b| (a, b))).map(|(a, b)| (x[a] - x[b]).length()).fold(0.0, f64::max);
+        if !(signed.abs() > 1e-12 * longest.powi(3)) {
+            return Err(format!("the four corners are degenerate (rest volume {signed:e} for a longest edge of {longest:e})"));
+        }
+        Ok(Self { dm_inv: dm.inverse(), volume: signed.abs() })
+    }
+
+    /// F = D_s·D_m⁻¹ at corners `x`.
+    pub fn deformation_gradient(&self, x: [DVec3; 4]) -> DMat3 {
+        tetra_edges(x) * self.dm_inv
+    }
+
+    /// The corner forces of an energy V_0·W(F) whose first Piola stress is `piola`.
+    pub fn forces(&self, piola: DMat3) -> [DVec3; 4] {
+        let h = -self.volume * piola * self.dm_inv.transpose();
+        let [f1, f2, f3] = [h.x_axis, h.y_axis, h.z_axis];
+        [-(f1 + f2 + f3), f1, f2, f3]
+    }
 }
 
 #[cfg(test)]

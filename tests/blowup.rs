@@ -106,3 +106,24 @@ fn a_collapsed_cell_names_its_body_term() {
     assert_eq!((culprit.kind, culprit.label.as_str(), culprit.interaction), ("body", "cell", "turgor_log"), "{error}");
     assert!(error.to_string().contains("non-finite force; largest force on it from body `cell` (turgor_log)"), "{error}");
 }
+
+#[test]
+fn an_inverted_volume_element_names_its_element() {
+    // A neo-Hookean tetrahedron whose apex is pushed through its base in one
+    // step: det F < 0, where the law has no energy. The run stops at that
+    // step naming the element and its type, and writes no NaN.
+    let top = "[ particles ]\n1 p 0 0 0\n2 p 1 0 0\n3 p 0 1 0\n4 p 0 0 1\n[ tetrahedra ]\nsolid 1 2 3 4\n";
+    let ff = "particle p drag 1\ntetra solid neo_hookean e 10 nu 0.3\n";
+    let deck = "units lj\ntopology t.top\nforcefield f.ff\nbox x -10 10 f y -10 10 f z -10 10 f\ntimestep 0.01\n\
+                integrator overdamped max_displacement 100\ngroup apex id 4\nexternal push apex constant_force fz -300\n\
+                dump x every 1 xyz traj.xyz\nrun 10\n";
+    let case = Case::new(&[("t.top", top), ("f.ff", ff), ("deck.in", deck)]);
+    let error = run_to_error(&case);
+    let RunError::Blowup { step, culprit, .. } = &error else { panic!("{error}") };
+    assert_eq!(*step, 1, "{error}");
+    let culprit = culprit.as_ref().unwrap();
+    assert_eq!((culprit.kind, culprit.interaction), ("tetra", "neo_hookean"), "{error}");
+    assert_eq!(culprit.label, "solid element 1 of particles 1–2–3–4, turned inside out (det F ≤ 0)", "{error}");
+    let xyz = std::fs::read_to_string(case.path("traj.xyz")).unwrap();
+    assert!(!xyz.to_lowercase().contains("nan"), "{xyz}");
+}

@@ -17,7 +17,8 @@
 //!
 //! The surface (`body`) types have no LAMMPS style: their golden files come
 //! from OpenMM custom forces (`reference/openmm_surfaces.py`; the generator
-//! header says which engine produced a file).
+//! header says which engine produced a file); so do the volume-element
+//! (`tetra`) types (`reference/openmm_solids.py`).
 
 use std::path::{Path, PathBuf};
 
@@ -180,8 +181,9 @@ fn kinetics_golden_files_tell_a_different_rule_apart() {
     assert_eq!(checked, 2, "expected the threshold and bind golden files");
 }
 
-/// The OpenMM golden files can fail: every surface case disagrees with
-/// cellmd once one parameter of each body term is off by one part in 10⁶.
+/// The OpenMM golden files can fail: every surface and volume case disagrees
+/// with cellmd once one parameter of each body or tetra term is off by one
+/// part in 10⁶.
 #[test]
 fn surface_golden_files_tell_a_perturbed_term_apart() {
     let mut checked = 0;
@@ -189,7 +191,7 @@ fn surface_golden_files_tell_a_perturbed_term_apart() {
         for doc in documents(&path).iter().filter(|d| is_openmm(d)) {
             let deck = Path::new("reference").join(doc.get("deck").unwrap());
             let mut plan = validate_file(&deck, &[]).unwrap();
-            for term in &mut plan.model.body_rules {
+            for term in plan.model.body_rules.iter_mut().chain(&mut plan.model.tetra_types) {
                 let k = term.params.iter().position(|p| *p != 0.0).unwrap();
                 term.params[k] *= 1.0 + 1e-6;
             }
@@ -199,14 +201,15 @@ fn surface_golden_files_tell_a_perturbed_term_apart() {
             checked += 1;
         }
     }
-    assert_eq!(checked, 12);
+    assert_eq!(checked, 16);
 }
 
 /// The LAMMPS inputs committed beside each case are what `cellmd
 /// export-lammps` writes for its deck today (`reference/regenerate` copies
 /// them there): the golden data came from these decks. OpenMM cases have
 /// none: their system is built from the deck's own files by
-/// `reference/openmm_surfaces.py`, and LAMMPS export refuses body terms.
+/// `reference/openmm_surfaces.py` (`openmm_solids.py` for the volume
+/// elements), and LAMMPS export refuses body terms and volume elements.
 #[test]
 fn committed_lammps_inputs_are_current_exports() {
     let mut openmm = 0;
@@ -215,7 +218,8 @@ fn committed_lammps_inputs_are_current_exports() {
             if is_openmm(&doc) {
                 let deck = Path::new("reference").join(doc.get("deck").unwrap());
                 let plan = validate_file(&deck, &[]).unwrap();
-                assert!(plan.model.has_surface_terms(), "{}: an OpenMM case without surface terms", deck.display());
+                let openmm_only = plan.model.has_surface_terms() || !plan.model.tetras.is_empty();
+                assert!(openmm_only, "{}: an OpenMM case without surface terms or volume elements", deck.display());
                 let refusal = cellmd::export::export(&plan, cellmd::export::ExportOptions { probes: true }).err().unwrap_or_default();
                 assert!(refusal.contains("which LAMMPS cannot express"), "{}: {refusal}", deck.display());
                 assert!(!deck.parent().unwrap().join("lammps").exists());
@@ -237,7 +241,7 @@ fn committed_lammps_inputs_are_current_exports() {
             }
         }
     }
-    assert_eq!(openmm, 12, "expected two OpenMM cases for each of the six surface types");
+    assert_eq!(openmm, 16, "expected two OpenMM cases for each of the six surface types and the two volume types");
 }
 
 /// Each name has `reference/NAME.yaml` or a row `| `NAME` | reason | `test` |`

@@ -6,10 +6,12 @@
 //!   [`super::newton`], with the pair forces.
 //! - **Angles**: in the row of the angle's lowest-index particle
 //!   ([`Bonded::row_angles`]), the three forces through the same scatter.
+//! - **Volume elements** (tetrahedra): likewise, in the row of their
+//!   lowest-index corner ([`Bonded::row_tetras`]), the four forces.
 //! - **Energies and virial** (thermo steps only): every term once, in term
 //!   order, sequentially.
 //!
-//! A row visits its bonds, then its angles, in ascending term index, so the
+//! A row visits its bonds, then its angles, then its elements, in ascending term index, so the
 //! order of every sum is fixed by the data (see [`super::newton`]).
 //!
 //! With bond kinetics, each bond also has a state: an unbound bond carries no
@@ -20,7 +22,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::virial::{add6, outer};
-use crate::interactions::{Law, Radial, ThreeBody};
+use crate::interactions::{FourBody, Law, Radial, ThreeBody};
 use crate::system::BondState;
 use crate::system::{registry_index, Images, Model};
 
@@ -63,6 +65,9 @@ pub(super) struct Bonded {
     bond_laws: Vec<(RadialEval, RadialForce)>,
     /// Evaluator per angle type, likewise.
     angle_laws: Vec<ThreeBodyEval>,
+    /// The volume elements whose lowest-index corner is i, likewise.
+    tetra_offsets: Vec<u32>,
+    owned_tetras: Vec<u32>,
 }
 
 impl Bonded {
@@ -70,7 +75,17 @@ impl Bonded {
         let n = model.len();
         let (owned_offsets, owned_bonds) = by_particle(n, model.bonds.iter().map(|&[i, j]| i.min(j)));
         let (angle_offsets, owned_angles) = by_particle(n, model.angles.iter().map(|a| a.iter().copied().min().unwrap()));
-        Self { owned_offsets, owned_bonds, angle_offsets, owned_angles, bond_laws: Vec::new(), angle_laws: Vec::new() }
+        let (tetra_offsets, owned_tetras) = by_particle(n, model.tetras.iter().map(|t| t.iter().copied().min().unwrap()));
+        Self {
+            owned_offsets,
+            owned_bonds,
+            angle_offsets,
+            owned_angles,
+            bond_laws: Vec::new(),
+            angle_laws: Vec::new(),
+            tetra_offsets,
+            owned_tetras,
+        }
     }
 
     /// The evaluators of each bond and angle type's law.
@@ -200,6 +215,18 @@ impl Bonded {
         }
     }
 
+    /// The volume elements owned by particle `i` (lowest-index corner),
+    /// ascending: calls `visit(p, f)` with each corner and its force.
+    #[inline(always)]
+    pub(super) fn row_tetras(&self, i: usize, model: &Model, x: &[DVec3], images: &Images, mut visit: impl FnMut(usize, DVec3)) {
+        for &e in &self.owned_tetras[self.tetra_offsets[i] as usize..self.tetra_offsets[i + 1] as usize] {
+            let (_, out) = eval_tetra(model, e as usize, x, images);
+            for (&p, f) in model.tetras[e as usize].iter().zip(out.forces) {
+                visit(p as usize, f);
+            }
+        }
+    }
+
     /// Bonded energies (per registry entry, added to `energy`) and virial
     /// (added to `virial`), every term once in term order.
     pub(super) fn energy(
@@ -227,9 +254,19 @@ impl Bonded {
             add6(virial, outer(xi - xj, out.forces[0]));
             add6(virial, outer(xk - xj, out.forces[2]));
         }
+        let tetra_registry: Vec<usize> = model.tetra_types.iter().map(registry_index).collect();
+        for e in 0..model.tetras.len() {
+            let (at, out) = eval_tetra(model, e, x, images);
+            energy[tetra_registry[model.tetra_type[e] as usize]] += out.energy;
+            for k in 1..4 {
+                add6(virial, outer(at[k] - at[0], out.forces[k]));
+            }
+        }
     }
 
-    /// The bonded terms on particle `i` with their forces (diagnostics).
+    /// The bonded terms on particle `i` with their forces (diagnostics):
+    /// (kind, index, force), the index being the type of a bond or angle and
+    /// the element itself for a volume element (its report names it).
     pub(super) fn terms_on(
         &self,
         i: usize,
@@ -246,6 +283,11 @@ impl Bonded {
         for (a, ends) in model.angles.iter().enumerate() {
             if let Some(k) = ends.iter().position(|&p| p as usize == i) {
                 parts.push(("angle", model.angle_type[a] as usize, eval_angle(model, a, x, images).1.forces[k]));
+            }
+        }
+        for (e, corners) in model.tetras.iter().enumerate() {
+            if let Some(k) = corners.iter().position(|&p| p as usize == i) {
+                parts.push(("tetra", e, eval_tetra(model, e, x, images).1.forces[k]));
             }
         }
         parts
@@ -268,6 +310,18 @@ pub(super) fn eval_angle(model: &Model, a: usize, x: &[DVec3], images: &Images) 
     let Law::ThreeBody(eval) = term.interaction.law() else { unreachable!("angle law is three-body") };
     let at = angle_positions(model, a, x, images);
     (at, eval(&term.params, at))
+}
+
+/// Volume element `e` at image-consistent positions (corners 1–3 at their
+/// minimum image around corner 0).
+#[inline]
+pub(super) fn eval_tetra(model: &Model, e: usize, x: &[DVec3], images: &Images) -> ([DVec3; 4], FourBody) {
+    let term = &model.tetra_types[model.tetra_type[e] as usize];
+    let Law::Tetra(eval) = term.interaction.law() else { unreachable!("tetra law is a volume law") };
+    let corners = model.tetras[e];
+    let x0 = x[corners[0] as usize];
+    let at = corners.map(|p| x0 + images.minimum_image(x[p as usize] - x0));
+    (at, eval(&term.params, &model.tetra_rest[e], at))
 }
 
 /// Largest parameter count of a bond law (checked by a test).

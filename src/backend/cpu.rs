@@ -9,7 +9,7 @@
 //!   ([`PairTable`](super::pair_table)), each pair's force added to both
 //!   particles by Newton's third law in the ordered scatter/gather of
 //!   [`newton`](super::newton) (first pass, and the start of the second).
-//! - **Bonds and angles**: each once, in the row of its lowest-index
+//! - **Bonds, angles and volume elements**: each once, in the row of its lowest-index
 //!   particle, in the same scatter as the pairs (see [`bonded`](super::bonded)).
 //! - The second pass gathers, per particle, the spills of the scatter, then
 //!   the slots of surface and contact terms.
@@ -278,7 +278,7 @@ impl CpuBackend {
         let (has_surfaces, has_contacts) = (!surfaces.is_empty(), !contacts.is_empty());
         let geometry = PairGeometry { x, types: &model.types, list: &self.neighbors, images };
         out.forces.resize(n, DVec3::ZERO);
-        let scattered = has_pairs || !model.bonds.is_empty() || !model.angles.is_empty();
+        let scattered = has_pairs || !model.bonds.is_empty() || !model.angles.is_empty() || !model.tetras.is_empty();
         let terms = ScatterTerms { pairs: has_pairs.then_some(pairs), geometry: &geometry, bonded, model, bond_state };
         let columns = self.pair_interactions.len();
         let pair_energy = match (scattered, energies) {
@@ -330,8 +330,18 @@ impl CpuBackend {
         let images = sim_box.images();
         let mut parts: Vec<ForceBreakdown> = (self.bonded.terms_on(i, model, &state.positions, &images, state.bonds.as_ref()).into_iter())
             .map(|(kind, t, force)| {
-                let term = if kind == "bond" { &model.bond_types[t] } else { &model.angle_types[t] };
-                ForceBreakdown { kind, label: term.label.text.clone(), interaction: term.interaction.name(), force }
+                let (term, label) = match kind {
+                    "bond" => (&model.bond_types[t], model.bond_types[t].label.text.clone()),
+                    "angle" => (&model.angle_types[t], model.angle_types[t].label.text.clone()),
+                    _ => {
+                        let term = &model.tetra_types[model.tetra_type[t] as usize];
+                        let ids = model.tetras[t].map(|p| model.ids[p as usize].to_string()).join("–");
+                        // A NaN force is the mark of an element turned inside out (J ≤ 0).
+                        let inverted = if force.is_finite() { "" } else { ", turned inside out (det F ≤ 0)" };
+                        (term, format!("{} element {} of particles {ids}{inverted}", term.label.text, t + 1))
+                    }
+                };
+                ForceBreakdown { kind, label, interaction: term.interaction.name(), force }
             })
             .collect();
         for (rule, force) in self.surfaces.terms_on(i) {
@@ -397,7 +407,7 @@ impl CpuBackend {
 }
 
 /// The terms of the first pass: pairs (when the model has any), bonds and
-/// angles, row by row.
+/// angles and volume elements, row by row.
 struct ScatterTerms<'a> {
     pairs: Option<&'a PairTable>,
     geometry: &'a PairGeometry<'a>,
@@ -407,7 +417,7 @@ struct ScatterTerms<'a> {
 }
 
 impl ScatterTerms<'_> {
-    /// The scatter (first pass): in each row, its pairs, bonds and angles,
+    /// The scatter (first pass): in each row, its pairs, bonds, angles and volume elements,
     /// each force on all of the term's particles; with `ENERGY` also the energy per pair column
     /// and the pair virial, each block's in row order and the blocks' in block
     /// order (`None` without `ENERGY`: nothing is allocated then).
@@ -421,6 +431,7 @@ impl ScatterTerms<'_> {
                 }
                 self.bonded.row_bonds(i, self.model, x, images, self.bond_state, |j, f| scatter.pair(i, j, f));
                 self.bonded.row_angles(i, self.model, x, images, |p, f| scatter.add(p, f));
+                self.bonded.row_tetras(i, self.model, x, images, |p, f| scatter.add(p, f));
             }
         };
         if !ENERGY {

@@ -12,7 +12,7 @@
 //!   and E′/r without the clamps; they drop only the destabilising parts
 //!   (a compressed spring's negative transverse stiffness, the concave side
 //!   of a potential), which an implicit step must not amplify.
-//! - **Angles and externals**: the block Hessian of the term alone by central
+//! - **Angles, volume elements and externals**: the block Hessian of the term alone by central
 //!   differences of its own analytic forces, projected onto the positive
 //!   semi-definite cone ([`crate::hessian`]: symmetrised, negative
 //!   eigenvalues set to 0).
@@ -60,14 +60,14 @@
 //!   area–distance terms ε·s′_k·(…)·∇A_t∇d_kᵀ (indefinite), and the pull
 //!   ε·s′_k·B_k·∇²d_k.
 //!
-//! Blocks come in term order (bonds, angles, pairs by particle and ascending
+//! Blocks come in term order (bonds, angles, volume elements, pairs by particle and ascending
 //! neighbour, contact pairs, adhesion by node and rule, externals, then
 //! bodies by body, term and stencil), so the assembled matrix is the same on
 //! any thread count.
 
 use glam::{DMat3, DVec3};
 
-use super::bonded::eval_angle;
+use super::bonded::{eval_angle, eval_tetra};
 use super::cpu::CpuBackend;
 use super::stiffness_blocks::{push_blocks, Stiffness, StiffnessBlock};
 use crate::hessian::{finite_difference_hessian, project_psd};
@@ -116,6 +116,18 @@ impl CpuBackend {
             let term = &model.angle_types[model.angle_type[a] as usize];
             let Law::ThreeBody(eval) = term.interaction.law() else { unreachable!("angle law is three-body") };
             projected_term_blocks(&model.angles[a], &at, |p| eval(&term.params, [p[0], p[1], p[2]]).forces.to_vec(), &mut blocks);
+        }
+        for e in 0..model.tetras.len() {
+            let (at, _) = eval_tetra(model, e, x, &images);
+            let term = &model.tetra_types[model.tetra_type[e] as usize];
+            let Law::Tetra(eval) = term.interaction.law() else { unreachable!("tetra law is a volume law") };
+            let rest = &model.tetra_rest[e];
+            projected_term_blocks(
+                &model.tetras[e],
+                &at,
+                |p| eval(&term.params, rest, [p[0], p[1], p[2], p[3]]).forces.to_vec(),
+                &mut blocks,
+            );
         }
         if let Some(list) = self.neighbor_list() {
             for i in 0..model.len() {

@@ -10,6 +10,7 @@
 //! | bond, pair (i, j) | (x_i, x_j − x_i, f_j) | r_ji ⊗ f_j = r_ij ⊗ f_i |
 //! | angle (i, j, k), vertex j | (x_j, x_i − x_j, f_i), (x_j, x_k − x_j, f_k) | as the global virial |
 //! | body term on nodes k | (c, x_k − c, f_k), c the nodes' centroid | as the global virial |
+//! | volume element (x_0 … x_3) | (x_0, x_k − x_0, f_k), k = 1, 2, 3 | as the global virial |
 //!
 //! Positions are image-consistent (minimum image from `from`), so the sum of
 //! the segments' d ⊗ f over all terms is exactly the virial tensor W of
@@ -23,7 +24,7 @@
 
 use glam::DVec3;
 
-use super::bonded::eval_angle;
+use super::bonded::{eval_angle, eval_tetra};
 use super::pair_table::PairGeometry;
 use super::CpuBackend;
 use crate::system::{Model, SimBox, State};
@@ -36,6 +37,8 @@ pub enum TermKind {
     Angle,
     /// A surface (`body`) term; segments start at the body's node centroid.
     Body,
+    /// A volume element; segments start at its first corner.
+    Tetra,
 }
 
 /// One segment of a term: `force` acts on the particle at `from + d`.
@@ -57,8 +60,8 @@ pub struct Term<'a> {
 }
 
 impl CpuBackend {
-    /// Calls `visit` for every bond, pair (each unordered pair once), angle
-    /// and body term at `state`, in that order. Unbound bonds and terms that
+    /// Calls `visit` for every bond, pair (each unordered pair once), angle,
+    /// volume element and body term at `state`, in that order. Unbound bonds and terms that
     /// exert no force are skipped. Needs a force evaluation at `state` first.
     pub fn for_each_term(&self, model: &Model, state: &State, sim_box: &SimBox, mut visit: impl FnMut(&Term)) {
         let x = &state.positions;
@@ -90,6 +93,11 @@ impl CpuBackend {
             let ([xi, xj, xk], out) = eval_angle(model, a, x, &images);
             let segments = [Segment { from: xj, d: xi - xj, force: out.forces[0] }, Segment { from: xj, d: xk - xj, force: out.forces[2] }];
             visit(&Term { kind: TermKind::Angle, particles: &model.angles[a], segments: &segments, bond: usize::MAX });
+        }
+        for e in 0..model.tetras.len() {
+            let (at, out) = eval_tetra(model, e, x, &images);
+            let segments = [1usize, 2, 3].map(|k| Segment { from: at[0], d: at[k] - at[0], force: out.forces[k] });
+            visit(&Term { kind: TermKind::Tetra, particles: &model.tetras[e], segments: &segments, bond: usize::MAX });
         }
         let mut segments = Vec::new();
         self.surfaces().for_each_term(model, |nodes, xs, forces| {

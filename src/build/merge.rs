@@ -105,6 +105,10 @@ fn render(top: &Topology, args: &MergeArgs, mut lines: Vec<String>) -> Built {
         distinct(top.angles.iter().map(|a| a.type_name.text.as_str())),
         distinct(top.bodies.iter().map(|b| b.1.text.as_str()))
     ));
+    if !top.tetrahedra.is_empty() {
+        let types = distinct(top.tetrahedra.iter().map(|e| e.type_name.text.as_str()));
+        lines.push(format!("{} tetrahedra; tetra types {types}", top.tetrahedra.len()));
+    }
     lines.push(match top.box_axes {
         Some(_) => "box: the first [ box ] given (a deck's `box` command overrides it)".into(),
         None => "box: none given (the deck's `box` command sets it)".into(),
@@ -161,6 +165,13 @@ fn render(top: &Topology, args: &MergeArgs, mut lines: Vec<String>) -> Built {
             writeln!(t, "{body} {i} {j} {k}").unwrap();
         }
     }
+    if !top.tetrahedra.is_empty() {
+        writeln!(t, "[ tetrahedra ]\n# type  i  j  k  l").unwrap();
+        for element in &top.tetrahedra {
+            let [i, j, k, l] = element.particles.map(id);
+            writeln!(t, "{} {i} {j} {k} {l}", element.type_name.text).unwrap();
+        }
+    }
     Built {
         text: t,
         lines,
@@ -169,6 +180,7 @@ fn render(top: &Topology, args: &MergeArgs, mut lines: Vec<String>) -> Built {
         angles: top.angles.len(),
         bodies: top.bodies.len(),
         triangles: top.triangles.len(),
+        tetrahedra: top.tetrahedra.len(),
         shells: Vec::new(),
     }
 }

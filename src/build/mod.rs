@@ -25,6 +25,7 @@
 //! | [`tensegrity()`] | `tensegrity` | a tensegrity cell (Vassaux & Milan 2017): cortex and nucleus shells, radial microtubule struts, actin cables and stress fibres from focal adhesions |
 //! | [`lattice()`] | `lattice` | a diluted triangular lattice of fibres in a disc with a clamped rim (Broedersz et al. 2011), optionally with a contractile force dipole |
 //! | [`collagen()`] | `collagen` | a planar collagen fibre network (Ouyang et al. 2022): crosslinks as shared nodes, holes under cells that are rings of nodes with a hub |
+//! | [`ball()`] | `ball` | an elastic ball meshed with linear tetrahedra (`[ tetrahedra ]`, for `neo_hookean`/`linear_elastic`) |
 //! | [`merge()`] | `merge` | several topology files composed into one by the deck's rule for several `topology` lines |
 //!
 //! **Rest lengths** (`--rest-from-geometry`, every generator): by default a
@@ -70,6 +71,7 @@
 //! ```
 
 mod aster;
+mod ball;
 mod branched;
 mod cells;
 mod collagen;
@@ -94,6 +96,7 @@ use crate::rng::{block, open_unit_52};
 use crate::units::BOLTZMANN_PN_UM_PER_K;
 
 pub use self::aster::{aster, AsterArgs};
+pub use self::ball::{ball, BallArgs};
 pub use self::branched::{branched, BranchedArgs};
 pub use self::cells::{cells, CellsArgs, Layout};
 pub use self::collagen::{collagen, CellLayout, CollagenArgs};
@@ -148,6 +151,9 @@ pub enum Generator {
     /// cells, each cell a ring of nodes (83 by default) with a hub and spokes;
     /// cells in a pair, a square or at random.
     Collagen(CollagenArgs),
+    /// An elastic ball of radius RADIUS meshed with linear tetrahedra (a cubed-sphere
+    /// map of a lattice of CELLS³ cubes, six tetrahedra each), for `tetra` volume laws.
+    Ball(BallArgs),
     /// Several topology files composed into one by the rule of a deck with
     /// several `topology` lines (ids shifted by --offset, by default the
     /// largest so far; body ids follow; shared type names; the first box).
@@ -170,6 +176,7 @@ impl Generator {
             Self::Tensegrity(a) => tensegrity(a),
             Self::Lattice(a) => lattice(a),
             Self::Collagen(a) => collagen(a),
+            Self::Ball(a) => ball(a),
             Self::Merge(a) => merge(a),
         }
     }
@@ -189,6 +196,7 @@ impl Generator {
             Self::Tensegrity(a) => a.common.output.as_path(),
             Self::Lattice(a) => a.common.output.as_path(),
             Self::Collagen(a) => a.common.output.as_path(),
+            Self::Ball(a) => a.output.as_path(),
             Self::Merge(a) => a.output.as_path(),
         }
     }
@@ -247,6 +255,7 @@ pub struct Built {
     pub angles: usize,
     pub bodies: usize,
     pub triangles: usize,
+    pub tetrahedra: usize,
     /// The closed shells written (cells, nuclei), in body order.
     pub shells: Vec<Shell>,
 }
@@ -274,6 +283,7 @@ pub(crate) struct Writer {
     angles: Vec<(String, [u64; 3])>,
     bodies: Vec<(u64, String)>,
     triangles: Vec<(u64, [u64; 3])>,
+    tetrahedra: Vec<(String, [u64; 4])>,
     pub shells: Vec<Shell>,
 }
 
@@ -290,6 +300,7 @@ impl Writer {
             angles: Vec::new(),
             bodies: Vec::new(),
             triangles: Vec::new(),
+            tetrahedra: Vec::new(),
             shells: Vec::new(),
         }
     }
@@ -335,6 +346,11 @@ impl Writer {
 
     pub fn triangle(&mut self, body: u64, ids: [u64; 3]) {
         self.triangles.push((body, ids));
+    }
+
+    /// A volume element of type `type_name` on particles `ids`.
+    pub fn tetra(&mut self, type_name: &str, ids: [u64; 4]) {
+        self.tetrahedra.push((type_name.to_string(), ids));
     }
 
     /// Whether each bond's line ends with its length as built, its own rest length.
@@ -457,6 +473,12 @@ impl Writer {
                 writeln!(t, "{body} {i} {j} {k}").unwrap();
             }
         }
+        if !self.tetrahedra.is_empty() {
+            writeln!(t, "[ tetrahedra ]\n# type  i  j  k  l").unwrap();
+            for (type_name, [i, j, k, l]) in &self.tetrahedra {
+                writeln!(t, "{type_name} {i} {j} {k} {l}").unwrap();
+            }
+        }
         Built {
             text: t,
             lines,
@@ -465,6 +487,7 @@ impl Writer {
             angles: self.angles.len(),
             bodies: self.bodies.len(),
             triangles: self.triangles.len(),
+            tetrahedra: self.tetrahedra.len(),
             shells: self.shells,
         }
     }

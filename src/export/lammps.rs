@@ -795,7 +795,8 @@ impl Writer<'_> {
 /// are errors naming them.
 pub fn export(plan: &Plan, options: ExportOptions) -> Result<LammpsDeck, String> {
     let model = plan.model.clone();
-    if let Some(term) = model.body_rules.first().or(model.contact_rules.first()) {
+    let element = model.tetra_type.first().map(|&t| &model.tetra_types[t as usize]);
+    if let Some(term) = model.body_rules.first().or(model.contact_rules.first()).or(element) {
         return Err(styles::unsupported(term));
     }
     let bond_types = LammpsBondTypes::new(&model);

@@ -8,6 +8,7 @@
 //! particle anchor fixed                      # never moves (a substrate site)
 //! bond  actin_segment  harmonic  k 400 r0 0.1
 //! angle actin_bend     wlc_bending kappa 0.07 l0 0.1
+//! tetra nucleus        neo_hookean e 1000 nu 0.3   # volume elements ([ tetrahedra ])
 //! pair  actin actin    soft_repulsion k 100 sigma 0.05
 //! body  cell           turgor k 7e5 dp0 40 v0 4189
 //! contact cell cell    contact_barrier dhat 0.1 kappa 100

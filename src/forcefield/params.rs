@@ -32,8 +32,8 @@ pub fn parse_params(
     units: UnitSystem,
 ) -> Result<TermType, InputError> {
     let interaction = lookup(&interaction_token.text).ok_or_else(|| {
-        // `custom` (registered as a body term) takes every kind but contact.
-        let offered = |i: &&&dyn Interaction| i.kind() == kind || (i.name() == "custom" && kind != Kind::Contact);
+        // `custom` (registered as a body term) takes every kind but contact and tetra.
+        let offered = |i: &&&dyn Interaction| i.kind() == kind || (i.name() == "custom" && !matches!(kind, Kind::Contact | Kind::Tetra));
         let names: Vec<&str> = REGISTRY.iter().filter(offered).map(|i| i.name()).collect();
         interaction_token.error(format!(
             "found `{}`, expected a registered {} interaction: {}",

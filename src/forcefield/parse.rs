@@ -52,6 +52,8 @@ pub struct ForceField {
     /// Kinetic rules of each bond type (same order as `bond_types`).
     pub bond_kinetics: Vec<BondTypeKinetics>,
     pub angle_types: Vec<TermType>,
+    /// Volume element types (`tetra` lines), for the topology's `[ tetrahedra ]`.
+    pub tetra_types: Vec<TermType>,
     pub pair_rules: Vec<PairRule>,
     /// Surface terms by body type (`body` lines); several lines for one type add up.
     pub body_rules: Vec<BodyRule>,
@@ -206,6 +208,13 @@ pub fn load_forcefield(
                 check_unique(&t[1], ff.angle_types.iter().map(|x| &x.label), "angle type")?;
                 ff.angle_types.push(term_type(&t[1], &t[2], &t[3..], Kind::Angle, units)?);
             }
+            "tetra" => {
+                if t.len() < 3 {
+                    return Err(kw.error("expected `tetra NAME INTERACTION [param value]...`"));
+                }
+                check_unique(&t[1], ff.tetra_types.iter().map(|x| &x.label), "tetra type")?;
+                ff.tetra_types.push(term_type(&t[1], &t[2], &t[3..], Kind::Tetra, units)?);
+            }
             "pair" => {
                 if t.len() < 4 {
                     return Err(kw.error("expected `pair TYPE_A TYPE_B INTERACTION [param value]...`"));
@@ -230,7 +239,7 @@ pub fn load_forcefield(
             "bind" => ff.bind_lines.push(super::parse_bind(kw, &t[1..], units)?),
             other => {
                 return Err(kw.error(format!(
-                    "found `{other}`, expected `include`, `particle`, `bond`, `angle`, `pair`, `body`, `contact` or `bind`"
+                    "found `{other}`, expected `include`, `particle`, `bond`, `angle`, `tetra`, `pair`, `body`, `contact` or `bind`"
                 )))
             }
         }

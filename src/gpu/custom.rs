@@ -118,7 +118,7 @@ pub fn source(model: &Model) -> Result<CustomSource, String> {
                 .unwrap();
                 writeln!(out.one_cases, "        case {index}u: {{ return custom_{k}_one(p, x); }}").unwrap();
             }
-            Kind::Body | Kind::Contact => unreachable!("surface and contact terms are not packed"),
+            Kind::Body | Kind::Contact | Kind::Tetra => unreachable!("surface, contact and volume terms are not packed"),
         }
     }
     Ok(out)

@@ -59,7 +59,7 @@ fn dispatch(custom: &CustomSource) -> String {
             Law::OneBody(_) => (&mut one, format!("{name}_one(p, x)")),
             Law::Surface { gpu: SurfaceGpu::PerFace, .. } => (&mut surface, format!("{name}_face(p, body, g)")),
             Law::Surface { gpu: SurfaceGpu::NodeCurvature, .. } => (&mut node, format!("{name}_node(p, m, a)")),
-            Law::Surface { .. } | Law::Contact { .. } | Law::ContactArea { .. } => continue,
+            Law::Surface { .. } | Law::Contact { .. } | Law::ContactArea { .. } | Law::Tetra(_) => continue,
         };
         writeln!(out, "        case {index}u: {{ return {call}; }}").unwrap();
     }

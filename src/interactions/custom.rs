@@ -31,7 +31,7 @@ pub fn variables(kind: Kind) -> &'static [(&'static str, &'static str)] {
         Kind::Angle => &[("theta", "angle at the middle particle, in radians (0 to π)")],
         Kind::External => &[("x", "position x"), ("y", "position y"), ("z", "position z"), ("t", "time")],
         Kind::Body => &[("V", "enclosed volume of the body"), ("A", "surface area of the body")],
-        Kind::Contact => &[],
+        Kind::Contact | Kind::Tetra => &[],
     }
 }
 
@@ -231,7 +231,7 @@ impl Interaction for CustomLaw {
             Kind::Pair => Law::Radial { eval: pair_eval, force: pair_force, range: |p| p[0] },
             Kind::Angle => Law::ThreeBody(angle_eval),
             Kind::External => Law::OneBody(external_eval),
-            Kind::Body | Kind::Contact => Law::Surface { eval: body_eval, hessian: body_hessian, gpu: SurfaceGpu::None },
+            Kind::Body | Kind::Contact | Kind::Tetra => Law::Surface { eval: body_eval, hessian: body_hessian, gpu: SurfaceGpu::None },
         }
     }
 }

@@ -27,18 +27,23 @@
 //! energy per unit area of each face, switched on by its corners' distances
 //! to the nearest face of another body.
 //!
+//! Volume elements use [`Law::Tetra`]: an energy V_0·W(F) of one linear
+//! tetrahedron, W a strain-energy density of its deformation gradient F
+//! relative to its rest shape ([`TetraRest`], from the topology's initial
+//! positions); [`elastic_tetra`] turns W and its stress into corner forces.
+//!
 //! Laws carry what later solvers need: [`Radial`] returns d²E/dr², from which
 //! the analytic pair Hessian `E''·ûûᵀ + (E'/r)(I − ûûᵀ)` follows; state that
 //! changes during a run (e.g. a rest length under kinetics) is a parameter
 //! value, so a stateful bond owns its own parameter copy.
 
-use glam::DVec3;
+use glam::{DMat3, DVec3};
 
 pub(crate) use self::entry::entry;
 pub use self::entry::{documentation, Entry};
 pub use self::wall::plane as wall_plane;
 pub use crate::hessian::SurfaceHessian;
-pub use crate::mesh::SurfaceMesh;
+pub use crate::mesh::{SurfaceMesh, TetraRest};
 use crate::units::Dim;
 
 /// Implements [`Entry`] and [`Interaction`] for a unit struct from its
@@ -90,7 +95,9 @@ mod harmonic;
 mod harmonic_angle;
 mod helfrich_bending;
 mod indenter;
+mod linear_elastic;
 mod lj;
+mod neo_hookean;
 mod soft;
 mod soft_repulsion;
 mod spring;
@@ -130,6 +137,8 @@ pub static REGISTRY: &[&dyn Interaction] = &[
     &helfrich_bending::HelfrichBending,
     &contact_barrier::ContactBarrier,
     &contact_adhesion::ContactAdhesion,
+    &neo_hookean::NeoHookean,
+    &linear_elastic::LinearElastic,
     &custom::Custom,
 ];
 
@@ -153,6 +162,8 @@ pub enum Kind {
     Body,
     /// Node–face term between different bodies, by body-type pair (`contact` lines).
     Contact,
+    /// Four-particle volume element (`tetra` lines, `[ tetrahedra ]` of the topology).
+    Tetra,
 }
 
 impl Kind {
@@ -165,6 +176,7 @@ impl Kind {
             Kind::External => "external",
             Kind::Body => "body",
             Kind::Contact => "contact",
+            Kind::Tetra => "tetra",
         }
     }
 
@@ -177,6 +189,7 @@ impl Kind {
             Kind::External => "an external",
             Kind::Body => "a body",
             Kind::Contact => "a contact",
+            Kind::Tetra => "a tetra",
         }
     }
 }
@@ -224,6 +237,48 @@ pub fn over_r(de_dr: f64, r: f64) -> f64 {
 pub struct ThreeBody {
     pub energy: f64,
     pub forces: [DVec3; 3],
+}
+
+/// Energy and the force on each corner of a tetrahedron.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FourBody {
+    pub energy: f64,
+    pub forces: [DVec3; 4],
+}
+
+/// The energy V_0·W(F) and corner forces of a volume element, from
+/// `density(F, J)` = (W, P) (strain-energy density and first Piola stress at
+/// F, J = det F > 0). An element turned inside out or flat (J ≤ 0), where no
+/// elastic law is defined, gets a NaN energy and NaN forces: the run stops
+/// with a blow-up report that names the element and its term.
+pub fn elastic_tetra(rest: &TetraRest, x: [DVec3; 4], density: impl FnOnce(DMat3, f64) -> (f64, DMat3)) -> FourBody {
+    let f = rest.deformation_gradient(x);
+    let j = f.determinant();
+    if !(j > 0.0) {
+        return FourBody { energy: f64::NAN, forces: [DVec3::NAN; 4] };
+    }
+    let (w, piola) = density(f, j);
+    FourBody { energy: rest.volume * w, forces: rest.forces(piola) }
+}
+
+/// The parameters of the isotropic elastic volume laws: Young's modulus and Poisson's ratio.
+pub(crate) static ELASTIC_PARAMS: [ParamSpec; 2] = [
+    ParamSpec::new("e", Dim::Pressure, "Young's modulus E (pN/µm² = Pa in cell units)").positive(),
+    ParamSpec {
+        min: Bound::Exclusive(-1.0),
+        ..ParamSpec::new(
+            "nu",
+            Dim::Dimensionless,
+            "Poisson's ratio ν; up to 0.5 (exclusive): nearly incompressible is allowed, but linear tetrahedra lock as ν → 0.5",
+        )
+        .below(0.5)
+    },
+];
+
+/// Lamé's constants (μ, λ) = (E/(2(1 + ν)), Eν/((1 + ν)(1 − 2ν))) of `ELASTIC_PARAMS` values.
+pub fn lame(p: &[f64]) -> (f64, f64) {
+    let (e, nu) = (p[0], p[1]);
+    (e / (2.0 * (1.0 + nu)), e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)))
 }
 
 /// Energy and force of a one-particle external field.
@@ -277,6 +332,9 @@ pub enum Law {
     /// node–face candidates of [`Law::Contact`]) and adds both the area and
     /// the distance gradients. No GPU kernel yet.
     ContactArea { switch: fn(&[f64], f64) -> Radial, density: fn(&[f64]) -> f64, range: fn(&[f64]) -> f64 },
+    /// E(x_0 … x_3) of one linear tetrahedron with rest shape `TetraRest`;
+    /// positions are image-consistent (around x_0). No GPU kernel yet.
+    Tetra(fn(&[f64], &TetraRest, [DVec3; 4]) -> FourBody),
 }
 
 impl Law {
@@ -286,7 +344,7 @@ impl Law {
     pub fn runs_on_gpu(&self) -> bool {
         match self {
             Law::Surface { gpu, .. } => *gpu != SurfaceGpu::None,
-            Law::Contact { .. } | Law::ContactArea { .. } => false,
+            Law::Contact { .. } | Law::ContactArea { .. } | Law::Tetra(_) => false,
             _ => true,
         }
     }
@@ -480,7 +538,8 @@ mod tests {
                 | (Kind::Angle, Law::ThreeBody(_))
                 | (Kind::External, Law::OneBody(_))
                 | (Kind::Body, Law::Surface { .. })
-                | (Kind::Contact, Law::Contact { .. } | Law::ContactArea { .. }) => {}
+                | (Kind::Contact, Law::Contact { .. } | Law::ContactArea { .. })
+                | (Kind::Tetra, Law::Tetra(_)) => {}
                 _ => panic!("{}: kind and law disagree", i.name()),
             }
         }

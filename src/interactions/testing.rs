@@ -15,6 +15,10 @@
 //!
 //! [`Law::Surface`] laws need a mesh besides positions: their checks are the
 //! `assert_surface_*` functions, which run the same tests on a body.
+//! [`Law::Tetra`] laws need a rest shape besides positions:
+//! [`assert_tetra_checks`] runs the same tests on one element, and
+//! [`assert_small_strain_moduli`] measures its Young's modulus and Poisson's
+//! ratio by a small uniaxial stretch.
 //! [`Law::ContactArea`] laws need whole bodies and their nearest faces: the
 //! engine evaluates them, and [`assert_checks_of`] runs the same tests on
 //! any energy-and-forces function of all positions (e.g. the CPU backend's).
@@ -22,7 +26,7 @@
 use glam::{DMat3, DVec3};
 
 pub use super::{Entry, Interaction};
-use super::{Law, SurfaceHessian, SurfaceMesh};
+use super::{Law, SurfaceHessian, SurfaceMesh, TetraRest};
 use crate::hessian::project_psd;
 use faer::{Col, Mat};
 
@@ -51,6 +55,7 @@ pub fn evaluate(law: Law, params: &[f64], positions: &[DVec3]) -> (f64, Vec<DVec
         }
         Law::Surface { .. } => panic!("a surface law needs its mesh: use evaluate_surface"),
         Law::ContactArea { .. } => panic!("an area-weighted contact law needs whole bodies: use assert_checks_of on the engine"),
+        Law::Tetra(_) => panic!("a volume law needs its rest shape: use assert_tetra_checks"),
     }
 }
 
@@ -369,4 +374,86 @@ pub fn assert_force_matches_eval(interaction: &dyn Interaction, params: &[f64], 
     let (de_dr, fast) = (eval(params, r).de_dr, force(params, r * r) * r);
     let scale = de_dr.abs().max(fast.abs()).max(1e-300);
     assert!((de_dr - fast).abs() / scale < 1e-12, "{}: at r = {r}: force·r = {fast}, eval dE/dr = {de_dr}", interaction.name());
+}
+
+/// The unit right tetrahedron (corners 0, x̂, ŷ, ẑ: D_m = I, V_0 = 1/6) stretched by F = diag(s, t, t).
+pub fn stretched_unit_tetra(s: f64, t: f64) -> [DVec3; 4] {
+    [DVec3::ZERO, s * DVec3::X, t * DVec3::Y, t * DVec3::Z]
+}
+
+/// The rest shape of the unit right tetrahedron.
+pub fn unit_tetra_rest() -> TetraRest {
+    TetraRest::new(stretched_unit_tetra(1.0, 1.0)).unwrap()
+}
+
+/// (rest, current) corners of skewed tetrahedra under stretch, shear,
+/// compression and a large rotation, in both windings.
+pub fn deformed_tetrahedra() -> Vec<([DVec3; 4], [DVec3; 4])> {
+    let rest = [DVec3::new(0.1, -0.2, 0.05), DVec3::new(0.9, 0.1, -0.1), DVec3::new(0.2, 0.8, 0.15), DVec3::new(0.3, 0.25, 0.7)];
+    let mirrored = [rest[0], rest[2], rest[1], rest[3]];
+    let spin = glam::DQuat::from_axis_angle(DVec3::new(0.3, -1.0, 0.4).normalize(), 2.3);
+    let maps: [DMat3; 3] = [
+        DMat3::from_cols(DVec3::new(1.2, 0.1, 0.0), DVec3::new(-0.05, 0.9, 0.2), DVec3::new(0.0, 0.1, 1.05)),
+        DMat3::from_cols(DVec3::new(0.7, 0.0, 0.1), DVec3::new(0.3, 0.8, 0.0), DVec3::new(0.0, -0.2, 0.6)),
+        DMat3::from_quat(spin) * DMat3::from_diagonal(DVec3::new(1.4, 0.8, 0.95)),
+    ];
+    let mut out = Vec::new();
+    for r in [rest, mirrored] {
+        for m in maps {
+            out.push((r, r.map(|x| m * x + DVec3::new(0.3, -0.1, 0.2))));
+        }
+    }
+    out
+}
+
+/// F = −∇E, Σf = 0, Σ r×f = 0 and rigid-motion invariance of a volume law on
+/// one element with rest corners `rest` at corners `x`, and zero force at rest.
+pub fn assert_tetra_checks(interaction: &dyn Interaction, params: &[f64], rest: [DVec3; 4], x: [DVec3; 4], h: f64, force_floor: f64) {
+    let Law::Tetra(eval) = interaction.law() else { panic!("{} is not a volume law", interaction.name()) };
+    let shape = TetraRest::new(rest).unwrap();
+    let element = |p: &[DVec3]| {
+        let out = eval(params, &shape, [p[0], p[1], p[2], p[3]]);
+        (out.energy, out.forces.to_vec())
+    };
+    assert_checks_of(interaction.name(), &element, &x, h, force_floor);
+    zero_force_at_rest(interaction.name(), &element, &rest, force_floor);
+}
+
+/// The analytic oracle of a volume law with parameters `e` and `nu`: a uniaxial
+/// stretch ε = 10⁻⁵ of the unit right tetrahedron, its lateral stretch t
+/// found by bisection where the lateral stress vanishes, gives the nominal
+/// stress P₁₁ = E·ε and t = 1 − ν·ε (relative 10⁻³ for E, 10⁻³ for ν).
+pub fn assert_small_strain_moduli(interaction: &dyn Interaction, params: &[f64]) {
+    let Law::Tetra(eval) = interaction.law() else { panic!("{} is not a volume law", interaction.name()) };
+    let (e, nu) = (params[0], params[1]);
+    let (rest, eps) = (unit_tetra_rest(), 1e-5);
+    let lateral = |t: f64| eval(params, &rest, stretched_unit_tetra(1.0 + eps, t)).forces[2].y;
+    let (mut lo, mut hi) = (1.0 - eps, 1.0 + eps);
+    assert!(lateral(lo) > 0.0 && lateral(hi) < 0.0, "{}: the lateral stress does not change sign", interaction.name());
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if lateral(mid) > 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let t = 0.5 * (lo + hi);
+    let p11 = -eval(params, &rest, stretched_unit_tetra(1.0 + eps, t)).forces[1].x * 6.0;
+    let (young, poisson) = (p11 / eps, (1.0 - t) / eps);
+    assert!((young - e).abs() < 1e-3 * e, "{}: Young's modulus {young}, expected {e}", interaction.name());
+    assert!((poisson - nu).abs() < 1e-3, "{}: Poisson's ratio {poisson}, expected {nu}", interaction.name());
+}
+
+/// Every shared check of a volume law (parameters `e`, `nu`) at a stiff, a
+/// nearly incompressible and an auxetic material: [`assert_tetra_checks`]
+/// on [`deformed_tetrahedra`] and [`assert_small_strain_moduli`].
+pub fn assert_volume_law_checks(interaction: &dyn Interaction) {
+    for (e, nu) in [(1000.0, 0.3), (250.0, 0.49), (40.0, -0.2)] {
+        let p = params_of(interaction, &[("e", e), ("nu", nu)]);
+        for (rest, x) in deformed_tetrahedra() {
+            assert_tetra_checks(interaction, &p, rest, x, 1e-6, 1e-3 * e);
+        }
+        assert_small_strain_moduli(interaction, &p);
+    }
 }

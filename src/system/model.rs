@@ -116,6 +116,13 @@ pub struct Model {
     pub angle_types: Vec<TermType>,
     pub angles: Vec<[u32; 3]>,
     pub angle_type: Vec<u32>,
+    /// Volume element types (`tetra` lines).
+    pub tetra_types: Vec<TermType>,
+    /// Volume elements (`[ tetrahedra ]`), their types and rest shapes (the
+    /// topology's positions of their corners).
+    pub tetras: Vec<[u32; 4]>,
+    pub tetra_type: Vec<u32>,
+    pub tetra_rest: Vec<crate::mesh::TetraRest>,
     pub pair_rules: Vec<TermType>,
     /// The particle types (a, b) each pair rule acts between.
     pub pair_rule_types: Vec<(u32, u32)>,
@@ -208,6 +215,17 @@ impl Model {
             })
             .collect::<Result<_, InputError>>()?;
         let angle_type = topology.angles.iter().map(|a| resolve(&a.type_name, &ff.angle_types, "angle")).collect::<Result<_, _>>()?;
+        let tetra_type = topology.tetrahedra.iter().map(|t| resolve(&t.type_name, &ff.tetra_types, "tetra")).collect::<Result<_, _>>()?;
+        let tetra_rest = topology
+            .tetrahedra
+            .iter()
+            .map(|t| {
+                crate::mesh::TetraRest::new(t.particles.map(|p| topology.positions[p as usize])).map_err(|e| {
+                    let ids = t.particles.map(|p| topology.ids[p as usize].to_string()).join("–");
+                    t.type_name.error(format!("tetrahedron {ids}: {e}; expected four corners that span a volume"))
+                })
+            })
+            .collect::<Result<_, _>>()?;
         let nt = type_names.len();
         let mut pair_table = vec![Vec::new(); nt * nt];
         let mut pair_rule_types = Vec::with_capacity(ff.pair_rules.len());
@@ -272,6 +290,10 @@ impl Model {
             angle_types: ff.angle_types.clone(),
             angles: topology.angles.iter().map(|a| a.particles).collect(),
             angle_type,
+            tetra_types: ff.tetra_types.clone(),
+            tetras: topology.tetrahedra.iter().map(|t| t.particles).collect(),
+            tetra_type,
+            tetra_rest,
             pair_rules: ff.pair_rules.iter().map(|r| r.term.clone()).collect(),
             pair_rule_types,
             pair_table,
@@ -455,6 +477,7 @@ impl Model {
         };
         self.bond_types.iter().for_each(&mut mark);
         self.angle_types.iter().for_each(&mut mark);
+        self.tetra_types.iter().for_each(&mut mark);
         self.pair_rules.iter().for_each(&mut mark);
         self.externals.iter().for_each(|e| mark(&e.term));
         self.body_rules.iter().for_each(&mut mark);

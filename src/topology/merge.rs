@@ -67,6 +67,10 @@ impl Topology {
             t.particles.iter_mut().for_each(|p| *p += base);
             t
         }));
+        self.tetrahedra.extend(other.tetrahedra.into_iter().map(|mut t| {
+            t.particles.iter_mut().for_each(|p| *p += base);
+            t
+        }));
         self.bodies.extend(other.bodies.into_iter().map(|(id, name)| (id + body_offset, name)));
         self.triangles.extend(other.triangles.into_iter().map(|(b, t)| (b + body_offset, t.map(|p| p + base))));
         Ok(())

@@ -21,10 +21,12 @@
 //! # id  type                     (closed surfaces: a cell, a nucleus)
 //! [ triangles ]
 //! # body  i  j  k                (outward-wound face of that body: counter-clockwise seen from outside)
+//! [ tetrahedra ]
+//! # type  i  j  k  l             (a volume element; its rest shape is where [ particles ] places it)
 //! ```
 //!
 //! Particle ids are any distinct positive integers; types are names defined in
-//! the force field. Names of particle, bond and angle types are resolved
+//! the force field. Names of particle, bond, angle and tetra types are resolved
 //! against the force field when the deck is validated, so unknown names are
 //! reported at their position in this file.
 //!
@@ -37,6 +39,12 @@
 //! when the deck is validated, at the value's position). `cellmd build …
 //! --rest-from-geometry` writes every bond's length as built here, so an
 //! irregular mesh starts force-free.
+//!
+//! A `[ tetrahedra ]` line names a `tetra` type of the force field and four
+//! particles: a volume element whose rest shape is its corners as written
+//! here (either winding; a degenerate element is refused when the deck is
+//! validated). An element across a periodic boundary is written unwrapped
+//! (its corners contiguous, not wrapped into the box).
 //!
 //! Each body must be a closed, consistently oriented 2-manifold of sphere
 //! topology (every edge in exactly two faces, once in each direction; one fan

@@ -16,9 +16,10 @@ enum Section {
     Angles,
     Bodies,
     Triangles,
+    Tetrahedra,
 }
 
-const SECTIONS: &str = "[ box ], [ particles ], [ bonds ], [ angles ], [ bodies ] or [ triangles ]";
+const SECTIONS: &str = "[ box ], [ particles ], [ bonds ], [ angles ], [ bodies ], [ triangles ] or [ tetrahedra ]";
 
 fn section_of(statement: &Statement) -> Option<Result<Section, InputError>> {
     let first = statement.keyword();
@@ -33,6 +34,7 @@ fn section_of(statement: &Statement) -> Option<Result<Section, InputError>> {
         "[angles]" => Section::Angles,
         "[bodies]" => Section::Bodies,
         "[triangles]" => Section::Triangles,
+        "[tetrahedra]" => Section::Tetrahedra,
         _ => return Some(Err(first.error(format!("found section `{}`, expected {SECTIONS}", joined)))),
     };
     Some(Ok(section))
@@ -60,7 +62,7 @@ struct Parser {
     body_tokens: Vec<Token>,
     /// First line of each bonded term by (type, particles in canonical
     /// order): a term listed twice is counted twice. Type names are interned.
-    term_lines: HashMap<(u32, [u32; 3]), u32>,
+    term_lines: HashMap<(u32, [u32; 4]), u32>,
     term_types: HashMap<String, u32>,
 }
 
@@ -128,10 +130,11 @@ impl Parser {
             }
         }
         match self.earlier_line(s, particles) {
-            Some(first) if N == 3 => {
+            Some(first) if N > 2 => {
                 let ids: Vec<&str> = s.tokens[1..=N].iter().map(|t| t.text.as_str()).collect();
+                let what = if N == 3 { "angle" } else { "tetrahedron" };
                 return Err(s.tokens[0].error(format!(
-                    "angle `{}` {} is already listed at line {first}; expected each angle once",
+                    "{what} `{}` {} is already listed at line {first}; expected each {what} once",
                     s.tokens[0].text,
                     ids.join("–")
                 )));
@@ -143,11 +146,14 @@ impl Parser {
     }
 
     /// The line of an earlier term of the same type on the same particles
-    /// (a bond `i j` is `j i`, an angle `i j k` is `k j i`).
+    /// (a bond `i j` is `j i`, an angle `i j k` is `k j i`, a tetrahedron
+    /// is any order of its corners).
     fn earlier_line<const N: usize>(&mut self, s: &Statement, particles: [u32; N]) -> Option<u32> {
-        let mut key = [u32::MAX; 3];
+        let mut key = [u32::MAX; 4];
         key[..N].copy_from_slice(&particles);
-        if key[0] > key[N - 1] {
+        if N == 4 {
+            key.sort_unstable();
+        } else if key[0] > key[N - 1] {
             key[..N].reverse();
         }
         let types = self.term_types.len() as u32;
@@ -268,6 +274,10 @@ pub fn parse_topology(file: &Arc<SourceFile>) -> Result<Topology, InputError> {
             }
             Some(Section::Bodies) => parser.body(s)?,
             Some(Section::Triangles) => parser.triangle(s)?,
+            Some(Section::Tetrahedra) => {
+                let element = parser.term::<4>(s, 0, "type i j k l")?;
+                parser.topology.tetrahedra.push(element);
+            }
         }
     }
     if parser.topology.box_axes.is_some() && seen_axes != [true; 3] {
@@ -321,7 +331,7 @@ mod tests {
             parse("[ particles ]\n1 a 0 0 0\n[ bonds ]\ns 1 2\n").unwrap_err(),
             "t.top:4:5: found particle id 2, expected the id of a particle listed in [ particles ] before it"
         );
-        assert_eq!(parse("1 a 0 0 0\n").unwrap_err(), "t.top:1:1: found `1` before any section, expected a section header [ box ], [ particles ], [ bonds ], [ angles ], [ bodies ] or [ triangles ]");
+        assert_eq!(parse("1 a 0 0 0\n").unwrap_err(), "t.top:1:1: found `1` before any section, expected a section header [ box ], [ particles ], [ bonds ], [ angles ], [ bodies ], [ triangles ] or [ tetrahedra ]");
         assert!(parse("[ atoms ]\n").unwrap_err().starts_with("t.top:1:1: found section `[atoms]`"));
         assert!(parse("[ particles ]\n1 a 0 0 0\n1 a 1 0 0\n").unwrap_err().contains("already used at line 2"));
         assert!(parse("[ particles ]\n1 a 0 zero 0\n").unwrap_err().starts_with("t.top:2:7: found `zero`, expected the y coordinate"));

@@ -35,6 +35,8 @@ pub struct Topology {
     /// `[ bonds ]` line) with its token; `None`: its bond type's `r0`.
     pub bond_rest: Vec<Option<(f64, Token)>>,
     pub angles: Vec<TypedTerm<3>>,
+    /// Volume elements: their rest shape is where `positions` place them.
+    pub tetrahedra: Vec<TypedTerm<4>>,
     /// (body id, body type name).
     pub bodies: Vec<(u64, Token)>,
     /// (body id, three particle indices).

@@ -139,6 +139,8 @@ impl Simulation {
             Some("constrained bonds (`constrain`) run on the CPU backend only")
         } else if self.model.has_cpu_only_surface_terms() {
             Some("custom surface terms of bodies (`custom` body lines) run on the CPU backend only")
+        } else if !self.model.tetras.is_empty() {
+            Some("volume elements (`[ tetrahedra ]`, `tetra` lines) run on the CPU backend only")
         } else if self.model.has_contact_terms() {
             Some("contact terms between bodies (`contact` lines) run on the CPU backend only")
         } else if self.model.special_bonds.is_fractional() && !self.model.pair_rules.is_empty() {

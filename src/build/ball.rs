@@ -1,0 +1,210 @@
+//! `cellmd build ball`: an elastic ball meshed with linear tetrahedra, for
+//! the volume laws (`neo_hookean`, `linear_elastic`).
+//!
+//! The cube [−1, 1]³ is cut into n³ lattice cells (n = `--cells`, even),
+//! each split into the six Kuhn tetrahedra around its diagonal from the
+//! corner nearest the centre to the farthest (the split mirrored into each
+//! octant: a mirror keeps the diagonals of the faces on the mirror planes,
+//! so faces still match), and mapped onto the ball of
+//! radius R by the cubed-sphere map: a point p with s = max|p_a| on the face
+//! of dominant axis a, face coordinates u = p_b/s, v = p_c/s, goes to
+//! R·s·d/|d| with d_a = sign(p_a), d_b = tan(πu/4), d_c = tan(πv/4). The map
+//! is continuous, takes each cube shell s to the sphere of radius R·s and the
+//! cube's surface onto the sphere (nodes *on* it, equal-angle spacing), and is
+//! monotone along every ray, so no element is inverted. The summary prints
+//! the mesh quality q = 6√2·V/ℓ_rms³ (1 for a regular tetrahedron, 0.66
+//! for a Kuhn tetrahedron of a cube; distorted most near the cube's corners,
+//! where three faces of a cell map onto one patch of the sphere: every
+//! element there keeps the cell's inner corner, so none lies flat on it),
+//! the element volumes and the total volume against 4πR³/3.
+
+use std::f64::consts::{FRAC_PI_4, PI};
+use std::path::PathBuf;
+
+use glam::DVec3;
+
+use super::{min_mean_max, positive, vec3, Built, Writer};
+use crate::mesh::tetra_edges;
+
+/// Command-line options of `cellmd build ball`.
+#[derive(clap::Args, Clone, Debug)]
+pub struct BallArgs {
+    /// Radius of the ball (length units).
+    #[arg(allow_negative_numbers = true, long)]
+    pub radius: f64,
+    /// Lattice cells across the diameter (even, ≥ 2): (n + 1)³ nodes and 6n³ tetrahedra.
+    #[arg(long)]
+    pub cells: u32,
+    /// Centre of the ball.
+    #[arg(long, num_args = 3, value_names = ["X", "Y", "Z"], allow_negative_numbers = true, default_values_t = [0.0, 0.0, 0.0])]
+    pub centre: Vec<f64>,
+    /// Particle type of the nodes.
+    #[arg(long, default_value = "node")]
+    pub particle_type: String,
+    /// Tetra type of the elements (what a `tetra` line of the force field names).
+    #[arg(long, default_value = "solid")]
+    pub tetra_type: String,
+    /// The topology file to write.
+    #[arg(short, long)]
+    pub output: PathBuf,
+}
+
+/// The cubed-sphere image of lattice point `p` ∈ [−1, 1]³ on the unit ball.
+fn cube_to_ball(p: DVec3) -> DVec3 {
+    let s = p.abs().max_element();
+    if s == 0.0 {
+        return DVec3::ZERO;
+    }
+    let a = if p.x.abs() == s {
+        0
+    } else if p.y.abs() == s {
+        1
+    } else {
+        2
+    };
+    let mut d = DVec3::ZERO;
+    for b in 0..3 {
+        d[b] = if b == a { p[b].signum() } else { (FRAC_PI_4 * p[b] / s).tan() };
+    }
+    s * d.normalize()
+}
+
+/// The six Kuhn tetrahedra of a cube around one of its diagonals: one per
+/// order in which the path along the diagonal takes the axes.
+const KUHN: [[usize; 3]; 6] = [[0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]];
+
+/// Mesh quality 6√2·V/ℓ_rms³ of a tetrahedron (1: regular).
+fn quality(x: [DVec3; 4]) -> f64 {
+    let volume = tetra_edges(x).determinant().abs() / 6.0;
+    let sum: f64 = (0..4).flat_map(|a| (a + 1..4).map(move |b| (a, b))).map(|(a, b)| (x[a] - x[b]).length_squared()).sum();
+    6.0 * 2f64.sqrt() * volume / (sum / 6.0).powf(1.5)
+}
+
+/// Builds the ball (see the module docs).
+pub fn ball(args: &BallArgs) -> Result<Built, String> {
+    let radius = positive("--radius", args.radius)?;
+    let centre = vec3("--centre", &args.centre)?;
+    let n = args.cells as usize;
+    if n < 2 || n % 2 != 0 || n > 256 {
+        return Err(format!("expected --cells an even number in [2, 256], found {n}"));
+    }
+    let side = n + 1;
+    let index = |i: usize, j: usize, k: usize| (i * side + j) * side + k;
+    let mut writer = Writer::new(1);
+    let mut x = Vec::with_capacity(side * side * side);
+    for i in 0..side {
+        for j in 0..side {
+            for k in 0..side {
+                let p = DVec3::new(i as f64, j as f64, k as f64) * (2.0 / n as f64) - DVec3::ONE;
+                x.push(centre + radius * cube_to_ball(p));
+                writer.particle(&args.particle_type, x[x.len() - 1], None);
+            }
+        }
+    }
+    let (mut qualities, mut volumes) = (Vec::new(), Vec::new());
+    for i in 0..n {
+        for j in 0..n {
+            for k in 0..n {
+                // Along each axis, from the cell's side nearer the centre outwards.
+                let outward = [i, j, k].map(|c| 2 * c >= n);
+                let start = [i, j, k].map(|c| if 2 * c >= n { c } else { c + 1 });
+                for order in KUHN {
+                    let mut corner = start;
+                    let mut nodes = [index(start[0], start[1], start[2]); 4];
+                    for (step, &axis) in order.iter().enumerate() {
+                        corner[axis] = if outward[axis] { corner[axis] + 1 } else { corner[axis] - 1 };
+                        nodes[step + 1] = index(corner[0], corner[1], corner[2]);
+                    }
+                    let mut at = nodes.map(|v| x[v]);
+                    if tetra_edges(at).determinant() < 0.0 {
+                        nodes.swap(2, 3);
+                        at.swap(2, 3);
+                    }
+                    qualities.push(quality(at));
+                    volumes.push(tetra_edges(at).determinant() / 6.0);
+                    writer.tetra(&args.tetra_type, nodes.map(|v| v as u64 + 1));
+                }
+            }
+        }
+    }
+    let [q_lo, q_mean, _] = min_mean_max(&qualities);
+    let [v_lo, v_mean, v_hi] = min_mean_max(&volumes);
+    let total: f64 = volumes.iter().sum();
+    let sphere = 4.0 / 3.0 * PI * radius.powi(3);
+    let lines = vec![
+        format!("ball of radius {radius} at {centre}: {} nodes, {} tetrahedra (cubed-sphere map of a {n}³ lattice, 6 per cell)", x.len(), volumes.len()),
+        format!("volume {total:.6e} ({:.3} % below 4πR³/3, the sphere inscribed by the surface faces)", 100.0 * (sphere - total) / sphere),
+        format!("element volume min {v_lo:.3e} mean {v_mean:.3e} max {v_hi:.3e}; quality 6√2·V/ℓ_rms³ min {q_lo:.3} mean {q_mean:.3} (regular: 1)"),
+        format!("force field: tetra {} neo_hookean e E nu ν   (or linear_elastic; E in pN/µm²)", args.tetra_type),
+    ];
+    let command = format!("ball --radius {radius} --cells {n}");
+    Ok(writer.finish("Elastic ball of linear tetrahedra", &command, lines))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn args(cells: u32) -> BallArgs {
+        BallArgs {
+            radius: 2.0,
+            cells,
+            centre: vec![0.5, 0.0, -1.0],
+            particle_type: "node".into(),
+            tetra_type: "solid".into(),
+            output: "ball.top".into(),
+        }
+    }
+
+    #[test]
+    fn the_ball_is_a_positive_conforming_mesh_of_the_sphere() {
+        for cells in [2, 4, 8] {
+            let built = ball(&args(cells)).unwrap();
+            let n = cells as usize;
+            assert_eq!((built.particles, built.tetrahedra), ((n + 1).pow(3), 6 * n.pow(3)));
+            let top = crate::topology::parse_topology(&crate::input::SourceFile::new("ball.top", &built.text)).unwrap();
+            // Every face of an element is shared by two elements or lies on the sphere.
+            let mut faces = std::collections::HashMap::new();
+            let mut total = 0.0;
+            for t in &top.tetrahedra {
+                let at = t.particles.map(|p| top.positions[p as usize]);
+                let v = tetra_edges(at).determinant() / 6.0;
+                assert!(v > 0.0, "inverted element {:?}", t.particles);
+                total += v;
+                for skip in 0..4 {
+                    let mut face: Vec<u32> = (0..4).filter(|&k| k != skip).map(|k| t.particles[k]).collect();
+                    face.sort_unstable();
+                    *faces.entry(face).or_insert(0) += 1;
+                }
+            }
+            let centre = DVec3::new(0.5, 0.0, -1.0);
+            for (face, count) in &faces {
+                assert!(*count <= 2, "face {face:?} in {count} elements");
+                if *count == 1 {
+                    for &p in face {
+                        assert!(((top.positions[p as usize] - centre).length() - 2.0).abs() < 1e-12, "open face {face:?} inside the ball");
+                    }
+                }
+            }
+            let sphere = 4.0 / 3.0 * PI * 8.0;
+            assert!(total < sphere && total > 0.75 * sphere, "{cells}: volume {total} vs {sphere}");
+        }
+    }
+
+    #[test]
+    fn refinement_fills_the_sphere() {
+        let volume = |cells| ball(&args(cells)).unwrap().lines[1].clone();
+        assert!(volume(16).contains("% below"), "{}", volume(16));
+        let gap = |cells: u32| -> f64 {
+            let line = volume(cells);
+            line.split('(').nth(1).unwrap().split(' ').next().unwrap().parse().unwrap()
+        };
+        assert!(gap(16) < gap(8) / 3.0 && gap(16) < 1.0, "{} vs {}", gap(16), gap(8));
+    }
+
+    #[test]
+    fn bad_options_are_refused() {
+        assert!(ball(&args(3)).unwrap_err().contains("even"));
+        assert!(ball(&BallArgs { radius: 0.0, ..args(4) }).unwrap_err().contains("--radius > 0"));
+    }
+}
