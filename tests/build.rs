@@ -244,6 +244,7 @@ fn bad_options_exit_with_status_2_and_say_what_was_expected() {
         ),
         (&["lattice", "--radius", "2", "--spacing", "1"][..], "expected --radius at least 3 spacings"),
         (&["lattice", "--radius", "1", "--spacing", "1e-300"][..], "expected --radius at most 2000 spacings"),
+        (
             &[
                 "collagen",
                 "--separation",
