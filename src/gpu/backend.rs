@@ -178,6 +178,9 @@ impl GpuBackend {
         if model.has_cpu_only_surface_terms() {
             return Err("the GPU backend has no kernels for custom surface terms of bodies (`custom` body lines) yet; use `device cpu`".into());
         }
+        if !model.tetras.is_empty() {
+            return Err("the GPU backend has no kernels for volume elements (`[ tetrahedra ]`) yet; use `device cpu`".into());
+        }
         if model.has_contact_terms() {
             return Err(
                 "the GPU backend has no kernels for contact terms between bodies yet; use `device cpu` for decks with `contact` lines"
