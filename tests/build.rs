@@ -234,10 +234,19 @@ fn bad_options_exit_with_status_2_and_say_what_was_expected() {
         (&["sheet", "--rows", "2", "--columns", "2", "--cell-size", "3", "--jitter", "0.49", "--gap", "1"][..], "convex hexagon"),
         (&["tensegrity", "--radius", "5", "--level", "1", "--microtubules", "50"][..], "expected --microtubules <= 42"),
         (&["tensegrity", "--radius", "5", "--nucleus", "6"][..], "expected 0 < --nucleus RADIUS < --radius 5, found 6"),
-        (&["tensegrity", "--radius", "10", "--substrate", "dish"][..], "expected --substrate `flat` or a curvature radius in µm, found `dish`"),
+        (
+            &["tensegrity", "--radius", "10", "--substrate", "dish"][..],
+            "expected --substrate `flat` or a curvature radius in µm, found `dish`",
+        ),
         (&["tensegrity", "--radius", "10", "--substrate", "-5"][..], "curvature radius of magnitude > 10 µm"),
-        (&["tensegrity", "--radius", "10", "--substrate", "20", "--substrate-extent", "25"][..], "expected --substrate-extent < |curvature radius| 20, found 25"),
-        (&["tensegrity", "--radius", "10", "--substrate", "flat", "--substrate-spacing", "0"][..], "expected --substrate-spacing > 0, found 0"),
+        (
+            &["tensegrity", "--radius", "10", "--substrate", "20", "--substrate-extent", "25"][..],
+            "expected --substrate-extent < |curvature radius| 20, found 25",
+        ),
+        (
+            &["tensegrity", "--radius", "10", "--substrate", "flat", "--substrate-spacing", "0"][..],
+            "expected --substrate-spacing > 0, found 0",
+        ),
         (
             &["lattice", "--radius", "10", "--spacing", "1", "--bond-probability", "1.5"][..],
             "expected --bond-probability in [0, 1], found 1.5",

@@ -419,7 +419,11 @@ fn the_same_surface_run_twice_gives_the_same_bits() {
     let moved = a.0.iter().zip(&start).map(|(x, y)| (*x - *y).length()).fold(0.0, f64::max);
     assert!(moved > 1e-3, "nothing moved ({moved:e}): the test would be vacuous");
     assert!(a.0.iter().zip(&b.0).all(|(x, y)| x.to_array().map(f64::to_bits) == y.to_array().map(f64::to_bits)), "positions differ");
-    assert!(a.1.iter().zip(&b.1).all(|(x, y)| x.0.to_array().map(f64::to_bits) == y.0.to_array().map(f64::to_bits) && x.1.to_bits() == y.1.to_bits()));
+    assert!(a
+        .1
+        .iter()
+        .zip(&b.1)
+        .all(|(x, y)| x.0.to_array().map(f64::to_bits) == y.0.to_array().map(f64::to_bits) && x.1.to_bits() == y.1.to_bits()));
 }
 
 /// A custom body term has no GPU kernel: the GPU backend and `device gpu`

@@ -84,7 +84,9 @@ fn a_moved_group_moves_at_its_velocity_and_reports_the_drag_it_pulls() {
     assert_eq!(sim.state.positions[1].y, 0.0);
     let r = sim.state.positions[1].x - sim.state.positions[0].x;
     assert!((r - (1.0 + 2.0 * 0.3 / 3.0)).abs() < 1e-9, "stretch {r}");
-    let reaction = sim.thermo_value(&ThermoColumn::Group { group: Group { name: "drv".into(), members: vec![1] }, quantity: GroupQuantity::Force(0) }).unwrap();
+    let reaction = sim
+        .thermo_value(&ThermoColumn::Group { group: Group { name: "drv".into(), members: vec![1] }, quantity: GroupQuantity::Force(0) })
+        .unwrap();
     assert!((reaction + 2.0 * 0.3).abs() < 1e-9, "reaction {reaction}");
 }
 
@@ -192,7 +194,9 @@ fn an_indenter_driven_to_a_load_stops_there_and_reports_load_and_depth() {
     assert!((load - 10.0 * depth * depth).abs() < 1e-12, "load {load} at depth {depth}");
     assert!((0.9..=10.0 * 0.301 * 0.301 + 1e-9).contains(&load), "load {load}: reached within one step");
     // The anchor's reaction is the load.
-    let reaction = sim.thermo_value(&ThermoColumn::Group { group: Group { name: "a".into(), members: vec![0] }, quantity: GroupQuantity::Force(2) }).unwrap();
+    let reaction = sim
+        .thermo_value(&ThermoColumn::Group { group: Group { name: "a".into(), members: vec![0] }, quantity: GroupQuantity::Force(2) })
+        .unwrap();
     assert!((reaction + load).abs() < 1e-12, "reaction {reaction}");
     // Without `until` it keeps going; `indent tip stop` holds it.
     let body = "group a id 1\nexternal tip a indenter z 1.5 r 1 k 10\nindent tip velocity 0 0 -1\nrun 300\nindent tip stop\nrun 300\n";

@@ -129,7 +129,14 @@ fn every_force_scales_with_the_common_stiffness_factor() {
     let unit = spread("flat", &fixed);
     let stiff = spread("flat", &[fixed[0].clone(), fixed[1].clone(), ("scale", "2.5".to_string())]);
     let (a, b) = (unit.spread.last().unwrap(), stiff.spread.last().unwrap());
-    println!("Σ|f| {:.3} and {:.3} pN (ratio {:.5}); footprint {:.4} and {:.4} µm²", a["fabs/fa"], b["fabs/fa"], b["fabs/fa"] / a["fabs/fa"], a["hullarea/cortex"], b["hullarea/cortex"]);
+    println!(
+        "Σ|f| {:.3} and {:.3} pN (ratio {:.5}); footprint {:.4} and {:.4} µm²",
+        a["fabs/fa"],
+        b["fabs/fa"],
+        b["fabs/fa"] / a["fabs/fa"],
+        a["hullarea/cortex"],
+        b["hullarea/cortex"]
+    );
     assert!(a["fabs/fa"] > 100.0, "the spreading loaded nothing: {a:?}");
     assert!((b["fabs/fa"] / a["fabs/fa"] / 2.5 - 1.0).abs() < 2e-3, "{} vs {}", b["fabs/fa"], a["fabs/fa"]);
     assert!((b["hullarea/cortex"] / a["hullarea/cortex"] - 1.0).abs() < 1e-3);

@@ -176,7 +176,9 @@ impl GpuBackend {
     /// Uploads the model and state and compiles the kernels.
     pub fn new(ctx: &GpuContext, model: &Model, state: &State, sim_box: &SimBox, settings: &StepSettings) -> Result<Self, String> {
         if model.has_cpu_only_surface_terms() {
-            return Err("the GPU backend has no kernels for custom surface terms of bodies (`custom` body lines) yet; use `device cpu`".into());
+            return Err(
+                "the GPU backend has no kernels for custom surface terms of bodies (`custom` body lines) yet; use `device cpu`".into()
+            );
         }
         if !model.tetras.is_empty() {
             return Err("the GPU backend has no kernels for volume elements (`[ tetrahedra ]`) yet; use `device cpu`".into());

@@ -48,8 +48,9 @@ fn dispatch(custom: &CustomSource) -> String {
         "fn three_body_law(kind: u32, p: array<f32, 8>, ri: vec3<f32>, rj: vec3<f32>, rk: vec3<f32>) -> ThreeBody {\n    switch kind {\n",
     );
     let mut one = String::from("fn one_body_law(kind: u32, p: array<f32, 8>, x: vec3<f32>) -> OneBody {\n    switch kind {\n");
-    let mut surface =
-        String::from("fn surface_law(kind: u32, p: array<f32, 8>, body: BodyTotals, g: FaceGeometry) -> SurfaceFace {\n    switch kind {\n");
+    let mut surface = String::from(
+        "fn surface_law(kind: u32, p: array<f32, 8>, body: BodyTotals, g: FaceGeometry) -> SurfaceFace {\n    switch kind {\n",
+    );
     let mut node = String::from("fn node_law(kind: u32, p: array<f32, 8>, m: f32, a: f32) -> NodeCurvature {\n    switch kind {\n");
     for (index, interaction) in REGISTRY.iter().enumerate() {
         let name = interaction.name();

@@ -141,7 +141,8 @@ pub fn pack_surfaces(model: &Model, term_base: usize) -> SurfacePack {
             continue;
         }
         let packed_body = out.body_ids.len() as u32;
-        let curvature = rules.iter().any(|&r| matches!(model.body_rules[r].interaction.law(), Law::Surface { gpu: SurfaceGpu::NodeCurvature, .. }));
+        let curvature =
+            rules.iter().any(|&r| matches!(model.body_rules[r].interaction.law(), Law::Surface { gpu: SurfaceGpu::NodeCurvature, .. }));
         let node_base = out.node_body.len() as u32;
         let body_node = |k: u32| if curvature { node_base + k } else { u32::MAX };
         let particle = |k: u32| body.nodes[k as usize];

@@ -30,7 +30,13 @@ fn hessian(p: &[f64], mesh: &SurfaceMesh, x: &[DVec3], out: &mut SurfaceHessian)
     }
 }
 
-interaction!(SurfaceTension, "surface_tension", Kind::Body, "Surface tension of a closed body, E = γ·A", Law::Surface { eval, hessian, gpu: SurfaceGpu::PerFace });
+interaction!(
+    SurfaceTension,
+    "surface_tension",
+    Kind::Body,
+    "Surface tension of a closed body, E = γ·A",
+    Law::Surface { eval, hessian, gpu: SurfaceGpu::PerFace }
+);
 
 #[cfg(test)]
 mod tests {

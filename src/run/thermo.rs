@@ -40,10 +40,10 @@ use std::path::PathBuf;
 use super::protocol::indenter_load;
 use crate::backend::Forces;
 use crate::deck::{GroupQuantity, ThermoColumn};
-use glam::DVec2;
 use crate::interactions::REGISTRY;
 use crate::measure::{clustering, filaments, fracture, planes};
 use crate::units::{Dim, UnitSystem};
+use glam::DVec2;
 
 /// Values a thermo row is made from.
 pub struct ThermoInputs<'a> {

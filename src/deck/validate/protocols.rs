@@ -9,9 +9,9 @@ use super::{expect_len, positive, Validator};
 use crate::deck::plan::{Action, CoeffTarget, ThermoColumn};
 use crate::deck::protocol::{Protocol, Ramp, Velocity};
 use crate::expr::ExprError;
-use crate::system::position_or_time;
 use crate::input::{parse_f64, InputError, Token};
 use crate::interactions::param_index;
+use crate::system::position_or_time;
 
 /// The interaction types whose centre `indent` drives and whose load and
 /// depth thermo reports (laws E = (K/3)δ³ with a centre `x y z` and a `k`).
