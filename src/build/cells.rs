@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use glam::DVec3;
 
 use super::icosphere::{unit_icosphere, ShellOptions, ShellSpec};
+use super::substrate::SubstrateOptions;
 use super::{positive, stream, vec3, Built, Common, Draws, Writer};
 
 /// How `cells` arranges the cells.
@@ -45,6 +46,9 @@ pub struct CellsArgs {
     // The cells' (and nuclei's) types; `--nucleus RADIUS` puts a nucleus in every cell.
     #[command(flatten)]
     pub shell: ShellOptions,
+    // `--layout spheroid`: `--substrate flat|R` puts a rigid substrate under the spheroid.
+    #[command(flatten)]
+    pub substrate: SubstrateOptions,
     #[command(flatten)]
     pub common: Common,
 }
@@ -61,6 +65,7 @@ impl Default for CellsArgs {
             centre: vec![0.0; 3],
             box_size: Vec::new(),
             shell: ShellOptions::default(),
+            substrate: SubstrateOptions::default(),
             common: Common { seed: 1, output: PathBuf::from("cells.top"), rest_from_geometry: false },
         }
     }
@@ -104,6 +109,12 @@ fn fcc_sites(d: f64, reach: f64, turn: glam::DQuat) -> Vec<DVec3> {
 ///   nx·ny cells, `--seed` draws which sites are taken. Node positions are
 ///   written wrapped into the box.
 ///
+/// `--substrate flat|R` (spheroid only) writes a rigid substrate of fixed
+/// particles `--substrate-gap` below the lowest node, centred under the
+/// spheroid's centre, out to `--substrate-extent` [3 × the spheroid's
+/// radius] (see the substrate module): a spheroid spreading on a
+/// ligand-coated dish (seed 000's checkpoint 2).
+///
 /// More cells than fit is an error that says how many do.
 pub fn cells(a: &CellsArgs) -> Result<Built, String> {
     let r = positive("--radius", a.radius)?;
@@ -121,6 +132,7 @@ pub fn cells(a: &CellsArgs) -> Result<Built, String> {
     let draws = Draws::new(a.common.seed, stream::CELLS);
     let mut periodic_box = None;
     let mut fixed_box = None;
+    let mut under = None;
     let (centres, where_) = match a.layout {
         Layout::Spheroid => {
             let s = positive("--spheroid-radius", a.spheroid_radius.ok_or("expected --spheroid-radius S with --layout spheroid")?)?;
@@ -139,9 +151,13 @@ pub fn cells(a: &CellsArgs) -> Result<Built, String> {
                     a.gap
                 ));
             }
+            under = Some((centre, s));
             (sites[..count].iter().map(|c| *c + centre).collect::<Vec<_>>(), format!("in a spheroid of radius {s:?} (FCC, turned by seed)"))
         }
         Layout::Layer => {
+            if a.substrate.substrate.is_some() {
+                return Err("expected --substrate only with --layout spheroid".into());
+            }
             let [lx, ly] = match a.box_size[..] {
                 [x, y] => [positive("--box LX", x)?, positive("--box LY", y)?],
                 _ => return Err(format!("expected --box LX LY with --layout layer, found {:?}", a.box_size)),
@@ -204,6 +220,11 @@ pub fn cells(a: &CellsArgs) -> Result<Built, String> {
             .write(&mut w);
         }
     }
+    let mut substrate = None;
+    if let Some((centre, s)) = under {
+        let lowest = (1..w.next_id()).map(|id| w.position(id).z).fold(f64::INFINITY, f64::min);
+        substrate = a.substrate.write(&mut w, centre, lowest, s, "the spheroid")?;
+    }
     if let Some(axes) = periodic_box {
         w.set_box(axes);
         w.wrap_periodic();
@@ -221,6 +242,7 @@ pub fn cells(a: &CellsArgs) -> Result<Built, String> {
     if nucleus.is_some() {
         lines.push(format!("each nucleus: {}", w.shells[1].summary()));
     }
+    lines.extend(substrate);
     let title = format!("{} icosphere cells (level {}), {:?} layout, seed {}", centres.len(), a.level, a.layout, a.common.seed)
         .replace("Spheroid", "spheroid")
         .replace("Layer", "layer");
@@ -296,5 +318,24 @@ mod tests {
         let err = cells(&CellsArgs { count: Some(17), ..a.clone() }).unwrap_err();
         assert_eq!(err, "too many cells: at most 16 cells of radius 1 with gap 0.1 fit in the layer 10 × 10, found --count 17");
         assert!(cells(&CellsArgs { box_size: vec![1.0, 1.0], ..a }).unwrap_err().starts_with("too many cells: at most 0"));
+    }
+
+    #[test]
+    fn a_spheroid_sits_on_its_substrate_and_a_layer_has_none() {
+        let substrate = SubstrateOptions { substrate: Some("flat".into()), substrate_spacing: 2.0, substrate_gap: 0.5, ..SubstrateOptions::default() };
+        let a = CellsArgs { centre: vec![1.0, 2.0, 10.0], substrate, ..CellsArgs::default() };
+        let built = cells(&a).unwrap();
+        let top = parse(&built);
+        let cells_only = 13 * 42;
+        let lowest = top.positions[..cells_only].iter().map(|p| p.z).fold(f64::INFINITY, f64::min);
+        let sites = &top.positions[cells_only..];
+        assert!(!sites.is_empty() && sites.iter().all(|p| p.z == lowest - 0.5));
+        // Out to 3 × the spheroid's radius around its axis, one site on the axis.
+        assert!(sites.iter().all(|p| (p.truncate() - glam::DVec2::new(1.0, 2.0)).length() <= 12.0 + 1e-9));
+        assert!(sites.iter().any(|p| p.x == 1.0 && p.y == 2.0));
+        assert!(top.type_names[cells_only..].iter().all(|t| t.text == "substrate"));
+        assert_eq!(built.bodies, 13);
+        let layer = CellsArgs { layout: Layout::Layer, count: None, box_size: vec![10.0, 10.0], spheroid_radius: None, ..a };
+        assert_eq!(cells(&layer).unwrap_err(), "expected --substrate only with --layout spheroid");
     }
 }

@@ -108,6 +108,7 @@ pub use self::lattice::{lattice, LatticeArgs};
 pub use self::merge::{merge, MergeArgs};
 pub use self::network::{network, NetworkArgs, SlabAxis};
 pub use self::sheet::{sheet, SheetArgs};
+pub use self::substrate::SubstrateOptions;
 pub use self::tensegrity::{tensegrity, TensegrityArgs};
 
 /// The `cellmd build` subcommands: one per generator.

@@ -18,19 +18,83 @@
 //! at slope angle α the spacing along the surface grows by 1/cos α (at most
 //! 1.09 for ρ ≤ 30 µm on R = 75 µm). Every particle's distance from the
 //! centre of curvature is |R| to rounding.
+//!
+//! [`SubstrateOptions`] are the command-line options of the builders that
+//! can put their structure on such a substrate: `tensegrity` (one cell) and
+//! `cells --layout spheroid` (a spheroid, seed 000's spreading assay).
 
 use glam::DVec3;
 
+use super::{positive, Writer};
+
+/// `--substrate flat|R` and its lattice: a rigid substrate under the built structure.
+#[derive(clap::Args, Clone, Debug)]
+pub struct SubstrateOptions {
+    /// Also write a substrate under the structure: `flat` or its signed curvature radius in µm (> 0 concave, < 0 convex).
+    #[arg(allow_negative_numbers = true, long, value_name = "flat|RADIUS")]
+    pub substrate: Option<String>,
+    /// Spacing of the substrate's hexagonal particle lattice (µm).
+    #[arg(long, default_value_t = 1.0)]
+    pub substrate_spacing: f64,
+    /// In-plane radius of the substrate around the structure's axis (µm) [default: 3 × the cell's or spheroid's radius].
+    #[arg(long)]
+    pub substrate_extent: Option<f64>,
+    /// Distance from the lowest node down to the substrate's particles (µm; 1 = two 0.5 µm particles touching).
+    #[arg(long, default_value_t = 1.0)]
+    pub substrate_gap: f64,
+    /// Particle type of the substrate (give it `fixed` in the force field).
+    #[arg(long, default_value = "substrate")]
+    pub substrate_type: String,
+}
+
+impl Default for SubstrateOptions {
+    fn default() -> Self {
+        Self { substrate: None, substrate_spacing: 1.0, substrate_extent: None, substrate_gap: 1.0, substrate_type: "substrate".into() }
+    }
+}
+
+impl SubstrateOptions {
+    /// Writes the substrate, if `--substrate` asks for one, `--substrate-gap`
+    /// below `lowest` on the vertical axis through `axis`, for a structure
+    /// (`what`) of radius `radius`; returns the summary line.
+    pub(super) fn write(&self, w: &mut Writer, axis: DVec3, lowest: f64, radius: f64, what: &str) -> Result<Option<String>, String> {
+        let Some(text) = &self.substrate else { return Ok(None) };
+        let curvature = parse_curvature(text, radius)?;
+        let spacing = positive("--substrate-spacing", self.substrate_spacing)?;
+        let extent = positive("--substrate-extent", self.substrate_extent.unwrap_or(3.0 * radius))?;
+        let gap = positive("--substrate-gap", self.substrate_gap)?;
+        if curvature.is_finite() && extent >= curvature.abs() {
+            return Err(format!("expected --substrate-extent < |curvature radius| {}, found {extent}", curvature.abs()));
+        }
+        let bottom = DVec3::new(axis.x, axis.y, lowest - gap);
+        let points = substrate(bottom, curvature, spacing, extent);
+        for &p in &points {
+            w.particle(&self.substrate_type, p, None);
+        }
+        let shape = match curvature {
+            c if c.is_infinite() => "flat".to_string(),
+            c if c > 0.0 => format!("concave, curvature radius {c:?} µm"),
+            c => format!("convex, curvature radius {c:?} µm"),
+        };
+        Ok(Some(format!(
+            "substrate `{}` ({shape}): {} particles {spacing:?} µm apart out to {extent:?} µm from the axis, touching z = {:?} under {what}",
+            self.substrate_type,
+            points.len(),
+            bottom.z
+        )))
+    }
+}
+
 /// The signed curvature radius of `--substrate`: `flat` or a number (µm)
 /// of magnitude above `least` (the cell's radius).
-pub fn parse_curvature(text: &str, least: f64) -> Result<f64, String> {
+fn parse_curvature(text: &str, least: f64) -> Result<f64, String> {
     if text == "flat" {
         return Ok(f64::INFINITY);
     }
     let r: f64 = text.parse().map_err(|_| format!("expected --substrate `flat` or a curvature radius in µm, found `{text}`"))?;
     if !r.is_finite() || r.abs() <= least {
         return Err(format!(
-            "expected --substrate `flat` or a curvature radius of magnitude > {least} µm (the cell's radius; > 0 concave, < 0 convex), found {text}"
+            "expected --substrate `flat` or a curvature radius of magnitude > {least} µm (the structure's radius; > 0 concave, < 0 convex), found {text}"
         ));
     }
     Ok(r)

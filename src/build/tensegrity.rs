@@ -109,7 +109,7 @@ use std::f64::consts::FRAC_PI_2;
 use glam::DVec3;
 
 use super::icosphere::{unit_icosphere, ShellOptions, ShellSpec};
-use super::substrate::{parse_curvature, substrate};
+use super::substrate::SubstrateOptions;
 use super::{min_mean_max, positive, stream, vec3, Built, Common, Draws, Writer};
 
 /// Command-line options of `cellmd build tensegrity`.
@@ -160,21 +160,9 @@ pub struct TensegrityArgs {
     /// Particle type of the centrosome node (without --nucleus).
     #[arg(long, default_value = "centrosome")]
     pub centrosome_type: String,
-    /// Also write a substrate under the cell: `flat` or its signed curvature radius in µm (> 0 concave, < 0 convex).
-    #[arg(allow_negative_numbers = true, long, value_name = "flat|RADIUS")]
-    pub substrate: Option<String>,
-    /// Spacing of the substrate's hexagonal particle lattice (µm).
-    #[arg(long, default_value_t = 1.0)]
-    pub substrate_spacing: f64,
-    /// In-plane radius of the substrate around the cell's axis (µm) [default: 3 × --radius].
-    #[arg(long)]
-    pub substrate_extent: Option<f64>,
-    /// Distance from the lowest cortex node down to the substrate's particles (µm; 1 = two 0.5 µm particles touching).
-    #[arg(long, default_value_t = 1.0)]
-    pub substrate_gap: f64,
-    /// Particle type of the substrate (give it `fixed` in the force field).
-    #[arg(long, default_value = "substrate")]
-    pub substrate_type: String,
+    // `--substrate flat|R` and its options: a rigid substrate under the cell.
+    #[command(flatten)]
+    pub substrate: SubstrateOptions,
     /// Also write a fixed (non-periodic) cubic [ box ] of this half-width around the centre.
     #[arg(allow_negative_numbers = true, long = "box", value_name = "HALF_WIDTH")]
     pub box_half_width: Option<f64>,
@@ -200,11 +188,7 @@ impl Default for TensegrityArgs {
             fibre_bead_type: "fibre_bead".into(),
             adhesion_type: "focal_adhesion".into(),
             centrosome_type: "centrosome".into(),
-            substrate: None,
-            substrate_spacing: 1.0,
-            substrate_extent: None,
-            substrate_gap: 1.0,
-            substrate_type: "substrate".into(),
+            substrate: SubstrateOptions::default(),
             box_half_width: None,
             common: Common { seed: 1, output: "tensegrity.top".into(), rest_from_geometry: false },
         }
@@ -238,35 +222,6 @@ fn draw_struts(unit: &[DVec3], struts: usize, towards: DVec3, sigma: f64, draws:
         chosen[k] = true;
     }
     chosen
-}
-
-/// Writes `--substrate` under the cortex (its first `rays` particles) and
-/// returns the summary line.
-fn write_substrate(a: &TensegrityArgs, text: &str, w: &mut Writer, radius: f64, centre: DVec3, rays: usize) -> Result<String, String> {
-    let curvature = parse_curvature(text, radius)?;
-    let spacing = positive("--substrate-spacing", a.substrate_spacing)?;
-    let extent = positive("--substrate-extent", a.substrate_extent.unwrap_or(3.0 * radius))?;
-    let gap = positive("--substrate-gap", a.substrate_gap)?;
-    if curvature.is_finite() && extent >= curvature.abs() {
-        return Err(format!("expected --substrate-extent < |curvature radius| {}, found {extent}", curvature.abs()));
-    }
-    let lowest = (1..=rays as u64).map(|id| w.position(id).z).fold(f64::INFINITY, f64::min);
-    let bottom = DVec3::new(centre.x, centre.y, lowest - gap);
-    let points = substrate(bottom, curvature, spacing, extent);
-    for &p in &points {
-        w.particle(&a.substrate_type, p, None);
-    }
-    let shape = match curvature {
-        c if c.is_infinite() => "flat".to_string(),
-        c if c > 0.0 => format!("concave, curvature radius {c:?} µm"),
-        c => format!("convex, curvature radius {c:?} µm"),
-    };
-    Ok(format!(
-        "substrate `{}` ({shape}): {} particles {spacing:?} µm apart out to {extent:?} µm from the axis, touching z = {:?} under the cell",
-        a.substrate_type,
-        points.len(),
-        bottom.z
-    ))
 }
 
 /// `x` rounded to 4 decimals, a rounding error around 0 printed as 0 (not −0).
@@ -371,9 +326,8 @@ pub fn tensegrity(a: &TensegrityArgs) -> Result<Built, String> {
             }
         }
     }
-    if let Some(text) = &a.substrate {
-        lines.push(write_substrate(a, text, &mut w, radius, centre, rays)?);
-    }
+    let lowest = (1..=rays as u64).map(|id| w.position(id).z).fold(f64::INFINITY, f64::min);
+    lines.extend(a.substrate.write(&mut w, centre, lowest, radius, "the cell")?);
     if let Some(h) = a.box_half_width {
         w.fixed_cube(centre, h)?;
     }
