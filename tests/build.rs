@@ -248,6 +248,14 @@ fn bad_options_exit_with_status_2_and_say_what_was_expected() {
             "expected --substrate-spacing > 0, found 0",
         ),
         (
+            &["cells", "--layout", "layer", "--radius", "1", "--box", "10", "10", "--substrate", "flat"][..],
+            "expected --substrate only with --layout spheroid",
+        ),
+        (
+            &["cells", "--layout", "spheroid", "--count", "2", "--radius", "1", "--spheroid-radius", "4", "--substrate", "3"][..],
+            "curvature radius of magnitude > 4 µm",
+        ),
+        (
             &["lattice", "--radius", "10", "--spacing", "1", "--bond-probability", "1.5"][..],
             "expected --bond-probability in [0, 1], found 1.5",
         ),
