@@ -57,8 +57,13 @@ fn spread(adhesion: u32) -> Vec<(f64, f64, f64)> {
     let built = cells(&args(-floor)).unwrap();
     let top = dir.path().join("spheroid.top");
     std::fs::write(&top, &built.text).unwrap();
-    let vars = [("topology", top.display().to_string()), ("adhesion", adhesion.to_string()), ("steps", "6000".into()), ("interval", "1000".into())]
-        .map(|(k, v)| (k.to_string(), v));
+    let vars = [
+        ("topology", top.display().to_string()),
+        ("adhesion", adhesion.to_string()),
+        ("steps", "6000".into()),
+        ("interval", "1000".into()),
+    ]
+    .map(|(k, v)| (k.to_string(), v));
     let plan = validate_file(Path::new(DECK), &vars).unwrap_or_else(|e| panic!("{e}"));
     Simulation::execute(plan, RunOptions { output_dir: dir.path().to_path_buf(), ..Default::default() }).unwrap_or_else(|e| panic!("{e}"));
     let text = std::fs::read_to_string(dir.path().join("spheroid_spreading.thermo.csv")).unwrap();

@@ -322,7 +322,8 @@ mod tests {
 
     #[test]
     fn a_spheroid_sits_on_its_substrate_and_a_layer_has_none() {
-        let substrate = SubstrateOptions { substrate: Some("flat".into()), substrate_spacing: 2.0, substrate_gap: 0.5, ..SubstrateOptions::default() };
+        let substrate =
+            SubstrateOptions { substrate: Some("flat".into()), substrate_spacing: 2.0, substrate_gap: 0.5, ..SubstrateOptions::default() };
         let a = CellsArgs { centre: vec![1.0, 2.0, 10.0], substrate, ..CellsArgs::default() };
         let built = cells(&a).unwrap();
         let top = parse(&built);

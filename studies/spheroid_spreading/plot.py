@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Plots sweep.py's OUT/spheroid_spreading.csv: equilibrium A/A0 against the
+"""Plots sweep.py's OUT/spheroid_spreading.csv: A/A0 at the end of the run against the
 spheroid radius R, with the least-squares fit a + b/R + c/R² and the PI's
 MCF7 law (seed 000) overlaid, and the controls without clutch bonds.
 Writes OUT/spheroid_spreading.png. Needs numpy and matplotlib.
@@ -44,7 +44,7 @@ def main():
             label=f"PI MCF7 law: a = {PI['a']}, b = {PI['b']} µm, c = {PI['c']:.0f} µm² (R = 31–78 µm)")
     ax.axhline(1, color="#999", lw=0.6)
     ax.set_xlabel("spheroid radius R = √(A0/π) (µm)")
-    ax.set_ylabel("equilibrium A/A0 (top-down silhouette)")
+    ax.set_ylabel("A/A0 at the end of the run (top-down silhouette)")
     ax.set_title("Spheroid spreading on a ligand-coated substrate (seed 000, checkpoint 2)", fontsize=10)
     ax.legend(frameon=False, fontsize=7)
     fig.tight_layout()

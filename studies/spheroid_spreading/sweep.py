@@ -3,17 +3,21 @@
 
 For each cell count N, builds a spheroid of N shell cells on a flat substrate
 of fixed ligand sites (`cellmd build cells --layout spheroid --count N
---substrate flat`), runs inputs/spheroid_spreading.in until the footprint is
-stationary and reads its thermo file: the spheroid's radius R = √(A0/π) from
-the top-down silhouette (the convex hull of the nodes projected on xy) at the
-start, and A/A0 at equilibrium. The same spheroid without clutch bonds
-(`adhesion=0`) is the control. Fits A/A0 = a + b/R + c/R² by least squares
+--substrate flat`, lowered so that the substrate lies at z = 0), runs
+inputs/spheroid_spreading.in (20 000 steps, a thermo row every 2000) and reads
+its thermo file: the spheroid's radius R = √(A0/π) from the top-down
+silhouette (the convex hull of the nodes projected on xy) at the start, and
+A/A0 at the end, A the mean of the last three rows (the silhouette fluctuates
+by a few % as cells reshape), with its drift from the three rows before (how
+far from rest the run ended). The same spheroid without clutch bonds
+(`adhesion=0`) is the control; cells are R = 8 µm, level-1 shells. Fits A/A0 = a + b/R + c/R² by least squares
 and compares with the PI's MCF7 law (a = −0.33, b = 188.7 µm, c = −2655 µm²,
 R = 31–78 µm, r² = 0.98). Writes OUT/spheroid_spreading.csv and
 OUT/summary.txt; plot.py draws OUT/spheroid_spreading.png. Needs numpy
 (`bash scripts/reference-venv` prints the reference venv).
 
     python3 studies/spheroid_spreading/sweep.py --cellmd target/release/cellmd --out out/spheroid_spreading
+    python3 studies/spheroid_spreading/plot.py --out out/spheroid_spreading
 """
 
 import argparse
@@ -32,6 +36,8 @@ DECK = ROOT / "inputs" / "spheroid_spreading.in"
 # The PI's MCF7 spheroids (seed 000): A/A0 = a + b/R + c/R², R in µm.
 PI = {"a": -0.33, "b": 188.7, "c": -2655.0, "r_min": 31.0, "r_max": 78.0, "r2": 0.98}
 CELL_RADIUS = 8.0
+# Thermo rows (every 2000 steps) averaged for the equilibrium A.
+TAIL = 3
 
 
 def run(cmd):
@@ -47,25 +53,32 @@ def thermo(path):
     return {k: np.array([float(r[k]) for r in rows]) for k in rows[0]}
 
 
-def spread(cellmd, out, count, adhesion, seed):
+def spread(cellmd, out, count, adhesion, seed, reuse):
     d = out / f"n{count}_adh{adhesion:g}_s{seed}"
     d.mkdir(parents=True, exist_ok=True)
-    top = d / "spheroid.top"
-    extent = CELL_RADIUS * (4 + 3 * count ** (1 / 3))
-    build = [cellmd, "build", "cells", "--layout", "spheroid", "--count", count, "--radius", CELL_RADIUS, "--level", 1, "--gap", 0.2,
-             "--spheroid-radius", 200, "--substrate", "flat", "--substrate-spacing", 2, "--substrate-gap", 0.5,
-             "--substrate-extent", extent, "--box", extent + 10, "--seed", seed, "-o", top]
-    # Built around z = 0 first; then lowered so that the substrate lies at z = 0, the deck's dish.
-    floor = float(run(build).split("touching z = ")[1].split()[0])
-    run(build + ["--centre", 0, 0, -floor])
-    start = time.time()
-    run([cellmd, "run", DECK, "-o", d, "--quiet", "--threads", 1, "--var", f"topology={top}", "--var", f"adhesion={adhesion}",
-         "--var", f"seed={seed}"])
-    t = thermo(d / "spheroid_spreading.thermo.csv")
-    area = t["hullarea/cells"]
+    csv_path = d / "spheroid_spreading.thermo.csv"
+    if not (reuse and csv_path.exists()):
+        top = d / "spheroid.top"
+        extent = CELL_RADIUS * (4 + 3 * count ** (1 / 3))
+        build = [cellmd, "build", "cells", "--layout", "spheroid", "--count", count, "--radius", CELL_RADIUS, "--level", 1, "--gap", 0.2,
+                 "--spheroid-radius", 200, "--substrate", "flat", "--substrate-spacing", 2, "--substrate-gap", 0.5,
+                 "--substrate-extent", extent, "--box", extent + 10, "--seed", seed, "-o", top]
+        # Built around z = 0 first; then lowered so that the substrate lies at z = 0, the deck's dish.
+        floor = float(run(build).split("touching z = ")[1].split()[0])
+        run(build + ["--centre", 0, 0, -floor])
+        start = time.time()
+        run([cellmd, "run", DECK, "-o", d, "--quiet", "--threads", 1, "--var", f"topology={top}", "--var", f"adhesion={adhesion}",
+             "--var", f"seed={seed}"])
+        (d / "runtime_s.txt").write_text(f"{time.time() - start:.1f}\n")
+    t = thermo(csv_path)
+    area = t["hullarea/cells[µm²]"]
+    # The silhouette fluctuates by a few % as cells reshape: the equilibrium A is
+    # the mean of the last TAIL rows, its drift the change from the TAIL rows before.
+    late, earlier = area[-TAIL:].mean(), area[-2 * TAIL:-TAIL].mean()
+    runtime = d / "runtime_s.txt"
     return {"count": count, "adhesion": adhesion, "seed": seed, "R": float(np.sqrt(area[0] / np.pi)),
-            "A_over_A0": float(area[-1] / area[0]), "last_change": float(abs(area[-1] / area[-2] - 1)),
-            "time": float(t["time"][-1]), "clutches": int(t["nbound/clutch"][-1]), "runtime_s": round(time.time() - start, 1)}
+            "A_over_A0": float(late / area[0]), "drift": float(late / earlier - 1), "time": float(t["time[s]"][-1]),
+            "clutches": int(t["nbound/clutch[-]"][-1]), "runtime_s": float(runtime.read_text()) if runtime.exists() else float("nan")}
 
 
 def fit(R, y):
@@ -84,20 +97,21 @@ def main():
     a.add_argument("--control-counts", type=int, nargs="+", default=[1, 4, 13], help="cell counts also run without clutches")
     a.add_argument("--seeds", type=int, default=1)
     a.add_argument("--workers", type=int, default=os.cpu_count())
+    a.add_argument("--reuse", action="store_true", help="read the runs already in OUT instead of running them again")
     o = a.parse_args()
     out = Path(o.out).resolve()
     out.mkdir(parents=True, exist_ok=True)
     jobs = [(n, adh, s) for n in o.counts for adh in (1, 0) for s in range(1, o.seeds + 1) if adh or n in o.control_counts]
     jobs.sort(key=lambda j: -j[0])
     with ThreadPoolExecutor(o.workers) as pool:
-        rows = list(pool.map(lambda j: spread(o.cellmd, out, *j), jobs))
+        rows = list(pool.map(lambda j: spread(o.cellmd, out, *j, o.reuse), jobs))
     rows.sort(key=lambda r: (r["count"], -r["adhesion"], r["seed"]))
     with open(out / "spheroid_spreading.csv", "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=list(rows[0]))
         w.writeheader()
         w.writerows(rows)
-    lines = [f"{'N':>4} {'adh':>3} {'seed':>4} {'R/µm':>7} {'A/A0':>7} {'last ΔA/A':>9} {'t/s':>7} {'clutches':>8} {'wall/s':>7}"]
-    lines += [f"{r['count']:>4} {r['adhesion']:>3g} {r['seed']:>4} {r['R']:>7.2f} {r['A_over_A0']:>7.3f} {r['last_change']:>9.1e} "
+    lines = [f"{'N':>4} {'adh':>3} {'seed':>4} {'R/µm':>7} {'A/A0':>7} {'drift':>8} {'t/s':>7} {'clutches':>8} {'wall/s':>7}"]
+    lines += [f"{r['count']:>4} {r['adhesion']:>3g} {r['seed']:>4} {r['R']:>7.2f} {r['A_over_A0']:>7.3f} {r['drift']:>+8.3f} "
               f"{r['time']:>7.1f} {r['clutches']:>8} {r['runtime_s']:>7.1f}" for r in rows]
     adhered = [r for r in rows if r["adhesion"] == 1]
     R = np.array([r["R"] for r in adhered])
