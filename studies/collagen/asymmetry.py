@@ -4,22 +4,24 @@
 Runs inputs/collagen_two_cells.in on the two-cell network built with
 `--seed` 1 … N (independent realisations), each with asymmetric fibres
 (k_compression = 1 pN/µm, tension 100) and symmetric ones (100), and reads
-two measures at every stage:
+three measures at every stage:
 
 - `paper`: the deck's thermo column clustering/fibre/cell1/cell2, the
   paper's S_max/S_min in the band between the rings (the band follows the
   rings as they shrink);
-- `band`: the same profile in a frame fixed at the network as built (the
-  gap between the initial rings, x within ±(D/2 − R), 21 strips over
+- `band_gain`: the same profile in a frame fixed at the network as built
+  (the gap between the initial rings, x within ±(D/2 − R), 21 strips over
   |y| ≤ 1.5 R): the mean of the 7 central strips (on the axis) over that of
   the 3 outermost at each end, divided by its value as built. It is 1
   when nothing moves and > 1 when fibres gather onto the axis between the
-  cells, whatever the realisation's initial profile.
+  cells, whatever the realisation's initial profile;
+- `mid_half`: the paper's S_max/S_min in that fixed frame's middle half of
+  the gap (x within ±(D/2 − R)/2).
 
 Writes OUT/asymmetry.csv (one row per run and stage) and prints, for the
 last stage, the mean ± standard error over the realisations of the paper
-ratio's growth and of the band gain, asymmetric and symmetric, and of their
-paired difference. The README's table (*Collagen clustering study*) is its
+ratio's growth, the band gain and the mid-half ratio's growth, asymmetric
+and symmetric, and of their paired difference. The README's table (*Collagen clustering study*) is its
 output. Needs numpy (`bash scripts/reference-venv`).
 
     python3 studies/collagen/asymmetry.py --cellmd target/release/cellmd --out out/collagen_asym --seeds 5 --steps 1000
@@ -47,14 +49,25 @@ FIBRES = {"asymmetric": 1.0, "symmetric": 100.0}  # k_compression, pN/µm (k_ten
 STRIPS, PEAK, END = 21, 7, 3  # as the clustering column (src/measure/clustering.rs)
 
 
-def band(pos, bonds):
-    """Central over outer fibre density across the initial gap (fixed frame)."""
-    gap, half = SEPARATION / 2 - RADIUS, 1.5 * RADIUS
+def profile(pos, bonds, reach):
+    """Fibre length in 21 strips across |y| ≤ 1.5 R, of the part of the
+    network within |x| ≤ reach (a frame fixed at the network as built)."""
+    half = 1.5 * RADIUS
     pts, w = sample(pos, bonds, 0.5)
-    inside = (np.abs(pts[:, 0]) <= gap) & (np.abs(pts[:, 1]) <= half)
-    profile, _ = np.histogram(pts[inside, 1], bins=STRIPS, range=(-half, half), weights=w[inside])
+    inside = (np.abs(pts[:, 0]) <= reach) & (np.abs(pts[:, 1]) <= half)
+    return np.histogram(pts[inside, 1], bins=STRIPS, range=(-half, half), weights=w[inside])[0]
+
+
+def band(p):
+    """The 7 central strips (on the axis) over the 3 outermost at each end."""
     middle = (STRIPS - PEAK) // 2
-    return profile[middle : middle + PEAK].mean() / np.r_[profile[:END], profile[-END:]].mean()
+    return p[middle : middle + PEAK].mean() / np.r_[p[:END], p[-END:]].mean()
+
+
+def paper_ratio(p):
+    """S_max/S_min as the clustering column takes it (7 strips around the densest)."""
+    first = min(max(int(np.argmax(p)) - PEAK // 2, 0), STRIPS - PEAK)
+    return p[first : first + PEAK].mean() / np.r_[p[:END], p[-END:]].mean()
 
 
 def run(a, seed, fibres):
@@ -70,11 +83,14 @@ def run(a, seed, fibres):
     wall = run_deck(a.cellmd, DECK, point, variables)
     paper = [r["clustering/fibre/cell1/cell2"] for r in thermo_rows(point / f"{name}.thermo.csv")]
     bonds = fibres_of(top)
-    bands = [band(pos, bonds) for pos in frames(point / f"{name}.xyz")]  # as built, then each stage's end
+    gap = SEPARATION / 2 - RADIUS
+    shots = frames(point / f"{name}.xyz")  # as built, then each stage's end
+    bands = [band(profile(pos, bonds, gap)) for pos in shots]
+    mids = [paper_ratio(profile(pos, bonds, gap / 2)) for pos in shots]
     print(f"{name}: paper {paper[0]:.3f} -> {paper[-1]:.3f}, band gain {bands[-1] / bands[0]:.3f}, {wall:.0f} s", flush=True)
     return [
-        {"seed": seed, "fibres": fibres, "stage": s, "paper": round(p, 5), "band_gain": round(b / bands[0], 5), "wall_s": round(wall, 1)}
-        for s, (p, b) in enumerate(zip(paper, bands))
+        {"seed": seed, "fibres": fibres, "stage": s, "paper": round(p, 5), "band_gain": round(b / bands[0], 5), "mid_half": round(m, 5), "wall_s": round(wall, 1)}
+        for s, (p, b, m) in enumerate(zip(paper, bands, mids))
     ]
 
 
@@ -106,8 +122,9 @@ def main():
     first = {(r["seed"], r["fibres"]): r for r in rows if r["stage"] == 0}
     growth = {f: [last[(s, f)]["paper"] - first[(s, f)]["paper"] for s in range(1, a.seeds + 1)] for f in FIBRES}
     gain = {f: [last[(s, f)]["band_gain"] for s in range(1, a.seeds + 1)] for f in FIBRES}
+    mid = {f: [last[(s, f)]["mid_half"] - first[(s, f)]["mid_half"] for s in range(1, a.seeds + 1)] for f in FIBRES}
     print(f"{a.seeds} realisations, {a.stages} stages × {a.steps} steps, K {a.bend}, dt {a.dt}: mean ± s.e.")
-    for label, q in (("paper ratio growth", growth), ("band gain", gain)):
+    for label, q in (("paper ratio growth", growth), ("band gain", gain), ("mid-half growth", mid)):
         diff = [x - y for x, y in zip(q["asymmetric"], q["symmetric"])]
         print(f"  {label}: asymmetric {mean_se(q['asymmetric'])}, symmetric {mean_se(q['symmetric'])}, difference {mean_se(diff)}")
 
