@@ -42,30 +42,34 @@ def fibres_of(top):
     return bonds
 
 
-def last_frame(xyz):
-    """id → (x, y) of the last frame of an xyz dump (`species x y z type id`)."""
+def frames(xyz):
+    """Every frame of an xyz dump (`species x y z type id`), each id → (x, y)."""
     lines = Path(xyz).read_text().splitlines()
-    frames, k = [], 0
+    out, k = [], 0
     while k < len(lines):
         n = int(lines[k])
-        frames.append(lines[k + 2 : k + 2 + n])
+        out.append({int(w[5]): (float(w[1]), float(w[2])) for w in (line.split() for line in lines[k + 2 : k + 2 + n])})
         k += n + 2
-    return {int(w[5]): (float(w[1]), float(w[2])) for w in (line.split() for line in frames[-1])}
+    return out
+
+
+def sample(pos, bonds, spacing):
+    """Points along each bond (i, j) at most `spacing` apart, each carrying its
+    share of the bond's length: (points, weights) for length histograms."""
+    a = np.array([pos[i] for i, _ in bonds])
+    b = np.array([pos[j] for _, j in bonds])
+    lengths = np.linalg.norm(b - a, axis=1)
+    n = np.maximum(1, np.ceil(lengths / spacing)).astype(int)
+    t = np.concatenate([(np.arange(k) + 0.5) / k for k in n])
+    pts = np.repeat(a, n, axis=0) + np.repeat(b - a, n, axis=0) * t[:, None]
+    return pts, np.repeat(lengths / n, n)
 
 
 def density_map(run_dir):
     """Fibre length per pixel of the run's last frame, and its extent."""
     name = run_dir.name
-    pos = last_frame(run_dir / f"{name}.xyz")
-    segments = np.array([(pos[i], pos[j]) for i, j in fibres_of(run_dir / "collagen.top")])
-    a, b = segments[:, 0], segments[:, 1]
-    lengths = np.linalg.norm(b - a, axis=1)
-    # Points along each bond, at most half a pixel apart, each carrying its share of the length.
-    n = np.maximum(1, np.ceil(lengths / (PIXEL / 2))).astype(int)
-    t = np.concatenate([(np.arange(k) + 0.5) / k for k in n])
-    start, d = np.repeat(a, n, axis=0), np.repeat(b - a, n, axis=0)
-    pts = start + d * t[:, None]
-    weights = np.repeat(lengths / n, n)
+    pos = frames(run_dir / f"{name}.xyz")[-1]
+    pts, weights = sample(pos, fibres_of(run_dir / "collagen.top"), PIXEL / 2)
     xs = np.arange(np.floor(pts[:, 0].min() / PIXEL) * PIXEL, pts[:, 0].max() + PIXEL, PIXEL)
     ys = np.arange(np.floor(pts[:, 1].min() / PIXEL) * PIXEL, pts[:, 1].max() + PIXEL, PIXEL)
     h, _, _ = np.histogram2d(pts[:, 0], pts[:, 1], bins=[xs, ys], weights=weights)

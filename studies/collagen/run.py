@@ -20,11 +20,13 @@ import csv
 import math
 import subprocess
 import sys
-import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "studies"))
+from cellmd_run import run_deck, thermo_rows  # noqa: E402
+
 DECK = ROOT / "inputs" / "collagen_two_cells.in"
 FF = ROOT / "forcefields" / "collagen.ff"
 # The deck's two-cell columns, replaced by each layout's pairs and hubs.
@@ -99,33 +101,21 @@ def run(cellmd, out, layout, fibres, mobile, steps, stages):
         sys.exit(f"{DECK}: expected the thermo columns `{COLUMNS}` once")
     deck = point / "collagen.in"
     deck.write_text(text.replace(COLUMNS, " ".join(columns)))
-    args = [str(cellmd), "run", str(deck), "-o", str(point), "--quiet", "--threads", "1"]
-    for key, value in (
-        ("top", top),
-        ("ff", FF),
-        ("ncells", len(hubs)),
-        ("kc", FIBRES[fibres]),
-        ("mobile", int(mobile)),
-        ("steps", steps),
-        ("stages", stages),
-        ("name", name),
-    ):
-        args += ["--var", f"{key}={value}"]
-    start = time.monotonic()
-    proc = subprocess.run(args, capture_output=True, text=True)
-    wall = time.monotonic() - start
-    if proc.returncode != 0:
-        sys.exit(f"{' '.join(args)}\nexit {proc.returncode}\n{proc.stderr}")
-    with open(point / f"{name}.thermo.csv") as f:
-        table = list(csv.reader(f))
-    header = [h.split("[")[0] for h in table[0]]
-    by_step = {}
-    for row in table[1:]:
-        by_step[int(row[0])] = dict(zip(header, row))  # each run repeats its first row: keep the last
+    variables = {
+        "top": top,
+        "ff": FF,
+        "ncells": len(hubs),
+        "kc": FIBRES[fibres],
+        "mobile": int(mobile),
+        "steps": steps,
+        "stages": stages,
+        "name": name,
+    }
+    wall = run_deck(cellmd, deck, point, variables)
+    by_step = thermo_rows(point / f"{name}.thermo.csv")
     area0 = polygon_area(hubs)
     rows = []
-    for stage, step in enumerate(sorted(by_step)):
-        r = by_step[step]
+    for stage, r in enumerate(by_step):
         ratios = [float(r[c]) for c in columns if c.startswith("clustering/")]
         corners = [(float(r[f"xu/hub{c + 1}"]), float(r[f"yu/hub{c + 1}"])) for c in range(len(hubs))]
         rows.append(

@@ -33,6 +33,9 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "studies"))
+from cellmd_run import run_deck, thermo_rows  # noqa: E402
+
 DECK = ROOT / "inputs" / "tensegrity_substrate.in"
 F_SPRD = 47150.0  # pN, Vassaux & Milan's total adhesion force at 962 µm²
 AREA = 962.0  # µm²
@@ -63,20 +66,13 @@ def run(cellmd, top, out, curvature, volumes, **variables):
               "curvature": 0 if flat else float(curvature), "zc": -1000 if flat else bottom + float(curvature)}
     values.update(variables)
     out.mkdir(parents=True, exist_ok=True)
-    command = [cellmd, "run", str(DECK), "-o", str(out), "--threads", "1"]
-    for key, value in values.items():
-        command += ["--var", f"{key}={value}"]
-    subprocess.run(command, check=True, capture_output=True, text=True)
+    run_deck(cellmd, DECK, out, values)
     phases = {}
     for phase in ["spread", "contract", "indentation"]:
         path = out / f"tensegrity_{phase}.thermo.csv"
         if path.exists():
-            rows = [{k.split("[")[0]: float(v) for k, v in r.items()} for r in csv.DictReader(open(path))]
-            # A stage's run and its minimize both end on the same step: keep the relaxed (last) row.
-            last = {}
-            for r in rows:
-                last[r["step"]] = r
-            phases[phase] = list(last.values())
+            # A stage's run and its minimize both end on the same step: the relaxed (last) row is kept.
+            phases[phase] = thermo_rows(path)
     return phases
 
 

@@ -14,13 +14,15 @@ import argparse
 import csv
 import os
 import re
-import subprocess
 import sys
 import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "studies"))
+from cellmd_run import run_deck, thermo_rows  # noqa: E402
+
 DECK = ROOT / "inputs" / "tissue_fracture.in"
 FF = ROOT / "forcefields" / "tissue_fracture.ff"
 LABELS = {0: "elastic", 1: "ductile", 2: "brittle"}
@@ -49,18 +51,9 @@ def run_point(cellmd, out, g, strain, k_on, tau, ramp, steps):
     point.mkdir(parents=True, exist_ok=True)
     ff = point / "tissue_fracture.ff"
     ff.write_text(forcefield(strain, k_on, tau))
-    args = [str(cellmd), "run", str(DECK), "-o", str(point), "--quiet", "--threads", "1"]
-    for key, value in (("g", g), ("tau", tau), ("ramp", ramp), ("steps", steps), ("ff", ff), ("name", name)):
-        args += ["--var", f"{key}={value}"]
-    start = time.monotonic()
-    proc = subprocess.run(args, capture_output=True, text=True)
-    wall = time.monotonic() - start
-    if proc.returncode != 0:
-        sys.exit(f"{' '.join(args)}\nexit {proc.returncode}\n{proc.stderr}")
-    with open(point / f"{name}.thermo.csv") as f:
-        rows = list(csv.reader(f))
-    header = [h.split("[")[0] for h in rows[0]]
-    last = dict(zip(header, rows[-1]))
+    variables = {"g": g, "tau": tau, "ramp": ramp, "steps": steps, "ff": ff, "name": name}
+    wall = run_deck(cellmd, DECK, point, variables)
+    last = thermo_rows(point / f"{name}.thermo.csv")[-1]
     row = {"g": g, "strain": strain, "k_on": k_on, "tau": tau, "ramp": ramp, "time": float(last["time"])}
     for q in QUANTITIES:
         row[q] = float(last[f"fracture/junction/{q}"])

@@ -1,0 +1,44 @@
+"""Runs a cellmd deck for a study and reads its thermo CSV: the one home of
+the run-and-read block the studies share (tissue_fracture/sweep.py,
+collagen/run.py, tensegrity_substrate/sweep.py).
+
+A study script imports it after putting studies/ on sys.path:
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+    from cellmd_run import run_deck, thermo_rows
+"""
+
+import csv
+import subprocess
+import sys
+import time
+
+
+def run_deck(cellmd, deck, out, variables):
+    """`cellmd run DECK -o OUT --quiet --threads 1 --var KEY=VALUE …` (one
+    thread: a study runs its points in parallel); exits with the command and
+    its stderr if cellmd fails, else returns the wall time in seconds."""
+    command = [str(cellmd), "run", str(deck), "-o", str(out), "--quiet", "--threads", "1"]
+    for key, value in variables.items():
+        command += ["--var", f"{key}={value}"]
+    start = time.monotonic()
+    proc = subprocess.run(command, capture_output=True, text=True)
+    wall = time.monotonic() - start
+    if proc.returncode != 0:
+        sys.exit(f"{' '.join(command)}\nexit {proc.returncode}\n{proc.stderr}")
+    return wall
+
+
+def thermo_rows(path):
+    """The rows of a thermo CSV as dicts of floats keyed by column name
+    (the `[unit]` cut off), one per step: where several rows share a step
+    (a run's first row repeats the previous run's last; a minimize ends on
+    the step of the run before it) the last is kept."""
+    with open(path, newline="") as f:
+        table = list(csv.reader(f))
+    header = [h.split("[")[0] for h in table[0]]
+    by_step = {}
+    for row in table[1:]:
+        values = {k: float(v) for k, v in zip(header, row)}
+        by_step[values["step"]] = values
+    return list(by_step.values())
