@@ -12,7 +12,7 @@
 //!
 //! Every sub-expression is parenthesised, so precedence never differs.
 
-use super::number::num;
+use crate::interactions::lammps::num;
 use crate::expr::{BinaryOp, Expr, UnaryOp};
 
 /// The formula of a tree whose names are `x`, `y`, `z` and `t` only.

@@ -32,7 +32,7 @@ use std::collections::{BTreeMap, HashMap};
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::number::num;
+use crate::interactions::lammps::num;
 
 /// The files an import writes, and what it could not translate.
 #[derive(Clone, Debug, Default)]

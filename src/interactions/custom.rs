@@ -17,8 +17,10 @@
 //! the body-term evaluator with no parameters of its own.
 
 mod laws;
+mod lepton;
 
 use self::laws::{angle_eval, body_eval, body_hessian, external_eval, pair_eval, pair_force, radial_eval, radial_force};
+use super::lammps::{bonded, lepton_bond, num, pair, LammpsStyle, LammpsTerm, Translation};
 use super::{Entry, Interaction, Kind, Law, ParamSpec, SurfaceGpu};
 use crate::expr::tape::{compile, Slot};
 use crate::expr::{parse, Expr, ExprError, Span};
@@ -224,6 +226,28 @@ impl Interaction for CustomLaw {
     }
     fn expression(&self) -> Option<&Expr> {
         Some(&self.energy)
+    }
+    /// Bonds, angles and pairs: LAMMPS' lepton styles with the expression,
+    /// parameters written as numbers; r0 = 0 and θ0 = 0 make Lepton's
+    /// displacement variables the distance and the angle (θ in radians).
+    /// Externals: `fix addforce` with atom-style variables of −∇E and E.
+    fn lammps(&self, term: &LammpsTerm) -> Translation {
+        if self.kind == Kind::External {
+            return Some(Ok(LammpsStyle::ExpressionVariables));
+        }
+        if !matches!(self.kind, Kind::Bond | Kind::Angle | Kind::Pair) {
+            return None;
+        }
+        let value = |n: &str| self.specs.iter().position(|p| p.name == n).map(|k| term.params[k]);
+        let expression = match lepton::lepton(&self.energy, &value) {
+            Ok(expression) => expression,
+            Err(e) => return Some(Err(format!("{} `{}`: {e}", self.kind.with_article(), term.label))),
+        };
+        match self.kind {
+            Kind::Bond => lepton_bond(expression, 0.0),
+            Kind::Angle => bonded("lepton", format!("0.0 \"{expression}\"")),
+            _ => pair("lepton", format!("\"{expression}\" {}", num(term.params[0]))),
+        }
     }
     fn law(&self) -> Law {
         match self.kind {

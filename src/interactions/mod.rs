@@ -49,9 +49,9 @@ use crate::units::Dim;
 /// Implements [`Entry`] and [`Interaction`] for a unit struct from its
 /// registration data: the name (also the stem of its `.md` doc file), kind,
 /// one-line summary, the module's `PARAMS` schema, its law, and optionally a
-/// `validate` function.
+/// `validate` function and a `lammps` translation ([`Interaction::lammps`]).
 macro_rules! interaction {
-    ($ty:ident, $name:literal, $kind:expr, $summary:literal, $law:expr $(, validate = $validate:path)?) => {
+    ($ty:ident, $name:literal, $kind:expr, $summary:literal, $law:expr $(, validate = $validate:path)? $(, lammps = $lammps:path)?) => {
         $crate::interactions::entry!($ty, $name, $kind.keyword(), $summary $(, validate = $validate)?);
 
         impl $crate::interactions::Interaction for $ty {
@@ -61,6 +61,9 @@ macro_rules! interaction {
             fn law(&self) -> $crate::interactions::Law {
                 $law
             }
+            $(fn lammps(&self, term: &$crate::interactions::lammps::LammpsTerm) -> $crate::interactions::lammps::Translation {
+                $lammps(term)
+            })?
         }
     };
 }
@@ -79,6 +82,7 @@ macro_rules! radial_force {
 
 pub mod custom;
 mod entry;
+pub mod lammps;
 pub mod testing;
 
 mod area_conservation;
@@ -485,6 +489,11 @@ pub trait Interaction: Entry {
     fn expression(&self) -> Option<&crate::expr::Expr> {
         None
     }
+    /// How LAMMPS writes a term of this type (module [`lammps`]); `None`
+    /// (the default) when it has no equivalent.
+    fn lammps(&self, _term: &lammps::LammpsTerm) -> lammps::Translation {
+        None
+    }
 }
 
 /// Index of a parameter in an interaction's schema.
@@ -512,7 +521,7 @@ mod tests {
         for entry in std::fs::read_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/src/interactions")).unwrap() {
             let path = entry.unwrap().path();
             let stem = path.file_stem().unwrap().to_str().unwrap().to_string();
-            if ["mod", "entry", "testing"].contains(&stem.as_str()) {
+            if ["mod", "entry", "lammps", "testing"].contains(&stem.as_str()) {
                 continue;
             }
             assert!(lookup(&stem).is_some(), "{} has no REGISTRY entry", path.display());

@@ -1,6 +1,7 @@
 #![doc = include_str!("soft_repulsion.md")]
 
 use super::{Kind, Law, ParamSpec, Radial};
+use super::lammps::{num, pair, LammpsTerm, Translation};
 use crate::units::Dim;
 
 const K: usize = 0;
@@ -20,12 +21,19 @@ fn eval(p: &[f64], r: f64) -> Radial {
     }
 }
 
+/// LAMMPS `pair_style harmonic/cut` k(rc − r)²: k/2, rc = σ.
+fn lammps(term: &LammpsTerm) -> Translation {
+    let p = term.params;
+    pair("harmonic/cut", format!("{} {}", num(0.5 * p[K]), num(p[SIGMA])))
+}
+
 interaction!(
     SoftRepulsion,
     "soft_repulsion",
     Kind::Pair,
     "One-sided harmonic excluded volume E = ½k(σ − r)² for r < σ",
-    Law::Radial { eval, force: radial_force!(eval), range: |p| p[SIGMA] }
+    Law::Radial { eval, force: radial_force!(eval), range: |p| p[SIGMA] },
+    lammps = lammps
 );
 
 #[cfg(test)]

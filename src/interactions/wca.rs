@@ -2,6 +2,7 @@
 
 use super::lj::{lennard_jones, lennard_jones_over_r};
 use super::{Kind, Law, ParamSpec, Radial};
+use super::lammps::{num, LammpsStyle, LammpsTerm, Translation};
 use crate::units::Dim;
 
 const EPSILON: usize = 0;
@@ -38,12 +39,20 @@ fn force(p: &[f64], r2: f64) -> f64 {
     }
 }
 
+/// LAMMPS `pair_style lj/cut` at 2^(1/6)σ with `pair_modify shift yes`.
+fn lammps(term: &LammpsTerm) -> Translation {
+    let p = term.params;
+    let coeffs = format!("{} {} {}", num(p[EPSILON]), num(p[SIGMA]), num(cutoff(p)));
+    Some(Ok(LammpsStyle::Pair { style: "lj/cut", coeffs, shift: true }))
+}
+
 interaction!(
     Wca,
     "wca",
     Kind::Pair,
     "Weeks–Chandler–Andersen repulsion: LJ cut at 2^(1/6)σ and shifted up by ε",
-    Law::Radial { eval, force, range: cutoff }
+    Law::Radial { eval, force, range: cutoff },
+    lammps = lammps
 );
 
 #[cfg(test)]
