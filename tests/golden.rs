@@ -191,9 +191,10 @@ fn surface_golden_files_tell_a_perturbed_term_apart() {
         for doc in documents(&path).iter().filter(|d| is_openmm(d)) {
             let deck = Path::new("reference").join(doc.get("deck").unwrap());
             let mut plan = validate_file(&deck, &[]).unwrap();
-            for term in plan.model.body_rules.iter_mut().chain(&mut plan.model.tetra_types) {
-                let k = term.params.iter().position(|p| *p != 0.0).unwrap();
-                term.params[k] *= 1.0 + 1e-6;
+            let bodies = plan.model.body_rules.iter_mut().map(|t| t.params_mut());
+            for params in bodies.chain(plan.model.tetra_types.iter_mut().map(|t| t.params_mut())) {
+                let k = params.iter().position(|p| *p != 0.0).unwrap();
+                params[k] *= 1.0 + 1e-6;
             }
             let agreement = Agreement::new(&cellmd_probes(&plan).unwrap(), &golden::probes_of(doc).unwrap()).unwrap();
             println!("{}: worst relative error {:.1e} with a parameter off by 1e-6", deck.display(), agreement.init.worst());

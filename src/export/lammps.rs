@@ -46,12 +46,12 @@ use std::fmt::Write;
 
 use super::bond_types::LammpsBondTypes;
 use super::formula;
-use crate::interactions::lammps::num;
 use super::styles::{self, ExternalStyle, PairStyled, Styled};
 use crate::deck::{Action, CoeffTarget, Plan};
 use crate::expr::{Expr, UnaryOp};
-use crate::forcefield::TermType;
+use crate::forcefield::{TermType, Typed};
 use crate::integrate::Integrator;
+use crate::interactions::lammps::num;
 use crate::kinetics::{deterministic_strain, Effect};
 use crate::rng::Noise;
 use crate::system::{External, Model};
@@ -791,15 +791,17 @@ impl Writer<'_> {
 /// are errors naming them.
 pub fn export(plan: &Plan, options: ExportOptions) -> Result<LammpsDeck, String> {
     let model = plan.model.clone();
-    let element = model.tetra_type.first().map(|&t| &model.tetra_types[t as usize]);
-    if let Some(term) = model.body_rules.first().or(model.contact_rules.first()).or(element) {
+    let element = model.tetra_type.first().map(|&t| model.tetra_types[t as usize].term());
+    let body = model.body_rules.first().map(Typed::term);
+    if let Some(term) = body.or(model.contact_rules.first().map(Typed::term)).or(element) {
         return Err(styles::unsupported(term));
     }
     let bond_types = LammpsBondTypes::new(&model);
     let kinetic = kinetic_fixes(plan, &bond_types)?;
     let terms: Vec<TermType> = (0..bond_types.count()).map(|l| bond_types.term(&model, l)).collect();
     let bonds = Hybrid::new(&terms, styles::bonded)?;
-    let angles = Hybrid::new(&model.angle_types, styles::bonded)?;
+    let angle_types: Vec<TermType> = model.angle_types.iter().map(|t| t.term().clone()).collect();
+    let angles = Hybrid::new(&angle_types, styles::bonded)?;
     let pairs = Pairs::new(&model)?;
     // Externals and coefficients that only appear later are checked when written.
     let title = format!("cellmd export of {}", plan.deck_path.display());

@@ -40,7 +40,8 @@ pub(super) fn unsupported(term: &TermType) -> String {
 
 /// The translation of a bond, angle or pair term (no box, no expressions).
 fn translate(term: &TermType) -> Option<Result<LammpsStyle, String>> {
-    let view = LammpsTerm { params: &term.params, label: &term.label.text, box_lengths: [0.0; 3], periodic: [false; 3], moving: Moving::Fixed };
+    let view =
+        LammpsTerm { params: &term.params, label: &term.label.text, box_lengths: [0.0; 3], periodic: [false; 3], moving: Moving::Fixed };
     term.interaction.lammps(&view)
 }
 

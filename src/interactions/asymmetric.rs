@@ -1,7 +1,7 @@
 #![doc = include_str!("asymmetric.md")]
 
-use super::{Kind, Law, ParamSpec, Radial};
 use super::lammps::{lepton_bond, num, LammpsTerm, Translation};
+use super::{Kind, Law, ParamSpec, Radial};
 use crate::units::Dim;
 
 const K_TENSION: usize = 0;

@@ -2,8 +2,8 @@
 
 use glam::DVec3;
 
-use super::{Kind, Law, ParamSpec, ThreeBody};
 use super::lammps::{bonded, num, LammpsTerm, Translation};
+use super::{Kind, Law, ParamSpec, ThreeBody};
 use crate::units::Dim;
 
 const K: usize = 0;
@@ -27,7 +27,14 @@ fn lammps(term: &LammpsTerm) -> Translation {
     bonded("cosine", num(term.params[K]))
 }
 
-interaction!(CosineAngle, "cosine_angle", Kind::Angle, "Cosine angle E = K[1 + cos θ] (LAMMPS angle_style cosine)", Law::ThreeBody(eval), lammps = lammps);
+interaction!(
+    CosineAngle,
+    "cosine_angle",
+    Kind::Angle,
+    "Cosine angle E = K[1 + cos θ] (LAMMPS angle_style cosine)",
+    Law::ThreeBody(eval),
+    lammps = lammps
+);
 
 #[cfg(test)]
 mod tests {

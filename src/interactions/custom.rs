@@ -278,7 +278,7 @@ mod tests {
 
     use super::*;
     use crate::interactions::testing::*;
-    use crate::interactions::{cosine_angle, harmonic, harmonic_angle, soft, surface_tension, turgor};
+    use crate::interactions::{cosine_angle, harmonic, harmonic_angle, soft, surface_tension, turgor, KindLaw, RadialLaw};
 
     fn law(kind: Kind, text: &str, params: &[(&str, f64)]) -> (&'static CustomLaw, Vec<f64>) {
         let declared: Vec<Declared> = params.iter().map(|(n, _)| Declared { name: n.to_string(), dim: Dim::Dimensionless }).collect();
@@ -370,10 +370,8 @@ mod tests {
             ),
         ];
         for ((custom, cp), bp, builtin) in radial {
-            let (Law::Radial { eval: ce, force: cf, range: cr }, Law::Radial { eval: be, force: bf, range: br }) = (custom.law(), builtin)
-            else {
-                unreachable!()
-            };
+            let RadialLaw { eval: ce, force: cf, range: cr } = RadialLaw::from_law(custom.law()).unwrap();
+            let RadialLaw { eval: be, force: bf, range: br } = RadialLaw::from_law(builtin).unwrap();
             assert_eq!(cr(&cp), br(&bp));
             for r in [0.05, 0.1, 0.37, 0.9, 1.49, 1.5, 2.0] {
                 let (c, b) = (ce(&cp, r), be(&bp, r));
@@ -477,7 +475,7 @@ mod tests {
     #[test]
     fn parameters_are_read_from_the_vector() {
         let (spring, mut p) = law(Kind::Bond, "0.5*k*(r-r0)^2", &[("k", 2.0), ("r0", 1.0)]);
-        let Law::Radial { eval, .. } = spring.law() else { unreachable!() };
+        let eval = RadialLaw::from_law(spring.law()).unwrap().eval;
         assert_eq!(eval(&p, 3.0).energy, 4.0);
         p[param_index_of(spring, "r0")] = 2.0;
         assert_eq!(eval(&p, 3.0).energy, 1.0);

@@ -2,8 +2,8 @@
 
 use glam::DVec3;
 
-use super::{Kind, Law, OneBody, ParamSpec};
 use super::lammps::{LammpsStyle, LammpsTerm, Translation};
+use super::{Kind, Law, OneBody, ParamSpec};
 use crate::units::Dim;
 
 const FX: usize = 0;

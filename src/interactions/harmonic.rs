@@ -1,7 +1,7 @@
 #![doc = include_str!("harmonic.md")]
 
-use super::{Kind, Law, ParamSpec, Radial};
 use super::lammps::{bonded, num, LammpsTerm, Translation};
+use super::{Kind, Law, ParamSpec, Radial};
 use crate::units::Dim;
 
 const K: usize = 0;

@@ -2,8 +2,8 @@
 
 use glam::DVec3;
 
-use super::{Kind, Law, ParamSpec, ThreeBody};
 use super::lammps::{bonded, num, LammpsTerm, Translation};
+use super::{Kind, Law, ParamSpec, ThreeBody};
 use crate::units::Dim;
 
 const K: usize = 0;
@@ -44,7 +44,14 @@ fn lammps(term: &LammpsTerm) -> Translation {
     bonded("harmonic", format!("{} {}", num(0.5 * p[K]), num(p[THETA0])))
 }
 
-interaction!(HarmonicAngle, "harmonic_angle", Kind::Angle, "Harmonic angle E = ½k(θ − θ0)², θ0 in degrees", Law::ThreeBody(eval), lammps = lammps);
+interaction!(
+    HarmonicAngle,
+    "harmonic_angle",
+    Kind::Angle,
+    "Harmonic angle E = ½k(θ − θ0)², θ0 in degrees",
+    Law::ThreeBody(eval),
+    lammps = lammps
+);
 
 #[cfg(test)]
 mod tests {

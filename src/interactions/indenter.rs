@@ -2,8 +2,8 @@
 
 use glam::DVec3;
 
-use super::{Kind, Law, OneBody, ParamSpec};
 use super::lammps::{fix, num, LammpsTerm, Translation};
+use super::{Kind, Law, OneBody, ParamSpec};
 use crate::units::Dim;
 
 const X: usize = 0;

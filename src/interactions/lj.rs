@@ -1,7 +1,7 @@
 #![doc = include_str!("lj.md")]
 
-use super::{Kind, Law, ParamSpec, Radial};
 use super::lammps::{num, pair, LammpsTerm, Translation};
+use super::{Kind, Law, ParamSpec, Radial};
 use crate::units::Dim;
 
 const EPSILON: usize = 0;

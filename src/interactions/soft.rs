@@ -2,8 +2,8 @@
 
 use std::f64::consts::PI;
 
-use super::{Kind, Law, ParamSpec, Radial};
 use super::lammps::{num, pair, LammpsTerm, Translation};
+use super::{Kind, Law, ParamSpec, Radial};
 use crate::units::Dim;
 
 const A: usize = 0;

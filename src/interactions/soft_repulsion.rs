@@ -1,7 +1,7 @@
 #![doc = include_str!("soft_repulsion.md")]
 
-use super::{Kind, Law, ParamSpec, Radial};
 use super::lammps::{num, pair, LammpsTerm, Translation};
+use super::{Kind, Law, ParamSpec, Radial};
 use crate::units::Dim;
 
 const K: usize = 0;
@@ -40,6 +40,7 @@ interaction!(
 mod tests {
     use super::*;
     use crate::interactions::testing::*;
+    use crate::interactions::{KindLaw, RadialLaw};
     use glam::DVec3;
 
     fn pair(r: f64) -> [DVec3; 2] {
@@ -64,8 +65,7 @@ mod tests {
         let out = eval(&p, 0.9);
         assert!((out.energy - 0.5).abs() < 1e-12 && (out.de_dr + 10.0).abs() < 1e-12);
         assert_eq!(eval(&p, 1.0), Radial::ZERO);
-        let Law::Radial { range, .. } = SoftRepulsion.law() else { unreachable!() };
-        assert_eq!(range(&p), 1.0);
+        assert_eq!((RadialLaw::from_law(SoftRepulsion.law()).unwrap().range)(&p), 1.0);
         // At contact d²E/dr² takes the one-sided (separated) value.
         assert_eq!(eval(&p, 1.0).d2e_dr2, 0.0);
         assert_eq!(eval(&p, 1.0 - 1e-12).d2e_dr2, 100.0);

@@ -2,8 +2,8 @@
 
 use glam::DVec3;
 
-use super::{Kind, Law, OneBody, ParamSpec};
 use super::lammps::{num, LammpsStyle, LammpsTerm, Moving, Translation};
+use super::{Kind, Law, OneBody, ParamSpec};
 use crate::units::Dim;
 
 const NX: usize = 0;

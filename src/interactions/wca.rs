@@ -1,8 +1,8 @@
 #![doc = include_str!("wca.md")]
 
+use super::lammps::{num, LammpsStyle, LammpsTerm, Translation};
 use super::lj::{lennard_jones, lennard_jones_over_r};
 use super::{Kind, Law, ParamSpec, Radial};
-use super::lammps::{num, LammpsStyle, LammpsTerm, Translation};
 use crate::units::Dim;
 
 const EPSILON: usize = 0;
@@ -81,8 +81,7 @@ mod tests {
     fn vanishes_continuously_at_the_cutoff() {
         let p = params_of(&Wca, &[("epsilon", 0.004), ("sigma", 0.05)]);
         let rc = TWO_SIXTH * 0.05;
-        let Law::Radial { range, .. } = Wca.law() else { unreachable!() };
-        assert!((range(&p) - rc).abs() < 1e-18);
+        assert!((cutoff(&p) - rc).abs() < 1e-18);
         // E(rc⁻) → 0 and F(rc⁻) → 0: continuous energy and force.
         let just_inside = eval(&p, rc * (1.0 - 1e-10));
         assert!(just_inside.energy.abs() < 1e-14 && just_inside.de_dr.abs() < 1e-6, "{just_inside:?}");

@@ -2,8 +2,8 @@
 
 use glam::DVec3;
 
-use super::{Kind, Law, ParamSpec, ThreeBody};
 use super::lammps::{bonded, num, LammpsTerm, Translation};
+use super::{Kind, Law, ParamSpec, ThreeBody};
 use crate::units::Dim;
 
 const KAPPA: usize = 0;

@@ -18,8 +18,8 @@
 //!
 //! `round` has no Lepton equivalent and is an error that says so.
 
-use crate::interactions::lammps::num;
 use crate::expr::{BinaryOp, Expr, UnaryOp};
+use crate::interactions::lammps::num;
 
 /// The Lepton text of `expr`; `value` gives the number of each parameter
 /// name, any other name (the law's variable) is written as it is.
