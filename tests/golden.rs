@@ -311,3 +311,18 @@ fn regenerated_data_matches_the_committed_golden_files() {
         }
     }
 }
+
+/// The golden cases are defined in one data file keyed by interaction name
+/// (`reference/cases.json`, read by the reference scripts): every key is a
+/// registered interaction of the kind the entry says, with a golden file.
+#[test]
+fn case_definitions_are_keyed_by_registered_interactions() {
+    let text = std::fs::read_to_string("reference/cases.json").unwrap();
+    let cases: serde_json::Map<String, serde_json::Value> = serde_json::from_str(&text).unwrap();
+    assert!(cases.len() >= 20, "{} cases", cases.len());
+    for (name, case) in &cases {
+        let interaction = cellmd::interactions::lookup(name).unwrap_or_else(|| panic!("reference/cases.json: `{name}` is not registered"));
+        assert_eq!(case["kind"].as_str(), Some(interaction.kind().keyword()), "reference/cases.json: `{name}`");
+        assert!(Path::new("reference").join(format!("{name}.yaml")).exists(), "reference/cases.json: `{name}` has no golden file");
+    }
+}
