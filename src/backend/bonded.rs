@@ -22,7 +22,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::virial::{add6, outer};
-use crate::interactions::{FourBody, Radial, ThreeBody};
+use crate::interactions::{FourBody, Kind, Radial, ThreeBody};
 use crate::system::BondState;
 use crate::system::{registry_index, Images, Model};
 
@@ -268,20 +268,20 @@ impl Bonded {
         x: &[DVec3],
         images: &Images,
         state: Option<&BondState>,
-    ) -> Vec<(&'static str, usize, DVec3)> {
+    ) -> Vec<(Kind, usize, DVec3)> {
         let mut parts = Vec::new();
         for (b, _) in model.bonds.iter().enumerate().filter(|(_, ends)| ends.contains(&(i as u32))) {
             let (t, f) = self.bond_force(b, i, model, x, images, state);
-            parts.push(("bond", t, f));
+            parts.push((Kind::Bond, t, f));
         }
         for (a, ends) in model.angles.iter().enumerate() {
             if let Some(k) = ends.iter().position(|&p| p as usize == i) {
-                parts.push(("angle", model.angle_type[a] as usize, eval_angle(model, a, x, images).1.forces[k]));
+                parts.push((Kind::Angle, model.angle_type[a] as usize, eval_angle(model, a, x, images).1.forces[k]));
             }
         }
         for (e, corners) in model.tetras.iter().enumerate() {
             if let Some(k) = corners.iter().position(|&p| p as usize == i) {
-                parts.push(("tetra", e, eval_tetra(model, e, x, images).1.forces[k]));
+                parts.push((Kind::Tetra, e, eval_tetra(model, e, x, images).1.forces[k]));
             }
         }
         parts

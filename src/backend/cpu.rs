@@ -43,7 +43,7 @@ use super::pair_table::{PairGeometry, PairTable};
 use super::special::SpecialPairs;
 use super::surface::Surfaces;
 use super::virial::add6;
-use crate::interactions::{RadialLaw, REGISTRY};
+use crate::interactions::{Kind, RadialLaw, REGISTRY};
 use crate::neighbor::{Exclusions, NeighborList};
 use crate::system::BondState;
 use crate::system::{registry_index, External, Model, SimBox, State};
@@ -331,8 +331,8 @@ impl CpuBackend {
         let mut parts: Vec<ForceBreakdown> = (self.bonded.terms_on(i, model, &state.positions, &images, state.bonds.as_ref()).into_iter())
             .map(|(kind, t, force)| {
                 let (term, label) = match kind {
-                    "bond" => (model.bond_types[t].term(), model.bond_types[t].label.text.clone()),
-                    "angle" => (model.angle_types[t].term(), model.angle_types[t].label.text.clone()),
+                    Kind::Bond => (model.bond_types[t].term(), model.bond_types[t].label.text.clone()),
+                    Kind::Angle => (model.angle_types[t].term(), model.angle_types[t].label.text.clone()),
                     _ => {
                         let term = model.tetra_types[model.tetra_type[t] as usize].term();
                         let ids = model.tetras[t].map(|p| model.ids[p as usize].to_string()).join("–");
@@ -341,7 +341,7 @@ impl CpuBackend {
                         (term, format!("{} element {} of particles {ids}{inverted}", term.label.text, t + 1))
                     }
                 };
-                ForceBreakdown { kind, label, interaction: term.interaction.name(), force }
+                ForceBreakdown { kind: kind.keyword(), label, interaction: term.interaction.name(), force }
             })
             .collect();
         for (rule, force) in self.surfaces.terms_on(i) {

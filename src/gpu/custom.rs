@@ -20,7 +20,7 @@ use crate::system::{registry_index, Model};
 
 /// Whether a term is a custom expression.
 fn is_custom(term: &TermType) -> bool {
-    term.interaction.name() == "custom"
+    term.interaction.expression().is_some()
 }
 
 /// The terms the GPU packs, in its order: bond types, angle types, pair
