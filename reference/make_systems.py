@@ -11,32 +11,23 @@ the systems, then `reference/regenerate` to record LAMMPS' answers.
 Likewise reference/per_bond_r0: bonds with their own rest lengths, which the
 export writes as one LAMMPS bond type per distinct (type, r0).
 Likewise reference/custom: `custom` expressions as LAMMPS lepton styles.
+The per-type choices of the bond, angle and pair cases (force-field lines,
+time step, small system) are data in reference/cases.json, keyed by the
+interaction's name beside the surface and volume types' parameters.
 """
+import json
 import math
 import os
 import random
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 
-# name: (force-field body, dt, small topology, kind of random system)
-BOND_FF = {
-    "harmonic": "bond s harmonic k 50 r0 1.0\nbond t harmonic k 80 r0 0.8\n",
-    "fene": "bond s fene K 30 R0 1.5 epsilon 1 sigma 1\nbond t fene K 20 R0 1.6 epsilon 0.5 sigma 0.9\n",
-    "cable": "bond s cable k 40 r0 1.0 tau 0.1\nbond t cable k 60 r0 1.1\n",
-    "spring": "bond s spring k 40 r0 1.0 tau -0.1\nbond t spring k 25 r0 0.9 tau 0.05\n",
-    "asymmetric": "bond s asymmetric k_tension 100 k_compression 10 r0 1.0\nbond t asymmetric k_tension 20 k_compression 60 r0 0.9\n",
-}
-ANGLE_FF = {
-    "harmonic_angle": "angle s harmonic_angle k 3 theta0 110\nangle t harmonic_angle k 5 theta0 150\n",
-    "cosine_angle": "angle s cosine_angle K 2\nangle t cosine_angle K 0.7\n",
-    "wlc_bending": "angle s wlc_bending kappa 0.5 l0 0.25\nangle t wlc_bending kappa 0.3 l0 0.5\n",
-}
-PAIR_FF = {
-    "lj": "pair a a lj epsilon 1 sigma 1 rc 2.5\npair a b lj epsilon 0.8 sigma 0.9 rc 2.2\npair b b lj epsilon 1.2 sigma 1.1 rc 2.5\n",
-    "wca": "pair a a wca epsilon 1 sigma 1\npair a b wca epsilon 1.5 sigma 0.9\npair b b wca epsilon 0.5 sigma 1.2\n",
-    "soft_repulsion": "pair a a soft_repulsion k 50 sigma 1.0\npair a b soft_repulsion k 30 sigma 1.2\npair b b soft_repulsion k 80 sigma 0.9\n",
-    "soft": "pair a a soft A 5 rc 1.0\npair a b soft A 3 rc 1.2\npair b b soft A 8 rc 1.1\n",
-}
+# The case of each interaction type, keyed by its name (reference/cases.json,
+# entries whose "script" is this file): its force-field lines, time step and
+# the 3-particle `small` system; bonds and angles also give the range of the
+# random chains' segment lengths, pairs the minimum distance between particles.
+with open(os.path.join(HERE, "cases.json")) as _f:
+    CASES = {name: case for name, case in json.load(_f).items() if case["script"] == "make_systems.py"}
 TYPES = "particle a drag 1\nparticle b drag 2.5\n"
 
 
@@ -93,11 +84,16 @@ def write(name, files):
             f.write(text)
 
 
-def bonded(name, ff, kind):
-    rng = random.Random(hash(name) % 1000 if False else sum(map(ord, name)))
-    lo, hi = {"fene": (0.95, 1.25)}.get(name, (0.7, 1.3))
+def forcefield(case):
+    return "".join(line + "\n" for line in case["forcefield"])
+
+
+def bonded(name, case):
+    kind = case["kind"]
+    rng = random.Random(sum(map(ord, name)))
+    lo, hi = case["segment"]
     # small: a 3-particle chain, one bond stretched and one compressed (angle: one angle)
-    small = [[0.1, 0.2, 0.3], [1.2, 0.5, 0.1], [1.7, 1.2, 0.6]] if name != "fene" else [[0.1, 0.2, 0.3], [1.1, 0.5, 0.1], [1.9, 1.0, 0.4]]
+    small = case["small"]
     top = particles_block(small, ["a", "b", "a"])
     top += "[ bonds ]\ns 1 2\nt 2 3\n" if kind == "bond" else "[ angles ]\ns 1 2 3\n"
     n_chains, length, box = 12, 10, 6.0
@@ -108,9 +104,9 @@ def bonded(name, ff, kind):
         rtop += "[ bonds ]\n" + "".join(f"{'s' if k % 2 else 't'} {c * length + k + 1} {c * length + k + 2}\n" for c in range(n_chains) for k in range(length - 1))
     else:
         rtop += "[ angles ]\n" + "".join(f"{'s' if k % 2 else 't'} {c * length + k + 1} {c * length + k + 2} {c * length + k + 3}\n" for c in range(n_chains) for k in range(length - 2))
-    dt = {"fene": 1e-4, "harmonic": 1e-3, "asymmetric": 1e-3}.get(name, 2e-3)
+    dt = case["dt"]
     write(name, {
-        f"{name}.ff": TYPES + ff,
+        f"{name}.ff": TYPES + forcefield(case),
         "small.top": top,
         "random.top": rtop,
         "small.in": deck("small.top", f"{name}.ff", "x -5 5 f y -5 5 f z -5 5 f", dt),
@@ -118,9 +114,9 @@ def bonded(name, ff, kind):
     })
 
 
-def pairs(name, ff):
+def pairs(name, case):
     rng = random.Random(sum(map(ord, name)))
-    dmin = {"lj": 0.9, "wca": 0.9}.get(name, 0.3)
+    dmin = case["min_distance"]
     box, n = 6.5, 150
     pts = []
     # chains of 5 bonded beads (exclusions), placed with a minimum distance
@@ -133,11 +129,10 @@ def pairs(name, ff):
             del pts[-(len(pts) % 5):]
     types = ["b" if k % 3 == 0 else "a" for k in range(n)]
     rtop = particles_block(pts, types) + "[ bonds ]\n" + "".join(f"s {c * 5 + k + 1} {c * 5 + k + 2}\n" for c in range(n // 5) for k in range(4))
-    small = [[0.1, 0.2, 0.3], [0.95, 0.4, 0.1], [0.6, 1.0, 0.5]] if name != "soft_repulsion" else [[0.1, 0.2, 0.3], [0.8, 0.4, 0.1], [0.5, 0.9, 0.5]]
-    stop = particles_block(small, ["a", "a", "b"])
-    dt = {"lj": 5e-5, "wca": 5e-5}.get(name, 1e-3)
+    stop = particles_block(case["small"], ["a", "a", "b"])
+    dt = case["dt"]
     write(name, {
-        f"{name}.ff": TYPES + "bond s harmonic k 20 r0 1.0\n" + ff,
+        f"{name}.ff": TYPES + "bond s harmonic k 20 r0 1.0\n" + forcefield(case),
         "small.top": stop,
         "random.top": rtop,
         "small.in": deck("small.top", f"{name}.ff", "x -5 5 f y -5 5 f z -5 5 f", dt),
@@ -394,12 +389,8 @@ def custom():
 
 
 if __name__ == "__main__":
-    for name, ff in BOND_FF.items():
-        bonded(name, ff, "bond")
-    for name, ff in ANGLE_FF.items():
-        bonded(name, ff, "angle")
-    for name, ff in PAIR_FF.items():
-        pairs(name, ff)
+    for name, case in CASES.items():
+        (pairs if case["kind"] == "pair" else bonded)(name, case)
     externals()
     indenter()
     kinetics()

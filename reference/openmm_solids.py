@@ -29,6 +29,7 @@ cellmd's documented formulas, and the script stops if OpenMM disagrees.
 """
 import argparse
 import datetime
+import json
 import math
 import os
 import random
@@ -40,7 +41,9 @@ from openmm_surfaces import document, fmt, snapshot  # the golden format, shared
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 STEPS = 100
-PARAMS = {"neo_hookean": dict(e=40.0, nu=0.3), "linear_elastic": dict(e=25.0, nu=0.4)}
+# Parameters of each type (reference/cases.json, keyed by the interaction's name).
+with open(os.path.join(HERE, "cases.json")) as _f:
+    PARAMS = {name: case["params"] for name, case in json.load(_f).items() if case["script"] == "openmm_solids.py"}
 KUHN = [(0, 1, 2), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0)]
 
 # Ds[a][c] = (x_{c+2} − x_1)_a (rows x, y, z; columns the three edges from corner 1);
@@ -64,6 +67,20 @@ def lame(p):
     return e / (2.0 * (1.0 + nu)), e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
 
 
+def neo_hookean_density(mu, lam, f):
+    j = np.linalg.det(f)
+    return 0.5 * mu * (np.sum(f * f) - 3) - mu * math.log(j) + 0.5 * lam * math.log(j) ** 2
+
+
+def linear_elastic_density(mu, lam, f):
+    g = 0.5 * (f.T @ f - np.eye(3))
+    return mu * np.sum(g * g) + 0.5 * lam * np.trace(g) ** 2
+
+
+# cellmd's documented strain-energy density W(F), by interaction name.
+DENSITY_NUMPY = {"neo_hookean": neo_hookean_density, "linear_elastic": linear_elastic_density}
+
+
 def energy_numpy(name, p, rest, x, elements):
     mu, lam = lame(p)
     total = 0.0
@@ -72,13 +89,7 @@ def energy_numpy(name, p, rest, x, elements):
         ds = np.array([x[t[k]] for k in (1, 2, 3)]).T - np.array(x[t[0]])[:, None]
         f = ds @ np.linalg.inv(dm)
         v0 = abs(np.linalg.det(dm)) / 6.0
-        if name == "neo_hookean":
-            j = np.linalg.det(f)
-            w = 0.5 * mu * (np.sum(f * f) - 3) - mu * math.log(j) + 0.5 * lam * math.log(j) ** 2
-        else:
-            g = 0.5 * (f.T @ f - np.eye(3))
-            w = mu * np.sum(g * g) + 0.5 * lam * np.trace(g) ** 2
-        total += v0 * w
+        total += v0 * DENSITY_NUMPY[name](mu, lam, f)
     return total
 
 

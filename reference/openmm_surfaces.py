@@ -27,6 +27,7 @@ forces in the golden files are OpenMM's derivatives of its own expressions.
 """
 import argparse
 import datetime
+import json
 import math
 import os
 import random
@@ -39,14 +40,11 @@ STEPS = 100
 
 # Parameters per body type, per interaction type; `v0`/`a0` as a factor of
 # the body's initial volume/area (so the terms act from the first step).
-PARAMS = {
-    "turgor": {"cell": dict(k=50.0, dp0=3.0, v0=1.1), "nucleus": dict(k=80.0, dp0=0.0, v0=0.9)},
-    "turgor_log": {"cell": dict(k=40.0, dp0=2.0, v0=1.15), "nucleus": dict(k=60.0, dp0=0.0, v0=0.85)},
-    "surface_tension": {"cell": dict(gamma=2.0), "nucleus": dict(gamma=3.5)},
-    "area_conservation": {"cell": dict(ka=20.0, kl=10.0, a0=0.9), "nucleus": dict(ka=10.0, kl=15.0, a0=1.05)},
-    "surface_shear": {"cell": dict(k=0.8), "nucleus": dict(k=1.3)},
-    "helfrich_bending": {"cell": dict(kappa=1.5, c0=0.4), "nucleus": dict(kappa=0.8, c0=-0.7)},
-}
+# Parameters of each type's two body types (reference/cases.json, keyed by
+# the interaction's name); v0 and a0 are relative to the body's own volume
+# and area (body_params).
+with open(os.path.join(HERE, "cases.json")) as _f:
+    PARAMS = {name: case["params"] for name, case in json.load(_f).items() if case["script"] == "openmm_surfaces.py"}
 DRAG = {"a": 1.0, "b": 2.5}
 
 
@@ -171,37 +169,58 @@ def bending_angle(xi, xj, xa, xb):
     return math.atan2(np.dot(np.cross(na, nb), e / np.linalg.norm(e)), np.dot(na, nb))
 
 
-def energy_numpy(name, p, x, faces):
-    if name == "turgor":
-        dv = volume(x, faces) - p["v0"]
-        return -p["dp0"] * dv + 0.5 * p["k"] * dv * dv / p["v0"]
-    if name == "turgor_log":
-        v = volume(x, faces)
-        return -p["dp0"] * (v - p["v0"]) + p["k"] * (v * math.log(v / p["v0"]) - v + p["v0"])
+def turgor_numpy(p, x, faces):
+    dv = volume(x, faces) - p["v0"]
+    return -p["dp0"] * dv + 0.5 * p["k"] * dv * dv / p["v0"]
+
+
+def turgor_log_numpy(p, x, faces):
+    v = volume(x, faces)
+    return -p["dp0"] * (v - p["v0"]) + p["k"] * (v * math.log(v / p["v0"]) - v + p["v0"])
+
+
+def surface_tension_numpy(p, x, faces):
+    return p["gamma"] * face_areas(x, faces).sum()
+
+
+def area_conservation_numpy(p, x, faces):
     areas = face_areas(x, faces)
-    if name == "surface_tension":
-        return p["gamma"] * areas.sum()
-    if name == "area_conservation":
-        at0 = p["a0"] / len(faces)
-        return 0.5 * p["ka"] * (areas.sum() - p["a0"]) ** 2 / p["a0"] + 0.5 * p["kl"] * ((areas - at0) ** 2 / at0).sum()
-    if name == "surface_shear":
-        f = np.array(faces)
-        a, b, c = x[f[:, 0]], x[f[:, 1]], x[f[:, 2]]
-        squares = ((b - a) ** 2).sum(axis=1) + ((c - b) ** 2).sum(axis=1) + ((a - c) ** 2).sum(axis=1)
-        return p["k"] * (squares / (4.0 * math.sqrt(3.0) * areas) - 1.0).sum()
-    if name == "helfrich_bending":
-        m = np.zeros(len(x))
-        a = np.zeros(len(x))
-        for i, j, wa, wb in edges_with_wings(faces):
-            lt = 0.25 * np.linalg.norm(x[j] - x[i]) * bending_angle(x[i], x[j], x[wa], x[wb])
-            m[i] += lt
-            m[j] += lt
-        for f, area in zip(faces, areas):
-            for v in f:
-                a[v] += area / 3.0
-        u = m - 0.5 * p["c0"] * a
-        return (2.0 * p["kappa"] * u * u / a).sum()
-    raise ValueError(name)
+    at0 = p["a0"] / len(faces)
+    return 0.5 * p["ka"] * (areas.sum() - p["a0"]) ** 2 / p["a0"] + 0.5 * p["kl"] * ((areas - at0) ** 2 / at0).sum()
+
+
+def surface_shear_numpy(p, x, faces):
+    areas = face_areas(x, faces)
+    f = np.array(faces)
+    a, b, c = x[f[:, 0]], x[f[:, 1]], x[f[:, 2]]
+    squares = ((b - a) ** 2).sum(axis=1) + ((c - b) ** 2).sum(axis=1) + ((a - c) ** 2).sum(axis=1)
+    return p["k"] * (squares / (4.0 * math.sqrt(3.0) * areas) - 1.0).sum()
+
+
+def helfrich_bending_numpy(p, x, faces):
+    areas = face_areas(x, faces)
+    m = np.zeros(len(x))
+    a = np.zeros(len(x))
+    for i, j, wa, wb in edges_with_wings(faces):
+        lt = 0.25 * np.linalg.norm(x[j] - x[i]) * bending_angle(x[i], x[j], x[wa], x[wb])
+        m[i] += lt
+        m[j] += lt
+    for f, area in zip(faces, areas):
+        for v in f:
+            a[v] += area / 3.0
+    u = m - 0.5 * p["c0"] * a
+    return (2.0 * p["kappa"] * u * u / a).sum()
+
+
+# cellmd's documented energy of one body, by interaction name.
+ENERGY_NUMPY = {
+    "turgor": turgor_numpy,
+    "turgor_log": turgor_log_numpy,
+    "surface_tension": surface_tension_numpy,
+    "area_conservation": area_conservation_numpy,
+    "surface_shear": surface_shear_numpy,
+    "helfrich_bending": helfrich_bending_numpy,
+}
 
 
 # --- OpenMM expressions -------------------------------------------------------
@@ -260,63 +279,79 @@ def helfrich_expr(n):
     return "; ".join(parts)
 
 
-def add_terms(system, name, bodies, group):
-    """Adds the OpenMM forces of interaction `name` on `bodies` [(type, x, faces, nodes, params)]."""
-    # Energies that are a sum over faces of one expression with one parameter.
-    shape = "(distance(p1,p2)^2+distance(p2,p3)^2+distance(p3,p1)^2)"
-    per_face = {"surface_tension": (f"gamma*{area_expr(1, 2, 3)}", "gamma"),
-                "surface_shear": (f"k*({shape}/(4*sqrt(3)*{area_expr(1, 2, 3)})-1)", "k")}
-    if name in per_face:
-        expression, key = per_face[name]
+def per_face_terms(expression, key):
+    """An energy that is a sum over faces of one expression with one parameter `key`."""
+    def add(system, bodies, group):
         f = face_force(expression, [key])
         for _, _, faces, nodes, p in bodies:
             for a, b, c in faces:
                 f.addBond([nodes[a], nodes[b], nodes[c]], [p[key]])
         f.setForceGroup(group)
         system.addForce(f)
-        return
-    if name == "helfrich_bending":
-        by_valence = {}
-        for _, x, faces, nodes, p in bodies:
-            for i in range(len(x)):
-                rg = ring(faces, i)
-                if len(rg) not in by_valence:
-                    f = mm.CustomCompoundBondForce(1 + len(rg), helfrich_expr(len(rg)))
-                    f.addPerBondParameter("kappa")
-                    f.addPerBondParameter("c")
-                    f.setForceGroup(group)
-                    by_valence[len(rg)] = f
-                by_valence[len(rg)].addBond([nodes[i]] + [nodes[j] for j in rg], [p["kappa"], 0.5 * p["c0"]])
-        for n in sorted(by_valence):
-            system.addForce(by_valence[n])
-        return
+    return add
+
+
+def helfrich_terms(system, bodies, group):
+    by_valence = {}
     for _, x, faces, nodes, p in bodies:
-        centre = x.mean(axis=0)
-        if name in ("turgor", "turgor_log"):
+        for i in range(len(x)):
+            rg = ring(faces, i)
+            if len(rg) not in by_valence:
+                f = mm.CustomCompoundBondForce(1 + len(rg), helfrich_expr(len(rg)))
+                f.addPerBondParameter("kappa")
+                f.addPerBondParameter("c")
+                f.setForceGroup(group)
+                by_valence[len(rg)] = f
+            by_valence[len(rg)].addBond([nodes[i]] + [nodes[j] for j in rg], [p["kappa"], 0.5 * p["c0"]])
+    for n in sorted(by_valence):
+        system.addForce(by_valence[n])
+
+
+def volume_terms(law):
+    """A law of each body's enclosed volume V (CustomCVForce) with global parameters k, dp0, v0."""
+    def add(system, bodies, group):
+        for _, x, faces, nodes, p in bodies:
+            centre = x.mean(axis=0)
             cv = face_force(VOLUME_EXPR, ["cx", "cy", "cz"])
             for a, b, c in faces:
                 cv.addBond([nodes[a], nodes[b], nodes[c]], list(centre))
-            law = "-dp0*(V-v0)+0.5*k*(V-v0)^2/v0" if name == "turgor" else "-dp0*(V-v0)+k*(V*log(V/v0)-V+v0)"
             f = mm.CustomCVForce(law)
             f.addCollectiveVariable("V", cv)
             for key in ("k", "dp0", "v0"):
                 f.addGlobalParameter(key, p[key])
-        elif name == "area_conservation":
-            cv = face_force(area_expr(1, 2, 3), [])
-            local = face_force(f"0.5*kl*({area_expr(1, 2, 3)}-at0)^2/at0", ["kl", "at0"])
-            for a, b, c in faces:
-                cv.addBond([nodes[a], nodes[b], nodes[c]], [])
-                local.addBond([nodes[a], nodes[b], nodes[c]], [p["kl"], p["a0"] / len(faces)])
-            local.setForceGroup(group)
-            system.addForce(local)
-            f = mm.CustomCVForce("0.5*ka*(A-a0)^2/a0")
-            f.addCollectiveVariable("A", cv)
-            f.addGlobalParameter("ka", p["ka"])
-            f.addGlobalParameter("a0", p["a0"])
-        else:
-            raise ValueError(name)
+            f.setForceGroup(group)
+            system.addForce(f)
+    return add
+
+
+def area_conservation_terms(system, bodies, group):
+    for _, x, faces, nodes, p in bodies:
+        cv = face_force(area_expr(1, 2, 3), [])
+        local = face_force(f"0.5*kl*({area_expr(1, 2, 3)}-at0)^2/at0", ["kl", "at0"])
+        for a, b, c in faces:
+            cv.addBond([nodes[a], nodes[b], nodes[c]], [])
+            local.addBond([nodes[a], nodes[b], nodes[c]], [p["kl"], p["a0"] / len(faces)])
+        local.setForceGroup(group)
+        system.addForce(local)
+        f = mm.CustomCVForce("0.5*ka*(A-a0)^2/a0")
+        f.addCollectiveVariable("A", cv)
+        f.addGlobalParameter("ka", p["ka"])
+        f.addGlobalParameter("a0", p["a0"])
         f.setForceGroup(group)
         system.addForce(f)
+
+
+SHAPE = "(distance(p1,p2)^2+distance(p2,p3)^2+distance(p3,p1)^2)"
+
+# How each interaction's OpenMM forces are added for `bodies` [(type, x, faces, nodes, params)].
+OPENMM_TERMS = {
+    "turgor": volume_terms("-dp0*(V-v0)+0.5*k*(V-v0)^2/v0"),
+    "turgor_log": volume_terms("-dp0*(V-v0)+k*(V*log(V/v0)-V+v0)"),
+    "surface_tension": per_face_terms(f"gamma*{area_expr(1, 2, 3)}", "gamma"),
+    "area_conservation": area_conservation_terms,
+    "surface_shear": per_face_terms(f"k*({SHAPE}/(4*sqrt(3)*{area_expr(1, 2, 3)})-1)", "k"),
+    "helfrich_bending": helfrich_terms,
+}
 
 
 def rename_globals(law, suffix, keys):
@@ -375,7 +410,7 @@ def openmm_probes(name, bodies):
             gamma[nodes[k]] = DRAG["a" if btype == "cell" else "b"]
     for _ in range(n):
         system.addParticle(1.0)
-    add_terms(system, name, bodies, 1)
+    OPENMM_TERMS[name](system, bodies, 1)
     # Unique global parameter names per CustomCVForce (one per body).
     for k, f in enumerate(system.getForces()):
         if isinstance(f, mm.CustomCVForce):
@@ -440,7 +475,7 @@ def main():
             bodies, box, periodic = case_bodies(name, case, rng)
             system, positions, gamma = openmm_probes(name, bodies)
             # Self-check: OpenMM's expressions against the numpy formulas, per body.
-            check = sum(energy_numpy(name, p, x, faces) for _, x, faces, _, p in bodies)
+            check = sum(ENERGY_NUMPY[name](p, x, faces) for _, x, faces, _, p in bodies)
             integrator = mm.CustomIntegrator(0.0)
             context = mm.Context(system, integrator, platform)
             context.setPositions(positions)

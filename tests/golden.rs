@@ -191,9 +191,10 @@ fn surface_golden_files_tell_a_perturbed_term_apart() {
         for doc in documents(&path).iter().filter(|d| is_openmm(d)) {
             let deck = Path::new("reference").join(doc.get("deck").unwrap());
             let mut plan = validate_file(&deck, &[]).unwrap();
-            for term in plan.model.body_rules.iter_mut().chain(&mut plan.model.tetra_types) {
-                let k = term.params.iter().position(|p| *p != 0.0).unwrap();
-                term.params[k] *= 1.0 + 1e-6;
+            let bodies = plan.model.body_rules.iter_mut().map(|t| t.params_mut());
+            for params in bodies.chain(plan.model.tetra_types.iter_mut().map(|t| t.params_mut())) {
+                let k = params.iter().position(|p| *p != 0.0).unwrap();
+                params[k] *= 1.0 + 1e-6;
             }
             let agreement = Agreement::new(&cellmd_probes(&plan).unwrap(), &golden::probes_of(doc).unwrap()).unwrap();
             println!("{}: worst relative error {:.1e} with a parameter off by 1e-6", deck.display(), agreement.init.worst());
@@ -308,5 +309,20 @@ fn regenerated_data_matches_the_committed_golden_files() {
             let agreement = Agreement::new(&a, &b).unwrap();
             assert!(agreement.agrees(tol), "{} drifted from {}:\n{}", new.display(), path.display(), agreement.table("committed", tol));
         }
+    }
+}
+
+/// The golden cases are defined in one data file keyed by interaction name
+/// (`reference/cases.json`, read by the reference scripts): every key is a
+/// registered interaction of the kind the entry says, with a golden file.
+#[test]
+fn case_definitions_are_keyed_by_registered_interactions() {
+    let text = std::fs::read_to_string("reference/cases.json").unwrap();
+    let cases: serde_json::Map<String, serde_json::Value> = serde_json::from_str(&text).unwrap();
+    assert!(cases.len() >= 20, "{} cases", cases.len());
+    for (name, case) in &cases {
+        let interaction = cellmd::interactions::lookup(name).unwrap_or_else(|| panic!("reference/cases.json: `{name}` is not registered"));
+        assert_eq!(case["kind"].as_str(), Some(interaction.kind().keyword()), "reference/cases.json: `{name}`");
+        assert!(Path::new("reference").join(format!("{name}.yaml")).exists(), "reference/cases.json: `{name}` has no golden file");
     }
 }

@@ -3,10 +3,10 @@
 // ½k_a(A − A0)²/A0 shared equally by the faces, plus the face's own
 // ½k_l(A_t − a0)²/a0. p: ka, kl, a0.
 fn area_conservation_face(p: array<f32, 8>, body: BodyTotals, g: FaceGeometry) -> SurfaceFace {
-    let a0_face = p[2] / body.faces;
-    let body_excess = body.area - p[2];
+    let a0_face = p[AREA_CONSERVATION_A0] / body.faces;
+    let body_excess = body.area - p[AREA_CONSERVATION_A0];
     let face_excess = g.area - a0_face;
-    let tension = p[0] * body_excess / p[2] + p[1] * face_excess / a0_face;
-    let energy = 0.5 * p[0] * body_excess * body_excess / p[2] / body.faces + 0.5 * p[1] * face_excess * face_excess / a0_face;
+    let tension = p[AREA_CONSERVATION_KA] * body_excess / p[AREA_CONSERVATION_A0] + p[AREA_CONSERVATION_KL] * face_excess / a0_face;
+    let energy = 0.5 * p[AREA_CONSERVATION_KA] * body_excess * body_excess / p[AREA_CONSERVATION_A0] / body.faces + 0.5 * p[AREA_CONSERVATION_KL] * face_excess * face_excess / a0_face;
     return SurfaceFace(energy, -tension * g.ga0, -tension * g.ga1, -tension * g.ga2);
 }

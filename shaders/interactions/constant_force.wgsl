@@ -1,5 +1,5 @@
 // constant_force: E = −f·x, F = f; p = [fx, fy, fz].
 fn constant_force_one(p: array<f32, 8>, x: vec3<f32>) -> OneBody {
-    let f = vec3<f32>(p[0], p[1], p[2]);
+    let f = vec3<f32>(p[CONSTANT_FORCE_FX], p[CONSTANT_FORCE_FY], p[CONSTANT_FORCE_FZ]);
     return OneBody(-dot(f, x), f);
 }

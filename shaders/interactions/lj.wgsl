@@ -7,8 +7,8 @@ fn lennard_jones(epsilon: f32, sigma: f32, r: f32) -> Radial {
 }
 
 fn lj_radial(p: array<f32, 8>, r: f32) -> Radial {
-    if r < p[2] {
-        return lennard_jones(p[0], p[1], r);
+    if r < p[LJ_RC] {
+        return lennard_jones(p[LJ_EPSILON], p[LJ_SIGMA], r);
     }
     return RADIAL_ZERO;
 }

@@ -5,9 +5,9 @@ fn surface_shear_face(p: array<f32, 8>, body: BodyTotals, g: FaceGeometry) -> Su
     let x21 = g.x2 - g.x1;
     let s = dot(g.x1, g.x1) + dot(x21, x21) + dot(g.x2, g.x2);
     let ratio = s / g.area;
-    let c = -p[0] * shape / g.area;
+    let c = -p[SURFACE_SHEAR_K] * shape / g.area;
     let f0 = c * (-2.0 * (g.x1 + g.x2) - ratio * g.ga0);
     let f1 = c * (2.0 * (2.0 * g.x1 - g.x2) - ratio * g.ga1);
     let f2 = c * (2.0 * (2.0 * g.x2 - g.x1) - ratio * g.ga2);
-    return SurfaceFace(p[0] * (shape * ratio - 1.0), f0, f1, f2);
+    return SurfaceFace(p[SURFACE_SHEAR_K] * (shape * ratio - 1.0), f0, f1, f2);
 }

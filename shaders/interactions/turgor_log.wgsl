@@ -4,10 +4,10 @@
 // the largest f32 stands for it, so the step is refused. p: k, dp0, v0.
 fn turgor_log_face(p: array<f32, 8>, body: BodyTotals, g: FaceGeometry) -> SurfaceFace {
     let v = body.volume;
-    let v0 = p[2];
+    let v0 = p[TURGOR_LOG_V0];
     let ln_ratio = log(max(v, 1e-30) / v0);
-    let pressure = select(p[1] - p[0] * ln_ratio, 3.4e38, v <= 0.0);
-    let energy = select(-p[1] * (v - v0) + p[0] * (v * ln_ratio - v + v0), 3.4e38, v <= 0.0);
+    let pressure = select(p[TURGOR_LOG_DP0] - p[TURGOR_LOG_K] * ln_ratio, 3.4e38, v <= 0.0);
+    let energy = select(-p[TURGOR_LOG_DP0] * (v - v0) + p[TURGOR_LOG_K] * (v * ln_ratio - v + v0), 3.4e38, v <= 0.0);
     let f = pressure * g.gv;
     return SurfaceFace(energy / body.faces, f, f, f);
 }

@@ -1,6 +1,6 @@
 // wlc_bending: E = (κ/ℓ)(1 − t̂1·t̂2) with t̂1 = (rj − ri)/|·|, t̂2 = (rk − rj)/|·|; p = [κ, ℓ].
 fn wlc_bending_three(p: array<f32, 8>, ri: vec3<f32>, rj: vec3<f32>, rk: vec3<f32>) -> ThreeBody {
-    let strength = p[0] / p[1];
+    let strength = p[WLC_BENDING_KAPPA] / p[WLC_BENDING_L0];
     let a = rj - ri;
     let b = rk - rj;
     let la = length(a);

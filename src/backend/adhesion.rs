@@ -35,7 +35,7 @@ use rayon::prelude::*;
 use super::contact_mesh::{csr, face_corners, push_pair_blocks, Candidates, ContactMesh};
 use super::stiffness_blocks::StiffnessBlock;
 use super::virial::{add6, outer};
-use crate::interactions::{node_face_forces, Law, Radial};
+use crate::interactions::{node_face_forces, ContactLaw, Radial};
 use crate::mesh::triangle_area_gradient;
 use crate::system::{registry_index, Images, Model};
 
@@ -43,8 +43,8 @@ use crate::system::{registry_index, Images, Model};
 /// per-face and per-node results of the last evaluation.
 #[derive(Default)]
 pub(super) struct Adhesion {
-    /// Indices into `Model::contact_rules` of the area-weighted rules.
-    rules: Vec<u32>,
+    /// The area-weighted rules, in `Model::contact_rules` order.
+    rules: Vec<AreaRule>,
     /// For (node body type a, face body type b) at `a·types + b`: the rules
     /// (positions in `rules`) acting between them.
     between: Vec<Vec<u32>>,
@@ -66,30 +66,47 @@ pub(super) struct Adhesion {
     shared: Vec<f64>,
 }
 
-/// Switch s(d) (in `energy`, with s′ in `de_dr`) and density ε of contact
-/// rule `rule`, an area-weighted one (s = 0 beyond its range).
-fn switch_of(model: &Model, rule: u32, d: f64) -> Radial {
-    let term = &model.contact_rules[rule as usize];
-    let Law::ContactArea { switch, range, .. } = term.interaction.law() else { unreachable!("area-weighted law") };
-    if d < range(&term.params) {
-        switch(&term.params, d)
-    } else {
-        Radial::ZERO
-    }
+/// An area-weighted contact rule: its index into `Model::contact_rules` and its law.
+#[derive(Clone, Copy)]
+struct AreaRule {
+    index: u32,
+    switch: fn(&[f64], f64) -> Radial,
+    density: fn(&[f64]) -> f64,
+    range: fn(&[f64]) -> f64,
 }
 
-fn density_of(model: &Model, rule: u32) -> f64 {
-    let term = &model.contact_rules[rule as usize];
-    let Law::ContactArea { density, .. } = term.interaction.law() else { unreachable!("area-weighted law") };
-    density(&term.params)
+impl AreaRule {
+    /// The area-weighted rule of contact rule `index`, if it is one.
+    fn of(model: &Model, index: usize) -> Option<Self> {
+        match model.contact_rules[index].law {
+            ContactLaw::Area { switch, density, range } => Some(AreaRule { index: index as u32, switch, density, range }),
+            ContactLaw::NodeFace { .. } => None,
+        }
+    }
+
+    fn params<'a>(&self, model: &'a Model) -> &'a [f64] {
+        &model.contact_rules[self.index as usize].params
+    }
+
+    /// Switch s(d) (in `energy`, with s′ in `de_dr`); s = 0 beyond the range.
+    fn switch(&self, model: &Model, d: f64) -> Radial {
+        let p = self.params(model);
+        if d < (self.range)(p) {
+            (self.switch)(p, d)
+        } else {
+            Radial::ZERO
+        }
+    }
+
+    /// Density ε (energy per area).
+    fn density(&self, model: &Model) -> f64 {
+        (self.density)(self.params(model))
+    }
 }
 
 impl Adhesion {
     pub(super) fn new(model: &Model, mesh: &ContactMesh) -> Self {
-        let rules: Vec<u32> = (0..model.contact_rules.len())
-            .filter(|&r| matches!(model.contact_rules[r].interaction.law(), Law::ContactArea { .. }))
-            .map(|r| r as u32)
-            .collect();
+        let rules: Vec<AreaRule> = (0..model.contact_rules.len()).filter_map(|r| AreaRule::of(model, r)).collect();
         if rules.is_empty() {
             return Self::default();
         }
@@ -97,7 +114,7 @@ impl Adhesion {
         let between = (0..types * types)
             .map(|ab| {
                 let covered: Vec<usize> = model.contact_rules_between((ab / types) as u32, (ab % types) as u32).collect();
-                (0..rules.len() as u32).filter(|&j| covered.contains(&(rules[j as usize] as usize))).collect()
+                (0..rules.len() as u32).filter(|&j| covered.contains(&(rules[j as usize].index as usize))).collect()
             })
             .collect();
         let face_nodes: Vec<[u32; 3]> = mesh.faces.iter().map(|(corners, _)| corners.map(|p| mesh.compact(p) as u32)).collect();
@@ -132,7 +149,7 @@ impl Adhesion {
             return;
         }
         let count = self.rules.len();
-        let densities: Vec<f64> = self.rules.iter().map(|&r| density_of(model, r)).collect();
+        let densities: Vec<f64> = self.rules.iter().map(|r| r.density(model)).collect();
         let Self { rules, between, body_types, face_nodes, offsets, corner_of, area, gradient, weight, switch, nearest, shared } = self;
         area.par_iter_mut().zip(gradient.par_iter_mut()).zip(&mesh.faces).with_min_len(256).for_each(|((a, g), (corners, _))| {
             (*a, *g) = triangle_area_gradient(face_corners(x, images, *corners));
@@ -154,7 +171,7 @@ impl Adhesion {
                 }
             }
             for ((s, &pair), &rule) in switch.iter_mut().zip(nearest.iter()).zip(rules.iter()) {
-                *s = if pair == u32::MAX { Radial::ZERO } else { switch_of(model, rule, s.energy) };
+                *s = if pair == u32::MAX { Radial::ZERO } else { rule.switch(model, s.energy) };
             }
         });
         let switch = &*switch;
@@ -188,7 +205,7 @@ impl Adhesion {
     /// at its nearest pair ([`push_pair_blocks`]), in node and rule order, at
     /// the last evaluation (the area part is left out: `src/backend/stiffness.rs`).
     pub(super) fn stiffness(&self, model: &Model, mesh: &ContactMesh, candidates: &Candidates, blocks: &mut Vec<StiffnessBlock>) {
-        let densities: Vec<f64> = self.rules.iter().map(|&r| density_of(model, r)).collect();
+        let densities: Vec<f64> = self.rules.iter().map(|r| r.density(model)).collect();
         for (slot, (&pair, &b)) in self.nearest.iter().zip(&self.shared).enumerate().filter(|(_, (_, b))| **b != 0.0) {
             let curvature = densities[slot % self.rules.len()] * self.switch[slot].d2e_dr2 * b;
             push_pair_blocks(mesh, candidates, pair as usize, curvature, blocks);
@@ -225,9 +242,9 @@ impl Adhesion {
         }
         let s = |k: u32, j: usize| self.switch[k as usize * count + j].energy;
         for (j, &rule) in self.rules.iter().enumerate() {
-            let eps = density_of(model, rule);
+            let eps = rule.density(model);
             let sum: f64 = self.face_nodes.iter().zip(&self.area).map(|(&[a, b, c], area)| eps * area * s(a, j) * s(b, j) * s(c, j)).sum();
-            energy[registry_index(&model.contact_rules[rule as usize])] += sum;
+            energy[registry_index(&model.contact_rules[rule.index as usize])] += sum;
         }
         for (f, (corners, _)) in mesh.faces.iter().enumerate().filter(|(f, _)| self.weight[*f] != 0.0) {
             let at = face_corners(x, images, *corners);

@@ -22,7 +22,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::virial::{add6, outer};
-use crate::interactions::{FourBody, Law, Radial, ThreeBody};
+use crate::interactions::{FourBody, Kind, Radial, ThreeBody};
 use crate::system::BondState;
 use crate::system::{registry_index, Images, Model};
 
@@ -45,10 +45,10 @@ fn by_particle(n: usize, owner: impl Iterator<Item = u32> + Clone) -> (Vec<u32>,
     (offsets, entries)
 }
 
-/// A [`Law::Radial`]'s `eval` and `force`.
+/// A radial law's `eval` and `force` (`interactions::RadialLaw`).
 type RadialEval = fn(&[f64], f64) -> Radial;
 type RadialForce = fn(&[f64], f64) -> f64;
-/// A [`Law::ThreeBody`]'s evaluator.
+/// An angle law's evaluator (`interactions::AngleLaw`).
 type ThreeBodyEval = fn(&[f64], [DVec3; 3]) -> ThreeBody;
 
 /// The bonds and angles owned by each particle, and the resolved laws.
@@ -91,15 +91,9 @@ impl Bonded {
     /// The evaluators of each bond and angle type's law.
     pub(super) fn resolve_laws(&mut self, model: &Model) {
         self.bond_laws.clear();
-        self.bond_laws.extend(model.bond_types.iter().map(|t| match t.interaction.law() {
-            Law::Radial { eval, force, .. } => (eval, force),
-            _ => unreachable!("bond law is radial"),
-        }));
+        self.bond_laws.extend(model.bond_types.iter().map(|t| (t.law.eval, t.law.force)));
         self.angle_laws.clear();
-        self.angle_laws.extend(model.angle_types.iter().map(|t| match t.interaction.law() {
-            Law::ThreeBody(eval) => eval,
-            _ => unreachable!("angle law is three-body"),
-        }));
+        self.angle_laws.extend(model.angle_types.iter().map(|t| t.law.0));
     }
 
     /// `law(params)` of bond `b` of type `t` with its state if it has one
@@ -238,7 +232,7 @@ impl Bonded {
         energy: &mut [f64],
         virial: &mut [f64; 6],
     ) {
-        let bond_registry: Vec<usize> = model.bond_types.iter().map(registry_index).collect();
+        let bond_registry: Vec<usize> = model.bond_types.iter().map(|t| registry_index(t)).collect();
         for (b, &[i, j]) in model.bonds.iter().enumerate() {
             let t = model.bond_type[b] as usize;
             let d = images.minimum_image(x[j as usize] - x[i as usize]);
@@ -247,14 +241,14 @@ impl Bonded {
             energy[bond_registry[t]] += radial.energy;
             add6(virial, outer(d, -radial.force_along(d, r)));
         }
-        let angle_registry: Vec<usize> = model.angle_types.iter().map(registry_index).collect();
+        let angle_registry: Vec<usize> = model.angle_types.iter().map(|t| registry_index(t)).collect();
         for a in 0..model.angles.len() {
             let ([xi, xj, xk], out) = eval_angle(model, a, x, images);
             energy[angle_registry[model.angle_type[a] as usize]] += out.energy;
             add6(virial, outer(xi - xj, out.forces[0]));
             add6(virial, outer(xk - xj, out.forces[2]));
         }
-        let tetra_registry: Vec<usize> = model.tetra_types.iter().map(registry_index).collect();
+        let tetra_registry: Vec<usize> = model.tetra_types.iter().map(|t| registry_index(t)).collect();
         for e in 0..model.tetras.len() {
             let (at, out) = eval_tetra(model, e, x, images);
             energy[tetra_registry[model.tetra_type[e] as usize]] += out.energy;
@@ -274,20 +268,20 @@ impl Bonded {
         x: &[DVec3],
         images: &Images,
         state: Option<&BondState>,
-    ) -> Vec<(&'static str, usize, DVec3)> {
+    ) -> Vec<(Kind, usize, DVec3)> {
         let mut parts = Vec::new();
         for (b, _) in model.bonds.iter().enumerate().filter(|(_, ends)| ends.contains(&(i as u32))) {
             let (t, f) = self.bond_force(b, i, model, x, images, state);
-            parts.push(("bond", t, f));
+            parts.push((Kind::Bond, t, f));
         }
         for (a, ends) in model.angles.iter().enumerate() {
             if let Some(k) = ends.iter().position(|&p| p as usize == i) {
-                parts.push(("angle", model.angle_type[a] as usize, eval_angle(model, a, x, images).1.forces[k]));
+                parts.push((Kind::Angle, model.angle_type[a] as usize, eval_angle(model, a, x, images).1.forces[k]));
             }
         }
         for (e, corners) in model.tetras.iter().enumerate() {
             if let Some(k) = corners.iter().position(|&p| p as usize == i) {
-                parts.push(("tetra", e, eval_tetra(model, e, x, images).1.forces[k]));
+                parts.push((Kind::Tetra, e, eval_tetra(model, e, x, images).1.forces[k]));
             }
         }
         parts
@@ -307,9 +301,8 @@ fn angle_positions(model: &Model, a: usize, x: &[DVec3], images: &Images) -> [DV
 #[inline]
 pub(super) fn eval_angle(model: &Model, a: usize, x: &[DVec3], images: &Images) -> ([DVec3; 3], ThreeBody) {
     let term = &model.angle_types[model.angle_type[a] as usize];
-    let Law::ThreeBody(eval) = term.interaction.law() else { unreachable!("angle law is three-body") };
     let at = angle_positions(model, a, x, images);
-    (at, eval(&term.params, at))
+    (at, (term.law.0)(&term.params, at))
 }
 
 /// Volume element `e` at image-consistent positions (corners 1–3 at their
@@ -317,11 +310,10 @@ pub(super) fn eval_angle(model: &Model, a: usize, x: &[DVec3], images: &Images) 
 #[inline]
 pub(super) fn eval_tetra(model: &Model, e: usize, x: &[DVec3], images: &Images) -> ([DVec3; 4], FourBody) {
     let term = &model.tetra_types[model.tetra_type[e] as usize];
-    let Law::Tetra(eval) = term.interaction.law() else { unreachable!("tetra law is a volume law") };
     let corners = model.tetras[e];
     let x0 = x[corners[0] as usize];
     let at = corners.map(|p| x0 + images.minimum_image(x[p as usize] - x0));
-    (at, eval(&term.params, &model.tetra_rest[e], at))
+    (at, (term.law.0)(&term.params, &model.tetra_rest[e], at))
 }
 
 /// Largest parameter count of a bond law (checked by a test).

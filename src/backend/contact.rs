@@ -41,8 +41,7 @@ use super::adhesion::Adhesion;
 use super::contact_mesh::{csr, face_corners, push_pair_blocks, Candidates, ContactMesh, Face};
 use super::stiffness_blocks::StiffnessBlock;
 use super::virial::{add6, outer};
-use crate::forcefield::TermType;
-use crate::interactions::{node_face_forces, Law, Radial};
+use crate::interactions::{node_face_forces, ContactLaw, Radial};
 use crate::mesh::{point_triangle, PointTriangle};
 use crate::neighbor::{Exclusions, NeighborList};
 use crate::system::{registry_index, Images, Model, SimBox};
@@ -59,7 +58,7 @@ pub(super) struct Contacts {
     first_faces: Vec<u32>,
     /// Node–face rules ([`Law::Contact`]) between a node of body type a and a
     /// face of body type b, at `a·types + b`; `any` also counts area-weighted ones.
-    barriers: Vec<Vec<u32>>,
+    barriers: Vec<Vec<Barrier>>,
     any: Vec<bool>,
     body_types: usize,
     /// The largest contact range d̂ (also the skin).
@@ -74,14 +73,32 @@ pub(super) struct Contacts {
     adhesion: Adhesion,
 }
 
-/// b(d) of one node–face term (zero beyond its range).
-#[inline]
-fn radial(term: &TermType, d: f64) -> Radial {
-    let Law::Contact { eval, range } = term.interaction.law() else { unreachable!("node–face law") };
-    if d < range(&term.params) {
-        eval(&term.params, d)
-    } else {
-        Radial::ZERO
+/// A node–face contact rule: its index into `Model::contact_rules` and its law.
+#[derive(Clone, Copy)]
+struct Barrier {
+    index: u32,
+    eval: fn(&[f64], f64) -> Radial,
+    range: fn(&[f64]) -> f64,
+}
+
+impl Barrier {
+    /// The node–face rule of contact rule `index`, if it is one.
+    fn of(model: &Model, index: usize) -> Option<Self> {
+        match model.contact_rules[index].law {
+            ContactLaw::NodeFace { eval, range } => Some(Barrier { index: index as u32, eval, range }),
+            ContactLaw::Area { .. } => None,
+        }
+    }
+
+    /// b(d) (zero beyond the range).
+    #[inline]
+    fn radial(&self, model: &Model, d: f64) -> Radial {
+        let params = &model.contact_rules[self.index as usize].params;
+        if d < (self.range)(params) {
+            (self.eval)(params, d)
+        } else {
+            Radial::ZERO
+        }
     }
 }
 
@@ -91,11 +108,8 @@ impl Contacts {
             return Self::default();
         }
         let types = model.body_type_names.len();
-        let barriers: Vec<Vec<u32>> = (0..types * types)
-            .map(|ab| {
-                let rules = model.contact_rules_between((ab / types) as u32, (ab % types) as u32);
-                rules.filter(|&r| matches!(model.contact_rules[r].interaction.law(), Law::Contact { .. })).map(|r| r as u32).collect()
-            })
+        let barriers: Vec<Vec<Barrier>> = (0..types * types)
+            .map(|ab| model.contact_rules_between((ab / types) as u32, (ab % types) as u32).filter_map(|r| Barrier::of(model, r)).collect())
             .collect();
         let any: Vec<bool> =
             (0..types * types).map(|ab| model.contact_rules_between((ab / types) as u32, (ab % types) as u32).next().is_some()).collect();
@@ -119,7 +133,7 @@ impl Contacts {
             rows[mesh.compact(corners[0])].push(f as u32);
         }
         let (first_offsets, first_faces) = csr(rows);
-        let dhat = model.contact_rules.iter().filter_map(|t| t.interaction.law().contact_range(&t.params)).fold(0.0, f64::max);
+        let dhat = model.contact_rules.iter().map(|t| t.law.range(&t.params)).fold(0.0, f64::max);
         Self {
             adhesion: Adhesion::new(model, &mesh),
             mesh,
@@ -151,7 +165,7 @@ impl Contacts {
     }
 
     /// The node–face rules of pair `k`.
-    fn barriers_of(&self, k: usize, model: &Model) -> &[u32] {
+    fn barriers_of(&self, k: usize, model: &Model) -> &[Barrier] {
         let [node, face] = self.candidates.pairs[k];
         &self.barriers[self.type_pair(self.mesh.node_body[node as usize], self.mesh.faces[face as usize].1, model)]
     }
@@ -245,8 +259,8 @@ impl Contacts {
                 let [node, face] = this.candidates.pairs[k];
                 let pt = closest(x, images, this.mesh.nodes[node as usize], this.mesh.faces[face as usize].0);
                 let mut forces = [DVec3::ZERO; 4];
-                for &r in this.barriers_of(k, model) {
-                    let f = node_face_forces(&radial(&model.contact_rules[r as usize], pt.distance), &pt);
+                for r in this.barriers_of(k, model) {
+                    let f = node_face_forces(&r.radial(model, pt.distance), &pt);
                     forces.iter_mut().zip(f).for_each(|(a, b)| *a += b);
                 }
                 (pt, forces)
@@ -296,8 +310,7 @@ impl Contacts {
     /// `src/backend/stiffness.rs`).
     pub(super) fn stiffness(&self, model: &Model, blocks: &mut Vec<StiffnessBlock>) {
         for (k, pt) in self.candidates.points.iter().enumerate() {
-            let curvature: f64 =
-                self.barriers_of(k, model).iter().map(|&r| radial(&model.contact_rules[r as usize], pt.distance).d2e_dr2).sum();
+            let curvature: f64 = self.barriers_of(k, model).iter().map(|r| r.radial(model, pt.distance).d2e_dr2).sum();
             push_pair_blocks(&self.mesh, &self.candidates, k, curvature, blocks);
         }
         self.adhesion.stiffness(model, &self.mesh, &self.candidates, blocks);
@@ -307,9 +320,8 @@ impl Contacts {
     /// then the area-weighted terms, at the positions of the last [`Self::prepare`].
     pub(super) fn energy(&self, model: &Model, x: &[DVec3], images: &Images, energy: &mut [f64], virial: &mut [f64; 6]) {
         for (k, pt) in self.candidates.points.iter().enumerate() {
-            for &r in self.barriers_of(k, model) {
-                let term = &model.contact_rules[r as usize];
-                energy[registry_index(term)] += radial(term, pt.distance).energy;
+            for r in self.barriers_of(k, model) {
+                energy[registry_index(&model.contact_rules[r.index as usize])] += r.radial(model, pt.distance).energy;
             }
             add6(virial, outer(pt.distance * pt.normal, self.candidates.forces[k][0]));
         }

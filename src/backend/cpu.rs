@@ -43,7 +43,7 @@ use super::pair_table::{PairGeometry, PairTable};
 use super::special::SpecialPairs;
 use super::surface::Surfaces;
 use super::virial::add6;
-use crate::interactions::{Law, REGISTRY};
+use crate::interactions::{Kind, RadialLaw, REGISTRY};
 use crate::neighbor::{Exclusions, NeighborList};
 use crate::system::BondState;
 use crate::system::{registry_index, External, Model, SimBox, State};
@@ -104,7 +104,7 @@ pub struct CpuBackend {
 impl CpuBackend {
     /// Prepares buffers and builds the first neighbour list.
     pub fn new(model: &Model, state: &State, sim_box: &SimBox, skin: f64) -> Result<Self, String> {
-        let mut pair_interactions: Vec<usize> = model.pair_rules.iter().map(registry_index).collect();
+        let mut pair_interactions: Vec<usize> = model.pair_rules.iter().map(|t| registry_index(t)).collect();
         pair_interactions.sort_unstable();
         pair_interactions.dedup();
         let pair_rule_column = model.pair_rules.iter().map(|r| pair_interactions.binary_search(&registry_index(r)).unwrap()).collect();
@@ -331,17 +331,17 @@ impl CpuBackend {
         let mut parts: Vec<ForceBreakdown> = (self.bonded.terms_on(i, model, &state.positions, &images, state.bonds.as_ref()).into_iter())
             .map(|(kind, t, force)| {
                 let (term, label) = match kind {
-                    "bond" => (&model.bond_types[t], model.bond_types[t].label.text.clone()),
-                    "angle" => (&model.angle_types[t], model.angle_types[t].label.text.clone()),
+                    Kind::Bond => (model.bond_types[t].term(), model.bond_types[t].label.text.clone()),
+                    Kind::Angle => (model.angle_types[t].term(), model.angle_types[t].label.text.clone()),
                     _ => {
-                        let term = &model.tetra_types[model.tetra_type[t] as usize];
+                        let term = model.tetra_types[model.tetra_type[t] as usize].term();
                         let ids = model.tetras[t].map(|p| model.ids[p as usize].to_string()).join("–");
                         // A NaN force is the mark of an element turned inside out (J ≤ 0).
                         let inverted = if force.is_finite() { "" } else { ", turned inside out (det F ≤ 0)" };
                         (term, format!("{} element {} of particles {ids}{inverted}", term.label.text, t + 1))
                     }
                 };
-                ForceBreakdown { kind, label, interaction: term.interaction.name(), force }
+                ForceBreakdown { kind: kind.keyword(), label, interaction: term.interaction.name(), force }
             })
             .collect();
         for (rule, force) in self.surfaces.terms_on(i) {
@@ -366,7 +366,7 @@ impl CpuBackend {
                 let r = d.length();
                 for &rule in model.pair_rules_between(model.types[i], model.types[j as usize]) {
                     let term = &model.pair_rules[rule as usize];
-                    let Law::Radial { eval, range, .. } = term.interaction.law() else { continue };
+                    let RadialLaw { eval, range, .. } = term.law;
                     if r < range(&term.params) {
                         let radial = eval(&term.params, r);
                         let label = format!("{} {}-{}", term.label.text, model.ids[i], model.ids[j as usize]);

@@ -21,7 +21,7 @@ use glam::DVec3;
 
 use super::candidates::{Near, BATCH};
 use super::virial::{add6, outer};
-use crate::interactions::{Law, Radial};
+use crate::interactions::{Radial, RadialLaw};
 use crate::neighbor::NeighborList;
 use crate::system::{Images, Model};
 
@@ -74,7 +74,7 @@ impl PairTable {
                 let mut reach = 0.0f64;
                 for &rule in model.pair_rules_between(a, b) {
                     let term = &model.pair_rules[rule as usize];
-                    let Law::Radial { eval, force, range } = term.interaction.law() else { unreachable!("pair law is radial") };
+                    let RadialLaw { eval, force, range } = term.law;
                     let cutoff = range(&term.params);
                     let first = self.params.len() as u32;
                     self.params.extend_from_slice(&term.params);

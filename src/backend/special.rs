@@ -12,7 +12,7 @@
 use glam::DVec3;
 
 use super::virial::{add6, outer};
-use crate::interactions::{Law, Radial};
+use crate::interactions::{Radial, RadialLaw};
 use crate::system::{registry_index, Images, Model};
 
 /// The bonded neighbour pairs of fractional weight (i < j, weight).
@@ -37,7 +37,7 @@ impl SpecialPairs {
             let r = d.length();
             for &rule in model.pair_rules_between(model.types[i as usize], model.types[j as usize]) {
                 let term = &model.pair_rules[rule as usize];
-                let Law::Radial { eval, range, .. } = term.interaction.law() else { continue };
+                let RadialLaw { eval, range, .. } = term.law;
                 if r < range(&term.params) {
                     let e = eval(&term.params, r);
                     let weighted = Radial { energy: w * e.energy, de_dr: w * e.de_dr, d2e_dr2: w * e.d2e_dr2 };

@@ -71,7 +71,7 @@ use super::bonded::{eval_angle, eval_tetra};
 use super::cpu::CpuBackend;
 use super::stiffness_blocks::{push_blocks, Stiffness, StiffnessBlock};
 use crate::hessian::{finite_difference_hessian, project_psd};
-use crate::interactions::{Law, Radial};
+use crate::interactions::{AngleLaw, Radial, RadialLaw, TetraLaw};
 use crate::system::{Images, Model, SimBox, State};
 
 /// The projected block of a radial term along `d` (length r).
@@ -114,13 +114,13 @@ impl CpuBackend {
         for a in 0..model.angles.len() {
             let (at, _) = eval_angle(model, a, x, &images);
             let term = &model.angle_types[model.angle_type[a] as usize];
-            let Law::ThreeBody(eval) = term.interaction.law() else { unreachable!("angle law is three-body") };
+            let AngleLaw(eval) = term.law;
             projected_term_blocks(&model.angles[a], &at, |p| eval(&term.params, [p[0], p[1], p[2]]).forces.to_vec(), &mut blocks);
         }
         for e in 0..model.tetras.len() {
             let (at, _) = eval_tetra(model, e, x, &images);
             let term = &model.tetra_types[model.tetra_type[e] as usize];
-            let Law::Tetra(eval) = term.interaction.law() else { unreachable!("tetra law is a volume law") };
+            let TetraLaw(eval) = term.law;
             let rest = &model.tetra_rest[e];
             projected_term_blocks(
                 &model.tetras[e],
@@ -136,7 +136,7 @@ impl CpuBackend {
                     let r = d.length();
                     for &rule in model.pair_rules_between(model.types[i], model.types[j as usize]) {
                         let term = &model.pair_rules[rule as usize];
-                        let Law::Radial { eval, range, .. } = term.interaction.law() else { unreachable!("pair law is radial") };
+                        let RadialLaw { eval, range, .. } = term.law;
                         if r < range(&term.params) {
                             push_pair(&mut blocks, i as u32, j, radial_block(&eval(&term.params, r), d, r));
                         }

@@ -27,7 +27,6 @@ use rayon::prelude::*;
 use super::stiffness_blocks::{push_blocks, RankOneTerm, StiffnessBlock};
 use super::virial::{add6, outer};
 use crate::hessian::{project_psd, SurfaceHessian};
-use crate::interactions::Law;
 use crate::system::{registry_index, Images, Model};
 
 /// One body's scratch: positions and per-term slots.
@@ -101,10 +100,9 @@ impl Surfaces {
             body.mesh.unwrap_into(|k| x[body.nodes[k as usize] as usize], |d| images.minimum_image(d), &mut scratch.x);
             for (r, &rule) in scratch.rules.iter().enumerate() {
                 let term = &model.body_rules[rule];
-                let Law::Surface { eval, .. } = term.interaction.law() else { unreachable!("body law is a surface law") };
                 let forces = &mut scratch.forces[r];
                 forces.fill(DVec3::ZERO);
-                scratch.energy[r] = eval(&term.params, &body.mesh, &scratch.x, forces);
+                scratch.energy[r] = (term.law.eval)(&term.params, &body.mesh, &scratch.x, forces);
             }
         });
     }
@@ -159,9 +157,8 @@ impl Surfaces {
             let body = &model.bodies[b];
             for &rule in &scratch.rules {
                 let term = &model.body_rules[rule];
-                let Law::Surface { hessian, .. } = term.interaction.law() else { unreachable!("body law is a surface law") };
                 let mut local = SurfaceHessian::default();
-                hessian(&term.params, &body.mesh, &scratch.x, &mut local);
+                (term.law.hessian)(&term.params, &body.mesh, &scratch.x, &mut local);
                 let projected: Vec<Vec<StiffnessBlock>> = local
                     .stencils
                     .par_iter()

@@ -19,7 +19,6 @@
 use glam::DVec3;
 
 use crate::input::InputError;
-use crate::interactions::Law;
 use crate::system::{Model, SimBox};
 use crate::topology::Topology;
 
@@ -35,10 +34,7 @@ fn pulls_at_zero_length(model: &Model, b: usize) -> bool {
     if let (Some(k), Some(rest)) = (model.bond_kinetics[t].rest_index, model.initial_rest_length(b)) {
         params[k] = rest;
     }
-    match model.bond_types[t].interaction.law() {
-        Law::Radial { eval, .. } => eval(&params, 0.0).de_dr != 0.0,
-        _ => true,
-    }
+    (model.bond_types[t].law.eval)(&params, 0.0).de_dr != 0.0
 }
 
 /// Checks the topology's initial positions in `sim_box` (`model` built from it).

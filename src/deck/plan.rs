@@ -323,15 +323,32 @@ pub enum CoeffTarget {
 impl CoeffTarget {
     /// The term this target names in `model`; an external must be active
     /// there (the deck checked it is at this point of the deck).
-    pub fn term_mut<'a>(&self, model: &'a mut Model) -> &'a mut TermType {
+    pub fn term<'a>(&self, model: &'a Model) -> &'a TermType {
         match self {
-            CoeffTarget::BondType(k) => &mut model.bond_types[*k],
-            CoeffTarget::AngleType(k) => &mut model.angle_types[*k],
-            CoeffTarget::PairRule(k) => &mut model.pair_rules[*k],
-            CoeffTarget::BodyRule(k) => &mut model.body_rules[*k],
+            CoeffTarget::BondType(k) => &model.bond_types[*k],
+            CoeffTarget::AngleType(k) => &model.angle_types[*k],
+            CoeffTarget::PairRule(k) => &model.pair_rules[*k],
+            CoeffTarget::BodyRule(k) => &model.body_rules[*k],
             CoeffTarget::External(name) => {
-                &mut model.externals.iter_mut().find(|e| e.term.label.text == *name).expect("the deck checked the external is active").term
+                &model.externals.iter().find(|e| e.term.label.text == *name).expect("the deck checked the external is active").term
             }
+        }
+    }
+
+    /// The parameters of [`CoeffTarget::term`], to change them.
+    fn params_mut<'a>(&self, model: &'a mut Model) -> &'a mut Vec<f64> {
+        match self {
+            CoeffTarget::BondType(k) => model.bond_types[*k].params_mut(),
+            CoeffTarget::AngleType(k) => model.angle_types[*k].params_mut(),
+            CoeffTarget::PairRule(k) => model.pair_rules[*k].params_mut(),
+            CoeffTarget::BodyRule(k) => model.body_rules[*k].params_mut(),
+            CoeffTarget::External(name) => model
+                .externals
+                .iter_mut()
+                .find(|e| e.term.label.text == *name)
+                .expect("the deck checked the external is active")
+                .term
+                .params_mut(),
         }
     }
 
@@ -339,7 +356,7 @@ impl CoeffTarget {
     /// one application of a `coeff` edit or a ramp's value, in the deck's
     /// checks and in the run.
     pub fn set(&self, model: &mut Model, param: usize, value: f64) {
-        self.term_mut(model).params[param] = value;
+        self.params_mut(model)[param] = value;
     }
 }
 

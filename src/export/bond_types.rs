@@ -75,7 +75,7 @@ impl LammpsBondTypes {
     /// LAMMPS type `l`'s law: its cellmd type's current parameters, with its own r0.
     pub fn term(&self, model: &Model, l: usize) -> TermType {
         let (t, r0) = self.types[l];
-        let mut term = model.bond_types[t].clone();
+        let mut term = model.bond_types[t].term().clone();
         if let (Some(r0), Some(k)) = (r0, model.bond_kinetics[t].rest_index) {
             term.params[k] = r0;
         }

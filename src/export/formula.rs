@@ -12,8 +12,8 @@
 //!
 //! Every sub-expression is parenthesised, so precedence never differs.
 
-use super::number::num;
 use crate::expr::{BinaryOp, Expr, UnaryOp};
+use crate::interactions::lammps::num;
 
 /// The formula of a tree whose names are `x`, `y`, `z` and `t` only.
 pub fn lammps_formula(expr: &Expr) -> Result<String, String> {

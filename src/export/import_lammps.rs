@@ -32,7 +32,8 @@ use std::collections::{BTreeMap, HashMap};
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::number::num;
+use crate::interactions::lammps::num;
+use crate::interactions::Kind;
 
 /// The files an import writes, and what it could not translate.
 #[derive(Clone, Debug, Default)]
@@ -103,24 +104,26 @@ fn parse_script(text: &str) -> Result<Script, String> {
             "angle_style" => angle_style = w[1..].join(" "),
             "pair_style" => pair_style = w[1..].join(" "),
             "bond_coeff" | "angle_coeff" => {
-                let style = if cmd == "bond_coeff" { &bond_style } else { &angle_style };
+                let (kind, style) = if cmd == "bond_coeff" { (Kind::Bond, &bond_style) } else { (Kind::Angle, &angle_style) };
                 let (sub, v) = coeffs(style.split_whitespace().next().unwrap_or(""), &w[2..], &at)?;
-                let t = w[1];
-                let name = if cmd == "bond_coeff" { format!("bond{t}") } else { format!("angle{t}") };
-                let kind = if cmd == "bond_coeff" { "bond" } else { "angle" };
+                let name = format!("{}{}", kind.keyword(), w[1]);
                 let translated = match (kind, sub, v.as_slice()) {
-                    ("bond", "harmonic", [k, r0]) => Some(format!("bond {name} harmonic k {} r0 {}", num(2.0 * k), num(*r0))),
-                    ("bond", "fene", [k, r0, e, sg]) => {
+                    (Kind::Bond, "harmonic", [k, r0]) => Some(format!("bond {name} harmonic k {} r0 {}", num(2.0 * k), num(*r0))),
+                    (Kind::Bond, "fene", [k, r0, e, sg]) => {
                         Some(format!("bond {name} fene K {} R0 {} epsilon {} sigma {}", num(*k), num(*r0), num(*e), num(*sg)))
                     }
-                    ("angle", "harmonic", [k, t0]) => Some(format!("angle {name} harmonic_angle k {} theta0 {}", num(2.0 * k), num(*t0))),
-                    ("angle", "cosine", [k]) => Some(format!("angle {name} cosine_angle K {}", num(*k))),
+                    (Kind::Angle, "harmonic", [k, t0]) => {
+                        Some(format!("angle {name} harmonic_angle k {} theta0 {}", num(2.0 * k), num(*t0)))
+                    }
+                    (Kind::Angle, "cosine", [k]) => Some(format!("angle {name} cosine_angle K {}", num(*k))),
                     _ => None,
                 };
                 match translated {
-                    Some(l) if kind == "bond" => s.bond_lines.push(l),
+                    Some(l) if kind == Kind::Bond => s.bond_lines.push(l),
                     Some(l) => s.angle_lines.push(l),
-                    None => s.notes.push(format!("{at}: `{line}`: {kind} style `{sub}` is not translated; `{name}` has no law")),
+                    None => {
+                        s.notes.push(format!("{at}: `{line}`: {} style `{sub}` is not translated; `{name}` has no law", kind.keyword()))
+                    }
                 }
             }
             "pair_coeff" => pair_coeffs.push((at, line.to_string())),

@@ -46,13 +46,13 @@ use std::fmt::Write;
 
 use super::bond_types::LammpsBondTypes;
 use super::formula;
-use super::number::num;
-use super::styles::{self, PairStyled, Styled};
+use super::styles::{self, ExternalStyle, PairStyled, Styled};
 use crate::deck::{Action, CoeffTarget, Plan};
 use crate::expr::{Expr, UnaryOp};
-use crate::forcefield::TermType;
+use crate::forcefield::{TermType, Typed};
 use crate::integrate::Integrator;
-use crate::kinetics::deterministic_strain;
+use crate::interactions::lammps::num;
+use crate::kinetics::{deterministic_strain, Effect};
 use crate::rng::Noise;
 use crate::system::{External, Model};
 use crate::units::UnitSystem;
@@ -273,7 +273,7 @@ fn bond_break_length(model: &Model, bond_types: &LammpsBondTypes, l: usize) -> R
     let label = &model.bond_types[t].label.text;
     let names: Vec<&str> = kinetics.rules.iter().map(|r| r.rule.name()).collect();
     match kinetics.rules.as_slice() {
-        [r] if r.rule.name() == "threshold" => {
+        [r] if matches!(r.rule.effect(), Effect::Threshold(_)) => {
             let strain = deterministic_strain(&r.params).ok_or_else(|| {
                 format!("bond type `{label}`: only a `threshold` with a `strain` alone (no `force`, `spread` or `rate`) maps to LAMMPS `fix bond/break`; export the deck without it")
             })?;
@@ -574,19 +574,15 @@ impl Writer<'_> {
     fn external(&mut self, external: &External) -> Result<(), String> {
         let b = self.plan.sim_box;
         let id = ident("x_", &external.term.label.text);
-        let args = if external.term.interaction.name() == "field" {
-            self.field_variables(external, &id)?
-        } else if external.term.interaction.name() == "custom" {
-            self.custom_variables(external, &id, b.periodic)?
-        } else {
-            let d = moving_wall_offset(external).map_err(|e| format!("external `{}`: {e}", external.term.label.text))?;
-            let variable = format!("{id}_face");
-            let moving = d.as_deref().map(|d| styles::MovingWall { d, variable: &variable });
-            let (args, line) = styles::external(&external.term, |a| b.lengths()[a], |a| b.periodic[a], moving)?;
-            if let Some(line) = line {
-                self.line(line);
+        let args = match styles::external(external, b.lengths().to_array(), b.periodic, &format!("{id}_face"))? {
+            ExternalStyle::ParameterVariables => self.field_variables(external, &id)?,
+            ExternalStyle::ExpressionVariables => self.custom_variables(external, &id, b.periodic)?,
+            ExternalStyle::Fix { args, variable } => {
+                if let Some(line) = variable {
+                    self.line(line);
+                }
+                args
             }
-            args
         };
         let mut ids: Vec<u64> = external.members.iter().map(|&m| self.model.ids[m as usize]).collect();
         let group = ident("g_", &external.term.label.text);
@@ -673,7 +669,7 @@ impl Writer<'_> {
             CoeffTarget::BondType(k) => {
                 target.set(&mut self.model, param, value);
                 for l in self.bond_types.of_cellmd_type(*k).collect::<Vec<_>>() {
-                    let s = styles::bond(&self.bond_types.term(&self.model, l))?;
+                    let s = styles::bonded(&self.bond_types.term(&self.model, l))?;
                     self.line(format!("bond_coeff {} {} {}", l + 1, s.style, s.coeffs));
                     if self.kinetic.breaks.contains(&l) {
                         // A new r0 moves the break length.
@@ -684,7 +680,7 @@ impl Writer<'_> {
             }
             CoeffTarget::AngleType(k) => {
                 target.set(&mut self.model, param, value);
-                let s = styles::angle(&self.model.angle_types[*k])?;
+                let s = styles::bonded(&self.model.angle_types[*k])?;
                 self.line(format!("angle_coeff {} {} {}", k + 1, s.style, s.coeffs));
             }
             CoeffTarget::PairRule(k) => {
@@ -795,15 +791,17 @@ impl Writer<'_> {
 /// are errors naming them.
 pub fn export(plan: &Plan, options: ExportOptions) -> Result<LammpsDeck, String> {
     let model = plan.model.clone();
-    let element = model.tetra_type.first().map(|&t| &model.tetra_types[t as usize]);
-    if let Some(term) = model.body_rules.first().or(model.contact_rules.first()).or(element) {
+    let element = model.tetra_type.first().map(|&t| model.tetra_types[t as usize].term());
+    let body = model.body_rules.first().map(Typed::term);
+    if let Some(term) = body.or(model.contact_rules.first().map(Typed::term)).or(element) {
         return Err(styles::unsupported(term));
     }
     let bond_types = LammpsBondTypes::new(&model);
     let kinetic = kinetic_fixes(plan, &bond_types)?;
     let terms: Vec<TermType> = (0..bond_types.count()).map(|l| bond_types.term(&model, l)).collect();
-    let bonds = Hybrid::new(&terms, styles::bond)?;
-    let angles = Hybrid::new(&model.angle_types, styles::angle)?;
+    let bonds = Hybrid::new(&terms, styles::bonded)?;
+    let angle_types: Vec<TermType> = model.angle_types.iter().map(|t| t.term().clone()).collect();
+    let angles = Hybrid::new(&angle_types, styles::bonded)?;
     let pairs = Pairs::new(&model)?;
     // Externals and coefficients that only appear later are checked when written.
     let title = format!("cellmd export of {}", plan.deck_path.display());
@@ -841,25 +839,4 @@ pub fn write(deck: &LammpsDeck, dir: &std::path::Path) -> std::io::Result<()> {
     std::fs::create_dir_all(dir)?;
     std::fs::write(dir.join(DATA_FILE), &deck.data)?;
     std::fs::write(dir.join(INPUT_FILE), &deck.input)
-}
-
-/// The LAMMPS formula of an external's expression parameters where LAMMPS
-/// can take one outside `field`: a wall's offset `d` as a function of t only
-/// (None: no expression parameters).
-fn moving_wall_offset(external: &External) -> Result<Option<String>, String> {
-    let name = external.term.interaction.name();
-    match &external.expressions[..] {
-        [] => Ok(None),
-        [(k, expr)]
-            if name == "wall"
-                && external.term.interaction.params()[*k].name == "d"
-                && expr.refs().iter().all(|(r, _)| *r == crate::expr::Ref::Name("t")) =>
-        {
-            formula::lammps_formula(expr).map(Some)
-        }
-        _ => Err(format!(
-            "expression parameters of `{name}` are not exported (LAMMPS takes a wall's `d` as a formula of t, and a `field` as \
-             `fix addforce` with atom-style variables)"
-        )),
-    }
 }

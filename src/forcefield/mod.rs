@@ -41,5 +41,7 @@ mod parse;
 
 pub use self::bind::{parse_bind, BindLine, BindRule};
 pub use self::custom::{parse_custom, parse_custom_external};
-pub use self::params::{check_param, param_position, param_value, parse_kinetics, parse_params, parse_values, BondTypeKinetics, TermType};
-pub use self::parse::{check_pair_types, load_forcefield, BodyRule, ContactRule, ForceField, PairRule, ParticleType};
+pub use self::params::{
+    check_param, param_position, param_value, parse_kinetics, parse_params, parse_values, BondTypeKinetics, TermType, Typed,
+};
+pub use self::parse::{check_pair_types, load_forcefield, typed, BodyRule, ContactRule, ForceField, PairRule, ParticleType};

@@ -1,7 +1,7 @@
 //! `name value` parameter lists checked against an interaction's schema.
 
 use crate::input::{parse_f64, InputError, Token};
-use crate::interactions::{lookup, Interaction, Kind, ParamSpec, REGISTRY};
+use crate::interactions::{lookup, Interaction, Kind, KindLaw, ParamSpec, REGISTRY};
 use crate::kinetics::{lookup_rule, RuleUse, RULES};
 use crate::units::UnitSystem;
 
@@ -19,6 +19,43 @@ pub struct TermType {
 impl std::fmt::Debug for TermType {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(f, "{} {} {:?}", self.label.text, self.interaction.name(), self.params)
+    }
+}
+
+/// A term type of one kind with its law taken out at build time
+/// ([`KindLaw`]): `law` is what the loops over this kind evaluate. It
+/// dereferences to its [`TermType`] (label, interaction, parameters); the
+/// parameters may change (`coeff`, ramps, drives), the interaction may not.
+#[derive(Clone, Debug)]
+pub struct Typed<L> {
+    term: TermType,
+    pub law: L,
+}
+
+impl<L: KindLaw> Typed<L> {
+    /// `term` with its law, or `term` back when its law is not of family `L`.
+    pub fn new(term: TermType) -> Result<Self, TermType> {
+        match L::from_law(term.interaction.law()) {
+            Some(law) => Ok(Typed { term, law }),
+            None => Err(term),
+        }
+    }
+
+    /// The term type, for code that reads terms of every kind.
+    pub fn term(&self) -> &TermType {
+        &self.term
+    }
+
+    /// The parameters, for the edits that change them.
+    pub fn params_mut(&mut self) -> &mut Vec<f64> {
+        &mut self.term.params
+    }
+}
+
+impl<L> std::ops::Deref for Typed<L> {
+    type Target = TermType;
+    fn deref(&self) -> &TermType {
+        &self.term
     }
 }
 

@@ -4,10 +4,10 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use crate::input::{lex, parse_f64, InputError, SourceFile, Statement, Token};
-use crate::interactions::Kind;
+use crate::interactions::{AngleLaw, ContactLaw, Kind, KindLaw, RadialLaw, SurfaceLaw, TetraLaw};
 use crate::units::UnitSystem;
 
-use super::params::{parse_kinetics, parse_params, BondTypeKinetics, TermType};
+use super::params::{parse_kinetics, parse_params, BondTypeKinetics, TermType, Typed};
 use super::parse_custom;
 
 /// A particle type: overdamped drag coefficient and radius.
@@ -25,7 +25,7 @@ pub struct ParticleType {
 pub struct PairRule {
     pub type_a: Token,
     pub type_b: Token,
-    pub term: TermType,
+    pub term: Typed<RadialLaw>,
 }
 
 /// A many-body term of every body of a type (`body TYPE INTERACTION ...`).
@@ -33,7 +33,7 @@ pub struct PairRule {
 pub struct BodyRule {
     /// The body type, as named in the topology's `[ bodies ]` section.
     pub body_type: Token,
-    pub term: TermType,
+    pub term: Typed<SurfaceLaw>,
 }
 
 /// A contact term between bodies of two types (`contact TYPE_A TYPE_B INTERACTION ...`).
@@ -41,19 +41,19 @@ pub struct BodyRule {
 pub struct ContactRule {
     pub type_a: Token,
     pub type_b: Token,
-    pub term: TermType,
+    pub term: Typed<ContactLaw>,
 }
 
 /// Everything the force-field files of a deck define.
 #[derive(Clone, Debug, Default)]
 pub struct ForceField {
     pub particle_types: Vec<ParticleType>,
-    pub bond_types: Vec<TermType>,
+    pub bond_types: Vec<Typed<RadialLaw>>,
     /// Kinetic rules of each bond type (same order as `bond_types`).
     pub bond_kinetics: Vec<BondTypeKinetics>,
-    pub angle_types: Vec<TermType>,
+    pub angle_types: Vec<Typed<AngleLaw>>,
     /// Volume element types (`tetra` lines), for the topology's `[ tetrahedra ]`.
-    pub tetra_types: Vec<TermType>,
+    pub tetra_types: Vec<Typed<TetraLaw>>,
     pub pair_rules: Vec<PairRule>,
     /// Surface terms by body type (`body` lines); several lines for one type add up.
     pub body_rules: Vec<BodyRule>,
@@ -143,13 +143,23 @@ fn particle(s: &Statement) -> Result<ParticleType, InputError> {
     Ok(ParticleType { name: name.clone(), drag, radius })
 }
 
-/// A term of a registered law, or a `custom` expression.
-fn term_type(label: &Token, law: &Token, tokens: &[Token], kind: Kind, units: UnitSystem) -> Result<TermType, InputError> {
-    if law.text == "custom" {
-        parse_custom(label, law, tokens, kind, units)
-    } else {
-        parse_params(label, law, tokens, kind, units)
-    }
+/// A term of a registered law, or a `custom` expression, with its law of family `L`.
+fn term_type<L: KindLaw>(label: &Token, law: &Token, tokens: &[Token], kind: Kind, units: UnitSystem) -> Result<Typed<L>, InputError> {
+    let term =
+        if law.text == "custom" { parse_custom(label, law, tokens, kind, units) } else { parse_params(label, law, tokens, kind, units) };
+    typed(term?, law)
+}
+
+/// `term` with its law taken out, or an error at `at` if the law is not of family `L`.
+pub fn typed<L: KindLaw>(term: TermType, at: &Token) -> Result<Typed<L>, InputError> {
+    Typed::new(term).map_err(|t| {
+        at.error(format!(
+            "`{}` has no {} law; expected {} interaction",
+            t.interaction.name(),
+            t.interaction.kind().keyword(),
+            t.interaction.kind().with_article()
+        ))
+    })
 }
 
 /// Reads a force-field file (and its includes) into `ff`.

@@ -14,19 +14,20 @@
 use std::fmt::Write;
 
 use crate::expr::wgsl::wgsl;
-use crate::forcefield::TermType;
+use crate::forcefield::{TermType, Typed};
 use crate::interactions::{Kind, REGISTRY};
 use crate::system::{registry_index, Model};
 
 /// Whether a term is a custom expression.
 fn is_custom(term: &TermType) -> bool {
-    term.interaction.name() == "custom"
+    term.interaction.expression().is_some()
 }
 
 /// The terms the GPU packs, in its order: bond types, angle types, pair
 /// rules, externals.
 fn terms(model: &Model) -> impl Iterator<Item = &TermType> {
-    model.bond_types.iter().chain(&model.angle_types).chain(&model.pair_rules).chain(model.externals.iter().map(|e| &e.term))
+    let (bonds, angles, pairs) = (model.bond_types.iter(), model.angle_types.iter(), model.pair_rules.iter());
+    bonds.map(Typed::term).chain(angles.map(Typed::term)).chain(pairs.map(Typed::term)).chain(model.externals.iter().map(|e| e.term.term()))
 }
 
 /// The dispatch index of every packed term: its registry index, or for the

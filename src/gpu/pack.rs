@@ -24,6 +24,7 @@
 
 use bytemuck::{Pod, Zeroable};
 
+use crate::forcefield::Typed;
 use crate::neighbor::Exclusions;
 use crate::system::BondState;
 use crate::system::{Model, SimBox};
@@ -127,10 +128,11 @@ pub fn pack(model: &Model, exclusions: &Exclusions, dt: f64, kt: f64, bonds: Opt
     let terms: Vec<_> = model
         .bond_types
         .iter()
-        .chain(&model.angle_types)
-        .chain(&model.pair_rules)
-        .chain(model.externals.iter().map(|e| &e.term))
-        .chain(&model.body_rules)
+        .map(Typed::term)
+        .chain(model.angle_types.iter().map(Typed::term))
+        .chain(model.pair_rules.iter().map(Typed::term))
+        .chain(model.externals.iter().map(|e| e.term.term()))
+        .chain(model.body_rules.iter().map(Typed::term))
         .collect();
     let angle_base = model.bond_types.len();
     let pair_base = angle_base + model.angle_types.len();
@@ -266,10 +268,7 @@ pub fn pack(model: &Model, exclusions: &Exclusions, dt: f64, kt: f64, bonds: Opt
 
 fn pair_range(model: &Model, rule: usize) -> f64 {
     let term = &model.pair_rules[rule];
-    match term.interaction.law() {
-        crate::interactions::Law::Radial { range, .. } => range(&term.params),
-        _ => unreachable!("pair law is radial"),
-    }
+    (term.law.range)(&term.params)
 }
 
 /// The cell grid for a neighbour range: cells at least `range` wide, at most

@@ -17,11 +17,20 @@
 //! that use them, so such a deck never runs on the GPU without those
 //! forces. A WGSL file for a law without the kernel to call it is refused
 //! by a test, so a shader cannot pretend to cover one.
+//!
+//! Parameter names: an evaluator receives its parameters as `p: array<f32,
+//! 8>` in schema order (`PARAMS` of the interaction's `.rs`) and reads them
+//! by name, never by bare number. Before each evaluator file the program
+//! declares one constant per schema entry, `NAME_PARAM` in upper case with
+//! its schema index ([`param_constants`]: `const HARMONIC_K: u32 = 0u;`,
+//! `const HARMONIC_R0: u32 = 1u;`), so `harmonic.wgsl` writes `p[HARMONIC_K]`.
+//! A test refuses any `p[<digit>` in `shaders/interactions/`. (A new
+//! evaluator, e.g. a volume element's, follows the same rule.)
 
 use std::fmt::Write;
 
 use super::custom::CustomSource;
-use crate::interactions::{Law, SurfaceGpu, REGISTRY};
+use crate::interactions::{Interaction, Law, SurfaceGpu, REGISTRY};
 
 mod embedded {
     include!(concat!(env!("OUT_DIR"), "/shaders.rs"));
@@ -80,6 +89,14 @@ pub fn compose() -> String {
     compose_with(&CustomSource::default())
 }
 
+/// The WGSL constants naming an interaction's parameters: `const NAME_PARAM:
+/// u32 = INDEX;` for each entry of its schema (see the module doc).
+pub fn param_constants(interaction: &dyn Interaction) -> String {
+    let prefix = interaction.name().to_uppercase();
+    let lines = interaction.params().iter().enumerate().map(|(k, p)| format!("const {prefix}_{}: u32 = {k}u;\n", p.name.to_uppercase()));
+    lines.collect()
+}
+
 /// The whole program, with a model's generated custom evaluators.
 pub fn compose_with(custom: &CustomSource) -> String {
     let mut program = String::new();
@@ -89,6 +106,7 @@ pub fn compose_with(custom: &CustomSource) -> String {
     for interaction in REGISTRY.iter().filter(|i| i.law().runs_on_gpu()) {
         let source = interaction_source(interaction.name())
             .unwrap_or_else(|| panic!("interaction `{}` has no shaders/interactions/{0}.wgsl", interaction.name()));
+        program.push_str(&param_constants(*interaction));
         program.push_str(source);
     }
     program.push_str(&custom.functions);
@@ -145,6 +163,24 @@ mod tests {
         for name in form(SurfaceGpu::NodeCurvature) {
             assert!(compose().contains(&format!("return {name}_node(p, m, a);")), "{name} has no `node_law` case");
         }
+    }
+
+    /// Evaluators read parameters by their generated names: no `p[0]`.
+    #[test]
+    fn shaders_index_parameters_by_name_only() {
+        for (stem, source) in INTERACTION_SHADERS {
+            let bare = source.match_indices("p[").any(|(at, _)| {
+                let before = source[..at].chars().next_back();
+                let after = source[at + 2..].chars().next();
+                !before.is_some_and(|c| c.is_alphanumeric() || c == '_') && after.is_some_and(|c| c.is_ascii_digit())
+            });
+            assert!(!bare, "shaders/interactions/{stem}.wgsl indexes a parameter by number; use its generated name (NAME_PARAM)");
+        }
+        assert_eq!(
+            param_constants(crate::interactions::lookup("harmonic").unwrap()),
+            "const HARMONIC_K: u32 = 0u;\nconst HARMONIC_R0: u32 = 1u;\n"
+        );
+        assert!(compose().contains("const FENE_SIGMA: u32 = 3u;\n"));
     }
 
     #[test]

@@ -1,5 +1,6 @@
 #![doc = include_str!("asymmetric.md")]
 
+use super::lammps::{lepton_bond, num, LammpsTerm, Translation};
 use super::{Kind, Law, ParamSpec, Radial};
 use crate::units::Dim;
 
@@ -19,12 +20,19 @@ fn eval(p: &[f64], r: f64) -> Radial {
     Radial { energy: 0.5 * k * stretch * stretch, de_dr: k * stretch, d2e_dr2: k }
 }
 
+/// LAMMPS `bond_style lepton`: the exact expression in Δr = r − r0.
+fn lammps(term: &LammpsTerm) -> Translation {
+    let p = term.params;
+    lepton_bond(format!("0.5*({}*step(r)+{}*(1-step(r)))*r^2", num(p[K_TENSION]), num(p[K_COMPRESSION])), p[R0])
+}
+
 interaction!(
     Asymmetric,
     "asymmetric",
     Kind::Bond,
     "Bilinear bond, stiffer in tension than compression: E = ½k_t(r − r0)² or ½k_c(r − r0)²",
-    Law::Radial { eval, force: radial_force!(eval), range: |_| f64::INFINITY }
+    Law::Radial { eval, force: radial_force!(eval), range: |_| f64::INFINITY },
+    lammps = lammps
 );
 
 #[cfg(test)]

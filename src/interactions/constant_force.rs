@@ -2,6 +2,7 @@
 
 use glam::DVec3;
 
+use super::lammps::{fix, num, LammpsTerm, Translation};
 use super::{Kind, Law, OneBody, ParamSpec};
 use crate::units::Dim;
 
@@ -20,12 +21,19 @@ fn eval(p: &[f64], x: DVec3) -> OneBody {
     OneBody { energy: -f.dot(x), force: f }
 }
 
+/// LAMMPS `fix addforce`: identical; its scalar is −F·x on unwrapped x.
+fn lammps(term: &LammpsTerm) -> Translation {
+    let p = term.params;
+    fix(term, format!("addforce {} {} {}", num(p[FX]), num(p[FY]), num(p[FZ])))
+}
+
 interaction!(
     ConstantForce,
     "constant_force",
     Kind::External,
     "Constant pulling force F on each particle of a group, E = −F·x",
-    Law::OneBody(eval)
+    Law::OneBody(eval),
+    lammps = lammps
 );
 
 #[cfg(test)]

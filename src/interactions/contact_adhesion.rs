@@ -64,17 +64,11 @@ interaction!(
 mod tests {
     use super::*;
     use crate::interactions::testing::*;
-    use crate::interactions::{Entry, Interaction};
-
-    fn switch(p: &[f64], d: f64) -> Radial {
-        let Law::ContactArea { switch, .. } = ContactAdhesion.law() else { unreachable!() };
-        switch(p, d)
-    }
+    use crate::interactions::Entry;
 
     #[test]
     fn switch_is_c2_from_full_contact_to_free() {
         let p = params_of(&ContactAdhesion, &[("w", 30.0), ("d_on", 0.05), ("d_off", 0.25)]);
-        let Law::ContactArea { density, range, .. } = ContactAdhesion.law() else { unreachable!() };
         assert_eq!((density(&p), range(&p)), (-30.0, 0.25));
         // Full contact up to d_on, nothing from d_off on.
         let full = Radial { energy: 1.0, de_dr: 0.0, d2e_dr2: 0.0 };

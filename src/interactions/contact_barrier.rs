@@ -51,7 +51,6 @@ mod tests {
     use crate::interactions::Interaction;
 
     fn law(p: &[f64], d: f64) -> Radial {
-        let Law::Contact { eval, .. } = ContactBarrier.law() else { unreachable!() };
         eval(p, d)
     }
 

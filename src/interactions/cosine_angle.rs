@@ -2,6 +2,7 @@
 
 use glam::DVec3;
 
+use super::lammps::{bonded, num, LammpsTerm, Translation};
 use super::{Kind, Law, ParamSpec, ThreeBody};
 use crate::units::Dim;
 
@@ -21,7 +22,19 @@ fn eval(p: &[f64], [ri, rj, rk]: [DVec3; 3]) -> ThreeBody {
     ThreeBody { energy: p[K] * (1.0 + c), forces: [fi, -fi - fk, fk] }
 }
 
-interaction!(CosineAngle, "cosine_angle", Kind::Angle, "Cosine angle E = K[1 + cos θ] (LAMMPS angle_style cosine)", Law::ThreeBody(eval));
+/// LAMMPS `angle_style cosine`: identical.
+fn lammps(term: &LammpsTerm) -> Translation {
+    bonded("cosine", num(term.params[K]))
+}
+
+interaction!(
+    CosineAngle,
+    "cosine_angle",
+    Kind::Angle,
+    "Cosine angle E = K[1 + cos θ] (LAMMPS angle_style cosine)",
+    Law::ThreeBody(eval),
+    lammps = lammps
+);
 
 #[cfg(test)]
 mod tests {

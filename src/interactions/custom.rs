@@ -17,8 +17,10 @@
 //! the body-term evaluator with no parameters of its own.
 
 mod laws;
+mod lepton;
 
 use self::laws::{angle_eval, body_eval, body_hessian, external_eval, pair_eval, pair_force, radial_eval, radial_force};
+use super::lammps::{bonded, lepton_bond, num, pair, LammpsStyle, LammpsTerm, Translation};
 use super::{Entry, Interaction, Kind, Law, ParamSpec, SurfaceGpu};
 use crate::expr::tape::{compile, Slot};
 use crate::expr::{parse, Expr, ExprError, Span};
@@ -225,6 +227,28 @@ impl Interaction for CustomLaw {
     fn expression(&self) -> Option<&Expr> {
         Some(&self.energy)
     }
+    /// Bonds, angles and pairs: LAMMPS' lepton styles with the expression,
+    /// parameters written as numbers; r0 = 0 and θ0 = 0 make Lepton's
+    /// displacement variables the distance and the angle (θ in radians).
+    /// Externals: `fix addforce` with atom-style variables of −∇E and E.
+    fn lammps(&self, term: &LammpsTerm) -> Translation {
+        if self.kind == Kind::External {
+            return Some(Ok(LammpsStyle::ExpressionVariables));
+        }
+        if !matches!(self.kind, Kind::Bond | Kind::Angle | Kind::Pair) {
+            return None;
+        }
+        let value = |n: &str| self.specs.iter().position(|p| p.name == n).map(|k| term.params[k]);
+        let expression = match lepton::lepton(&self.energy, &value) {
+            Ok(expression) => expression,
+            Err(e) => return Some(Err(format!("{} `{}`: {e}", self.kind.with_article(), term.label))),
+        };
+        match self.kind {
+            Kind::Bond => lepton_bond(expression, 0.0),
+            Kind::Angle => bonded("lepton", format!("0.0 \"{expression}\"")),
+            _ => pair("lepton", format!("\"{expression}\" {}", num(term.params[0]))),
+        }
+    }
     fn law(&self) -> Law {
         match self.kind {
             Kind::Bond => Law::Radial { eval: radial_eval, force: radial_force, range: |_| f64::INFINITY },
@@ -254,7 +278,7 @@ mod tests {
 
     use super::*;
     use crate::interactions::testing::*;
-    use crate::interactions::{cosine_angle, harmonic, harmonic_angle, soft, surface_tension, turgor};
+    use crate::interactions::{cosine_angle, harmonic, harmonic_angle, soft, surface_tension, turgor, KindLaw, RadialLaw};
 
     fn law(kind: Kind, text: &str, params: &[(&str, f64)]) -> (&'static CustomLaw, Vec<f64>) {
         let declared: Vec<Declared> = params.iter().map(|(n, _)| Declared { name: n.to_string(), dim: Dim::Dimensionless }).collect();
@@ -346,10 +370,8 @@ mod tests {
             ),
         ];
         for ((custom, cp), bp, builtin) in radial {
-            let (Law::Radial { eval: ce, force: cf, range: cr }, Law::Radial { eval: be, force: bf, range: br }) = (custom.law(), builtin)
-            else {
-                unreachable!()
-            };
+            let RadialLaw { eval: ce, force: cf, range: cr } = RadialLaw::from_law(custom.law()).unwrap();
+            let RadialLaw { eval: be, force: bf, range: br } = RadialLaw::from_law(builtin).unwrap();
             assert_eq!(cr(&cp), br(&bp));
             for r in [0.05, 0.1, 0.37, 0.9, 1.49, 1.5, 2.0] {
                 let (c, b) = (ce(&cp, r), be(&bp, r));
@@ -453,7 +475,7 @@ mod tests {
     #[test]
     fn parameters_are_read_from_the_vector() {
         let (spring, mut p) = law(Kind::Bond, "0.5*k*(r-r0)^2", &[("k", 2.0), ("r0", 1.0)]);
-        let Law::Radial { eval, .. } = spring.law() else { unreachable!() };
+        let eval = RadialLaw::from_law(spring.law()).unwrap().eval;
         assert_eq!(eval(&p, 3.0).energy, 4.0);
         p[param_index_of(spring, "r0")] = 2.0;
         assert_eq!(eval(&p, 3.0).energy, 1.0);

@@ -1,5 +1,6 @@
 #![doc = include_str!("fene.md")]
 
+use super::lammps::{bonded, num, LammpsTerm, Translation};
 use super::{Kind, Law, ParamSpec, Radial};
 use crate::units::Dim;
 
@@ -39,12 +40,19 @@ fn eval(p: &[f64], r: f64) -> Radial {
     out
 }
 
+/// LAMMPS `bond_style fene`: identical (K, R0, ε, σ).
+fn lammps(term: &LammpsTerm) -> Translation {
+    let p = term.params;
+    bonded("fene", format!("{} {} {} {}", num(p[K]), num(p[R0]), num(p[EPSILON]), num(p[SIGMA])))
+}
+
 interaction!(
     Fene,
     "fene",
     Kind::Bond,
     "FENE bond with WCA core, E = −½K·R0²·ln(1 − (r/R0)²) + WCA (LAMMPS bond_style fene)",
-    Law::Radial { eval, force: radial_force!(eval), range: |_| f64::INFINITY }
+    Law::Radial { eval, force: radial_force!(eval), range: |_| f64::INFINITY },
+    lammps = lammps
 );
 
 #[cfg(test)]

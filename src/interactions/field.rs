@@ -2,6 +2,7 @@
 
 use glam::DVec3;
 
+use super::lammps::{LammpsStyle, LammpsTerm, Translation};
 use super::{Kind, Law, OneBody, ParamSpec};
 use crate::units::Dim;
 
@@ -22,12 +23,18 @@ fn eval(p: &[f64], _x: DVec3) -> OneBody {
     OneBody { energy: p[E], force: DVec3::new(p[FX], p[FY], p[FZ]) }
 }
 
+/// LAMMPS `fix addforce v_fx v_fy v_fz energy v_e`: one atom-style variable per parameter.
+fn lammps(_term: &LammpsTerm) -> Translation {
+    Some(Ok(LammpsStyle::ParameterVariables))
+}
+
 interaction!(
     Field,
     "field",
     Kind::External,
     "Force field F(x, y, z, t) given by expressions, with an optional energy e(x, y, z, t)",
-    Law::OneBody(eval)
+    Law::OneBody(eval),
+    lammps = lammps
 );
 
 #[cfg(test)]

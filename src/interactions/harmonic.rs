@@ -1,5 +1,6 @@
 #![doc = include_str!("harmonic.md")]
 
+use super::lammps::{bonded, num, LammpsTerm, Translation};
 use super::{Kind, Law, ParamSpec, Radial};
 use crate::units::Dim;
 
@@ -16,12 +17,19 @@ fn eval(p: &[f64], r: f64) -> Radial {
     Radial { energy: 0.5 * p[K] * stretch * stretch, de_dr: p[K] * stretch, d2e_dr2: p[K] }
 }
 
+/// LAMMPS `bond_style harmonic` K(r − r0)²: K = k/2.
+fn lammps(term: &LammpsTerm) -> Translation {
+    let p = term.params;
+    bonded("harmonic", format!("{} {}", num(0.5 * p[K]), num(p[R0])))
+}
+
 interaction!(
     Harmonic,
     "harmonic",
     Kind::Bond,
     "Hookean bond E = ½k(r − r0)²",
-    Law::Radial { eval, force: radial_force!(eval), range: |_| f64::INFINITY }
+    Law::Radial { eval, force: radial_force!(eval), range: |_| f64::INFINITY },
+    lammps = lammps
 );
 
 #[cfg(test)]

@@ -2,6 +2,7 @@
 
 use glam::DVec3;
 
+use super::lammps::{bonded, num, LammpsTerm, Translation};
 use super::{Kind, Law, ParamSpec, ThreeBody};
 use crate::units::Dim;
 
@@ -37,7 +38,20 @@ fn eval(p: &[f64], [ri, rj, rk]: [DVec3; 3]) -> ThreeBody {
     ThreeBody { energy: 0.5 * p[K] * dtheta * dtheta, forces: [fi, -fi - fk, fk] }
 }
 
-interaction!(HarmonicAngle, "harmonic_angle", Kind::Angle, "Harmonic angle E = ½k(θ − θ0)², θ0 in degrees", Law::ThreeBody(eval));
+/// LAMMPS `angle_style harmonic` K(θ − θ0)²: K = k/2.
+fn lammps(term: &LammpsTerm) -> Translation {
+    let p = term.params;
+    bonded("harmonic", format!("{} {}", num(0.5 * p[K]), num(p[THETA0])))
+}
+
+interaction!(
+    HarmonicAngle,
+    "harmonic_angle",
+    Kind::Angle,
+    "Harmonic angle E = ½k(θ − θ0)², θ0 in degrees",
+    Law::ThreeBody(eval),
+    lammps = lammps
+);
 
 #[cfg(test)]
 mod tests {

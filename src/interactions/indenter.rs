@@ -2,6 +2,7 @@
 
 use glam::DVec3;
 
+use super::lammps::{fix, num, LammpsTerm, Translation};
 use super::{Kind, Law, OneBody, ParamSpec};
 use crate::units::Dim;
 
@@ -32,12 +33,20 @@ fn eval(p: &[f64], x: DVec3) -> OneBody {
     OneBody { energy, force }
 }
 
+/// LAMMPS `fix indent … sphere`: identical (K, centre, R). LAMMPS' force is
+/// −K(r − R)² outward inside the sphere, its energy K(R − r)³/3.
+fn lammps(term: &LammpsTerm) -> Translation {
+    let p = term.params;
+    fix(term, format!("indent {} sphere {} {} {} {} units box", num(p[K]), num(p[X]), num(p[Y]), num(p[Z]), num(p[R])))
+}
+
 interaction!(
     Indenter,
     "indenter",
     Kind::External,
     "Rigid spherical indenter (LAMMPS fix indent sphere): E = (K/3)(R − r)³ inside the sphere",
-    Law::OneBody(eval)
+    Law::OneBody(eval),
+    lammps = lammps
 );
 
 #[cfg(test)]

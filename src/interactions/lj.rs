@@ -1,5 +1,6 @@
 #![doc = include_str!("lj.md")]
 
+use super::lammps::{num, pair, LammpsTerm, Translation};
 use super::{Kind, Law, ParamSpec, Radial};
 use crate::units::Dim;
 
@@ -51,12 +52,19 @@ fn force(p: &[f64], r2: f64) -> f64 {
     }
 }
 
+/// LAMMPS `pair_style lj/cut`: identical, not shifted.
+fn lammps(term: &LammpsTerm) -> Translation {
+    let p = term.params;
+    pair("lj/cut", format!("{} {} {}", num(p[EPSILON]), num(p[SIGMA]), num(p[RC])))
+}
+
 interaction!(
     Lj,
     "lj",
     Kind::Pair,
     "Lennard-Jones 12-6, cut at rc and not shifted (LAMMPS lj/cut)",
-    Law::Radial { eval, force, range: |p| p[RC] }
+    Law::Radial { eval, force, range: |p| p[RC] },
+    lammps = lammps
 );
 
 #[cfg(test)]

@@ -49,9 +49,9 @@ use crate::units::Dim;
 /// Implements [`Entry`] and [`Interaction`] for a unit struct from its
 /// registration data: the name (also the stem of its `.md` doc file), kind,
 /// one-line summary, the module's `PARAMS` schema, its law, and optionally a
-/// `validate` function.
+/// `validate` function and a `lammps` translation ([`Interaction::lammps`]).
 macro_rules! interaction {
-    ($ty:ident, $name:literal, $kind:expr, $summary:literal, $law:expr $(, validate = $validate:path)?) => {
+    ($ty:ident, $name:literal, $kind:expr, $summary:literal, $law:expr $(, validate = $validate:path)? $(, lammps = $lammps:path)?) => {
         $crate::interactions::entry!($ty, $name, $kind.keyword(), $summary $(, validate = $validate)?);
 
         impl $crate::interactions::Interaction for $ty {
@@ -61,6 +61,9 @@ macro_rules! interaction {
             fn law(&self) -> $crate::interactions::Law {
                 $law
             }
+            $(fn lammps(&self, term: &$crate::interactions::lammps::LammpsTerm) -> $crate::interactions::lammps::Translation {
+                $lammps(term)
+            })?
         }
     };
 }
@@ -79,6 +82,7 @@ macro_rules! radial_force {
 
 pub mod custom;
 mod entry;
+pub mod lammps;
 pub mod testing;
 
 mod area_conservation;
@@ -178,6 +182,13 @@ impl Kind {
             Kind::Contact => "contact",
             Kind::Tetra => "tetra",
         }
+    }
+
+    /// The kind a force-field or deck keyword introduces.
+    pub fn from_keyword(word: &str) -> Option<Kind> {
+        [Kind::Bond, Kind::Angle, Kind::Pair, Kind::External, Kind::Body, Kind::Contact, Kind::Tetra]
+            .into_iter()
+            .find(|k| k.keyword() == word)
     }
 
     /// "a bond", "an angle", … for messages.
@@ -337,6 +348,114 @@ pub enum Law {
     Tetra(fn(&[f64], &TetraRest, [DVec3; 4]) -> FourBody),
 }
 
+/// A law of one kind of term, taken out of its [`Law`] once when the term
+/// is built (`forcefield::Typed`), so that the loops over terms of that kind
+/// read it directly: `Kind` says where a type may be used, the law's type
+/// says what evaluates it, and only that one place reconciles the two.
+pub trait KindLaw: Copy + std::fmt::Debug {
+    /// The law if `law` is of this family.
+    fn from_law(law: Law) -> Option<Self>;
+}
+
+/// E(r) of a bond or a pair ([`Law::Radial`]).
+#[derive(Clone, Copy, Debug)]
+pub struct RadialLaw {
+    pub eval: fn(&[f64], f64) -> Radial,
+    pub force: fn(&[f64], f64) -> f64,
+    pub range: fn(&[f64]) -> f64,
+}
+
+/// E(r_i, r_j, r_k) of an angle ([`Law::ThreeBody`]).
+#[derive(Clone, Copy, Debug)]
+pub struct AngleLaw(pub fn(&[f64], [DVec3; 3]) -> ThreeBody);
+
+/// E(r) of one particle in an external field ([`Law::OneBody`]).
+#[derive(Clone, Copy, Debug)]
+pub struct ExternalLaw(pub fn(&[f64], DVec3) -> OneBody);
+
+/// E of one closed surface ([`Law::Surface`]).
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceLaw {
+    pub eval: fn(params: &[f64], mesh: &SurfaceMesh, x: &[DVec3], forces: &mut [DVec3]) -> f64,
+    pub hessian: fn(params: &[f64], mesh: &SurfaceMesh, x: &[DVec3], out: &mut SurfaceHessian),
+    pub gpu: SurfaceGpu,
+}
+
+/// A term between bodies: node–face ([`Law::Contact`]) or area-weighted ([`Law::ContactArea`]).
+#[derive(Clone, Copy, Debug)]
+pub enum ContactLaw {
+    NodeFace { eval: fn(&[f64], f64) -> Radial, range: fn(&[f64]) -> f64 },
+    Area { switch: fn(&[f64], f64) -> Radial, density: fn(&[f64]) -> f64, range: fn(&[f64]) -> f64 },
+}
+
+/// E(x_0 … x_3) of a volume element ([`Law::Tetra`]).
+#[derive(Clone, Copy, Debug)]
+pub struct TetraLaw(pub fn(&[f64], &TetraRest, [DVec3; 4]) -> FourBody);
+
+impl KindLaw for RadialLaw {
+    fn from_law(law: Law) -> Option<Self> {
+        match law {
+            Law::Radial { eval, force, range } => Some(RadialLaw { eval, force, range }),
+            _ => None,
+        }
+    }
+}
+
+impl KindLaw for AngleLaw {
+    fn from_law(law: Law) -> Option<Self> {
+        match law {
+            Law::ThreeBody(eval) => Some(AngleLaw(eval)),
+            _ => None,
+        }
+    }
+}
+
+impl KindLaw for ExternalLaw {
+    fn from_law(law: Law) -> Option<Self> {
+        match law {
+            Law::OneBody(eval) => Some(ExternalLaw(eval)),
+            _ => None,
+        }
+    }
+}
+
+impl KindLaw for SurfaceLaw {
+    fn from_law(law: Law) -> Option<Self> {
+        match law {
+            Law::Surface { eval, hessian, gpu } => Some(SurfaceLaw { eval, hessian, gpu }),
+            _ => None,
+        }
+    }
+}
+
+impl KindLaw for ContactLaw {
+    fn from_law(law: Law) -> Option<Self> {
+        match law {
+            Law::Contact { eval, range } => Some(ContactLaw::NodeFace { eval, range }),
+            Law::ContactArea { switch, density, range } => Some(ContactLaw::Area { switch, density, range }),
+            _ => None,
+        }
+    }
+}
+
+impl ContactLaw {
+    /// Beyond this distance the term is zero.
+    pub fn range(&self, params: &[f64]) -> f64 {
+        match self {
+            ContactLaw::NodeFace { range, .. } | ContactLaw::Area { range, .. } => range(params),
+        }
+    }
+}
+
+impl KindLaw for TetraLaw {
+    fn from_law(law: Law) -> Option<Self> {
+        match law {
+            Law::Tetra(eval) => Some(TetraLaw(eval)),
+            _ => None,
+        }
+    }
+}
+
 impl Law {
     /// Whether the GPU backend has a kernel for this law (and so its
     /// interaction a `shaders/interactions/NAME.wgsl` evaluator): every law
@@ -346,14 +465,6 @@ impl Law {
             Law::Surface { gpu, .. } => *gpu != SurfaceGpu::None,
             Law::Contact { .. } | Law::ContactArea { .. } | Law::Tetra(_) => false,
             _ => true,
-        }
-    }
-
-    /// The range of a contact law (node–face or area-weighted): beyond it E ≡ 0.
-    pub fn contact_range(&self, params: &[f64]) -> Option<f64> {
-        match self {
-            Law::Contact { range, .. } | Law::ContactArea { range, .. } => Some(range(params)),
-            _ => None,
         }
     }
 }
@@ -452,25 +563,21 @@ impl ParamSpec {
 
     /// The allowed range in words, e.g. `> 0` or `in [0, 1]`.
     pub fn range_text(&self) -> String {
-        match (self.min, self.max) {
-            (Bound::None, Bound::None) => "any finite value".into(),
-            (Bound::Inclusive(a), Bound::None) => format!(">= {a}"),
-            (Bound::Exclusive(a), Bound::None) => format!("> {a}"),
-            (Bound::None, Bound::Inclusive(b)) => format!("<= {b}"),
-            (Bound::None, Bound::Exclusive(b)) => format!("< {b}"),
-            (lo, hi) => {
-                let (l, a) = match lo {
-                    Bound::Inclusive(a) => ('[', a),
-                    Bound::Exclusive(a) => ('(', a),
-                    Bound::None => unreachable!(),
-                };
-                let (r, b) = match hi {
-                    Bound::Inclusive(b) => (']', b),
-                    Bound::Exclusive(b) => (')', b),
-                    Bound::None => unreachable!(),
-                };
-                format!("in {l}{a}, {b}{r}")
-            }
+        // (bracket, comparison, value) of each side that is bounded.
+        let lower = match self.min {
+            Bound::None => None,
+            Bound::Inclusive(a) => Some(('[', ">=", a)),
+            Bound::Exclusive(a) => Some(('(', ">", a)),
+        };
+        let upper = match self.max {
+            Bound::None => None,
+            Bound::Inclusive(b) => Some((']', "<=", b)),
+            Bound::Exclusive(b) => Some((')', "<", b)),
+        };
+        match (lower, upper) {
+            (None, None) => "any finite value".into(),
+            (Some((_, op, v)), None) | (None, Some((_, op, v))) => format!("{op} {v}"),
+            (Some((l, _, a)), Some((r, _, b))) => format!("in {l}{a}, {b}{r}"),
         }
     }
 }
@@ -483,6 +590,11 @@ pub trait Interaction: Entry {
     /// The energy expression of a [`custom`] law (for translations to other
     /// engines); `None` for the registered laws.
     fn expression(&self) -> Option<&crate::expr::Expr> {
+        None
+    }
+    /// How LAMMPS writes a term of this type (module [`lammps`]); `None`
+    /// (the default) when it has no equivalent.
+    fn lammps(&self, _term: &lammps::LammpsTerm) -> lammps::Translation {
         None
     }
 }
@@ -512,7 +624,7 @@ mod tests {
         for entry in std::fs::read_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/src/interactions")).unwrap() {
             let path = entry.unwrap().path();
             let stem = path.file_stem().unwrap().to_str().unwrap().to_string();
-            if ["mod", "entry", "testing"].contains(&stem.as_str()) {
+            if ["mod", "entry", "lammps", "testing"].contains(&stem.as_str()) {
                 continue;
             }
             assert!(lookup(&stem).is_some(), "{} has no REGISTRY entry", path.display());

@@ -2,6 +2,7 @@
 
 use std::f64::consts::PI;
 
+use super::lammps::{num, pair, LammpsTerm, Translation};
 use super::{Kind, Law, ParamSpec, Radial};
 use crate::units::Dim;
 
@@ -24,12 +25,19 @@ fn eval(p: &[f64], r: f64) -> Radial {
     }
 }
 
+/// LAMMPS `pair_style soft`: identical.
+fn lammps(term: &LammpsTerm) -> Translation {
+    let p = term.params;
+    pair("soft", format!("{} {}", num(p[A]), num(p[RC])))
+}
+
 interaction!(
     Soft,
     "soft",
     Kind::Pair,
     "Cosine soft repulsion E = A[1 + cos(πr/rc)] (LAMMPS pair_style soft)",
-    Law::Radial { eval, force: radial_force!(eval), range: |p| p[RC] }
+    Law::Radial { eval, force: radial_force!(eval), range: |p| p[RC] },
+    lammps = lammps
 );
 
 #[cfg(test)]

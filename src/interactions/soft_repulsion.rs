@@ -1,5 +1,6 @@
 #![doc = include_str!("soft_repulsion.md")]
 
+use super::lammps::{num, pair, LammpsTerm, Translation};
 use super::{Kind, Law, ParamSpec, Radial};
 use crate::units::Dim;
 
@@ -20,18 +21,26 @@ fn eval(p: &[f64], r: f64) -> Radial {
     }
 }
 
+/// LAMMPS `pair_style harmonic/cut` k(rc − r)²: k/2, rc = σ.
+fn lammps(term: &LammpsTerm) -> Translation {
+    let p = term.params;
+    pair("harmonic/cut", format!("{} {}", num(0.5 * p[K]), num(p[SIGMA])))
+}
+
 interaction!(
     SoftRepulsion,
     "soft_repulsion",
     Kind::Pair,
     "One-sided harmonic excluded volume E = ½k(σ − r)² for r < σ",
-    Law::Radial { eval, force: radial_force!(eval), range: |p| p[SIGMA] }
+    Law::Radial { eval, force: radial_force!(eval), range: |p| p[SIGMA] },
+    lammps = lammps
 );
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::interactions::testing::*;
+    use crate::interactions::{KindLaw, RadialLaw};
     use glam::DVec3;
 
     fn pair(r: f64) -> [DVec3; 2] {
@@ -56,8 +65,7 @@ mod tests {
         let out = eval(&p, 0.9);
         assert!((out.energy - 0.5).abs() < 1e-12 && (out.de_dr + 10.0).abs() < 1e-12);
         assert_eq!(eval(&p, 1.0), Radial::ZERO);
-        let Law::Radial { range, .. } = SoftRepulsion.law() else { unreachable!() };
-        assert_eq!(range(&p), 1.0);
+        assert_eq!((RadialLaw::from_law(SoftRepulsion.law()).unwrap().range)(&p), 1.0);
         // At contact d²E/dr² takes the one-sided (separated) value.
         assert_eq!(eval(&p, 1.0).d2e_dr2, 0.0);
         assert_eq!(eval(&p, 1.0 - 1e-12).d2e_dr2, 100.0);

@@ -1,5 +1,6 @@
 #![doc = include_str!("spring.md")]
 
+use super::lammps::{lepton_bond, num, LammpsTerm, Translation};
 use super::{Kind, Law, ParamSpec, Radial};
 use crate::units::Dim;
 
@@ -19,12 +20,19 @@ fn eval(p: &[f64], r: f64) -> Radial {
     Radial { energy: 0.5 * k * r0 * strain * strain, de_dr: k * strain, d2e_dr2: k / r0 }
 }
 
+/// LAMMPS `bond_style lepton`: the exact expression in Δr = r − r0.
+fn lammps(term: &LammpsTerm) -> Translation {
+    let (k, r0, tau) = (term.params[K], term.params[R0], term.params[TAU]);
+    lepton_bond(format!("0.5*{}*{}*(r/{}+({}))^2", num(k), num(r0), num(r0), num(tau)), r0)
+}
+
 interaction!(
     Spring,
     "spring",
     Kind::Bond,
     "Strain spring with pre-strain, F = k·((r − r0)/r0 + τ) in tension and compression",
-    Law::Radial { eval, force: radial_force!(eval), range: |_| f64::INFINITY }
+    Law::Radial { eval, force: radial_force!(eval), range: |_| f64::INFINITY },
+    lammps = lammps
 );
 
 #[cfg(test)]

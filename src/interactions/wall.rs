@@ -2,6 +2,7 @@
 
 use glam::DVec3;
 
+use super::lammps::{num, LammpsStyle, LammpsTerm, Moving, Translation};
 use super::{Kind, Law, OneBody, ParamSpec};
 use crate::units::Dim;
 
@@ -47,13 +48,56 @@ fn eval(p: &[f64], x: DVec3) -> OneBody {
     }
 }
 
+/// LAMMPS `fix wall/harmonic` ε(r − rc)² for an axis-aligned normal: ε =
+/// k/2, the LAMMPS wall placed rc below the cellmd plane; a `d` that is a
+/// formula of time only becomes an equal-style variable of `time`.
+fn lammps(term: &LammpsTerm) -> Translation {
+    let p = term.params;
+    let moving = match &term.moving {
+        Moving::Fixed => None,
+        Moving::Time { index: D, formula: Ok(formula), variable } => Some((formula, *variable)),
+        Moving::Time { index: D, formula: Err(e), .. } => return Some(Err(format!("external `{}`: {e}", term.label))),
+        Moving::Time { .. } | Moving::Other => return None,
+    };
+    let n = [p[NX], p[NY], p[NZ]];
+    let axes: Vec<usize> = (0..3).filter(|&a| n[a] != 0.0).collect();
+    let [axis] = axes[..] else {
+        return Some(Err(format!(
+            "external `{}`: a wall with the oblique normal ({}, {}, {}) has no LAMMPS equivalent (fix wall/* faces are axis-aligned)",
+            term.label, n[0], n[1], n[2]
+        )));
+    };
+    let letter = "xyz".as_bytes()[axis] as char;
+    if term.periodic[axis] {
+        return Some(Err(format!("external `{}`: LAMMPS cannot put a wall across the periodic axis {letter}", term.label)));
+    }
+    // E = ε(r − rc)² for r < rc with r the distance from the LAMMPS wall:
+    // a wall rc below the cellmd plane gives ε(d − n̂·x)² = ½k(d − n̂·x)².
+    // rc only has to exceed the deepest penetration; a small rc keeps the
+    // round-off of (r − rc) small.
+    let rc = term.box_lengths[axis].max(1.0);
+    let lo = n[axis] > 0.0;
+    let side = if lo { "lo" } else { "hi" };
+    let (position, variable) = match moving {
+        None => (if lo { num(p[D] - rc) } else { num(-p[D] + rc) }, None),
+        // LAMMPS re-evaluates an equal-style face position every step.
+        Some((d, name)) => {
+            let formula = if lo { format!("{d}-{}", num(rc)) } else { format!("-{d}+{}", num(rc)) };
+            (format!("v_{name}"), Some(format!("variable {name} equal \"{formula}\"")))
+        }
+    };
+    let args = format!("wall/harmonic {letter}{side} {position} {} 1.0 {} units box", num(0.5 * p[K]), num(rc));
+    Some(Ok(LammpsStyle::Fix { args, variable }))
+}
+
 interaction!(
     Wall,
     "wall",
     Kind::External,
     "One-sided harmonic plane (substrate): E = ½k(d − n̂·x)² when n̂·x < d",
     Law::OneBody(eval),
-    validate = validate
+    validate = validate,
+    lammps = lammps
 );
 
 fn validate(p: &[f64]) -> Result<(), String> {

@@ -1,5 +1,6 @@
 #![doc = include_str!("wca.md")]
 
+use super::lammps::{num, LammpsStyle, LammpsTerm, Translation};
 use super::lj::{lennard_jones, lennard_jones_over_r};
 use super::{Kind, Law, ParamSpec, Radial};
 use crate::units::Dim;
@@ -38,12 +39,20 @@ fn force(p: &[f64], r2: f64) -> f64 {
     }
 }
 
+/// LAMMPS `pair_style lj/cut` at 2^(1/6)σ with `pair_modify shift yes`.
+fn lammps(term: &LammpsTerm) -> Translation {
+    let p = term.params;
+    let coeffs = format!("{} {} {}", num(p[EPSILON]), num(p[SIGMA]), num(cutoff(p)));
+    Some(Ok(LammpsStyle::Pair { style: "lj/cut", coeffs, shift: true }))
+}
+
 interaction!(
     Wca,
     "wca",
     Kind::Pair,
     "Weeks–Chandler–Andersen repulsion: LJ cut at 2^(1/6)σ and shifted up by ε",
-    Law::Radial { eval, force, range: cutoff }
+    Law::Radial { eval, force, range: cutoff },
+    lammps = lammps
 );
 
 #[cfg(test)]
@@ -72,8 +81,7 @@ mod tests {
     fn vanishes_continuously_at_the_cutoff() {
         let p = params_of(&Wca, &[("epsilon", 0.004), ("sigma", 0.05)]);
         let rc = TWO_SIXTH * 0.05;
-        let Law::Radial { range, .. } = Wca.law() else { unreachable!() };
-        assert!((range(&p) - rc).abs() < 1e-18);
+        assert!((cutoff(&p) - rc).abs() < 1e-18);
         // E(rc⁻) → 0 and F(rc⁻) → 0: continuous energy and force.
         let just_inside = eval(&p, rc * (1.0 - 1e-10));
         assert!(just_inside.energy.abs() < 1e-14 && just_inside.de_dr.abs() < 1e-6, "{just_inside:?}");

@@ -2,6 +2,7 @@
 
 use glam::DVec3;
 
+use super::lammps::{bonded, num, LammpsTerm, Translation};
 use super::{Kind, Law, ParamSpec, ThreeBody};
 use crate::units::Dim;
 
@@ -30,12 +31,18 @@ fn eval(p: &[f64], [ri, rj, rk]: [DVec3; 3]) -> ThreeBody {
     ThreeBody { energy: strength * (1.0 - c), forces: [fi, -fi - fk, fk] }
 }
 
+/// LAMMPS `angle_style cosine` K(1 + cos θ): K = κ/ℓ, since t1·t2 = −cos θ.
+fn lammps(term: &LammpsTerm) -> Translation {
+    bonded("cosine", num(term.params[KAPPA] / term.params[L0]))
+}
+
 interaction!(
     WlcBending,
     "wlc_bending",
     Kind::Angle,
     "Discrete worm-like-chain bending E = (κ/ℓ)(1 − t1·t2) (Cytosim)",
-    Law::ThreeBody(eval)
+    Law::ThreeBody(eval),
+    lammps = lammps
 );
 
 #[cfg(test)]

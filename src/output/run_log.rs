@@ -157,15 +157,19 @@ pub fn model_parameters(model: &Model) -> String {
     let names = &model.type_names;
     let label = |t: &TermType| t.label.text.clone();
     let mut terms: Vec<(&str, String, &TermType)> = Vec::new();
-    terms.extend(model.bond_types.iter().map(|t| ("bond", label(t), t)));
-    terms.extend(model.angle_types.iter().map(|t| ("angle", label(t), t)));
+    terms.extend(model.bond_types.iter().map(|t| ("bond", label(t), t.term())));
+    terms.extend(model.angle_types.iter().map(|t| ("angle", label(t), t.term())));
     let pair_types = &model.pair_rule_types;
     terms.extend(
-        model.pair_rules.iter().zip(pair_types).map(|(t, &(a, b))| ("pair", format!("{} {}", names[a as usize], names[b as usize]), t)),
+        model
+            .pair_rules
+            .iter()
+            .zip(pair_types)
+            .map(|(t, &(a, b))| ("pair", format!("{} {}", names[a as usize], names[b as usize]), t.term())),
     );
-    terms.extend(model.body_rules.iter().map(|t| ("body", label(t), t)));
-    terms.extend(model.contact_rules.iter().map(|t| ("contact", label(t), t)));
-    terms.extend(model.externals.iter().map(|e| ("external", format!("{} {}", label(&e.term), e.group), &e.term)));
+    terms.extend(model.body_rules.iter().map(|t| ("body", label(t), t.term())));
+    terms.extend(model.contact_rules.iter().map(|t| ("contact", label(t), t.term())));
+    terms.extend(model.externals.iter().map(|e| ("external", format!("{} {}", label(&e.term), e.group), e.term.term())));
     for (kind, name, term) in terms {
         let _ = write!(out, "{kind} {name} {}", term.interaction.name());
         for (spec, value) in term.interaction.params().iter().zip(&term.params) {

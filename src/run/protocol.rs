@@ -9,7 +9,7 @@ use glam::DVec3;
 
 use crate::deck::{Protocol, Ramp, Velocity};
 use crate::integrate::context::StepContext;
-use crate::interactions::{param_index, Law};
+use crate::interactions::{param_index, ExternalLaw};
 use crate::system::{Model, SimBox, State};
 
 /// One prescribed particle: which axes the protocol holds and, for a moved
@@ -120,7 +120,7 @@ impl Protocols {
             let term = &mut external.term;
             for (a, name) in ["x", "y", "z"].into_iter().enumerate() {
                 let k = param_index(term.interaction, name).expect("the deck checked the indenter has a centre");
-                term.params[k] += drive.velocity[a] * ctx.dt;
+                term.params_mut()[k] += drive.velocity[a] * ctx.dt;
             }
         }
     }
@@ -255,7 +255,7 @@ pub(super) fn reset_rest(model: &mut Model, state: &mut State, sim_box: &SimBox,
 pub(super) fn indenter_load(model: &Model, state: &State, sim_box: &SimBox, name: &str) -> Option<(f64, f64)> {
     let external = model.externals.iter().find(|e| e.term.label.text == name)?;
     let term = &external.term;
-    let Law::OneBody(eval) = term.interaction.law() else { unreachable!("external law is one-body") };
+    let ExternalLaw(eval) = term.law;
     let k = param_index(term.interaction, "k").map_or(0.0, |k| term.params[k]);
     let (mut total, mut deepest) = (DVec3::ZERO, 0.0f64);
     for &m in &external.members {

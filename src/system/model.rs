@@ -3,16 +3,16 @@
 //! Built from a parsed topology and force field; every name is resolved here,
 //! so an unknown type is reported at its position in the topology file.
 
-use crate::forcefield::{BondTypeKinetics, ForceField, TermType};
+use crate::forcefield::{BondTypeKinetics, ForceField, TermType, Typed};
 use crate::input::{InputError, Token};
-use crate::interactions::{Law, REGISTRY};
+use crate::interactions::{AngleLaw, ContactLaw, ExternalLaw, RadialLaw, SurfaceLaw, TetraLaw, REGISTRY};
 use crate::topology::Topology;
 use crate::units::UnitSystem;
 
 /// An external field acting on a group of particles (deck `external`).
 #[derive(Clone, Debug)]
 pub struct External {
-    pub term: TermType,
+    pub term: Typed<ExternalLaw>,
     pub group: String,
     /// Internal indices of the particles it acts on, ascending.
     pub members: Vec<u32>,
@@ -28,7 +28,7 @@ impl External {
     /// a NaN parameter, so the run stops with a blow-up report naming this
     /// external as the particle's culprit.
     pub fn at(&self, x: glam::DVec3, t: f64) -> crate::interactions::OneBody {
-        let Law::OneBody(eval) = self.term.interaction.law() else { unreachable!("external law is one-body") };
+        let ExternalLaw(eval) = self.term.law;
         if self.expressions.is_empty() {
             return eval(&self.term.params, x);
         }
@@ -100,7 +100,7 @@ pub struct Model {
     pub type_drag: Vec<f64>,
     /// Radius per particle type (0 if not given).
     pub type_radius: Vec<f64>,
-    pub bond_types: Vec<TermType>,
+    pub bond_types: Vec<Typed<RadialLaw>>,
     /// Kinetic rules of each bond type (same order as `bond_types`).
     pub bond_kinetics: Vec<BondTypeKinetics>,
     pub bonds: Vec<[u32; 2]>,
@@ -113,17 +113,17 @@ pub struct Model {
     pub topology_bonds: usize,
     /// Bond formation rules (`bind` lines).
     pub bind_rules: Vec<crate::forcefield::BindRule>,
-    pub angle_types: Vec<TermType>,
+    pub angle_types: Vec<Typed<AngleLaw>>,
     pub angles: Vec<[u32; 3]>,
     pub angle_type: Vec<u32>,
     /// Volume element types (`tetra` lines).
-    pub tetra_types: Vec<TermType>,
+    pub tetra_types: Vec<Typed<TetraLaw>>,
     /// Volume elements (`[ tetrahedra ]`), their types and rest shapes (the
     /// topology's positions of their corners).
     pub tetras: Vec<[u32; 4]>,
     pub tetra_type: Vec<u32>,
     pub tetra_rest: Vec<crate::mesh::TetraRest>,
-    pub pair_rules: Vec<TermType>,
+    pub pair_rules: Vec<Typed<RadialLaw>>,
     /// The particle types (a, b) each pair rule acts between.
     pub pair_rule_types: Vec<(u32, u32)>,
     /// For type pair (a, b): indices into `pair_rules` (symmetric).
@@ -137,11 +137,11 @@ pub struct Model {
     /// Body types: the names `body` lines of the force field give.
     pub body_type_names: Vec<String>,
     /// Surface terms (`body` lines), each acting on every body of its type.
-    pub body_rules: Vec<TermType>,
+    pub body_rules: Vec<Typed<SurfaceLaw>>,
     /// The body type of each surface term.
     pub body_rule_type: Vec<u32>,
     /// Node–face contact terms between bodies (`contact` lines).
-    pub contact_rules: Vec<TermType>,
+    pub contact_rules: Vec<Typed<ContactLaw>>,
     /// The body types (a, b) each contact term acts between (symmetric).
     pub contact_rule_types: Vec<(u32, u32)>,
     /// The bodies of the topology, in `[ bodies ]` order.
@@ -171,7 +171,7 @@ fn check_bond_rest(topology: &Topology, ff: &ForceField, bond_type: &[u32]) -> R
     Ok(())
 }
 
-fn resolve(name: &Token, table: &[TermType], what: &str) -> Result<u32, InputError> {
+fn resolve<L>(name: &Token, table: &[Typed<L>], what: &str) -> Result<u32, InputError> {
     table.iter().position(|t| t.label.text == name.text).map(|i| i as u32).ok_or_else(|| {
         let names: Vec<&str> = table.iter().map(|t| t.label.text.as_str()).collect();
         let listed = if names.is_empty() { "none are defined".to_string() } else { names.join(", ") };
@@ -409,13 +409,7 @@ impl Model {
 
     /// The largest pair cutoff (0 when there are no pair rules).
     pub fn max_pair_cutoff(&self) -> f64 {
-        self.pair_rules
-            .iter()
-            .map(|r| match r.interaction.law() {
-                Law::Radial { range, .. } => range(&r.params),
-                _ => 0.0,
-            })
-            .fold(0.0, f64::max)
+        self.pair_rules.iter().map(|r| (r.law.range)(&r.params)).fold(0.0, f64::max)
     }
 
     /// Pairs left out of the neighbour list by `special_bonds` (i < j): those
@@ -475,13 +469,13 @@ impl Model {
                 used[k] = true;
             }
         };
-        self.bond_types.iter().for_each(&mut mark);
-        self.angle_types.iter().for_each(&mut mark);
-        self.tetra_types.iter().for_each(&mut mark);
-        self.pair_rules.iter().for_each(&mut mark);
+        self.bond_types.iter().for_each(|t| mark(t));
+        self.angle_types.iter().for_each(|t| mark(t));
+        self.tetra_types.iter().for_each(|t| mark(t));
+        self.pair_rules.iter().for_each(|t| mark(t));
         self.externals.iter().for_each(|e| mark(&e.term));
-        self.body_rules.iter().for_each(&mut mark);
-        self.contact_rules.iter().for_each(&mut mark);
+        self.body_rules.iter().for_each(|t| mark(t));
+        self.contact_rules.iter().for_each(|t| mark(t));
         (0..REGISTRY.len()).filter(|&k| used[k]).collect()
     }
 }
@@ -543,7 +537,7 @@ mod tests {
     fn an_external_evaluates_its_expression_parameters_at_each_position_and_time() {
         let label = crate::input::lex(&SourceFile::new("t.in", "trap")).unwrap()[0].tokens[0].clone();
         let field = crate::interactions::lookup("field").unwrap();
-        let term = TermType { label, interaction: field, params: vec![0.0; 4] };
+        let term = Typed::new(TermType { label, interaction: field, params: vec![0.0; 4] }).unwrap();
         let exprs = ["-2*(x - 0.5*t)", "-2*y", "-2*(z - sin(t))", "(x - 0.5*t)^2 + y^2 + (z - sin(t))^2"];
         let expressions = exprs.iter().enumerate().map(|(k, e)| (k, crate::expr::parse(e).unwrap())).collect();
         let trap = External { term, group: "all".into(), members: vec![0], expressions };

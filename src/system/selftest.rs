@@ -21,8 +21,9 @@ use glam::DVec3;
 
 use super::{External, Model, SimBox};
 use crate::forcefield::TermType;
+use crate::forcefield::Typed;
 use crate::interactions::testing::{assert_all_checks, assert_surface_checks};
-use crate::interactions::Law;
+use crate::interactions::{Law, RadialLaw};
 
 /// One line per custom term: `Ok("bond spring: 3 geometries")` or the
 /// first check that failed.
@@ -168,8 +169,8 @@ fn finite_radial(e: crate::interactions::Radial) -> bool {
 /// of the largest |E| and |dE/dr| at the checked distances): where they do
 /// not, the truncation is a jump the dynamics feel as an impulse, reported
 /// as a warning (not refused: LAMMPS' unshifted pair styles truncate alike).
-fn at_cutoff(term: &TermType, cutoff: f64) -> String {
-    let Law::Radial { eval, .. } = term.interaction.law() else { unreachable!("pair law is radial") };
+fn at_cutoff(term: &Typed<RadialLaw>, cutoff: f64) -> String {
+    let RadialLaw { eval, .. } = term.law;
     let inside: Vec<_> = [0.3, 0.55, 0.8].iter().map(|s| eval(&term.params, s * cutoff)).collect();
     let (e_scale, f_scale) = inside.iter().fold((0.0f64, 0.0f64), |(e, f), x| (e.max(x.energy.abs()), f.max(x.de_dr.abs())));
     let edge = eval(&term.params, cutoff * (1.0 - 1e-12));

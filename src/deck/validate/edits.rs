@@ -7,7 +7,7 @@ use super::{expect_len, options, positive, NamedExpr, Validator};
 use crate::deck::expression::DeckExpr;
 use crate::deck::plan::{Action, Group};
 use crate::expr::{ExprError, Ref};
-use crate::forcefield::{param_value, parse_params, TermType};
+use crate::forcefield::{param_value, parse_params, typed, TermType};
 use crate::input::{parse_f64, parse_u64, InputError, Token};
 use crate::interactions::{param_index, Kind};
 use crate::system::{position_or_time, External};
@@ -82,10 +82,11 @@ impl Validator {
         self.model(kw)?;
         let group = self.group_named(&s[2])?.clone();
         let (term, expressions) = if s[3].text == "custom" {
-            crate::forcefield::parse_custom_external(&s[1], &s[3], &s[4..], units)?
+            let (term, expressions) = crate::forcefield::parse_custom_external(&s[1], &s[3], &s[4..], units)?;
+            (typed(term, &s[3])?, expressions)
         } else {
             let (values, expressions) = self.external_expressions(&s[4..], &group)?;
-            let term = parse_params(&s[1], &s[3], &values, Kind::External, units)?;
+            let term = typed(parse_params(&s[1], &s[3], &values, Kind::External, units)?, &s[3])?;
             let expressions = self.check_external_expressions(&term, &group, expressions)?;
             (term, expressions)
         };
@@ -172,7 +173,7 @@ impl Validator {
         for target in targets {
             for pair in s[start..].chunks(2) {
                 let index = self.target_param(&target, &pair[0])?;
-                let value = param_value(&target.term_mut(self.model(&pair[0])?).interaction.params()[index], &pair[1], units)?;
+                let value = param_value(&target.term(self.model(&pair[0])?).interaction.params()[index], &pair[1], units)?;
                 self.set_target_param(&target, index, value, &pair[1])?;
                 edits.push(Action::Coeff { target: target.clone(), param: index, value });
             }

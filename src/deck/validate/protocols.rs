@@ -111,7 +111,7 @@ impl Validator {
         let mut ramps = Vec::new();
         for target in targets {
             let param = self.target_param(&target, name)?;
-            let interaction = target.term_mut(self.model(name)?).interaction;
+            let interaction = target.term(self.model(name)?).interaction;
             let spec = &interaction.params()[param];
             let what = |end: &str| format!("the {end} value of `{}` in {}", spec.name, self.units.label(spec.dim));
             let from = parse_f64(from_token, &what("start"))?;

@@ -4,9 +4,9 @@
 
 use super::{expect_len, Validator};
 use crate::deck::plan::CoeffTarget;
-use crate::forcefield::{check_param, param_position};
+use crate::forcefield::{check_param, param_position, TermType};
 use crate::input::{InputError, Token};
-use crate::interactions::Law;
+use crate::interactions::Kind;
 
 impl Validator {
     /// The terms `s[1..]` names and the index of the first token after the
@@ -16,11 +16,13 @@ impl Validator {
         let model = self.model(&s[0])?;
         match s[1].text.as_str() {
             "bond" | "angle" => {
-                let table = if s[1].text == "bond" { &model.bond_types } else { &model.angle_types };
-                let index = table.iter().position(|t| t.label.text == s[2].text).ok_or_else(|| {
-                    s[2].error(format!("found {} type `{}`, expected one defined in the force field", s[1].text, s[2].text))
-                })?;
-                Ok((vec![if s[1].text == "bond" { CoeffTarget::BondType(index) } else { CoeffTarget::AngleType(index) }], 3))
+                let missing = || s[2].error(format!("found {} type `{}`, expected one defined in the force field", s[1].text, s[2].text));
+                let named = |t: &TermType| t.label.text == s[2].text;
+                let target = match Kind::from_keyword(&s[1].text) {
+                    Some(Kind::Bond) => CoeffTarget::BondType(model.bond_types.iter().position(|t| named(t)).ok_or_else(missing)?),
+                    _ => CoeffTarget::AngleType(model.angle_types.iter().position(|t| named(t)).ok_or_else(missing)?),
+                };
+                Ok((vec![target], 3))
             }
             "pair" => {
                 expect_len(s, 4..=usize::MAX, usage)?;
@@ -88,7 +90,7 @@ impl Validator {
             own_rest = (0..model.bond_rest.len()).filter(|&b| model.bond_type[b] as usize == *k && model.bond_rest[b].is_some()).count();
             rest_index = model.bond_kinetics[*k].rest_index;
         }
-        let term = target.term_mut(model);
+        let term = target.term(model);
         let (label, interaction) = (term.label.text.clone(), term.interaction);
         let index = param_position(interaction.params(), interaction.name(), name)?;
         if rest_index == Some(index) {
@@ -118,9 +120,9 @@ impl Validator {
     /// it in the working model. `at` is the value's token.
     pub(super) fn set_target_param(&mut self, target: &CoeffTarget, param: usize, value: f64, at: &Token) -> Result<(), InputError> {
         let model = self.model(at)?;
-        check_param(&target.term_mut(model).interaction.params()[param], value, at)?;
+        check_param(&target.term(model).interaction.params()[param], value, at)?;
         target.set(model, param, value);
-        let term = target.term_mut(model);
+        let term = target.term(model);
         term.interaction
             .validate(&term.params)
             .map_err(|e| at.error(format!("invalid `{}` parameters: expected {e}", term.interaction.name())))
@@ -129,9 +131,8 @@ impl Validator {
     /// The cutoff of a pair rule's law with its current parameters (None
     /// for other targets).
     pub(super) fn pair_cutoff(&mut self, target: &CoeffTarget, at: &Token) -> Result<Option<f64>, InputError> {
-        let CoeffTarget::PairRule(_) = target else { return Ok(None) };
-        let term = target.term_mut(self.model(at)?);
-        let Law::Radial { range, .. } = term.interaction.law() else { unreachable!("pair law is radial") };
-        Ok(Some(range(&term.params)))
+        let CoeffTarget::PairRule(k) = target else { return Ok(None) };
+        let term = &self.model(at)?.pair_rules[*k];
+        Ok(Some((term.law.range)(&term.params)))
     }
 }

@@ -1,4 +1,4 @@
-//! A `custom` law's energy tree as a Lepton expression (LAMMPS' `bond_style
+//! A `custom` law's energy tree as a Lepton expression, for its LAMMPS translation (LAMMPS' `bond_style
 //! lepton`, `angle_style lepton`, `pair_style lepton`; OpenMM's parser).
 //!
 //! Parameters are written as their current values (`coeff` may have changed
@@ -18,8 +18,8 @@
 //!
 //! `round` has no Lepton equivalent and is an error that says so.
 
-use super::number::num;
 use crate::expr::{BinaryOp, Expr, UnaryOp};
+use crate::interactions::lammps::num;
 
 /// The Lepton text of `expr`; `value` gives the number of each parameter
 /// name, any other name (the law's variable) is written as it is.
