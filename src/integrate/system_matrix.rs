@@ -16,7 +16,8 @@
 //!   dense solve).
 //!
 //! A `fixed` particle (infinite drag) has the identity row and no couplings,
-//! in the blocks and in the rank-one vectors alike.
+//! in the blocks and in the rank-one vectors alike; so has each held
+//! coordinate (`freeze`, `move`: `held`, per degree of freedom), alone.
 
 use faer::dyn_stack::{MemStack, StackReq};
 use faer::linalg::solvers::Solve;
@@ -36,11 +37,13 @@ pub struct SystemMatrix {
 }
 
 impl SystemMatrix {
-    /// Assembles γ_i/dt·I + K̃ (`drag[i]` infinite for a fixed particle).
-    pub fn new(drag: &[f64], dt: f64, stiffness: &Stiffness) -> Result<Self, String> {
+    /// Assembles γ_i/dt·I + K̃ (`drag[i]` infinite for a fixed particle;
+    /// `held[3i + a]` true for a held coordinate, or `held` empty).
+    pub fn new(drag: &[f64], held: &[bool], dt: f64, stiffness: &Stiffness) -> Result<Self, String> {
         let n = drag.len();
         let dim = 3 * n;
         let fixed = |i: usize| drag[i].is_infinite();
+        let pinned = |k: usize| fixed(k / 3) || held.get(k).copied().unwrap_or(false);
         // The diagonal, then the blocks between mobile particles, merged per
         // (i, j) in column order (a stable sort: duplicates add in term order)
         // so the triplets arrive sorted, 9 per distinct block.
@@ -60,7 +63,12 @@ impl SystemMatrix {
             }
             for col in 0..3 {
                 for row in 0..3 {
-                    triplets.push(Triplet::new(3 * i + row, 3 * j + col, block.col(col)[row]));
+                    let (r, c) = (3 * i + row, 3 * j + col);
+                    if !pinned(r) && !pinned(c) {
+                        triplets.push(Triplet::new(r, c, block.col(col)[row]));
+                    } else if r == c {
+                        triplets.push(Triplet::new(r, c, 1.0));
+                    }
                 }
             }
         }
@@ -69,7 +77,10 @@ impl SystemMatrix {
             .rank_one
             .iter()
             .map(|r| {
-                let entries = r.particles.iter().zip(&r.gradient).filter(|(&p, _)| !fixed(p as usize)).map(|(&p, &g)| (p as usize, g));
+                let entries = r.particles.iter().zip(&r.gradient).filter(|(&p, _)| !fixed(p as usize)).map(|(&p, &g)| {
+                    let p = p as usize;
+                    (p, DVec3::from_array(std::array::from_fn(|a| if pinned(3 * p + a) { 0.0 } else { g[a] })))
+                });
                 (r.weight, entries.collect())
             })
             .collect();
@@ -184,7 +195,7 @@ mod tests {
             ],
         };
         let dt = 0.1;
-        let a = SystemMatrix::new(&drag, dt, &stiffness).unwrap();
+        let a = SystemMatrix::new(&drag, &[], dt, &stiffness).unwrap();
         // The dense A: fixed particle 2 keeps the identity row and loses its couplings.
         let mut dense = Mat::<f64>::zeros(12, 12);
         for (i, gamma) in drag.iter().enumerate() {
