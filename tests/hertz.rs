@@ -25,7 +25,7 @@
 //! the elements of one side only, so it sinks by half the whole ball's
 //! (a quarter on the plate's axis): the octant's load ×4 is the ball's to
 //! that 0.1 % level. Measured: at `--cells 16` the whole ball and the octant
-//! agree to 4 digits at every stage; at `--cells 8` the whole ball, whose
+//! agree within 0.2 % at every stage; at `--cells 8` the whole ball, whose
 //! frictionless plates leave its orientation free, settles in tilted states
 //! of its faceted surface, 2–7 % off the symmetric one at δ/R = 0.06–0.08.
 //!
