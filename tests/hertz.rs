@@ -146,7 +146,13 @@ fn report(label: &str, cells: u32, stages: &[Stage]) -> (f64, f64, f64) {
     let (mut hertz_worst, mut tatara_worst): (f64, f64) = (0.0, 0.0);
     for s in stages {
         let (h, t) = (s.load / hertz(s.delta) - 1.0, s.load / tatara(s.delta) - 1.0);
-        println!("  {:.2}  {:10.3}  {h:+.4}  {t:+.4}  {:.2}  {:.1e}", s.delta / RADIUS, s.load, (RADIUS * s.delta).sqrt() / spacing, s.drift);
+        println!(
+            "  {:.2}  {:10.3}  {h:+.4}  {t:+.4}  {:.2}  {:.1e}",
+            s.delta / RADIUS,
+            s.load,
+            (RADIUS * s.delta).sqrt() / spacing,
+            s.drift
+        );
         hertz_worst = hertz_worst.max(h.abs());
         tatara_worst = tatara_worst.max(t.abs());
     }

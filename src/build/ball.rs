@@ -115,7 +115,8 @@ pub fn ball(args: &BallArgs) -> Result<Built, String> {
                 let p = DVec3::new(i as f64, j as f64, k as f64) * (2.0 / n as f64) - DVec3::ONE;
                 let v = index(i, j, k);
                 x[v] = centre + radius * cube_to_ball(p);
-                let held: String = [(i, 'x'), (j, 'y'), (k, 'z')].iter().filter(|&&(c, _)| args.octant && c == n / 2).map(|&(_, a)| a).collect();
+                let held: String =
+                    [(i, 'x'), (j, 'y'), (k, 'z')].iter().filter(|&&(c, _)| args.octant && c == n / 2).map(|&(_, a)| a).collect();
                 let type_name = if held.is_empty() { args.particle_type.clone() } else { format!("{}_{held}", args.particle_type) };
                 id[v] = writer.particle(&type_name, x[v], None);
                 count += 1;
