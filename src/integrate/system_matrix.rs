@@ -176,9 +176,18 @@ mod tests {
     use super::*;
     use crate::backend::{RankOneTerm, StiffnessBlock};
 
-    /// Products and the Woodbury solve agree with the dense matrix.
+    /// Products and the Woodbury solve agree with the dense matrix, without
+    /// and with held coordinates (particle 0's y and particle 3's x).
     #[test]
     fn low_rank_products_and_solves_match_the_dense_matrix() {
+        let mut held = [false; 12];
+        (held[1], held[9]) = (true, true);
+        for held in [&[][..], &held[..]] {
+            products_and_solves_match(held);
+        }
+    }
+
+    fn products_and_solves_match(held: &[bool]) {
         let drag = [2.0, 1.0, f64::INFINITY, 0.5];
         let block = DMat3::from_cols(DVec3::new(3.0, 1.0, 0.0), DVec3::new(1.0, 2.0, 0.5), DVec3::new(0.0, 0.5, 1.0));
         let stiffness = Stiffness {
@@ -195,7 +204,7 @@ mod tests {
             ],
         };
         let dt = 0.1;
-        let a = SystemMatrix::new(&drag, &[], dt, &stiffness).unwrap();
+        let a = SystemMatrix::new(&drag, held, dt, &stiffness).unwrap();
         // The dense A: fixed particle 2 keeps the identity row and loses its couplings.
         let mut dense = Mat::<f64>::zeros(12, 12);
         for (i, gamma) in drag.iter().enumerate() {
@@ -214,6 +223,14 @@ mod tests {
                 (0..3).for_each(|k| g[3 * p as usize + k] = v[k]);
             }
             dense += term.weight * &g * g.transpose();
+        }
+        // A held coordinate likewise: the identity row and column.
+        for k in (0..12).filter(|&k| held.get(k).copied().unwrap_or(false)) {
+            for m in 0..12 {
+                dense[(k, m)] = 0.0;
+                dense[(m, k)] = 0.0;
+            }
+            dense[(k, k)] = 1.0;
         }
         let v = Col::from_fn(12, |k| (k as f64 * 0.7).sin());
         assert!((a.times(&v) - &dense * &v).norm_l2() < 1e-12 * v.norm_l2());
