@@ -12,10 +12,11 @@
 //! the approach of points far from the contact. In a ball the opposite
 //! contact is only 2R away, and its load F pushes this one back by the
 //! Boussinesq displacement of a half-space at depth 2R (radius a off the
-//! axis): Tatara's finite-sphere law (Y. Tatara, J. Eng. Mater. Technol.
+//! axis), the idea of Tatara's finite-sphere law (Y. Tatara, J. Eng. Mater. Technol.
 //! 111, 163, 1989; its large-strain sequel ibid. 113, 285, 1991)
 //! δ = a²/R − F(1 + ν)/(2πE)·[2(1 − ν)/√(4R² + a²) + 4R²/(4R² + a²)^{3/2}],
-//! with Hertz's a³ = 3(1 − ν²)FR/(4E). The correction grows as a/R: at
+//! with Hertz's a³ = 3(1 − ν²)FR/(4E) (written here from the Boussinesq
+//! solution; the papers' text was not at hand to check it). The correction grows as a/R: at
 //! δ/R = 0.02 it raises the load by 8 % over Hertz, at 0.1 by 21 %, so no
 //! ball can meet the "Hertz within 5 %" at δ/R = 0.1 — the finite
 //! sphere is not a half-space. The tests compare with both laws.
@@ -25,9 +26,10 @@
 //! the elements of one side only, so it sinks by half the whole ball's
 //! (a quarter on the plate's axis): the octant's load ×4 is the ball's to
 //! that 0.1 % level. Measured: at `--cells 16` the whole ball and the octant
-//! agree within 0.2 % at every stage; at `--cells 8` the whole ball, whose
-//! frictionless plates leave its orientation free, settles in tilted states
-//! of its faceted surface, 2–7 % off the symmetric one at δ/R = 0.06–0.08.
+//! agree within 0.2 % at every stage; at `--cells 8` they differ by 2–7 %
+//! at δ/R = 0.06–0.08, the whole ball's stages barely converged (likely
+//! tilted states of its faceted surface, which its frictionless plates
+//! allow; not checked).
 //!
 //! The refinement study prints the tables (README, *Solid bodies*):
 //! `cargo test --test hertz -- --ignored --nocapture`.
@@ -183,10 +185,9 @@ fn tatara_exceeds_hertz_by_the_finite_sphere_correction() {
 /// What the CI-sized ball (`--cells 8`) shows: each stage relaxed, the two
 /// plates' loads equal and opposite, and the load growing as δ^{3/2}
 /// (fitted exponent within ±0.1 of Hertz's 1.5). Its amplitude is not
-/// compared: at this size the whole ball settles in tilted states that the
-/// faceted surface allows (its plates are frictionless, so nothing holds its
-/// orientation), 2–7 % off the mirror-symmetric state of the octant at
-/// δ/R = 0.06–0.08; from `--cells 16` on they agree (README).
+/// compared: at this size the whole ball lies 2–7 % off the octant's
+/// mirror-symmetric state at δ/R = 0.06–0.08 (module docs); from
+/// `--cells 16` on they agree (README).
 #[test]
 fn a_meshed_ball_loads_as_hertz_delta_to_the_three_halves() {
     let stages = sweep(8, false);
