@@ -17,6 +17,16 @@
 //! where three faces of a cell map onto one patch of the sphere: every
 //! element there keeps the cell's inner corner, so none lies flat on it),
 //! the element volumes and the total volume against 4πR³/3.
+//!
+//! `--octant` keeps one eighth of that mesh, the cells and nodes at or above
+//! the centre along every axis: the split is mirrored into each octant, so
+//! the octant is exactly the part of the full mesh that a load symmetric
+//! about the three planes through the centre deforms in mirror image. The
+//! nodes on those symmetry planes get the type `TYPE_AXES`, AXES the
+//! coordinates the planes fix (`node_x` on x = cx only, `node_xz` on the
+//! edge where x = cx and z = cz meet, `node_xyz` the centre): a deck holds
+//! them with `freeze` (mirror-symmetric boundary conditions) and so solves
+//! the whole ball's symmetric problem on an eighth of the nodes.
 
 use std::f64::consts::{FRAC_PI_4, PI};
 use std::path::PathBuf;
@@ -41,6 +51,9 @@ pub struct BallArgs {
     /// Particle type of the nodes.
     #[arg(long, default_value = "node")]
     pub particle_type: String,
+    /// Keep one octant (x, y, z ≥ centre) and type the nodes on its symmetry planes TYPE_x, TYPE_xy, …
+    #[arg(long)]
+    pub octant: bool,
     /// Tetra type of the elements (what a `tetra` line of the force field names).
     #[arg(long, default_value = "solid")]
     pub tetra_type: String,
@@ -90,21 +103,30 @@ pub fn ball(args: &BallArgs) -> Result<Built, String> {
     }
     let side = n + 1;
     let index = |i: usize, j: usize, k: usize| (i * side + j) * side + k;
+    // The octant keeps lattice indices ≥ n/2 along every axis.
+    let low = if args.octant { n / 2 } else { 0 };
     let mut writer = Writer::new(1);
-    let mut x = Vec::with_capacity(side * side * side);
-    for i in 0..side {
-        for j in 0..side {
-            for k in 0..side {
+    let mut x = vec![DVec3::ZERO; side * side * side];
+    let mut id = vec![0u64; side * side * side];
+    let mut count = 0;
+    for i in low..side {
+        for j in low..side {
+            for k in low..side {
                 let p = DVec3::new(i as f64, j as f64, k as f64) * (2.0 / n as f64) - DVec3::ONE;
-                x.push(centre + radius * cube_to_ball(p));
-                writer.particle(&args.particle_type, x[x.len() - 1], None);
+                let v = index(i, j, k);
+                x[v] = centre + radius * cube_to_ball(p);
+                let held: String =
+                    [(i, 'x'), (j, 'y'), (k, 'z')].iter().filter(|&&(c, _)| args.octant && c == n / 2).map(|&(_, a)| a).collect();
+                let type_name = if held.is_empty() { args.particle_type.clone() } else { format!("{}_{held}", args.particle_type) };
+                id[v] = writer.particle(&type_name, x[v], None);
+                count += 1;
             }
         }
     }
     let (mut qualities, mut volumes) = (Vec::new(), Vec::new());
-    for i in 0..n {
-        for j in 0..n {
-            for k in 0..n {
+    for i in low..n {
+        for j in low..n {
+            for k in low..n {
                 // Along each axis, from the cell's side nearer the centre outwards.
                 let outward = [i, j, k].map(|c| 2 * c >= n);
                 let start = [i, j, k].map(|c| if 2 * c >= n { c } else { c + 1 });
@@ -122,7 +144,7 @@ pub fn ball(args: &BallArgs) -> Result<Built, String> {
                     }
                     qualities.push(quality(at));
                     volumes.push(tetra_edges(at).determinant() / 6.0);
-                    writer.tetra(&args.tetra_type, nodes.map(|v| v as u64 + 1));
+                    writer.tetra(&args.tetra_type, nodes.map(|v| id[v]));
                 }
             }
         }
@@ -130,14 +152,19 @@ pub fn ball(args: &BallArgs) -> Result<Built, String> {
     let [q_lo, q_mean, _] = min_mean_max(&qualities);
     let [v_lo, v_mean, v_hi] = min_mean_max(&volumes);
     let total: f64 = volumes.iter().sum();
-    let sphere = 4.0 / 3.0 * PI * radius.powi(3);
-    let lines = vec![
-        format!("ball of radius {radius} at {centre}: {} nodes, {} tetrahedra (cubed-sphere map of a {n}³ lattice, 6 per cell)", x.len(), volumes.len()),
-        format!("volume {total:.6e} ({:.3} % below 4πR³/3, the sphere inscribed by the surface faces)", 100.0 * (sphere - total) / sphere),
+    let (part, share, exact) = if args.octant { ("octant of a ball", 8.0, "πR³/6") } else { ("ball", 1.0, "4πR³/3") };
+    let sphere = 4.0 / 3.0 * PI * radius.powi(3) / share;
+    let mut lines = vec![
+        format!("{part} of radius {radius} at {centre}: {count} nodes, {} tetrahedra (cubed-sphere map of a {n}³ lattice, 6 per cell)", volumes.len()),
+        format!("volume {total:.6e} ({:.3} % below {exact}, the sphere inscribed by the surface faces)", 100.0 * (sphere - total) / sphere),
         format!("element volume min {v_lo:.3e} mean {v_mean:.3e} max {v_hi:.3e}; quality 6√2·V/ℓ_rms³ min {q_lo:.3} mean {q_mean:.3} (regular: 1)"),
         format!("force field: tetra {} neo_hookean e E nu ν   (or linear_elastic; E in pN/µm²)", args.tetra_type),
     ];
-    let command = format!("ball --radius {radius} --cells {n}");
+    if args.octant {
+        let t = &args.particle_type;
+        lines.push(format!("symmetry planes: hold {t}_x {t}_xy {t}_xz {t}_xyz along x, {t}_y {t}_xy {t}_yz {t}_xyz along y, {t}_z {t}_xz {t}_yz {t}_xyz along z (`freeze`)"));
+    }
+    let command = format!("ball --radius {radius} --cells {n}{}", if args.octant { " --octant" } else { "" });
     Ok(writer.finish("Elastic ball of linear tetrahedra", &command, lines))
 }
 
@@ -151,8 +178,36 @@ mod tests {
             cells,
             centre: vec![0.5, 0.0, -1.0],
             particle_type: "node".into(),
+            octant: false,
             tetra_type: "solid".into(),
             output: "ball.top".into(),
+        }
+    }
+
+    #[test]
+    fn the_octant_is_the_full_mesh_above_the_centre_with_its_symmetry_planes_typed() {
+        let full = ball(&args(8)).unwrap();
+        let octant = ball(&BallArgs { octant: true, ..args(8) }).unwrap();
+        assert_eq!((octant.particles, octant.tetrahedra), (125, 6 * 64));
+        let parse = |b: &Built| crate::topology::parse_topology(&crate::input::SourceFile::new("ball.top", &b.text)).unwrap();
+        let (full, octant) = (parse(&full), parse(&octant));
+        let centre = DVec3::new(0.5, 0.0, -1.0);
+        // Every octant element is a full-mesh element (same corners, same order).
+        let key = |top: &crate::topology::Topology, t: [u32; 4]| t.map(|p| top.positions[p as usize].to_array().map(f64::to_bits));
+        let elements: std::collections::HashSet<_> = full.tetrahedra.iter().map(|t| key(&full, t.particles)).collect();
+        for t in &octant.tetrahedra {
+            assert!(elements.contains(&key(&octant, t.particles)), "octant element {:?} not in the full mesh", t.particles);
+        }
+        let volume = |top: &crate::topology::Topology| -> f64 {
+            top.tetrahedra.iter().map(|t| tetra_edges(t.particles.map(|p| top.positions[p as usize])).determinant() / 6.0).sum()
+        };
+        assert!((8.0 * volume(&octant) - volume(&full)).abs() < 1e-12 * volume(&full));
+        for (p, x) in octant.positions.iter().enumerate() {
+            let d = *x - centre;
+            assert!(d.min_element() > -1e-12, "node {p} below the centre: {d}");
+            let held: String = [(d.x, 'x'), (d.y, 'y'), (d.z, 'z')].iter().filter(|a| a.0 == 0.0).map(|a| a.1).collect();
+            let expected = if held.is_empty() { "node".to_string() } else { format!("node_{held}") };
+            assert_eq!(octant.type_names[p].text, expected, "node {p} at {d}");
         }
     }
 

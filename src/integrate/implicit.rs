@@ -17,7 +17,9 @@
 //! default; relative residual `tolerance`, at most `max_iterations`), or by a
 //! sparse Cholesky factorisation (`solver cholesky`). A `fixed` particle
 //! (infinite drag) has Δx = 0: its row is the identity and its couplings are
-//! dropped. Both solvers run sequentially, so the step is the same on any
+//! dropped; so has a held coordinate (`freeze`, `move`: the protocols put it
+//! back after the step), so the solve moves the free coordinates as the
+//! held ones will be, and its fixed point is the held equilibrium. Both solvers run sequentially, so the step is the same on any
 //! thread count.
 //!
 //! With constrained bonds (`constrain`), the step solves the constrained
@@ -106,6 +108,7 @@ pub fn implicit_step(
     implicit: &ImplicitSettings,
     constrained: &mut ConstrainedBonds,
     limits: Option<&[f64]>,
+    held: &[bool],
 ) -> Result<SolveReport, ImplicitError> {
     let StepContext { dt, kt, seed, noise, step, .. } = *ctx;
     let n = state.len();
@@ -113,7 +116,7 @@ pub fn implicit_step(
     let gamma = |i: usize| model.type_drag[model.types[i] as usize];
     let fixed = |i: usize| gamma(i).is_infinite();
     let drag: Vec<f64> = (0..n).map(gamma).collect();
-    let matrix = SystemMatrix::new(&drag, dt, stiffness).map_err(ImplicitError::Solve)?;
+    let matrix = SystemMatrix::new(&drag, held, dt, stiffness).map_err(ImplicitError::Solve)?;
     let mut rhs = Col::<f64>::zeros(dim);
     let mut guess = Mat::<f64>::zeros(dim, 1);
     for i in (0..n).filter(|&i| !fixed(i)) {
@@ -121,7 +124,7 @@ pub fn implicit_step(
         if kt > 0.0 {
             b += (2.0 * kt * gamma(i) / dt).sqrt() * DVec3::from_array(noise3(seed, step, i as u32, noise));
         }
-        for a in 0..3 {
+        for a in (0..3).filter(|&a| !held.get(3 * i + a).copied().unwrap_or(false)) {
             rhs[3 * i + a] = b[a];
             guess[(3 * i + a, 0)] = b[a] * dt / gamma(i); // the explicit step
         }

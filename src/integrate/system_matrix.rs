@@ -16,7 +16,8 @@
 //!   dense solve).
 //!
 //! A `fixed` particle (infinite drag) has the identity row and no couplings,
-//! in the blocks and in the rank-one vectors alike.
+//! in the blocks and in the rank-one vectors alike; so has each held
+//! coordinate (`freeze`, `move`: `held`, per degree of freedom), alone.
 
 use faer::dyn_stack::{MemStack, StackReq};
 use faer::linalg::solvers::Solve;
@@ -36,11 +37,13 @@ pub struct SystemMatrix {
 }
 
 impl SystemMatrix {
-    /// Assembles γ_i/dt·I + K̃ (`drag[i]` infinite for a fixed particle).
-    pub fn new(drag: &[f64], dt: f64, stiffness: &Stiffness) -> Result<Self, String> {
+    /// Assembles γ_i/dt·I + K̃ (`drag[i]` infinite for a fixed particle;
+    /// `held[3i + a]` true for a held coordinate, or `held` empty).
+    pub fn new(drag: &[f64], held: &[bool], dt: f64, stiffness: &Stiffness) -> Result<Self, String> {
         let n = drag.len();
         let dim = 3 * n;
         let fixed = |i: usize| drag[i].is_infinite();
+        let pinned = |k: usize| fixed(k / 3) || held.get(k).copied().unwrap_or(false);
         // The diagonal, then the blocks between mobile particles, merged per
         // (i, j) in column order (a stable sort: duplicates add in term order)
         // so the triplets arrive sorted, 9 per distinct block.
@@ -60,7 +63,12 @@ impl SystemMatrix {
             }
             for col in 0..3 {
                 for row in 0..3 {
-                    triplets.push(Triplet::new(3 * i + row, 3 * j + col, block.col(col)[row]));
+                    let (r, c) = (3 * i + row, 3 * j + col);
+                    if !pinned(r) && !pinned(c) {
+                        triplets.push(Triplet::new(r, c, block.col(col)[row]));
+                    } else if r == c {
+                        triplets.push(Triplet::new(r, c, 1.0));
+                    }
                 }
             }
         }
@@ -69,7 +77,10 @@ impl SystemMatrix {
             .rank_one
             .iter()
             .map(|r| {
-                let entries = r.particles.iter().zip(&r.gradient).filter(|(&p, _)| !fixed(p as usize)).map(|(&p, &g)| (p as usize, g));
+                let entries = r.particles.iter().zip(&r.gradient).filter(|(&p, _)| !fixed(p as usize)).map(|(&p, &g)| {
+                    let p = p as usize;
+                    (p, DVec3::from_array(std::array::from_fn(|a| if pinned(3 * p + a) { 0.0 } else { g[a] })))
+                });
                 (r.weight, entries.collect())
             })
             .collect();
@@ -165,9 +176,18 @@ mod tests {
     use super::*;
     use crate::backend::{RankOneTerm, StiffnessBlock};
 
-    /// Products and the Woodbury solve agree with the dense matrix.
+    /// Products and the Woodbury solve agree with the dense matrix, without
+    /// and with held coordinates (particle 0's y and particle 3's x).
     #[test]
     fn low_rank_products_and_solves_match_the_dense_matrix() {
+        let mut held = [false; 12];
+        (held[1], held[9]) = (true, true);
+        for held in [&[][..], &held[..]] {
+            products_and_solves_match(held);
+        }
+    }
+
+    fn products_and_solves_match(held: &[bool]) {
         let drag = [2.0, 1.0, f64::INFINITY, 0.5];
         let block = DMat3::from_cols(DVec3::new(3.0, 1.0, 0.0), DVec3::new(1.0, 2.0, 0.5), DVec3::new(0.0, 0.5, 1.0));
         let stiffness = Stiffness {
@@ -184,7 +204,7 @@ mod tests {
             ],
         };
         let dt = 0.1;
-        let a = SystemMatrix::new(&drag, dt, &stiffness).unwrap();
+        let a = SystemMatrix::new(&drag, held, dt, &stiffness).unwrap();
         // The dense A: fixed particle 2 keeps the identity row and loses its couplings.
         let mut dense = Mat::<f64>::zeros(12, 12);
         for (i, gamma) in drag.iter().enumerate() {
@@ -203,6 +223,14 @@ mod tests {
                 (0..3).for_each(|k| g[3 * p as usize + k] = v[k]);
             }
             dense += term.weight * &g * g.transpose();
+        }
+        // A held coordinate likewise: the identity row and column.
+        for k in (0..12).filter(|&k| held.get(k).copied().unwrap_or(false)) {
+            for m in 0..12 {
+                dense[(k, m)] = 0.0;
+                dense[(m, k)] = 0.0;
+            }
+            dense[(k, k)] = 1.0;
         }
         let v = Col::from_fn(12, |k| (k as f64 * 0.7).sin());
         assert!((a.times(&v) - &dense * &v).norm_l2() < 1e-12 * v.norm_l2());

@@ -165,6 +165,16 @@ impl Protocols {
         }
     }
 
+    /// The held coordinates, per degree of freedom (3i + axis) of `n`
+    /// particles; empty when none is held.
+    pub(super) fn held_coordinates(&self, n: usize) -> Vec<bool> {
+        let mut held = vec![false; if self.held.is_empty() { 0 } else { 3 * n }];
+        for h in &self.held {
+            (0..3).filter(|&a| h.axes[a]).for_each(|a| held[3 * h.particle as usize + a] = true);
+        }
+        held
+    }
+
     /// Before a step: records where the held particles are and their
     /// forces, then masks `forces` ([`Self::restore_forces`] undoes it).
     pub(super) fn before_step(&mut self, forces: &mut [DVec3], state: &State) {

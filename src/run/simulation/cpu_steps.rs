@@ -143,6 +143,7 @@ impl Simulation {
             implicit,
             &mut constrained,
             limited.then_some(self.step_limits.as_slice()),
+            &self.protocols.held_coordinates(model.len()),
         );
         self.implicit_tension = constrained.tension;
         match outcome {
