@@ -113,7 +113,8 @@ fn fcc_sites(d: f64, reach: f64, turn: glam::DQuat) -> Vec<DVec3> {
 /// particles `--substrate-gap` below the lowest node, centred under the
 /// spheroid's centre, out to `--substrate-extent` [3 × the spheroid's
 /// radius] (see the substrate module): a spheroid spreading on a
-/// ligand-coated dish (seed 000's checkpoint 2).
+/// ligand-coated dish (the wetting assay of Douezan et al., PNAS 108, 7315, 2011;
+/// `inputs/spheroid_spreading.in`).
 ///
 /// More cells than fit is an error that says how many do.
 pub fn cells(a: &CellsArgs) -> Result<Built, String> {

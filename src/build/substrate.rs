@@ -21,7 +21,8 @@
 //!
 //! [`SubstrateOptions`] are the command-line options of the builders that
 //! can put their structure on such a substrate: `tensegrity` (one cell) and
-//! `cells --layout spheroid` (a spheroid, seed 000's spreading assay).
+//! `cells --layout spheroid` (a spheroid spreading on a ligand-coated dish,
+//! Douezan et al., PNAS 108, 7315, 2011).
 
 use glam::DVec3;
 

@@ -1,5 +1,6 @@
-//! Fracture of a cell sheet (seed 001): how its junctions failed — by
-//! rearrangement (flow, ductile) or by opening cracks (brittle).
+//! Fracture of a cell sheet (Prakash, Bull & Prakash, Nat. Phys. 18, 444,
+//! 2022): how its junctions failed — by rearrangement (flow, ductile) or by
+//! opening cracks (brittle).
 //!
 //! # Definitions
 //!
@@ -29,7 +30,7 @@
 //!   the sheet has **separated** unless it is exactly one piece;
 //! - `label`: 0 **elastic** (no junction broken), 1 **ductile** (some broken,
 //!   one piece, and ratio ≥ ½: a majority of broken junctions were replaced
-//!   by new neighbours — seed 001 calls a material ductile when it passes from
+//!   by new neighbours — Prakash et al. call a material ductile when it passes from
 //!   the intact state to the rearranged one a majority of the time), 2
 //!   **brittle** (separated, or ratio < ½).
 //!
