@@ -1,17 +1,27 @@
-"""Runs a cellmd deck for a study and reads its thermo CSV: the one home of
-the run-and-read block the studies share (tissue_fracture/sweep.py,
-collagen/run.py, tensegrity_substrate/sweep.py).
+"""Runs cellmd for a study and reads its thermo CSV: the one home of the
+run-and-read block the studies share (tissue_fracture, collagen,
+tensegrity_substrate, force_dipole, contractile_lattice, spheroid_spreading).
 
 A study script imports it after putting studies/ on sys.path:
 
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-    from cellmd_run import run_deck, thermo_rows
+    from cellmd_run import run_command, run_deck, thermo_rows
 """
 
 import csv
 import subprocess
 import sys
 import time
+
+
+def run_command(command):
+    """Runs one command (arguments of any type, passed as strings); exits
+    with the command and its stderr if it fails, else returns its stdout."""
+    command = [str(c) for c in command]
+    proc = subprocess.run(command, capture_output=True, text=True)
+    if proc.returncode != 0:
+        sys.exit(f"{' '.join(command)}\nexit {proc.returncode}\n{proc.stderr}")
+    return proc.stdout
 
 
 def run_deck(cellmd, deck, out, variables):
@@ -22,11 +32,8 @@ def run_deck(cellmd, deck, out, variables):
     for key, value in variables.items():
         command += ["--var", f"{key}={value}"]
     start = time.monotonic()
-    proc = subprocess.run(command, capture_output=True, text=True)
-    wall = time.monotonic() - start
-    if proc.returncode != 0:
-        sys.exit(f"{' '.join(command)}\nexit {proc.returncode}\n{proc.stderr}")
-    return wall
+    run_command(command)
+    return time.monotonic() - start
 
 
 def thermo_rows(path):

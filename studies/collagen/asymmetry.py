@@ -30,7 +30,6 @@ output. Needs numpy (`bash scripts/reference-venv`).
 import argparse
 import csv
 import math
-import subprocess
 import sys
 from pathlib import Path
 
@@ -40,7 +39,7 @@ from plot import fibres_of, frames, sample
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "studies"))
-from cellmd_run import run_deck, thermo_rows  # noqa: E402
+from cellmd_run import run_command, run_deck, thermo_rows  # noqa: E402
 
 DECK = ROOT / "inputs" / "collagen_two_cells.in"
 SEPARATION, RADIUS = 600.0, 100.0  # µm, the deck's pair (the paper's clusters)
@@ -76,9 +75,7 @@ def run(a, seed, fibres):
     point.mkdir(parents=True, exist_ok=True)
     top = point / "collagen.top"
     network = NETWORK + ["--density", a.density, "--fibre-length", a.fibre_length, "--node-spacing", a.node_spacing]
-    built = subprocess.run([str(a.cellmd), "build", "collagen", *network, "--seed", str(seed), "-o", str(top)], capture_output=True, text=True)
-    if built.returncode != 0:
-        sys.exit(built.stderr)
+    run_command([a.cellmd, "build", "collagen", *network, "--seed", seed, "-o", top])
     variables = {"top": top, "kc": FIBRES[fibres], "bend": a.bend, "dt": a.dt, "steps": a.steps, "stages": a.stages, "name": name}
     wall = run_deck(a.cellmd, DECK, point, variables)
     paper = [r["clustering/fibre/cell1/cell2"] for r in thermo_rows(point / f"{name}.thermo.csv")]

@@ -18,14 +18,13 @@ study*, for the runtime).
 import argparse
 import csv
 import math
-import subprocess
 import sys
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "studies"))
-from cellmd_run import run_deck, thermo_rows  # noqa: E402
+from cellmd_run import run_command, run_deck, thermo_rows  # noqa: E402
 
 DECK = ROOT / "inputs" / "collagen_two_cells.in"
 FF = ROOT / "forcefields" / "collagen.ff"
@@ -89,9 +88,7 @@ def run(cellmd, out, layout, fibres, mobile, steps, stages):
     point = out / name
     point.mkdir(parents=True, exist_ok=True)
     top = point / "collagen.top"
-    built = subprocess.run([str(cellmd), "build", "collagen", *LAYOUTS[layout], *COMMON, "-o", str(top)], capture_output=True, text=True)
-    if built.returncode != 0:
-        sys.exit(built.stderr)
+    run_command([cellmd, "build", "collagen", *LAYOUTS[layout], *COMMON, "-o", top])
     hubs = hubs_of(top)
     pairs = pairs_of(layout, hubs)
     columns = [f"clustering/fibre/cell{a}/cell{b}" for a, b in pairs]

@@ -21,10 +21,12 @@ import argparse
 import csv
 import os
 import re
-import subprocess
 import sys
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from cellmd_run import run_command, run_deck, thermo_rows  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 DECK = ROOT / "inputs" / "contractile_lattice.in"
@@ -32,29 +34,19 @@ K = 100.0  # pN/µm, forcefields/fibre_lattice.ff's link stiffness
 Z_C = 3.961  # Jacobs & Thorpe 1995, triangular lattice, central forces
 
 
-def run(cmd):
-    proc = subprocess.run(cmd, capture_output=True, text=True)
-    if proc.returncode != 0:
-        sys.exit(f"{' '.join(map(str, cmd))}\nexit {proc.returncode}\n{proc.stderr}")
-    return proc.stdout
-
-
 def point(cellmd, out, radius, strain, iterations, p, seed):
     d = out / f"p{p:g}_s{seed}"
     d.mkdir(parents=True, exist_ok=True)
     top = d / "lattice.top"
-    said = run([cellmd, "build", "lattice", "--radius", str(radius), "--spacing", "1", "--bond-probability", str(p),
-                "--seed", str(seed), "-o", top])
+    said = run_command([cellmd, "build", "lattice", "--radius", str(radius), "--spacing", "1", "--bond-probability", str(p),
+                        "--seed", str(seed), "-o", top])
     nodes = int(re.search(r"(\d+) nodes in a disc", said).group(1))
     bonds = int(re.search(r"(\d+) bonds `link`", said).group(1))
     z = float(re.search(r"connectivity z = ([0-9.]+)", said).group(1))
     box = [float(line.split()[2]) - float(line.split()[1]) for line in top.read_text().splitlines()
            if re.match(r"^[xyz] -?[0-9.]+ -?[0-9.]+ f$", line)]
-    run([cellmd, "run", DECK, "-o", d, "--quiet", "--threads", "1", "--var", f"topology={top}", "--var", f"strain={strain}",
-         "--var", f"fire_iterations={iterations}"])
-    with open(d / "contractile_lattice.thermo.csv") as f:
-        rows = list(csv.reader(f))
-    last = dict(zip([h.split("[")[0] for h in rows[0]], map(float, rows[-1])))
+    run_deck(cellmd, DECK, d, {"topology": top, "strain": strain, "fire_iterations": iterations})
+    last = thermo_rows(d / "contractile_lattice.thermo.csv")[-1]
     volume = box[0] * box[1] * box[2]
     sigma = -(last["pxx"] + last["pyy"]) * volume / (2 * nodes * 3 ** 0.5 / 2)
     return {"p": p, "seed": seed, "nodes": nodes, "bonds": bonds, "z": z, "sigma": sigma, "fmax_incl_rim": last["fmax"]}

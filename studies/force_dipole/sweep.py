@@ -19,23 +19,19 @@ numpy and matplotlib (`bash scripts/reference-venv` prints the reference venv).
 import argparse
 import csv
 import os
-import subprocess
 import sys
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from cellmd_run import run_command, run_deck  # noqa: E402
+
 ROOT = Path(__file__).resolve().parents[2]
 DECK = ROOT / "inputs" / "force_dipole.in"
 RINGS = 6
 R_IN = 4.0
-
-
-def run(cmd):
-    proc = subprocess.run(cmd, capture_output=True, text=True)
-    if proc.returncode != 0:
-        sys.exit(f"{' '.join(map(str, cmd))}\nexit {proc.returncode}\n{proc.stderr}")
 
 
 def last_frame(path):
@@ -51,9 +47,9 @@ def profile(cellmd, out, radius, p, bending, seed):
     d = out / f"p{p:g}_{'fibres' if bending else 'springs'}_s{seed}"
     d.mkdir(parents=True, exist_ok=True)
     top = d / "lattice.top"
-    run([cellmd, "build", "lattice", "--radius", str(radius), "--spacing", "1", "--bond-probability", str(p), "--dipole",
-         "--seed", str(seed), "-o", top] + (["--bending"] if bending else []))
-    run([cellmd, "run", DECK, "-o", d, "--quiet", "--threads", "1", "--var", f"topology={top}"])
+    run_command([cellmd, "build", "lattice", "--radius", str(radius), "--spacing", "1", "--bond-probability", str(p), "--dipole",
+                 "--seed", str(seed), "-o", top] + (["--bending"] if bending else []))
+    run_deck(cellmd, DECK, d, {"topology": top})
     f = last_frame(d / "force_dipole.lammpstrj")
     r = np.hypot(f["x"], f["y"])
     sxx = np.abs(f["sxx"]) / (3 ** 0.5 / 2)

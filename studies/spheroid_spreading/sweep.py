@@ -23,13 +23,14 @@ OUT/summary.txt; plot.py draws OUT/spheroid_spreading.png. Needs numpy
 import argparse
 import csv
 import os
-import subprocess
 import sys
-import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from cellmd_run import run_command, run_deck, thermo_rows  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 DECK = ROOT / "inputs" / "spheroid_spreading.in"
@@ -38,19 +39,6 @@ PI = {"a": -0.33, "b": 188.7, "c": -2655.0, "r_min": 31.0, "r_max": 78.0, "r2": 
 CELL_RADIUS = 8.0
 # Thermo rows (every 2000 steps) averaged for the equilibrium A.
 TAIL = 3
-
-
-def run(cmd):
-    proc = subprocess.run([str(c) for c in cmd], capture_output=True, text=True)
-    if proc.returncode != 0:
-        sys.exit(f"{' '.join(map(str, cmd))}\nexit {proc.returncode}\n{proc.stderr}")
-    return proc.stdout
-
-
-def thermo(path):
-    with open(path) as f:
-        rows = list(csv.DictReader(f))
-    return {k: np.array([float(r[k]) for r in rows]) for k in rows[0]}
 
 
 def spread(cellmd, out, count, adhesion, seed, reuse):
@@ -64,21 +52,19 @@ def spread(cellmd, out, count, adhesion, seed, reuse):
                  "--spheroid-radius", 200, "--substrate", "flat", "--substrate-spacing", 2, "--substrate-gap", 0.5,
                  "--substrate-extent", extent, "--box", extent + 10, "--seed", seed, "-o", top]
         # Built around z = 0 first; then lowered so that the substrate lies at z = 0, the deck's dish.
-        floor = float(run(build).split("touching z = ")[1].split()[0])
-        run(build + ["--centre", 0, 0, -floor])
-        start = time.time()
-        run([cellmd, "run", DECK, "-o", d, "--quiet", "--threads", 1, "--var", f"topology={top}", "--var", f"adhesion={adhesion}",
-             "--var", f"seed={seed}"])
-        (d / "runtime_s.txt").write_text(f"{time.time() - start:.1f}\n")
-    t = thermo(csv_path)
-    area = t["hullarea/cells[µm²]"]
+        floor = float(run_command(build).split("touching z = ")[1].split()[0])
+        run_command(build + ["--centre", 0, 0, -floor])
+        wall = run_deck(cellmd, DECK, d, {"topology": top, "adhesion": adhesion, "seed": seed})
+        (d / "runtime_s.txt").write_text(f"{wall:.1f}\n")
+    rows = thermo_rows(csv_path)
+    area = np.array([r["hullarea/cells"] for r in rows])
     # The silhouette fluctuates by a few % as cells reshape: the equilibrium A is
     # the mean of the last TAIL rows, its drift the change from the TAIL rows before.
     late, earlier = area[-TAIL:].mean(), area[-2 * TAIL:-TAIL].mean()
     runtime = d / "runtime_s.txt"
     return {"count": count, "adhesion": adhesion, "seed": seed, "R": float(np.sqrt(area[0] / np.pi)),
-            "A_over_A0": float(late / area[0]), "drift": float(late / earlier - 1), "time": float(t["time[s]"][-1]),
-            "clutches": int(t["nbound/clutch[-]"][-1]), "runtime_s": float(runtime.read_text()) if runtime.exists() else float("nan")}
+            "A_over_A0": float(late / area[0]), "drift": float(late / earlier - 1), "time": rows[-1]["time"],
+            "clutches": int(rows[-1]["nbound/clutch"]), "runtime_s": float(runtime.read_text()) if runtime.exists() else float("nan")}
 
 
 def fit(R, y):

@@ -27,14 +27,13 @@ reduced case).
 import argparse
 import csv
 import re
-import subprocess
 import sys
 import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "studies"))
-from cellmd_run import run_deck, thermo_rows  # noqa: E402
+from cellmd_run import run_command, run_deck, thermo_rows  # noqa: E402
 
 DECK = ROOT / "inputs" / "tensegrity_substrate.in"
 F_SPRD = 47150.0  # pN, Vassaux & Milan's total adhesion force at 962 µm²
@@ -47,12 +46,11 @@ GAP = 1.0
 
 def build(cellmd, level, curvature, path):
     """Builds the cell on one substrate; returns the cortex's and the nucleus' volumes and the bottom z."""
-    out = subprocess.run(
-        [cellmd, "build", "tensegrity", "--radius", "10", "--level", str(level), "--nucleus", "5",
-         "--centre", "0", "0", str(CENTRE_Z), "--focal-adhesions", "30", "--fibre-segments", str(FIBRE_SEGMENTS),
+    out = run_command(
+        [cellmd, "build", "tensegrity", "--radius", "10", "--level", level, "--nucleus", "5",
+         "--centre", "0", "0", CENTRE_Z, "--focal-adhesions", "30", "--fibre-segments", FIBRE_SEGMENTS,
          "--bodies", "--seed", "3", "--rest-from-geometry", "--substrate", curvature, "--substrate-extent", "30",
-         "-o", str(path)],
-        check=True, capture_output=True, text=True).stdout
+         "-o", path])
     volumes = [float(v) for v in re.findall(r"enclosed volume ([0-9.eE+-]+)", out)]
     bottom = float(re.search(r"touching z = ([0-9.eE+-]+)", out).group(1))
     return volumes[0], volumes[1], bottom
