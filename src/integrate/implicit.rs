@@ -19,8 +19,8 @@
 //! (infinite drag) has Δx = 0: its row is the identity and its couplings are
 //! dropped; so has a held coordinate (`freeze`, `move`: the protocols put it
 //! back after the step), so the solve moves the free coordinates as the
-//! held ones will be, and its fixed point is the held equilibrium. Both solvers run sequentially, so the step is the same on any
-//! thread count.
+//! held ones will be, and its fixed point is the held equilibrium. Both
+//! solvers run sequentially, so the step is the same on any thread count.
 //!
 //! With constrained bonds (`constrain`), the step solves the constrained
 //! linear system instead — (γ/dt·I + K̃)·Δx = b + Jᵀλ with JΔx = 0 — by
