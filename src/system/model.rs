@@ -255,6 +255,7 @@ impl Model {
         }
         let contact_rule_types = ff.contact_rules.iter().map(|r| (body_type_index(&r.type_a), body_type_index(&r.type_b))).collect();
         let mut bodies = Vec::with_capacity(topology.bodies.len());
+        let faces_by_body = topology.faces_by_body();
         for (id, type_name) in &topology.bodies {
             let body_type = body_type_names.iter().position(|n| *n == type_name.text).ok_or_else(|| {
                 let listed = if body_type_names.is_empty() { "none are defined".to_string() } else { body_type_names.join(", ") };
@@ -263,7 +264,7 @@ impl Model {
                     type_name.text
                 ))
             })?;
-            let faces: Vec<[u32; 3]> = topology.triangles.iter().filter(|(b, _)| b == id).map(|(_, t)| *t).collect();
+            let faces: Vec<[u32; 3]> = faces_by_body.get(id).into_iter().flatten().map(|&t| topology.triangles[t].1).collect();
             let mut nodes: Vec<u32> = faces.iter().flatten().copied().collect();
             nodes.sort_unstable();
             nodes.dedup();

@@ -32,13 +32,14 @@ fn face_text(top: &Topology, face: [u32; 3]) -> String {
 /// Checks every body of a parsed topology; `face_tokens[t]` is the first token
 /// of triangle `t`'s line and `body_tokens[b]` the id token of body `b`.
 pub(super) fn check_bodies(top: &Topology, face_tokens: &[Token], body_tokens: &[Token]) -> Result<(), InputError> {
+    let by_body = top.faces_by_body();
     for (b, (body, _)) in top.bodies.iter().enumerate() {
-        let faces: Vec<usize> = (0..top.triangles.len()).filter(|&t| top.triangles[t].0 == *body).collect();
+        let faces = by_body.get(body).map_or(&[][..], Vec::as_slice);
         if faces.is_empty() {
             return Err(body_tokens[b]
                 .error(format!("body {body} has no faces, expected a closed surface: its triangles in [ triangles ] as `{body} i j k`")));
         }
-        check_body(top, *body, &faces, face_tokens)?;
+        check_body(top, *body, faces, face_tokens)?;
     }
     Ok(())
 }
