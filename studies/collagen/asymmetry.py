@@ -71,7 +71,7 @@ def paper_ratio(p):
 
 def run(a, seed, fibres):
     name = f"seed{seed}_{fibres}"
-    point = Path(a.out) / name
+    point = Path(a.out).resolve() / name
     point.mkdir(parents=True, exist_ok=True)
     top = point / "collagen.top"
     network = NETWORK + ["--density", a.density, "--fibre-length", a.fibre_length, "--node-spacing", a.node_spacing]
