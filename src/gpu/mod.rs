@@ -10,6 +10,8 @@
 //!   where it exceeds the adapter's largest storage binding.
 //! - [`surface`]: surface (body) terms: face, body, edge and node passes,
 //!   deterministic (no float atomics).
+//! - [`kinetics`]: bond breaking and rebinding decided on the device, events
+//!   compacted in bond order and drained by the host at synchronisations.
 //!
 //! One file-level circle, on purpose: `pack.rs` ↔ `surface.rs`. `pack.rs`
 //! lays out the whole topology, the surface sections included, and
@@ -26,7 +28,8 @@
 //! before a run; `device auto` falls back to the CPU): custom surface terms
 //! of bodies and contact
 //! terms between bodies (`Law::Contact`, `Law::ContactArea`), which have no
-//! kernel yet. Bond kinetics are decided on the host (see [`backend`]).
+//! kernel yet. Bond kinetics are decided on the device for the rules
+//! [`kinetics`] ports, else on the host after every step (see [`backend`]).
 //!
 //! # Precision
 //!
@@ -45,6 +48,7 @@
 pub mod backend;
 pub mod context;
 pub mod custom;
+pub mod kinetics;
 mod nlist;
 pub mod pack;
 pub mod shader;
