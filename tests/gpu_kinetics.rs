@@ -5,9 +5,11 @@
 //! breaking statistics against the closed-form rates, and the models whose
 //! kinetics stay on the host.
 
+mod common;
+
 use cellmd::gpu::backend::StepSettings;
 use cellmd::gpu::kinetics::{refusal, DeviceDecisions};
-use cellmd::gpu::{GpuBackend, GpuContext};
+use cellmd::gpu::{DevicePreference, GpuBackend, GpuContext};
 use cellmd::kinetics_engine::EventKind;
 use cellmd::run::{RunOptions, Simulation};
 use cellmd::system::BondState;
@@ -140,4 +142,35 @@ fn unported_rules_keep_kinetics_on_the_host() {
     assert_eq!(reason("inputs/catch_slip_sweep.in"), None);
     let motor = reason("inputs/contractile_network.in").unwrap();
     assert!(motor.contains("motor"), "{motor}");
+}
+
+/// A broken bond stops excluding its pair, also across GPU segments: 30
+/// pairs bonded below their WCA range break at step 0 (strain over the
+/// threshold) and then repel; with thermo every step (one-step segments) the
+/// GPU follows the CPU within 1e-5 of the distance travelled (f32 forces).
+#[test]
+fn a_broken_bond_releases_its_pair_on_the_device() {
+    let mut top = String::from("[ particles ]\n");
+    let mut bonds = String::from("[ bonds ]\n");
+    for m in 0..30 {
+        let (x, y) = ((m % 6) as f64 * 3.0, (m / 6) as f64 * 3.0);
+        top += &format!("{} bead {x} {y} 0\n{} bead {} {y} 0.01\n", 2 * m + 1, 2 * m + 2, x + 0.54 + 0.0005 * m as f64);
+        bonds += &format!("link {} {}\n", 2 * m + 1, 2 * m + 2);
+    }
+    let ff = "particle bead drag 1\nbond link harmonic k 5 r0 0.45 kinetics threshold strain 0.1\npair bead bead wca epsilon 1 sigma 0.5\n";
+    let deck = "units lj\ntopology t.top\nforcefield f.ff\nbox x -5 25 f y -5 20 f z -5 5 f\ntimestep 1e-3\nthermo 1 step\nrun 40\n";
+    let case = common::Case::new(&[("t.top", &(top + &bonds)), ("f.ff", ff), ("deck.in", deck)]);
+    let plan = case.plan();
+    assert_eq!(refusal(&plan.model), None);
+    let run = |device: DevicePreference| {
+        let options = RunOptions { output_dir: case.output_dir().to_path_buf(), device: Some(device), ..Default::default() };
+        Simulation::execute(plan.clone(), options).unwrap().state
+    };
+    let (start, cpu, gpu) = (Simulation::new(&plan, RunOptions::default()).state, run(DevicePreference::Cpu), run(DevicePreference::Gpu));
+    assert!(gpu.bonds.as_ref().unwrap().bound.iter().all(|&b| !b), "every bond broke");
+    let travelled = (0..start.len()).map(|i| (cpu.positions[i] - start.positions[i]).length()).fold(0.0, f64::max);
+    let deviation = (0..start.len()).map(|i| (cpu.positions[i] - gpu.positions[i]).length()).fold(0.0, f64::max);
+    println!("GPU − CPU {deviation:.3e} after travelling up to {travelled:.3e}");
+    assert!(travelled > 0.003, "the pairs barely moved: {travelled}");
+    assert!(deviation <= 1e-5 * travelled, "GPU − CPU {deviation:e} > 1e-5 × {travelled:e}");
 }

@@ -868,6 +868,9 @@ impl GpuBackend {
             let status = self.status();
             self.builds += status[ST_BUILDS] as u64;
             done += status[ST_STEPS_DONE] as u64;
+            // A rebuild the last step asked for (device kinetics changed the exclusions) carries over.
+            let requested = status[ST_FORCE_REBUILD] != 0;
+            self.pending_rebuild = requested;
             if status[ST_HALTED] & HALT_BLOWUP != 0 {
                 return Err(GpuHalt::Blowup { step: first_step + done, particle: status[ST_BLOWUP_PARTICLE] as usize });
             }
@@ -878,7 +881,8 @@ impl GpuBackend {
                 // The event buffer is full: the host drains it and goes on.
                 return Ok(done);
             }
-            force_rebuild = self.grow_if_overflowed(&status).map_err(|message| GpuHalt::Capacity { step: first_step + done, message })?;
+            force_rebuild =
+                self.grow_if_overflowed(&status).map_err(|message| GpuHalt::Capacity { step: first_step + done, message })? || requested;
         }
         Ok(done)
     }
