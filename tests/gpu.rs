@@ -767,9 +767,10 @@ fn a_large_dense_system_runs_with_its_list_chunked_where_needed() {
 }
 
 /// Every `inputs/` deck with bond kinetics, 400 steps per `run` at its own temperature
-/// on the CPU and on the GPU: the GPU steps, the host decides each step's events
-/// from the read-back positions with the same Philox numbers, so the event logs
-/// are identical, and positions agree within 1e-5 of the distance travelled
+/// on the CPU and on the GPU: the GPU steps, and each step's events are decided
+/// on the device (src/gpu/kinetics.rs: f32 tensions) or, for rules it lacks, by
+/// the host from the read-back positions, with the same Philox numbers, so the
+/// event logs and ages are identical, and positions agree within 1e-5 of the distance travelled
 /// (the noise is the same Philox stream, converted to f32 on the GPU) plus
 /// 1e-12 for fixed particles.
 #[test]

@@ -50,7 +50,7 @@ fn forces(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index)
         let r = length(d);
         let radial = radial_law(topo[P.off_term_kind + term], term_params(term), r);
         // A kinetic bond's maturation scale (1 for every other bond).
-        let scale = fparams[P.off_term_scale + term];
+        let scale = fparams[P.off_term_scale + term] * bond_on(term); // 0 for an unbound bond with device kinetics
         f += scale * force_along(radial, d, r);
         e += 0.5 * scale * radial.energy;
     }

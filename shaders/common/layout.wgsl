@@ -38,6 +38,8 @@ struct Params {
     off_node_slot_offsets: u32, off_node_slots: u32, off_edges: u32, off_node_body: u32,
     off_node_edge_offsets: u32, off_node_edges: u32, off_node_face_offsets: u32, off_node_faces: u32,
     n_faces: u32, n_bodies: u32, n_edges: u32, n_body_nodes: u32,
+    // bond kinetics on the device (shaders/common/kinetics.wgsl): kinetic bonds, their first term, event capacity, bond types
+    kin_bonds: u32, kin_first_term: u32, kin_capacity: u32, kin_types: u32,
 }
 
 @group(0) @binding(0) var<uniform> P: Params;
@@ -56,6 +58,8 @@ struct Params {
 @group(0) @binding(10) var<storage, read_write> status: array<atomic<u32>>;
 // Surface terms (shaders/common/surface.wgsl; regions in src/gpu/surface.rs).
 @group(0) @binding(12) var<storage, read_write> surf: array<vec4<f32>>;
+// Bond kinetics on the device (shaders/common/kinetics.wgsl; layout in src/gpu/kinetics.rs).
+@group(0) @binding(13) var<storage, read_write> kin: array<atomic<u32>>;
 
 struct Chunk {
     first: u32,  // first particle of the chunk

@@ -195,7 +195,7 @@ fn is_excluded(i: u32, j: u32) -> bool {
     let first = topo[P.off_excl_offsets + i];
     let end = topo[P.off_excl_offsets + i + 1u];
     for (var k = first; k < end; k++) {
-        if topo[P.off_excl + k] == j {
+        if topo[P.off_excl + k] == j && exclusion_on(k) { // a broken kinetic bond excludes nothing
             return true;
         }
     }

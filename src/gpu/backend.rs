@@ -12,7 +12,9 @@
 //! ([`super::surface`]); a body wider than half the periodic box halts the
 //! run ([`GpuHalt::Capacity`], with the body named).
 //!
-//! Bond kinetics are decided on the host from the read-back positions;
+//! Bond kinetics are decided on the device where the model allows it
+//! ([`GpuBackend::with_device_kinetics`], [`super::kinetics`]); otherwise on
+//! the host from the read-back positions, and
 //! [`GpuBackend::update_bonds`] then uploads the new bond state (bound bonds,
 //! their rest lengths and scales, the exclusions of the bound bonds) as one
 //! batch and has the neighbour list rebuilt.
@@ -21,12 +23,13 @@ use glam::DVec3;
 use wgpu::util::DeviceExt;
 
 use super::context::GpuContext;
+use super::kinetics::{KinKernels, KinLayout};
 use super::nlist::NeighbourStorage;
-use super::pack::{cell_grid, pack, FixedPoint, Params};
+use super::pack::{cell_grid, pack, FixedPoint, Packed, Params};
 use super::shader;
 use crate::integrate::context::StepContext;
 use crate::neighbor::Exclusions;
-use crate::system::{Model, SimBox, State};
+use crate::system::{BondState, Model, SimBox, State};
 
 const WORKGROUP: u32 = 256;
 const STATUS_WORDS: usize = 8;
@@ -40,6 +43,7 @@ const ST_SPAN_BODY: usize = 7;
 const HALT_OVERFLOW: u32 = 1;
 const HALT_BLOWUP: u32 = 2;
 const HALT_SPAN: u32 = 4;
+const HALT_EVENTS: u32 = 8;
 /// Steps per command buffer.
 const STEPS_PER_SUBMIT: u64 = 64;
 
@@ -138,6 +142,11 @@ pub struct GpuBackend {
     settings: StepSettings,
     /// The next `run` or `evaluate` rebuilds the neighbour list first.
     pending_rebuild: bool,
+    /// Bond kinetics on the device (src/gpu/kinetics.rs): its buffer (binding 13), layout and kernels.
+    kin: wgpu::Buffer,
+    kinetics: Option<(KinLayout, KinKernels)>,
+    /// Read-backs so far (each waits for the GPU): tests count the synchronisations.
+    reads: std::cell::Cell<u64>,
 }
 
 /// Refuses a storage buffer the adapter cannot bind (wgpu would abort).
@@ -175,6 +184,34 @@ fn words<T: bytemuck::Pod>(data: &[T]) -> &[u8] {
 impl GpuBackend {
     /// Uploads the model and state and compiles the kernels.
     pub fn new(ctx: &GpuContext, model: &Model, state: &State, sim_box: &SimBox, settings: &StepSettings) -> Result<Self, String> {
+        Self::build(ctx, model, state, sim_box, settings, None)
+    }
+
+    /// As [`Self::new`], with the bond kinetics decided on the device
+    /// (src/gpu/kinetics.rs; the model must pass its `refusal`); `warned`:
+    /// the bond types already warned about a coarse step.
+    pub fn with_device_kinetics(
+        ctx: &GpuContext,
+        model: &Model,
+        state: &State,
+        sim_box: &SimBox,
+        settings: &StepSettings,
+        warned: &[bool],
+    ) -> Result<Self, String> {
+        if let Some(why) = super::kinetics::refusal(model) {
+            return Err(format!("bond kinetics on the device: {why} is decided on the host"));
+        }
+        Self::build(ctx, model, state, sim_box, settings, Some(warned))
+    }
+
+    fn build(
+        ctx: &GpuContext,
+        model: &Model,
+        state: &State,
+        sim_box: &SimBox,
+        settings: &StepSettings,
+        device_kinetics: Option<&[bool]>,
+    ) -> Result<Self, String> {
         if model.has_cpu_only_surface_terms() {
             return Err(
                 "the GPU backend has no kernels for custom surface terms of bodies (`custom` body lines) yet; use `device cpu`".into()
@@ -193,7 +230,14 @@ impl GpuBackend {
         if n == 0 {
             return Err("the GPU backend needs at least one particle".into());
         }
-        let packed = pack_state(model, state, settings)?;
+        let (packed, exclusions) = pack_state(model, state, settings, device_kinetics.is_some())?;
+        let kin_words = match (device_kinetics, state.bonds.as_ref()) {
+            (Some(warned), Some(bonds)) => {
+                let (c, kt) = (settings.context.dt, settings.context.kt);
+                Some(KinLayout::pack(model, bonds, &packed, &exclusions, c, kt, warned))
+            }
+            _ => None,
+        };
         let cutoff = model.max_pair_cutoff();
         let has_pairs = !model.pair_rules.is_empty() && cutoff > 0.0;
         let range = cutoff + settings.skin;
@@ -231,6 +275,10 @@ impl GpuBackend {
             topo_offsets: packed.topo_offsets,
             fparam_offsets: packed.fparam_offsets,
             surface_offsets: packed.surface_offsets,
+            kin_bonds: kin_words.as_ref().map_or(0, |(_, l)| l.bonds()),
+            kin_first_term: kin_words.as_ref().map_or(0, |(_, l)| l.first_term),
+            kin_capacity: kin_words.as_ref().map_or(0, |(_, l)| l.capacity),
+            kin_types: model.bond_types.len() as u32,
         };
         let device = &ctx.device;
         let init = |label: &str, contents: &[u8], usage: wgpu::BufferUsages| {
@@ -261,6 +309,13 @@ impl GpuBackend {
         check_binding(ctx, "the surface terms' face and body values", surf_bytes)?;
         let surf = zeros("surf", surf_bytes, rw);
         let args = zeros("dispatch_args", 4 * 12, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT);
+        let kin = match &kin_words {
+            Some((words_, _)) => {
+                check_binding(ctx, "the bond kinetics' state and event buffer", 4 * words_.len() as u64)?;
+                init("kin", words(words_), rw)
+            }
+            None => zeros("kin", 16, rw),
+        };
 
         let mut entries = vec![wgpu::BindGroupLayoutEntry {
             binding: 0,
@@ -282,6 +337,7 @@ impl GpuBackend {
             count: None,
         });
         entries.push(storage_entry(12, false));
+        entries.push(storage_entry(13, false));
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("cellmd main"), entries: &entries });
         let args_layout = device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("cellmd args"), entries: &[storage_entry(0, false)] });
@@ -335,10 +391,11 @@ impl GpuBackend {
             commit: pipeline("commit", &main_layout),
             advance: pipeline("advance", &main_layout),
         };
+        let kinetics = kin_words.map(|(_, layout)| (layout, KinKernels::new(|entry| pipeline(entry, &main_layout))));
         let main_group = bind_main(
             device,
             &layout,
-            [&uniform, &state_buffer, &next, &reference, &topo, &fparams, &cell_count, &cell_data, &force, &status, &surf],
+            [&uniform, &state_buffer, &next, &reference, &topo, &fparams, &cell_count, &cell_data, &force, &status, &surf, &kin],
             &nlist,
         );
         let mut backend = Self {
@@ -370,6 +427,9 @@ impl GpuBackend {
             settings: *settings,
             pending_rebuild: true,
             ctx: ctx.clone(),
+            kin,
+            kinetics,
+            reads: Default::default(),
         };
         backend.upload(state);
         Ok(backend)
@@ -377,8 +437,20 @@ impl GpuBackend {
 
     fn bind_main(&self) -> wgpu::BindGroup {
         let s = self;
-        let buffers =
-            [&s.uniform, &s.state, &s.next, &s.reference, &s.topo, &s.fparams, &s.cell_count, &s.cell_data, &s.force, &s.status, &s.surf];
+        let buffers = [
+            &s.uniform,
+            &s.state,
+            &s.next,
+            &s.reference,
+            &s.topo,
+            &s.fparams,
+            &s.cell_count,
+            &s.cell_data,
+            &s.force,
+            &s.status,
+            &s.surf,
+            &s.kin,
+        ];
         bind_main(&self.ctx.device, &self.layout, buffers, &s.nlist)
     }
 
@@ -446,7 +518,10 @@ impl GpuBackend {
     /// rebuild before the next step (when bonds broke or bound, so that the
     /// pair exclusions changed).
     pub fn update_bonds(&mut self, model: &Model, state: &State, rebuild: bool) -> Result<(), String> {
-        let packed = pack_state(model, state, &self.settings)?;
+        if self.kinetics.is_some() {
+            return Err("the bond state of device kinetics lives on the device".into());
+        }
+        let (packed, _) = pack_state(model, state, &self.settings, false)?;
         let (topo, fparams) = (pad16(packed.topo), pad16(packed.fparams));
         let fits = |buffer: &wgpu::Buffer, bytes: usize| bytes as u64 <= buffer.size();
         if fits(&self.topo, 4 * topo.len()) && fits(&self.fparams, 4 * fparams.len()) {
@@ -518,6 +593,31 @@ impl GpuBackend {
     }
 
     fn read(&self, buffer: &wgpu::Buffer, bytes: u64) -> Vec<u8> {
+        self.read_at(buffer, 0, bytes)
+    }
+
+    /// Whether the bond kinetics are decided on the device, and its buffer's layout.
+    pub(super) fn device_kinetics(&self) -> Option<&KinLayout> {
+        self.kinetics.as_ref().map(|(layout, _)| layout)
+    }
+
+    /// `count` words of the device kinetics' buffer from word `at`.
+    pub(super) fn read_kin(&self, at: u64, count: u64) -> Vec<u32> {
+        bytemuck::cast_slice(&self.read_at(&self.kin, 4 * at, 4 * count)).to_vec()
+    }
+
+    /// Writes `data` into the device kinetics' buffer at word `at`.
+    pub(super) fn write_kin(&self, at: u64, data: &[u32]) {
+        self.ctx.queue.write_buffer(&self.kin, 4 * at, words(data));
+    }
+
+    /// Read-backs from the GPU so far (each one a synchronisation).
+    pub fn read_backs(&self) -> u64 {
+        self.reads.get()
+    }
+
+    fn read_at(&self, buffer: &wgpu::Buffer, offset: u64, bytes: u64) -> Vec<u8> {
+        self.reads.set(self.reads.get() + 1);
         let device = &self.ctx.device;
         let staging = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("readback"),
@@ -526,7 +626,7 @@ impl GpuBackend {
             mapped_at_creation: false,
         });
         let mut encoder = device.create_command_encoder(&Default::default());
-        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, bytes);
+        encoder.copy_buffer_to_buffer(buffer, offset, &staging, 0, bytes);
         self.ctx.queue.submit([encoder.finish()]);
         let slice = staging.slice(..);
         slice.map_async(wgpu::MapMode::Read, |r| r.expect("mapping a readback buffer"));
@@ -633,6 +733,10 @@ impl GpuBackend {
     fn encode_step(&self, pass: &mut wgpu::ComputePass, integrate: bool) {
         let k = &self.kernels;
         pass.set_bind_group(0, &self.main_group, &self.nlist.offsets(0));
+        let kinetics = self.kinetics.as_ref().map(|(layout, kernels)| (Over::Groups(layout.bonds().div_ceil(WORKGROUP)), kernels));
+        if let Some((_, kin)) = kinetics.filter(|_| integrate) {
+            self.dispatch(pass, &kin.room, Over::Groups(1));
+        }
         if self.has_pairs {
             self.dispatch(pass, &k.displacement, Over::Particles);
             pass.set_pipeline(&k.decide);
@@ -656,8 +760,16 @@ impl GpuBackend {
         }
         self.dispatch(pass, &k.forces, Over::Chunks);
         if integrate {
+            if let Some((bonds, kin)) = kinetics {
+                self.dispatch(pass, &kin.measure, bonds);
+            }
             self.dispatch(pass, &k.integrate, Over::Particles);
             self.dispatch(pass, &k.commit, Over::Particles);
+            if let Some((bonds, kin)) = kinetics {
+                self.dispatch(pass, &kin.decide, bonds);
+                self.dispatch(pass, &kin.scan, Over::Groups(1));
+                self.dispatch(pass, &kin.emit, bonds);
+            }
             self.dispatch(pass, &k.advance, Over::Groups(1));
         }
     }
@@ -756,13 +868,21 @@ impl GpuBackend {
             let status = self.status();
             self.builds += status[ST_BUILDS] as u64;
             done += status[ST_STEPS_DONE] as u64;
+            // A rebuild the last step asked for (device kinetics changed the exclusions) carries over.
+            let requested = status[ST_FORCE_REBUILD] != 0;
+            self.pending_rebuild = requested;
             if status[ST_HALTED] & HALT_BLOWUP != 0 {
                 return Err(GpuHalt::Blowup { step: first_step + done, particle: status[ST_BLOWUP_PARTICLE] as usize });
             }
             if let Some(message) = self.span_halt(&status) {
                 return Err(GpuHalt::Capacity { step: first_step + done, message });
             }
-            force_rebuild = self.grow_if_overflowed(&status).map_err(|message| GpuHalt::Capacity { step: first_step + done, message })?;
+            if status[ST_HALTED] & HALT_EVENTS != 0 {
+                // The event buffer is full: the host drains it and goes on.
+                return Ok(done);
+            }
+            force_rebuild =
+                self.grow_if_overflowed(&status).map_err(|message| GpuHalt::Capacity { step: first_step + done, message })? || requested;
         }
         Ok(done)
     }
@@ -783,12 +903,12 @@ enum Over {
 fn bind_main(
     device: &wgpu::Device,
     layout: &wgpu::BindGroupLayout,
-    buffers: [&wgpu::Buffer; 11],
+    buffers: [&wgpu::Buffer; 12],
     nlist: &NeighbourStorage,
 ) -> wgpu::BindGroup {
     let mut entries: Vec<wgpu::BindGroupEntry> = buffers
         .iter()
-        .zip((0..8).chain(9..11).chain(12..13))
+        .zip((0..8).chain(9..11).chain(12..14))
         .map(|(buf, b)| wgpu::BindGroupEntry { binding: b, resource: buf.as_entire_binding() })
         .collect();
     entries.extend(nlist.entries());
@@ -814,8 +934,13 @@ fn initial_capacity(n: usize, sim_box: &SimBox, range: f64, has_pairs: bool) -> 
 
 /// [`pack`] for the model at `state`: with bond state, only the bound bonds
 /// (with their own rest lengths and scales) and the exclusions they make.
-fn pack_state(model: &Model, state: &State, settings: &StepSettings) -> Result<super::pack::Packed, String> {
-    let bound = state.bonds.as_ref().map(|b| b.bound.as_slice());
+/// With `device_kinetics`, every bond is packed as bound with its
+/// exclusions (the device's bound flags switch them off).
+fn pack_state(model: &Model, state: &State, settings: &StepSettings, device_kinetics: bool) -> Result<(Packed, Exclusions), String> {
+    let all_bound = state.bonds.as_ref().filter(|_| device_kinetics).map(|b| BondState { bound: vec![true; b.len()], ..b.clone() });
+    let bonds = all_bound.as_ref().or(state.bonds.as_ref());
+    let bound = bonds.map(|b| b.bound.as_slice());
     let exclusions = Exclusions::from_pairs(model.len(), &model.excluded_pairs(bound));
-    pack(model, &exclusions, settings.context.dt, settings.context.kt, state.bonds.as_ref())
+    let packed = pack(model, &exclusions, settings.context.dt, settings.context.kt, bonds)?;
+    Ok((packed, exclusions))
 }

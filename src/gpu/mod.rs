@@ -10,11 +10,17 @@
 //!   where it exceeds the adapter's largest storage binding.
 //! - [`surface`]: surface (body) terms: face, body, edge and node passes,
 //!   deterministic (no float atomics).
+//! - [`kinetics`]: bond breaking and rebinding decided on the device, events
+//!   compacted in bond order and drained by the host at synchronisations.
 //!
-//! One file-level circle, on purpose: `pack.rs` ↔ `surface.rs`. `pack.rs`
+//! Two file-level circles, on purpose: `pack.rs` ↔ `surface.rs`. `pack.rs`
 //! lays out the whole topology, the surface sections included, and
 //! `surface.rs` builds those sections' CSR lists with pack's `push_csr`, the
-//! one CSR builder of the GPU buffers.
+//! one CSR builder of the GPU buffers. And `backend.rs` ↔ `kinetics.rs`:
+//! the backend owns the device kinetics' buffer and dispatches its kernels
+//! in each step, and `kinetics.rs` lays that buffer out and adds to
+//! `GpuBackend` the methods that read its events and bond state back, so
+//! the buffer's layout has one home.
 //!
 //! What runs where: each step — neighbour-list check and (when due) rebuild,
 //! forces, overdamped integration — runs on the GPU without reading anything
@@ -26,7 +32,8 @@
 //! before a run; `device auto` falls back to the CPU): custom surface terms
 //! of bodies and contact
 //! terms between bodies (`Law::Contact`, `Law::ContactArea`), which have no
-//! kernel yet. Bond kinetics are decided on the host (see [`backend`]).
+//! kernel yet. Bond kinetics are decided on the device for the rules
+//! [`kinetics`] ports, else on the host after every step (see [`backend`]).
 //!
 //! # Precision
 //!
@@ -45,6 +52,7 @@
 pub mod backend;
 pub mod context;
 pub mod custom;
+pub mod kinetics;
 mod nlist;
 pub mod pack;
 pub mod shader;

@@ -69,6 +69,11 @@ pub struct Params {
     /// ([`super::surface::SurfacePack::sections`]), then the numbers of
     /// faces, bodies, edges and body nodes.
     pub surface_offsets: [u32; 16],
+    /// Bond kinetics on the device (src/gpu/kinetics.rs): its bonds, their first term, event capacity, bond types.
+    pub kin_bonds: u32,
+    pub kin_first_term: u32,
+    pub kin_capacity: u32,
+    pub kin_types: u32,
 }
 
 /// The GPU's 64-bit fixed point (layout.wgsl): a length x is the integer
@@ -108,6 +113,9 @@ pub struct Packed {
     pub surf_entries: u64,
     /// The user id of each packed body (in packing order).
     pub body_ids: Vec<u64>,
+    /// The bond of each bond term of its own (after the shared terms, from `first_own_term`).
+    pub own_bonds: Vec<u32>,
+    pub first_own_term: u32,
 }
 
 /// Appends a CSR section (`offsets` for n + 1 entries, then rows flattened).
@@ -263,6 +271,8 @@ pub fn pack(model: &Model, exclusions: &Exclusions, dt: f64, kt: f64, bonds: Opt
         surface_offsets,
         surf_entries: surfaces.surf_entries(),
         body_ids: surfaces.body_ids,
+        own_bonds: kinetic.iter().map(|&b| b as u32).collect(),
+        first_own_term: terms.len() as u32,
     })
 }
 

@@ -39,7 +39,7 @@ mod embedded {
 pub use embedded::{COMMON_SHADERS, INTERACTION_SHADERS};
 
 /// The common files in the order they must appear (declarations first).
-const COMMON_ORDER: [&str; 6] = ["layout", "philox", "neighbor", "forces", "surface", "integrate"];
+const COMMON_ORDER: [&str; 7] = ["layout", "philox", "neighbor", "forces", "surface", "integrate", "kinetics"];
 
 fn common(name: &str) -> &'static str {
     COMMON_SHADERS.iter().find(|(stem, _)| *stem == name).map(|(_, src)| *src).unwrap_or_else(|| panic!("shaders/common/{name}.wgsl"))

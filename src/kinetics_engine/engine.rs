@@ -23,6 +23,24 @@ use crate::kinetics::Effect;
 use crate::rng::block;
 use crate::system::{BondState, FormedBond, Model, SimBox, State, StepClock};
 
+impl Event {
+    /// An event of bond `b` at the step `clock` describes.
+    fn of(model: &Model, b: usize, kind: EventKind, clock: StepClock, force: f64, length: f64, age: f64) -> Self {
+        let [i, j] = model.bonds[b];
+        Event {
+            step: clock.step,
+            time: clock.start,
+            kind,
+            bond: b,
+            bond_type: model.bond_types[model.bond_type[b] as usize].label.text.clone(),
+            particles: [model.ids[i as usize], model.ids[j as usize]],
+            force,
+            length,
+            age,
+        }
+    }
+}
+
 /// Philox stream of per-step kinetic decisions.
 const STREAM_KINETICS: u32 = 2;
 /// Philox stream of quenched per-bond disorder (threshold spread).
@@ -113,45 +131,74 @@ impl Kinetics {
             (0..bonds.len()).into_par_iter().map(|b| decide(model, bonds, b, tension[b], length[b], clock)).collect();
         for (b, o) in outcomes.iter().enumerate() {
             let t = model.bond_type[b] as usize;
-            if o.rate_dt > COARSE_RATE_DT && !self.warned[t] {
-                self.warned[t] = true;
-                report.warnings.push(format!(
-                    "warning: step {step}: bond type `{}` has k_off·dt = {:.3} > {COARSE_RATE_DT}: lifetimes shorter than ~10 steps are not resolved; reduce the timestep",
-                    model.bond_types[t].label.text, o.rate_dt
-                ));
+            if o.rate_dt > COARSE_RATE_DT {
+                report.warnings.extend(self.warn_coarse(model, t, step, o.rate_dt));
             }
             bonds.rest[b] = o.rest;
             bonds.scale[b] = o.scale;
             bonds.age[b] = o.age;
             let Some(kind) = o.event else { continue };
-            match kind {
-                EventKind::Break => {
-                    bonds.bound[b] = false;
-                    self.breaks += 1;
-                }
-                EventKind::Rebind => {
-                    bonds.bound[b] = true;
-                    self.rebinds += 1;
-                }
-                EventKind::Reset => self.resets += 1,
-                EventKind::Form => self.forms += 1,
-            }
             report.bonds_changed |= kind != EventKind::Reset;
-            let [i, j] = model.bonds[b];
-            report.events.push(Event {
-                step,
-                time: clock.start,
-                kind,
-                bond: b,
-                bond_type: model.bond_types[t].label.text.clone(),
-                particles: [model.ids[i as usize], model.ids[j as usize]],
-                force: tension[b],
-                length: length[b],
-                age: o.age,
-            });
+            report.events.push(self.tally(bonds, Event::of(model, b, kind, clock, tension[b], length[b], o.age)));
         }
         self.outcomes = outcomes;
         report
+    }
+
+    /// Counts an event and applies a break or rebind to the bound flags.
+    fn tally(&mut self, bonds: &mut BondState, event: Event) -> Event {
+        match event.kind {
+            EventKind::Break => {
+                bonds.bound[event.bond] = false;
+                self.breaks += 1;
+            }
+            EventKind::Rebind => {
+                bonds.bound[event.bond] = true;
+                self.rebinds += 1;
+            }
+            EventKind::Reset => self.resets += 1,
+            EventKind::Form => self.forms += 1,
+        }
+        event
+    }
+
+    /// A break or rebind decided elsewhere (bond kinetics on the GPU) at the
+    /// step `clock` describes: counted and applied to the bound flags as
+    /// the engine's own (ages come back from the device separately).
+    #[allow(clippy::too_many_arguments)]
+    pub fn apply_decided(
+        &mut self,
+        model: &Model,
+        state: &mut State,
+        bond: usize,
+        kind: EventKind,
+        clock: StepClock,
+        force: f64,
+        length: f64,
+        age: f64,
+    ) -> Event {
+        let bonds = state.bonds.as_mut().expect("kinetics has bond state");
+        self.tally(bonds, Event::of(model, bond, kind, clock, force, length, age))
+    }
+
+    /// The bond types already warned about a coarse step.
+    pub fn warned(&self, model: &Model) -> Vec<bool> {
+        let mut warned = self.warned.clone();
+        warned.resize(model.bond_types.len(), false);
+        warned
+    }
+
+    /// The coarse-step warning for bond type `t` whose k_off·dt is `rate_dt`
+    /// at `step`, the first time only.
+    pub fn warn_coarse(&mut self, model: &Model, t: usize, step: u64, rate_dt: f64) -> Option<String> {
+        self.warned.resize(model.bond_types.len(), false);
+        if std::mem::replace(&mut self.warned[t], true) {
+            return None;
+        }
+        Some(format!(
+            "warning: step {step}: bond type `{}` has k_off·dt = {rate_dt:.3} > {COARSE_RATE_DT}: lifetimes shorter than ~10 steps are not resolved; reduce the timestep",
+            model.bond_types[t].label.text
+        ))
     }
 }
 
@@ -188,17 +235,8 @@ impl Kinetics {
                 }
             };
             let [i, j] = model.bonds[b];
-            events.push(Event {
-                step: clock.step,
-                time: clock.start,
-                kind,
-                bond: b,
-                bond_type: model.bond_types[model.bond_type[b] as usize].label.text.clone(),
-                particles: [model.ids[i as usize], model.ids[j as usize]],
-                force: 0.0,
-                length: sim_box.minimum_image(state.positions[j as usize] - state.positions[i as usize]).length(),
-                age: 0.0,
-            });
+            let length = sim_box.minimum_image(state.positions[j as usize] - state.positions[i as usize]).length();
+            events.push(Event::of(model, b, kind, clock, 0.0, length, 0.0));
         }
         events
     }

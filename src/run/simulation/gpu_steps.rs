@@ -7,6 +7,7 @@ use crate::gpu::backend::StepSettings;
 use crate::gpu::{DevicePreference, GpuBackend, GpuContext, GpuHalt};
 use crate::integrate::Integrator;
 use crate::run::RunError;
+use crate::system::StepClock;
 
 /// The longest GPU segment between read-backs when no output is due.
 const GPU_SYNC_STEPS: u64 = 1000;
@@ -15,8 +16,12 @@ const GPU_SYNC_STEPS: u64 = 1000;
 /// (thermo, dump, checkpoint, the end) and at least every
 /// [`GPU_SYNC_STEPS`] steps (progress, blow-up checks), reading back the
 /// positions only where an output needs them; thermo quantities are then
-/// computed by the CPU backend at the read-back positions. With bond
-/// kinetics the host synchronises every step: it reads the positions back,
+/// computed by the CPU backend at the read-back positions. Bond kinetics
+/// whose rules the device has (src/gpu/kinetics.rs) are decided there: a
+/// segment is as long as without kinetics (it ends early only when the
+/// event buffer is full), and at its end the host drains the events, counts,
+/// logs and applies them step by step, and reads the ages back with the
+/// positions. With other bond kinetics the host synchronises every step: it reads the positions back,
 /// measures every bond's tension and length in f64, decides the step's
 /// events exactly as on the CPU, and uploads the changed bond state as one
 /// batch (a new GPU backend when bonds formed). A segment that ends at
@@ -32,6 +37,8 @@ pub(super) struct GpuSteps {
     resets: u64,
     /// A stop was requested when the last segment synchronised.
     stopping: bool,
+    /// Bond kinetics are decided on the device.
+    device_kinetics: bool,
 }
 
 impl GpuSteps {
@@ -43,15 +50,23 @@ impl GpuSteps {
             neighbor_every: sim.neighbor.every,
             neighbor_check: sim.neighbor.check,
         };
-        let gpu = GpuBackend::new(context, &sim.model, &sim.state, &sim.sim_box, &settings).map_err(RunError::Setup)?;
+        let device_kinetics = sim.model.has_kinetics() && crate::gpu::kinetics::refusal(&sim.model).is_none();
+        let (model, state, sim_box) = (&sim.model, &sim.state, &sim.sim_box);
+        let gpu = if device_kinetics {
+            GpuBackend::with_device_kinetics(context, model, state, sim_box, &settings, &sim.kinetics.warned(model))
+        } else {
+            GpuBackend::new(context, model, state, sim_box, &settings)
+        }
+        .map_err(RunError::Setup)?;
         let evolving = sim.model.bond_kinetics.iter().flat_map(|k| &k.rules).any(|r| r.rule.evolves_every_step());
-        Ok(Self { context: context.clone(), settings, gpu, evolving, resets: 0, stopping: false })
+        Ok(Self { context: context.clone(), settings, gpu, evolving, resets: 0, stopping: false, device_kinetics })
     }
 }
 
 impl Stepper for GpuSteps {
     fn take(&mut self, sim: &mut Simulation, until: u64, last: u64) -> Result<Taken, RunError> {
-        let kinetics = sim.model.has_kinetics();
+        // Bond kinetics decided on the host: one step per segment.
+        let kinetics = sim.model.has_kinetics() && !self.device_kinetics;
         let next_output = sim.next_output_step(last).min(sim.state.step + GPU_SYNC_STEPS).min(until);
         let steps = if kinetics { 1 } else { next_output - sim.state.step };
         let outcome = self.gpu.run(sim.state.step, steps);
@@ -61,8 +76,14 @@ impl Stepper for GpuSteps {
         };
         // Every GPU step takes the full dt (no contact clamp on the GPU).
         let mut taken = Taken { steps: done, last: None };
+        let mut clocks = Vec::new();
         for _ in 0..done {
-            taken.last = Some(sim.step_context().advance(&mut sim.state, 1.0));
+            let clock = sim.step_context().advance(&mut sim.state, 1.0);
+            clocks.extend(Some(clock).filter(|_| self.device_kinetics));
+            taken.last = Some(clock);
+        }
+        if self.device_kinetics {
+            self.record_device_kinetics(sim, &clocks)?;
         }
         sim.forces_current = false;
         let segment_end = sim.state.step == until;
@@ -75,6 +96,9 @@ impl Stepper for GpuSteps {
         let read_back = segment_end || thermo_due || dump_due || checkpoint_due || self.stopping || outcome.is_err() || kinetics;
         if read_back {
             self.gpu.download(&mut sim.state);
+            if let Some(bonds) = sim.state.bonds.as_mut() {
+                self.gpu.download_bond_state(bonds);
+            }
         }
         if let Err(GpuHalt::Capacity { message, .. }) = outcome {
             return Err(RunError::Setup(format!("device gpu at step {}: {message}", sim.state.step)));
@@ -122,6 +146,39 @@ impl Stepper for GpuSteps {
         if self.stopping {
             // The positions of this sync were read back above.
             sim.stop_if_requested()?;
+        }
+        Ok(())
+    }
+
+    fn decides_kinetics(&self) -> bool {
+        self.device_kinetics
+    }
+}
+
+impl GpuSteps {
+    /// The events the device decided in the segment whose steps `clocks`
+    /// describe: counted, applied to the host's bound flags and recorded
+    /// step by step (so each step's dump sees its own bond state), with the
+    /// coarse-step warnings; the CPU backend's exclusions follow.
+    fn record_device_kinetics(&mut self, sim: &mut Simulation, clocks: &[StepClock]) -> Result<(), RunError> {
+        let decided = self.gpu.drain_kinetics();
+        for &(t, step, rate_dt) in &decided.coarse {
+            if let Some(warning) = sim.kinetics.warn_coarse(&sim.model, t, step, rate_dt) {
+                eprintln!("{warning}");
+            }
+        }
+        let Some(first) = clocks.first().map(|c| c.step) else { return Ok(()) };
+        for group in decided.events.chunk_by(|a, b| a.step == b.step) {
+            let clock = clocks[(group[0].step - first) as usize];
+            let events: Vec<_> = group
+                .iter()
+                .map(|e| sim.kinetics.apply_decided(&sim.model, &mut sim.state, e.bond, e.kind, clock, e.force, e.length, e.age))
+                .collect();
+            sim.record_events(&events, clock.length)?;
+        }
+        if !decided.events.is_empty() {
+            let backend = sim.cpu.get(&sim.model, &sim.state, &sim.sim_box, sim.neighbor.skin)?;
+            backend.bonds_changed(&sim.model, &sim.state, &sim.sim_box).map_err(RunError::Setup)?;
         }
         Ok(())
     }

@@ -19,7 +19,7 @@ use super::gpu_steps::GpuSteps;
 use super::stepping::ActiveRun;
 use super::Simulation;
 use crate::integrate::context::StepContext;
-use crate::kinetics_engine::Binding;
+use crate::kinetics_engine::{Binding, Event};
 use crate::run::RunError;
 use crate::system::StepClock;
 
@@ -50,6 +50,13 @@ pub(super) trait Stepper {
     /// After the outputs of the step reached: a requested stop is honoured
     /// where the stepper has the state to write.
     fn after_outputs(&mut self, sim: &mut Simulation) -> Result<(), RunError>;
+
+    /// Whether the stepper decides bond kinetics itself (on the device) and
+    /// records their events in `take`; otherwise the loop decides them on
+    /// the host after every call.
+    fn decides_kinetics(&self) -> bool {
+        false
+    }
 }
 
 impl Simulation {
@@ -109,7 +116,7 @@ impl Simulation {
     fn step_loop(&mut self, stepper: &mut dyn Stepper, until: u64, last: u64, bar: &Option<ProgressBar>) -> Result<(), RunError> {
         while self.state.step < until {
             let taken = stepper.take(self, until, last)?;
-            if self.model.has_kinetics() {
+            if self.model.has_kinetics() && !stepper.decides_kinetics() {
                 // Decided from the tensions of the step's force pass.
                 let changed = match taken.last {
                     Some(clock) => self.kinetics_step(clock)?,
@@ -193,21 +200,7 @@ impl Simulation {
             report.bonds_changed |= !bindings.is_empty();
             report.events.extend(self.kinetics.apply_bindings(&mut self.model, &mut self.state, &self.sim_box, bindings, clock));
         }
-        if !report.events.is_empty() {
-            self.lifetimes.record(&self.model, &report.events, clock.length);
-            if let Some((log, path)) = &mut self.event_log {
-                if let Err(e) = log.write(&report.events) {
-                    let path = path.clone();
-                    return Err(self.output_error(&path, e));
-                }
-            }
-            let bound = &self.state.bonds.as_ref().expect("kinetics has bond state").bound;
-            let failed =
-                self.dumps.iter_mut().find_map(|d| d.writer.write_bond_events(&report.events, bound).err().map(|e| (d.path.clone(), e)));
-            if let Some((path, e)) = failed {
-                return Err(self.output_error(&path, e));
-            }
-        }
+        self.record_events(&report.events, clock.length)?;
         if formed_any {
             // New bonds change every per-bond buffer: rebuild the backend.
             self.cpu.invalidate();
@@ -216,6 +209,27 @@ impl Simulation {
             backend.bonds_changed(&self.model, &self.state, &self.sim_box).map_err(RunError::Setup)?;
         }
         Ok(report.bonds_changed)
+    }
+
+    /// The events of one step (`dt` long; none: nothing) into the lifetime
+    /// sums, the event log and the dumps (with the bond state after them).
+    pub(super) fn record_events(&mut self, events: &[Event], dt: f64) -> Result<(), RunError> {
+        if events.is_empty() {
+            return Ok(());
+        }
+        self.lifetimes.record(&self.model, events, dt);
+        if let Some((log, path)) = &mut self.event_log {
+            if let Err(e) = log.write(events) {
+                let path = path.clone();
+                return Err(self.output_error(&path, e));
+            }
+        }
+        let bound = &self.state.bonds.as_ref().expect("kinetics has bond state").bound;
+        let failed = self.dumps.iter_mut().find_map(|d| d.writer.write_bond_events(events, bound).err().map(|e| (d.path.clone(), e)));
+        if let Some((path, e)) = failed {
+            return Err(self.output_error(&path, e));
+        }
+        Ok(())
     }
 
     /// Rules whose rates depend on kT refuse to run at T = 0.

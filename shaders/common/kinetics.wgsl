@@ -1,0 +1,405 @@
+// Bond kinetics on the device (src/gpu/kinetics.rs has the buffer layout and
+// the host side). Each step, after the force pass:
+//   kin_measure  each kinetic bond's tension dE/dr and length at x_s (f32);
+// after `commit` (so a refused step changes nothing):
+//   kin_decide   each bond's break or rebind with the CPU's Philox key
+//                (seed, s, bond, stream 2), its bound flag and its f64 age
+//                (advanced by dt with an exact integer f64 addition, so ages
+//                are the CPU's bits); per-block event counts;
+//   kin_scan     one workgroup: exclusive scan of the block counts into the
+//                event buffer's cursor, coarse-step warnings;
+//   kin_emit     each event written at its block base + its rank in the block,
+//                so events are in bond order (no float atomics, no order
+//                dependence).
+// Before every step `kin_room` halts the run (HALT_EVENTS) when the event
+// buffer could not take one more step's events; the host drains it and goes on.
+
+const HALT_EVENTS: u32 = 8u;
+
+// Header words of `kin`.
+const KIN_BONDS: u32 = 0u;   // offset of the bond records (KIN_BOND_WORDS each)
+const KIN_BOUND: u32 = 1u;   // offset of the bound flags (1 each)
+const KIN_AGE: u32 = 2u;     // offset of the ages (f64 bits: high, low)
+const KIN_MEASURE: u32 = 3u; // offset of tension, length, k·dt (f32 bits)
+const KIN_FLAG: u32 = 4u;    // offset of this step's event kinds (1 each)
+const KIN_BLOCK: u32 = 5u;   // offset of the per-block event counts, then bases
+const KIN_TYPE: u32 = 6u;    // offset of the bond-type records (KIN_TYPE_WORDS each)
+const KIN_EXCL: u32 = 7u;    // offset of the exclusion tags (kinetic bond, or none)
+const KIN_EVENTS: u32 = 8u;  // offset of the events (KIN_EVENT_WORDS each)
+const KIN_CURSOR: u32 = 9u;  // events written since the host last drained
+const KIN_DT_HI: u32 = 10u;  // dt as f64 bits
+const KIN_DT_LO: u32 = 11u;
+const KIN_DT: u32 = 12u;     // dt, kT as f32 bits
+const KIN_KT: u32 = 13u;
+
+const KIN_BOND_WORDS: u32 = 6u;  // i, j, bond type, bond index, term, rest length (f32 bits)
+const KIN_TYPE_WORDS: u32 = 44u; // rules, warned, warned bond, step lo, step hi, k·dt, 2 spare, 4 × (rule, 8 params)
+const KIN_EVENT_WORDS: u32 = 8u; // step lo, step hi, bond index, kind, tension, length, age hi, age lo
+const KIN_NONE: u32 = 0xFFFFFFFFu;
+
+const RULE_SLIP: u32 = 1u;
+const RULE_CATCH_SLIP: u32 = 2u;
+const RULE_CADHERIN: u32 = 3u;
+const RULE_THRESHOLD: u32 = 4u;
+const RULE_REBIND: u32 = 5u;
+const EVENT_BREAK: u32 = 1u;
+const EVENT_REBIND: u32 = 2u;
+const STREAM_KINETICS: u32 = 2u;
+const STREAM_QUENCHED: u32 = 3u;
+const COARSE_RATE_DT: f32 = 0.1;
+
+fn kin_word(k: u32) -> u32 {
+    return atomicLoad(&kin[k]);
+}
+
+fn kin_f32(k: u32) -> f32 {
+    return bitcast<f32>(atomicLoad(&kin[k]));
+}
+
+// 1 for a bound bond, 0 for an unbound one: scales a term's force in the
+// force pass (every term but a kinetic bond's own is 1).
+fn bond_on(term: u32) -> f32 {
+    if P.kin_bonds == 0u || term < P.kin_first_term {
+        return 1.0;
+    }
+    return f32(kin_word(kin_word(KIN_BOUND) + term - P.kin_first_term));
+}
+
+// Whether exclusion entry `e` (index into the `topo` exclusion list) holds:
+// an entry made by a kinetic bond holds only while that bond is bound.
+fn exclusion_on(e: u32) -> bool {
+    if P.kin_bonds == 0u {
+        return true;
+    }
+    let tag = kin_word(kin_word(KIN_EXCL) + e);
+    return tag == KIN_NONE || kin_word(kin_word(KIN_BOUND) + tag) == 1u;
+}
+
+@compute @workgroup_size(1)
+fn kin_room() {
+    if kin_word(KIN_CURSOR) + P.kin_bonds > P.kin_capacity {
+        atomicOr(&status[ST_HALTED], HALT_EVENTS);
+    }
+}
+
+@compute @workgroup_size(256)
+fn kin_measure(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    let k = linear_index(wg, local);
+    if k >= P.kin_bonds || halted() {
+        return;
+    }
+    let rec = kin_word(KIN_BONDS) + KIN_BOND_WORDS * k;
+    let d = separation(kin_word(rec), kin_word(rec + 1u));
+    let r = length(d);
+    let term = kin_word(rec + 4u);
+    var tension = 0.0;
+    if kin_word(kin_word(KIN_BOUND) + k) == 1u {
+        tension = fparams[P.off_term_scale + term] * radial_law(topo[P.off_term_kind + term], term_params(term), r).de_dr;
+    }
+    let m = kin_word(KIN_MEASURE) + 3u * k;
+    atomicStore(&kin[m], bitcast<u32>(tension));
+    atomicStore(&kin[m + 1u], bitcast<u32>(r));
+}
+
+// 1 − exp(−a) without cancellation for small a (Taylor to a⁶ below 0.1:
+// relative error < 1e-9 there).
+fn one_minus_exp(a: f32) -> f32 {
+    if a < 0.1 {
+        return a * (1.0 - a * (0.5 - a * (1.0 / 6.0 - a * (1.0 / 24.0 - a * (1.0 / 120.0 - a / 720.0)))));
+    }
+    return 1.0 - exp(-a);
+}
+
+// The CPU's test u < p with u = (x + ½)/2³² (f32: p's rounding decides only
+// when u lies within ~1e-7·p of p).
+fn draws_below(x: u32, p: f32) -> bool {
+    return p >= 1.0 || f32(x) + 0.5 < p * 4294967296.0;
+}
+
+// The off-rate of an `Unbind` rule at tension f (src/kinetics/*.rs).
+fn unbind_rate(code: u32, p: u32, f: f32, kt: f32) -> f32 {
+    let q = array<f32, 8>(kin_f32(p), kin_f32(p + 1u), kin_f32(p + 2u), kin_f32(p + 3u), kin_f32(p + 4u), kin_f32(p + 5u), kin_f32(p + 6u), kin_f32(p + 7u));
+    if code == RULE_SLIP {
+        return q[0] * exp(abs(f) * q[1] / kt);
+    }
+    let g = max(f, 0.0);
+    if code == RULE_CATCH_SLIP {
+        return q[0] * exp(-g * q[1] / kt) + q[2] * exp(g * q[3] / kt);
+    }
+    // cadherin: the closed-form effective rate of its three-state generator.
+    let k1 = q[0] * exp(g * q[1] / kt);
+    let ks = q[2] * exp(g * q[3] / kt);
+    let kr = q[4] * exp(-g * q[5] / kt);
+    let k2 = q[6] * exp(g * q[7] / kt);
+    return (k1 * (kr + k2) + ks * k2) / (kr + k2 + ks);
+}
+
+// f64 addition a + b of two finite non-negative numbers given as (high, low)
+// words, rounded to nearest even as IEEE 754 does, in integer arithmetic
+// (WGSL has no f64): the ages are the CPU's bits.
+fn u64_shr(m: vec2<u32>, n: u32) -> vec2<u32> {
+    if n == 0u {
+        return m;
+    }
+    if n >= 64u {
+        return vec2<u32>(0u);
+    }
+    if n >= 32u {
+        return vec2<u32>(0u, m.x >> (n - 32u));
+    }
+    return vec2<u32>(m.x >> n, (m.y >> n) | (m.x << (32u - n)));
+}
+
+// Shifted right by n with the bits shifted out ORed into bit 0 (sticky).
+fn u64_shr_sticky(m: vec2<u32>, n: u32) -> vec2<u32> {
+    var lost = false;
+    if n >= 64u {
+        lost = (m.x | m.y) != 0u;
+    } else if n >= 32u {
+        lost = m.y != 0u || (m.x & ((1u << (n - 32u)) - 1u)) != 0u;
+    } else if n > 0u {
+        lost = (m.y & ((1u << n) - 1u)) != 0u;
+    }
+    var r = u64_shr(m, n);
+    if lost {
+        r.y |= 1u;
+    }
+    return r;
+}
+
+fn u64_add(a: vec2<u32>, b: vec2<u32>) -> vec2<u32> {
+    let lo = a.y + b.y;
+    return vec2<u32>(a.x + b.x + select(0u, 1u, lo < a.y), lo);
+}
+
+fn f64_add(a: vec2<u32>, b: vec2<u32>) -> vec2<u32> {
+    if (a.x | a.y) == 0u {
+        return b;
+    }
+    if (b.x | b.y) == 0u {
+        return a;
+    }
+    var ea = a.x >> 20u;
+    var eb = b.x >> 20u;
+    // Mantissas with the implicit bit, three guard bits below.
+    var ma = vec2<u32>((a.x & 0xFFFFFu) | select(0u, 0x100000u, ea != 0u), a.y);
+    var mb = vec2<u32>((b.x & 0xFFFFFu) | select(0u, 0x100000u, eb != 0u), b.y);
+    ea = max(ea, 1u);
+    eb = max(eb, 1u);
+    if eb > ea {
+        let m = ma;
+        let e = ea;
+        ma = mb;
+        ea = eb;
+        mb = m;
+        eb = e;
+    }
+    ma = vec2<u32>((ma.x << 3u) | (ma.y >> 29u), ma.y << 3u);
+    mb = vec2<u32>((mb.x << 3u) | (mb.y >> 29u), mb.y << 3u);
+    var s = u64_add(ma, u64_shr_sticky(mb, ea - eb));
+    var e = ea;
+    if (s.x >> 24u) != 0u {
+        s = u64_shr_sticky(s, 1u);
+        e += 1u;
+    }
+    let guard = s.y & 7u;
+    s = u64_shr(s, 3u);
+    if guard > 4u || (guard == 4u && (s.y & 1u) == 1u) {
+        s = u64_add(s, vec2<u32>(0u, 1u));
+        if (s.x >> 21u) != 0u {
+            s = u64_shr(s, 1u);
+            e += 1u;
+        }
+    }
+    if (s.x & 0x100000u) == 0u {
+        e = 0u; // both subnormal and the sum still is
+    }
+    return vec2<u32>((e << 20u) | (s.x & 0xFFFFFu), s.y);
+}
+
+var<workgroup> kin_block_events: atomic<u32>;
+
+@compute @workgroup_size(256)
+fn kin_decide(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    if local == 0u {
+        atomicStore(&kin_block_events, 0u);
+    }
+    workgroupBarrier();
+    let k = linear_index(wg, local);
+    var kind = 0u;
+    if k < P.kin_bonds && !halted() {
+        kind = kin_decide_bond(k);
+        atomicStore(&kin[kin_word(KIN_FLAG) + k], kind);
+        if kind != 0u {
+            atomicAdd(&kin_block_events, 1u);
+        }
+    }
+    workgroupBarrier();
+    if local == 0u && !halted() {
+        atomicStore(&kin[kin_word(KIN_BLOCK) + linear_index(wg, 0u) / WORKGROUP], atomicLoad(&kin_block_events));
+    }
+}
+
+// One bond's decision (as `decide` in src/kinetics_engine/engine.rs); updates
+// its bound flag and age, returns its event kind (0: none).
+fn kin_decide_bond(k: u32) -> u32 {
+    let rec = kin_word(KIN_BONDS) + KIN_BOND_WORDS * k;
+    let bond = kin_word(rec + 3u);
+    let trec = kin_word(KIN_TYPE) + KIN_TYPE_WORDS * kin_word(rec + 2u);
+    let rules = kin_word(trec);
+    if rules == 0u {
+        return 0u;
+    }
+    let m = kin_word(KIN_MEASURE) + 3u * k;
+    let force = kin_f32(m);
+    let len = kin_f32(m + 1u);
+    let dt = kin_f32(KIN_DT);
+    let kt = kin_f32(KIN_KT);
+    let seed = vec2<u32>(P.seed_lo, P.seed_hi);
+    let x = philox4x32_10(vec4<u32>(bond, STREAM_KINETICS, current_step()), seed).x;
+    let bound_at = kin_word(KIN_BOUND) + k;
+    let age_at = kin_word(KIN_AGE) + 2u * k;
+    if kin_word(bound_at) == 0u {
+        for (var r = 0u; r < rules; r++) {
+            let p = trec + 8u + 9u * r;
+            if kin_word(p) == RULE_REBIND && len < kin_f32(p + 2u) && draws_below(x, one_minus_exp(kin_f32(p + 1u) * dt)) {
+                atomicStore(&kin[bound_at], 1u);
+                atomicStore(&kin[age_at], 0u);
+                atomicStore(&kin[age_at + 1u], 0u);
+                return EVENT_REBIND;
+            }
+        }
+        return 0u;
+    }
+    let rest = kin_f32(rec + 5u);
+    let strain = select(0.0, (len - rest) / rest, rest > 0.0);
+    var rate = 0.0;
+    var immediate = false;
+    for (var r = 0u; r < rules; r++) {
+        let p = trec + 8u + 9u * r;
+        let code = kin_word(p);
+        if code == RULE_THRESHOLD {
+            let u = (f32(philox4x32_10(vec4<u32>(bond, STREAM_QUENCHED, KIN_NONE, KIN_NONE), seed).x) + 0.5) * 2.3283064365386963e-10;
+            let factor = 1.0 + kin_f32(p + 3u) * (u - 0.5);
+            let over_strain = kin_f32(p + 1u) > 0.0 && abs(strain) > kin_f32(p + 1u) * factor;
+            let over_force = kin_f32(p + 2u) > 0.0 && force > kin_f32(p + 2u) * factor;
+            if over_strain || over_force {
+                if kin_f32(p + 4u) > 0.0 {
+                    rate += kin_f32(p + 4u);
+                } else {
+                    immediate = true;
+                }
+            }
+        } else if code != RULE_REBIND {
+            rate += unbind_rate(code, p + 1u, force, kt);
+        }
+    }
+    let rate_dt = rate * dt;
+    atomicStore(&kin[m + 2u], bitcast<u32>(rate_dt));
+    if rate_dt > COARSE_RATE_DT && kin_word(trec + 1u) == 0u {
+        atomicMin(&kin[trec + 2u], k);
+    }
+    let age = f64_add(vec2<u32>(kin_word(age_at), kin_word(age_at + 1u)), vec2<u32>(kin_word(KIN_DT_HI), kin_word(KIN_DT_LO)));
+    atomicStore(&kin[age_at], age.x);
+    atomicStore(&kin[age_at + 1u], age.y);
+    if immediate || (rate > 0.0 && draws_below(x, one_minus_exp(rate_dt))) {
+        atomicStore(&kin[bound_at], 0u);
+        return EVENT_BREAK;
+    }
+    return 0u;
+}
+
+var<workgroup> kin_partial: array<u32, 256>;
+
+// One workgroup: block bases = cursor + exclusive scan of the block counts.
+@compute @workgroup_size(256)
+fn kin_scan(@builtin(local_invocation_index) local: u32) {
+    let blocks = (P.kin_bonds + WORKGROUP - 1u) / WORKGROUP;
+    let per = (blocks + WORKGROUP - 1u) / WORKGROUP;
+    let counts = kin_word(KIN_BLOCK);
+    let bases = counts + blocks;
+    let first = min(local * per, blocks);
+    let end = min(first + per, blocks);
+    var sum = 0u;
+    for (var b = first; b < end; b++) {
+        sum += kin_word(counts + b);
+    }
+    kin_partial[local] = sum;
+    workgroupBarrier();
+    // Inclusive Hillis–Steele scan of the 256 partial sums.
+    for (var step = 1u; step < WORKGROUP; step *= 2u) {
+        var v = kin_partial[local];
+        if local >= step {
+            v += kin_partial[local - step];
+        }
+        workgroupBarrier();
+        kin_partial[local] = v;
+        workgroupBarrier();
+    }
+    // A halted step decided nothing (the halt was set before this step).
+    let go = !halted();
+    let cursor = kin_word(KIN_CURSOR);
+    var base = cursor + kin_partial[local] - sum;
+    for (var b = first; b < end && go; b++) {
+        atomicStore(&kin[bases + b], base);
+        base += kin_word(counts + b);
+    }
+    workgroupBarrier();
+    if !go {
+        return;
+    }
+    if local == 0u {
+        let total = kin_partial[WORKGROUP - 1u];
+        atomicStore(&kin[KIN_CURSOR], cursor + total);
+        if total > 0u {
+            // Breaks and rebinds change the pair exclusions.
+            atomicStore(&status[ST_FORCE_REBUILD], 1u);
+        }
+    }
+    // Coarse-step warnings: the lowest bond of each type over k·dt = 0.1, once.
+    for (var t = local; t < P.kin_types; t += WORKGROUP) {
+        let trec = kin_word(KIN_TYPE) + KIN_TYPE_WORDS * t;
+        let k = kin_word(trec + 2u);
+        if kin_word(trec + 1u) == 0u && k != KIN_NONE {
+            let step = current_step();
+            atomicStore(&kin[trec + 1u], 1u);
+            atomicStore(&kin[trec + 3u], step.x);
+            atomicStore(&kin[trec + 4u], step.y);
+            atomicStore(&kin[trec + 5u], kin_word(kin_word(KIN_MEASURE) + 3u * k + 2u));
+        }
+    }
+}
+
+@compute @workgroup_size(256)
+fn kin_emit(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    let k = linear_index(wg, local);
+    if k >= P.kin_bonds || halted() {
+        return;
+    }
+    let flags = kin_word(KIN_FLAG);
+    let kind = kin_word(flags + k);
+    if kind == 0u {
+        return;
+    }
+    // Rank among this block's events: those of lower bonds.
+    let block = k / WORKGROUP;
+    var rank = 0u;
+    for (var q = block * WORKGROUP; q < k; q++) {
+        rank += select(0u, 1u, kin_word(flags + q) != 0u);
+    }
+    let blocks = (P.kin_bonds + WORKGROUP - 1u) / WORKGROUP;
+    let slot = kin_word(kin_word(KIN_BLOCK) + blocks + block) + rank;
+    let e = kin_word(KIN_EVENTS) + KIN_EVENT_WORDS * slot;
+    let rec = kin_word(KIN_BONDS) + KIN_BOND_WORDS * k;
+    let m = kin_word(KIN_MEASURE) + 3u * k;
+    let age_at = kin_word(KIN_AGE) + 2u * k;
+    let step = current_step();
+    atomicStore(&kin[e], step.x);
+    atomicStore(&kin[e + 1u], step.y);
+    atomicStore(&kin[e + 2u], kin_word(rec + 3u));
+    atomicStore(&kin[e + 3u], kind);
+    atomicStore(&kin[e + 4u], kin_word(m));
+    atomicStore(&kin[e + 5u], kin_word(m + 1u));
+    atomicStore(&kin[e + 6u], kin_word(age_at));
+    atomicStore(&kin[e + 7u], kin_word(age_at + 1u));
+}

@@ -1,0 +1,290 @@
+//! Bond kinetics decided on the device (kernels: shaders/common/kinetics.wgsl).
+//!
+//! For models whose every kinetic rule has a rate in closed form of the
+//! bond's tension — `slip`, `catch_slip`, `cadherin`, `threshold` (breaking)
+//! and `rebind` (rebinding to the same partner) — each step's breaks and
+//! rebinds are decided on the GPU, with no read-back: the tension dE/dr and
+//! length of every kinetic bond are measured at x_s after the force pass, and
+//! after the step each bond draws the CPU's Philox number (seed, s, bond
+//! index, stream 2) and compares it with 1 − exp(−k(F)·dt) (f32; the CPU's
+//! decision differs only where the uniform falls within ~1e-7·p of p). Bound
+//! flags and ages (f64 bits, advanced by an exact integer f64 addition, so
+//! the CPU's bits) live in device buffers; unbound bonds exert no force and
+//! stop excluding their pair, and a step with events has the neighbour list
+//! rebuilt. Events (step, bond, kind, tension, length, age) are compacted in
+//! bond order by a per-block count, a one-workgroup scan and a ranked write,
+//! so the event buffer is the same whatever the GPU's scheduling. The host
+//! drains it ([`GpuBackend::drain_kinetics`]) at every synchronisation
+//! (thermo, dump, checkpoint, the end, every 1000 steps) or when it could not
+//! take another step's events (the run halts there and resumes); it then
+//! counts, logs and applies the events and reads the ages back with the
+//! positions.
+//!
+//! Which models: [`refusal`] says why a model's kinetics stay on the host
+//! (one GPU step per segment, as before): `bind` formation, the rules that
+//! change a bond's law every step or at a strain (`motor`, `ratchet`,
+//! `maturation`, `plastic`), more than [`RULES_PER_TYPE`] rules on a bond
+//! type, `special_bonds` 1-3 or 1-4 weights other than 1 with pair terms (the
+//! exclusions of a broken bond would reach beyond its pair), or two bonds
+//! joining the same pair where one has kinetic rules.
+//!
+//! # The `kin` buffer (u32 words)
+//!
+//! A header (word indices as the `KIN_*` constants of kinetics.wgsl), then:
+//! per kinetic bond (the bonds with a term of their own, in bond order) its
+//! record (i, j, bond type, bond index, term, rest length), bound flag, age
+//! (high, low words of the f64), tension, length and k·dt (f32 bits) and this
+//! step's event kind; per block of 256 bonds its event count, then its base;
+//! per bond type its record (rule count, warned, the lowest bond over
+//! k·dt = 0.1, that step, that k·dt, two spare words, then up to four rules as
+//! a code and eight f32 parameters); per exclusion entry of the topology its
+//! kinetic bond (or none); the events (step low, high, bond, kind, tension,
+//! length, age high, low).
+
+use super::backend::GpuBackend;
+use super::pack::{Packed, PARAM_SLOTS};
+use crate::kinetics_engine::EventKind;
+use crate::neighbor::Exclusions;
+use crate::system::{BondState, Model};
+
+/// Rules a bond type may combine with kinetics on the device.
+pub const RULES_PER_TYPE: usize = 4;
+const HEADER_WORDS: usize = 16;
+const BOND_WORDS: usize = 6;
+const TYPE_WORDS: usize = 44;
+const EVENT_WORDS: usize = 8;
+const NONE: u32 = u32::MAX;
+const CURSOR: usize = 9;
+const WORKGROUP: usize = 256;
+
+/// The rule codes of kinetics.wgsl (`RULE_*`).
+fn rule_code(name: &str) -> Option<u32> {
+    ["slip", "catch_slip", "cadherin", "threshold", "rebind"].iter().position(|&r| r == name).map(|k| k as u32 + 1)
+}
+
+/// Why the model's bond kinetics cannot be decided on the device (None: they can).
+pub fn refusal(model: &Model) -> Option<String> {
+    if !model.bind_rules.is_empty() {
+        return Some("`bind` formation".into());
+    }
+    for (t, kinetics) in model.bond_kinetics.iter().enumerate() {
+        let label = &model.bond_types[t].label.text;
+        if kinetics.rules.len() > RULES_PER_TYPE {
+            return Some(format!("bond type `{label}` has more than {RULES_PER_TYPE} kinetic rules"));
+        }
+        if let Some(r) = kinetics.rules.iter().find(|r| rule_code(r.rule.name()).is_none()) {
+            return Some(format!("kinetic rule `{}` (bond type `{label}`)", r.rule.name()));
+        }
+    }
+    if !model.pair_rules.is_empty() && model.special_bonds.weights[1..] != [1.0, 1.0] {
+        return Some("`special_bonds` 1-3 or 1-4 weights other than 1 with pair terms".into());
+    }
+    let mut joined = std::collections::HashMap::new();
+    for (b, &[i, j]) in model.bonds.iter().enumerate() {
+        let kinetic = !model.bond_kinetics[model.bond_type[b] as usize].rules.is_empty();
+        let (count, any_kinetic) = joined.entry((i.min(j), i.max(j))).or_insert((0, false));
+        *count += 1;
+        *any_kinetic |= kinetic;
+        if *count > 1 && *any_kinetic {
+            return Some("two bonds joining the same pair, one with kinetic rules".into());
+        }
+    }
+    None
+}
+
+/// What the host keeps of the device kinetics' buffer.
+pub(super) struct KinLayout {
+    /// The model bond of each kinetic bond.
+    own_bonds: Vec<u32>,
+    header: [u32; HEADER_WORDS],
+    types: usize,
+    /// Events the buffer holds.
+    pub(super) capacity: u32,
+    /// The term of the first kinetic bond.
+    pub(super) first_term: u32,
+}
+
+/// The kernels of kinetics.wgsl.
+pub(super) struct KinKernels {
+    pub(super) room: wgpu::ComputePipeline,
+    pub(super) measure: wgpu::ComputePipeline,
+    pub(super) decide: wgpu::ComputePipeline,
+    pub(super) scan: wgpu::ComputePipeline,
+    pub(super) emit: wgpu::ComputePipeline,
+}
+
+impl KinKernels {
+    pub(super) fn new(pipeline: impl Fn(&str) -> wgpu::ComputePipeline) -> Self {
+        Self {
+            room: pipeline("kin_room"),
+            measure: pipeline("kin_measure"),
+            decide: pipeline("kin_decide"),
+            scan: pipeline("kin_scan"),
+            emit: pipeline("kin_emit"),
+        }
+    }
+}
+
+/// Events and warnings the device decided since the host last drained it.
+#[derive(Clone, Debug, Default)]
+pub struct DeviceDecisions {
+    /// In step order, then bond order.
+    pub events: Vec<DeviceEvent>,
+    /// (bond type, step, k·dt) of each type newly over k·dt = 0.1.
+    pub coarse: Vec<(usize, u64, f64)>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DeviceEvent {
+    pub step: u64,
+    pub bond: usize,
+    pub kind: EventKind,
+    pub force: f64,
+    pub length: f64,
+    pub age: f64,
+}
+
+fn f64_words(x: f64) -> [u32; 2] {
+    let bits = x.to_bits();
+    [(bits >> 32) as u32, bits as u32]
+}
+
+impl KinLayout {
+    /// The `kin` buffer for `model` at `bonds`, packed as `packed` (with
+    /// every bond bound) and its `exclusions`; `warned`: the bond types
+    /// already warned about a coarse step.
+    pub(super) fn pack(
+        model: &Model,
+        bonds: &BondState,
+        packed: &Packed,
+        exclusions: &Exclusions,
+        dt: f64,
+        kt: f64,
+        warned: &[bool],
+    ) -> (Vec<u32>, Self) {
+        let own = &packed.own_bonds;
+        let count = own.len();
+        let blocks = count.div_ceil(WORKGROUP);
+        let capacity = 2 * count + 1024;
+        let mut header = [0u32; HEADER_WORDS];
+        let sizes = [BOND_WORDS * count, count, 2 * count, 3 * count, count, 2 * blocks, TYPE_WORDS * model.bond_types.len()];
+        let mut at = HEADER_WORDS;
+        for (k, size) in sizes.iter().enumerate() {
+            header[k] = at as u32;
+            at += size;
+        }
+        let mut words = vec![0u32; at];
+        // Bonds, bound flags, ages.
+        let kinetic_of = {
+            let mut of = vec![NONE; model.bonds.len()];
+            own.iter().enumerate().for_each(|(k, &b)| of[b as usize] = k as u32);
+            of
+        };
+        for (k, &b) in own.iter().enumerate() {
+            let b = b as usize;
+            let [i, j] = model.bonds[b];
+            let rest = model.rest_length(b, Some(bonds)) as f32;
+            let record = [i, j, model.bond_type[b], b as u32, packed.first_own_term + k as u32, rest.to_bits()];
+            let at = header[0] as usize + BOND_WORDS * k;
+            words[at..at + BOND_WORDS].copy_from_slice(&record);
+            words[header[1] as usize + k] = bonds.bound[b] as u32;
+            let age = header[2] as usize + 2 * k;
+            words[age..age + 2].copy_from_slice(&f64_words(bonds.age[b]));
+        }
+        // Bond types and their rules.
+        for (t, kinetics) in model.bond_kinetics.iter().enumerate() {
+            let at = header[6] as usize + TYPE_WORDS * t;
+            words[at] = kinetics.rules.len() as u32;
+            words[at + 1] = warned.get(t).is_some_and(|&w| w) as u32;
+            words[at + 2] = NONE;
+            for (r, rule) in kinetics.rules.iter().enumerate() {
+                let slot = at + 8 + (1 + PARAM_SLOTS) * r;
+                words[slot] = rule_code(rule.rule.name()).expect("refusal() checked the rules");
+                for (q, &p) in rule.params.iter().enumerate() {
+                    words[slot + 1 + q] = (p as f32).to_bits();
+                }
+            }
+        }
+        // Exclusion tags: an entry holds while its kinetic bond is bound.
+        header[7] = words.len() as u32;
+        let mut tag = std::collections::HashMap::new();
+        for (b, &[i, j]) in model.bonds.iter().enumerate() {
+            let kinetic = !model.bond_kinetics[model.bond_type[b] as usize].rules.is_empty();
+            tag.insert((i.min(j), i.max(j)), if kinetic { kinetic_of[b] } else { NONE });
+        }
+        for i in 0..model.len() as u32 {
+            for &j in exclusions.partners(i) {
+                words.push(tag.get(&(i.min(j), i.max(j))).copied().unwrap_or(NONE));
+            }
+        }
+        header[8] = words.len() as u32;
+        words.resize(words.len() + EVENT_WORDS * capacity, 0);
+        let [dt_hi, dt_lo] = f64_words(dt);
+        header[10] = dt_hi;
+        header[11] = dt_lo;
+        header[12] = (dt as f32).to_bits();
+        header[13] = (kt as f32).to_bits();
+        words[..HEADER_WORDS].copy_from_slice(&header);
+        let layout = Self {
+            own_bonds: own.clone(),
+            header,
+            types: model.bond_types.len(),
+            capacity: capacity as u32,
+            first_term: packed.first_own_term,
+        };
+        (words, layout)
+    }
+
+    pub(super) fn bonds(&self) -> u32 {
+        self.own_bonds.len() as u32
+    }
+}
+
+impl GpuBackend {
+    /// The events and coarse-step warnings decided on the device since the
+    /// last call (empty without device kinetics); the event buffer is
+    /// emptied. Reads one word when there were none.
+    pub fn drain_kinetics(&self) -> DeviceDecisions {
+        let mut out = DeviceDecisions::default();
+        let Some(kinetics) = self.device_kinetics() else { return out };
+        let header = kinetics.header;
+        let (types_at, types) = (header[6] as u64, kinetics.types);
+        let count = self.read_kin(CURSOR as u64, 1)[0] as usize;
+        if count > 0 {
+            let words = self.read_kin(header[8] as u64, (EVENT_WORDS * count) as u64);
+            for e in words.chunks_exact(EVENT_WORDS) {
+                let kind = if e[3] == 1 { EventKind::Break } else { EventKind::Rebind };
+                out.events.push(DeviceEvent {
+                    step: (e[1] as u64) << 32 | e[0] as u64,
+                    bond: e[2] as usize,
+                    kind,
+                    force: f32::from_bits(e[4]) as f64,
+                    length: f32::from_bits(e[5]) as f64,
+                    age: f64::from_bits((e[6] as u64) << 32 | e[7] as u64),
+                });
+            }
+            self.write_kin(CURSOR as u64, &[0]);
+        }
+        let records = self.read_kin(types_at, (TYPE_WORDS * types) as u64);
+        for (t, r) in records.chunks_exact(TYPE_WORDS).enumerate() {
+            if r[1] == 1 && r[2] != NONE {
+                out.coarse.push((t, (r[4] as u64) << 32 | r[3] as u64, f32::from_bits(r[5]) as f64));
+                self.write_kin(types_at + (TYPE_WORDS * t) as u64 + 2, &[NONE]);
+            }
+        }
+        out
+    }
+
+    /// The device's bound flags and ages written into `bonds` (the kinetic
+    /// bonds'; nothing without device kinetics).
+    pub fn download_bond_state(&self, bonds: &mut BondState) {
+        let Some(kinetics) = self.device_kinetics() else { return };
+        let n = kinetics.own_bonds.len() as u64;
+        let bound = self.read_kin(kinetics.header[1] as u64, n);
+        let ages = self.read_kin(kinetics.header[2] as u64, 2 * n);
+        for (k, &b) in kinetics.own_bonds.iter().enumerate() {
+            bonds.bound[b as usize] = bound[k] == 1;
+            bonds.age[b as usize] = f64::from_bits((ages[2 * k] as u64) << 32 | ages[2 * k + 1] as u64);
+        }
+    }
+}
