@@ -25,6 +25,7 @@ fn forces(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index)
     let count = min(nlist[row], P.nlist_cap);
     for (var k = 0u; k < count; k++) {
         let j = nlist[row + 1u + k];
+        if j >= CONTACT_ONLY { continue; } // an excluded pair kept for the contact search
         let pair = ti * P.n_types + topo[j];
         let d = separation(i, j);
         let r2 = dot(d, d);

@@ -20,6 +20,7 @@
 use glam::DVec3;
 use wgpu::util::DeviceExt;
 
+use super::contact::{reach_message, ContactPack, CONTACT_ONLY, FRACTION_SLOTS};
 use super::context::GpuContext;
 use super::nlist::NeighbourStorage;
 use super::pack::{cell_grid, pack, FixedPoint, Params};
@@ -29,7 +30,7 @@ use crate::neighbor::Exclusions;
 use crate::system::{Model, SimBox, State};
 
 const WORKGROUP: u32 = 256;
-const STATUS_WORDS: usize = 8;
+const STATUS_WORDS: usize = 9;
 const ST_HALTED: usize = 0;
 const ST_OVERFLOW_NEED: usize = 1;
 const ST_BUILDS: usize = 3;
@@ -40,6 +41,10 @@ const ST_SPAN_BODY: usize = 7;
 const HALT_OVERFLOW: u32 = 1;
 const HALT_BLOWUP: u32 = 2;
 const HALT_SPAN: u32 = 4;
+/// This step's fraction of dt (f32 bits; the contact step clamp, src/gpu/contact.rs).
+const ST_FRACTION: usize = 8;
+/// A face edge outgrew the contact search (src/gpu/contact.rs).
+const HALT_REACH: u32 = 8;
 /// Steps per command buffer.
 const STEPS_PER_SUBMIT: u64 = 64;
 
@@ -68,6 +73,8 @@ pub struct PhaseTimes {
     pub integrate: f64,
     /// Reading positions back to the host (thermo, dump, end of run).
     pub readback: f64,
+    /// Node–face contact and the step clamp (0 without contact), apart from `forces`.
+    pub contact: f64,
 }
 
 /// Settings the kernels need besides the model.
@@ -102,6 +109,8 @@ struct Kernels {
     integrate: wgpu::ComputePipeline,
     commit: wgpu::ComputePipeline,
     advance: wgpu::ComputePipeline,
+    /// Node–face contact and the step clamp (src/gpu/contact.rs).
+    contact_forces: wgpu::ComputePipeline,
 }
 
 /// The GPU force engine and integrator for one model.
@@ -138,6 +147,10 @@ pub struct GpuBackend {
     settings: StepSettings,
     /// The next `run` or `evaluate` rebuilds the neighbour list first.
     pending_rebuild: bool,
+    /// The contact bodies' faces and rules (src/gpu/contact.rs).
+    contact: ContactPack,
+    /// The fraction of dt each step of the last `run` took (with contact).
+    fractions: Vec<f32>,
 }
 
 /// Refuses a storage buffer the adapter cannot bind (wgpu would abort).
@@ -183,9 +196,9 @@ impl GpuBackend {
         if !model.tetras.is_empty() {
             return Err("the GPU backend has no kernels for volume elements (`[ tetrahedra ]`) yet; use `device cpu`".into());
         }
-        if model.has_contact_terms() {
+        if model.contact_rules.iter().any(|r| !r.interaction.law().runs_on_gpu()) {
             return Err(
-                "the GPU backend has no kernels for contact terms between bodies yet; use `device cpu` for decks with `contact` lines"
+                "the GPU backend has no kernels for area-weighted contact terms between bodies (`contact_adhesion`) yet; use `device cpu`"
                     .into(),
             );
         }
@@ -193,10 +206,12 @@ impl GpuBackend {
         if n == 0 {
             return Err("the GPU backend needs at least one particle".into());
         }
-        let packed = pack_state(model, state, settings)?;
+        let contact = ContactPack::new(model, &state.positions, sim_box);
+        let (packed, contact_fields) = pack_state(model, state, settings, &contact)?;
         let cutoff = model.max_pair_cutoff();
-        let has_pairs = !model.pair_rules.is_empty() && cutoff > 0.0;
-        let range = cutoff + settings.skin;
+        // The list also serves the contact search (src/gpu/contact.rs).
+        let has_pairs = (!model.pair_rules.is_empty() && cutoff > 0.0) || contact.faces() > 0;
+        let range = cutoff.max(contact.reach()) + settings.skin;
         let (grid, inv_width) = if has_pairs { cell_grid(sim_box, range, n) } else { ([1, 1, 1], [0.0; 3]) };
         let cells = grid.iter().product::<u32>();
         let scan_blocks = cells.div_ceil(WORKGROUP);
@@ -231,6 +246,7 @@ impl GpuBackend {
             topo_offsets: packed.topo_offsets,
             fparam_offsets: packed.fparam_offsets,
             surface_offsets: packed.surface_offsets,
+            contact: contact_fields,
         };
         let device = &ctx.device;
         let init = |label: &str, contents: &[u8], usage: wgpu::BufferUsages| {
@@ -257,7 +273,7 @@ impl GpuBackend {
         let nlist = NeighbourStorage::new(ctx, n as u32, params.nlist_cap, nlist_binding_limit)?;
         let force = zeros("force", 16 * n as u64, rw);
         let status = zeros("status", 4 * STATUS_WORDS as u64, rw);
-        let surf_bytes = 16 * packed.surf_entries;
+        let surf_bytes = 16 * (packed.surf_entries + contact.surf_entries());
         check_binding(ctx, "the surface terms' face and body values", surf_bytes)?;
         let surf = zeros("surf", surf_bytes, rw);
         let args = zeros("dispatch_args", 4 * 12, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT);
@@ -334,6 +350,7 @@ impl GpuBackend {
             integrate: pipeline("integrate", &main_layout),
             commit: pipeline("commit", &main_layout),
             advance: pipeline("advance", &main_layout),
+            contact_forces: pipeline("contact_forces", &main_layout),
         };
         let main_group = bind_main(
             device,
@@ -370,6 +387,8 @@ impl GpuBackend {
             settings: *settings,
             pending_rebuild: true,
             ctx: ctx.clone(),
+            contact,
+            fractions: Vec::new(),
         };
         backend.upload(state);
         Ok(backend)
@@ -446,7 +465,7 @@ impl GpuBackend {
     /// rebuild before the next step (when bonds broke or bound, so that the
     /// pair exclusions changed).
     pub fn update_bonds(&mut self, model: &Model, state: &State, rebuild: bool) -> Result<(), String> {
-        let packed = pack_state(model, state, &self.settings)?;
+        let (packed, contact_fields) = pack_state(model, state, &self.settings, &self.contact)?;
         let (topo, fparams) = (pad16(packed.topo), pad16(packed.fparams));
         let fits = |buffer: &wgpu::Buffer, bytes: usize| bytes as u64 <= buffer.size();
         if fits(&self.topo, 4 * topo.len()) && fits(&self.fparams, 4 * fparams.len()) {
@@ -465,6 +484,7 @@ impl GpuBackend {
         self.params.topo_offsets = packed.topo_offsets;
         self.params.fparam_offsets = packed.fparam_offsets;
         self.params.surface_offsets = packed.surface_offsets;
+        self.params.contact = contact_fields;
         self.pending_rebuild |= rebuild;
         Ok(())
     }
@@ -474,6 +494,7 @@ impl GpuBackend {
         status[ST_BLOWUP_PARTICLE] = u32::MAX;
         status[ST_SPAN_BODY] = u32::MAX;
         status[ST_FORCE_REBUILD] = force_rebuild as u32;
+        status[ST_FRACTION] = 1f32.to_bits();
         self.ctx.queue.write_buffer(&self.status, 0, words(&status));
     }
 
@@ -511,6 +532,8 @@ impl GpuBackend {
             .map(|i| {
                 let start = i * (1 + cap);
                 let mut row = data[start + 1..start + 1 + (data[start] as usize).min(cap)].to_vec();
+                // Excluded pairs kept for the contact search only are no neighbours.
+                row.retain(|&j| j & CONTACT_ONLY == 0);
                 row.sort_unstable();
                 row
             })
@@ -518,6 +541,10 @@ impl GpuBackend {
     }
 
     fn read(&self, buffer: &wgpu::Buffer, bytes: u64) -> Vec<u8> {
+        self.read_at(buffer, 0, bytes)
+    }
+
+    fn read_at(&self, buffer: &wgpu::Buffer, offset: u64, bytes: u64) -> Vec<u8> {
         let device = &self.ctx.device;
         let staging = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("readback"),
@@ -526,7 +553,7 @@ impl GpuBackend {
             mapped_at_creation: false,
         });
         let mut encoder = device.create_command_encoder(&Default::default());
-        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, bytes);
+        encoder.copy_buffer_to_buffer(buffer, offset, &staging, 0, bytes);
         self.ctx.queue.submit([encoder.finish()]);
         let slice = staging.slice(..);
         slice.map_async(wgpu::MapMode::Read, |r| r.expect("mapping a readback buffer"));
@@ -590,6 +617,7 @@ impl GpuBackend {
         let mut force_pass = self.surface_passes();
         force_pass.push((&k.forces, Over::Chunks));
         let forces = time(self, &force_pass, false);
+        let contact = if self.has_contact() { time(self, &[(&k.contact_forces, Over::Chunks)], false) } else { 0.0 };
         let integrate = time(self, &[(&k.integrate, particles), (&k.commit, particles), (&k.advance, Over::Groups(1))], false);
         let started = std::time::Instant::now();
         for _ in 0..repetitions {
@@ -598,7 +626,7 @@ impl GpuBackend {
         let readback = started.elapsed().as_secs_f64() / repetitions as f64;
         self.ctx.queue.write_buffer(&self.state, 0, &saved);
         self.pending_rebuild = true;
-        Ok(PhaseTimes { check, neighbor_build, forces, integrate, readback })
+        Ok(PhaseTimes { check, neighbor_build, forces, integrate, readback, contact })
     }
 
     /// Dispatches `pipeline` over `over`: wider than the dispatch width,
@@ -655,6 +683,9 @@ impl GpuBackend {
             self.dispatch(pass, pipeline, over);
         }
         self.dispatch(pass, &k.forces, Over::Chunks);
+        if self.has_contact() {
+            self.dispatch(pass, &k.contact_forces, Over::Chunks);
+        }
         if integrate {
             self.dispatch(pass, &k.integrate, Over::Particles);
             self.dispatch(pass, &k.commit, Over::Particles);
@@ -683,9 +714,24 @@ impl GpuBackend {
         passes
     }
 
-    /// The message of a body-span halt (see [`super::surface`]), if there was one.
+    /// The message of a body-span halt (see [`super::surface`]) or of a
+    /// face that outgrew the contact search ([`super::contact`]), if there was one.
     fn span_halt(&self, status: &[u32; STATUS_WORDS]) -> Option<String> {
+        if status[ST_HALTED] & HALT_REACH != 0 {
+            return Some(reach_message(self.contact.edge_bound()));
+        }
         (status[ST_HALTED] & HALT_SPAN != 0).then(|| super::surface::span_message(self.body_ids[status[ST_SPAN_BODY] as usize]))
+    }
+
+    /// Whether node–face contact runs ([`super::contact`]).
+    fn has_contact(&self) -> bool {
+        self.contact.faces() > 0
+    }
+
+    /// The fraction of dt each step of the last [`Self::run`] took (below 1
+    /// where the contact step clamp shortened it; empty without contact).
+    pub fn step_fractions(&self) -> &[f32] {
+        &self.fractions
     }
 
     /// Handles an overflow: grows the list and clears the halt. Returns
@@ -732,9 +778,12 @@ impl GpuBackend {
     pub fn run(&mut self, first_step: u64, steps: u64) -> Result<u64, GpuHalt> {
         let mut done = 0u64;
         let mut force_rebuild = std::mem::take(&mut self.pending_rebuild);
+        self.fractions.clear();
         while done < steps {
             let step = first_step + done;
-            let chunk = (steps - done).min(u32::MAX as u64 / 2);
+            // With contact, the ring of step fractions bounds a chunk.
+            let most = if self.has_contact() { FRACTION_SLOTS as u64 } else { u32::MAX as u64 / 2 };
+            let chunk = (steps - done).min(most);
             self.params.step_lo = step as u32;
             self.params.step_hi = (step >> 32) as u32;
             self.params.steps_wanted = chunk as u32;
@@ -756,6 +805,12 @@ impl GpuBackend {
             let status = self.status();
             self.builds += status[ST_BUILDS] as u64;
             done += status[ST_STEPS_DONE] as u64;
+            if self.has_contact() && status[ST_STEPS_DONE] > 0 {
+                let ring = 16 * self.params.contact[15] as u64;
+                let entries: Vec<[f32; 4]> =
+                    bytemuck::cast_slice(&self.read_at(&self.surf, ring, 16 * status[ST_STEPS_DONE] as u64)).to_vec();
+                self.fractions.extend(entries.iter().map(|e| e[0]));
+            }
             if status[ST_HALTED] & HALT_BLOWUP != 0 {
                 return Err(GpuHalt::Blowup { step: first_step + done, particle: status[ST_BLOWUP_PARTICLE] as usize });
             }
@@ -814,8 +869,17 @@ fn initial_capacity(n: usize, sim_box: &SimBox, range: f64, has_pairs: bool) -> 
 
 /// [`pack`] for the model at `state`: with bond state, only the bound bonds
 /// (with their own rest lengths and scales) and the exclusions they make.
-fn pack_state(model: &Model, state: &State, settings: &StepSettings) -> Result<super::pack::Packed, String> {
+/// The contact sections follow the others in `topo`, the fraction ring the
+/// surface entries in `surf`; returns the layout's contact fields too.
+fn pack_state(
+    model: &Model,
+    state: &State,
+    settings: &StepSettings,
+    contact: &ContactPack,
+) -> Result<(super::pack::Packed, [u32; 16]), String> {
     let bound = state.bonds.as_ref().map(|b| b.bound.as_slice());
     let exclusions = Exclusions::from_pairs(model.len(), &model.excluded_pairs(bound));
-    pack(model, &exclusions, settings.context.dt, settings.context.kt, state.bonds.as_ref())
+    let mut packed = pack(model, &exclusions, settings.context.dt, settings.context.kt, state.bonds.as_ref())?;
+    let fields = contact.append(&mut packed.topo, packed.surf_entries);
+    Ok((packed, fields))
 }

@@ -10,6 +10,8 @@
 //!   where it exceeds the adapter's largest storage binding.
 //! - [`surface`]: surface (body) terms: face, body, edge and node passes,
 //!   deterministic (no float atomics).
+//! - [`contact`]: node–face contact between bodies (`Law::Contact`) and
+//!   the explicit step clamp as a device reduction.
 //!
 //! One file-level circle, on purpose: `pack.rs` ↔ `surface.rs`. `pack.rs`
 //! lays out the whole topology, the surface sections included, and
@@ -24,9 +26,9 @@
 //!
 //! Not on the GPU (refused by [`GpuBackend::new`], and by `device gpu`
 //! before a run; `device auto` falls back to the CPU): custom surface terms
-//! of bodies and contact
-//! terms between bodies (`Law::Contact`, `Law::ContactArea`), which have no
-//! kernel yet. Bond kinetics are decided on the host (see [`backend`]).
+//! of bodies and area-weighted contact terms between bodies
+//! (`Law::ContactArea`: adhesion), which have no kernel yet. Bond kinetics
+//! are decided on the host (see [`backend`]).
 //!
 //! # Precision
 //!
@@ -43,6 +45,7 @@
 //! rounding (relative ≈ 1e-7 per step), measured in `tests/gpu.rs`.
 
 pub mod backend;
+pub mod contact;
 pub mod context;
 pub mod custom;
 mod nlist;

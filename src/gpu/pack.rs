@@ -69,6 +69,8 @@ pub struct Params {
     /// ([`super::surface::SurfacePack::sections`]), then the numbers of
     /// faces, bodies, edges and body nodes.
     pub surface_offsets: [u32; 16],
+    /// Node–face contact: layout.wgsl's `off_cfaces` … (src/gpu/contact.rs).
+    pub contact: [u32; 16],
 }
 
 /// The GPU's 64-bit fixed point (layout.wgsl): a length x is the integer
