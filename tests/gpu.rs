@@ -985,6 +985,9 @@ const CONTACT_GPU_EPSILON: f64 = 1e-4;
 
 #[test]
 fn contact_barrier_forces_match_the_cpu() {
+    // The kernel's step clamp is the CPU's.
+    let step = cellmd::backend::CONTACT_STEP_FRACTION;
+    assert!(cellmd::gpu::shader::compose().contains(&format!("const STEP_FRACTION: f32 = {step};")));
     for ff in [CONTACT_BARRIER.to_string(), format!("{CONTACT_SHELLS}{CONTACT_BARRIER}")] {
         let case = contact_case(&ff, 0.03, 1.0, "timestep 1e-3\nrun 0\n");
         let plan = case.plan();
@@ -1066,4 +1069,18 @@ fn a_contact_blowup_on_the_gpu_names_the_step_particle_and_term() {
     assert_eq!((step, particle_id), (cpu_step, cpu_particle), "GPU: {gpu}\nCPU: {cpu}");
     let culprit = culprit.as_ref().unwrap();
     assert_eq!((culprit.kind, culprit.interaction), ("contact", "contact_barrier"), "{gpu}");
+}
+
+/// A face edge that grows past the contact search's reach (1.5 × the
+/// longest edge at the start) stops a GPU run with a message rather than
+/// letting contacts go unseen: one node of a cell without edge springs is
+/// pulled away by 100 pN (0.1 µm a step).
+#[test]
+fn a_face_that_outgrows_the_contact_search_stops_the_gpu_run() {
+    let settings = "group tip id 1\nexternal pull tip constant_force fx -100\ntemperature 0\ntimestep 1e-3\nrun 40\n";
+    let case = contact_case(CONTACT_BARRIER, 0.1, 0.0, settings);
+    let options = RunOptions { output_dir: case.output_dir().to_path_buf(), device: Some(DevicePreference::Gpu), ..Default::default() };
+    let error = Simulation::execute(case.plan(), options).err().map(|e| e.to_string()).unwrap_or_default();
+    println!("{error}");
+    assert!(error.starts_with("device gpu at step ") && error.contains("longer than"), "{error}");
 }

@@ -211,7 +211,8 @@ impl GpuBackend {
         let cutoff = model.max_pair_cutoff();
         // The list also serves the contact search (src/gpu/contact.rs).
         let has_pairs = (!model.pair_rules.is_empty() && cutoff > 0.0) || contact.faces() > 0;
-        let range = cutoff.max(contact.reach()) + settings.skin;
+        let skin = settings.skin.max(contact.skin());
+        let range = cutoff.max(contact.reach()) + skin;
         let (grid, inv_width) = if has_pairs { cell_grid(sim_box, range, n) } else { ([1, 1, 1], [0.0; 3]) };
         let cells = grid.iter().product::<u32>();
         let scan_blocks = cells.div_ceil(WORKGROUP);
@@ -232,7 +233,7 @@ impl GpuBackend {
             n_types: model.type_names.len() as u32,
             steps_wanted: 0,
             range2: (range * range) as f32,
-            half_skin2: (0.25 * settings.skin * settings.skin) as f32,
+            half_skin2: (0.25 * skin * skin) as f32,
             max_disp2: (settings.context.max_displacement * settings.context.max_displacement) as f32,
             neighbor_every: settings.neighbor_every.max(1) as u32,
             seed_lo: settings.context.seed as u32,

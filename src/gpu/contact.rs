@@ -16,7 +16,8 @@
 //!
 //! With contact terms the GPU's neighbour list reaches at least
 //! d̂ + ℓ (ℓ = [`EDGE_ALLOWANCE`] × the longest face edge at the start of the
-//! run) beyond the pair cutoff, plus the skin, and keeps the excluded
+//! run) beyond the pair cutoff, plus the skin (at least d̂, as the CPU's
+//! contact list: [`ContactPack::skin`]), and keeps the excluded
 //! (bonded) pairs between nodes of different contact bodies, marked so that
 //! the pair loop skips them (a junction bond must not hide a contact). A
 //! node closer than d̂ to a face is closer than d̂ + ℓ to each of its corners,
@@ -147,6 +148,17 @@ impl ContactPack {
         }
     }
 
+    /// The least skin of the neighbour list with contact: d̂, the CPU
+    /// contact list's (0 without contact). The deck's skin (often 0 for
+    /// decks without pair terms) would rebuild the list almost every step.
+    pub fn skin(&self) -> f64 {
+        if self.faces() == 0 {
+            0.0
+        } else {
+            self.dhat
+        }
+    }
+
     /// The longest face edge the search covers, ℓ.
     pub fn edge_bound(&self) -> f64 {
         EDGE_ALLOWANCE * self.longest_edge
@@ -195,14 +207,12 @@ pub fn reach_message(edge: f64) -> String {
 mod tests {
     use super::*;
 
-    /// The kernels' constants are the host's.
+    /// The kernels' constants are the host's (the step fraction's: tests/gpu.rs).
     #[test]
     fn the_shader_constants_match() {
         let program = super::super::shader::compose();
         assert!(program.contains(&format!("const FRACTION_SLOTS: u32 = {FRACTION_SLOTS}u;")));
         assert!(program.contains(&format!("const CONTACT_ONLY: u32 = 0x{CONTACT_ONLY:08x}u;")));
         assert!(program.contains(&format!("const CONTACT_RULE_WORDS: u32 = {RULE_WORDS}u;")));
-        let step = crate::backend::CONTACT_STEP_FRACTION;
-        assert!(program.contains(&format!("const STEP_FRACTION: f32 = {step};")));
     }
 }
