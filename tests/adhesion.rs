@@ -261,5 +261,5 @@ fn adhesion_runs_are_bit_identical_on_one_and_two_threads() {
 fn the_gpu_refuses_adhesion() {
     let case = cells_case(ADHESION, "temperature 0\ntimestep 1e-3\nrun 0\n");
     let sim = Simulation::before_first_run(&case.plan(), RunOptions::default()).unwrap();
-    assert_eq!(sim.cpu_only_feature(), Some("contact terms between bodies (`contact` lines) run on the CPU backend only"));
+    assert_eq!(sim.cpu_only_feature(), Some("area-weighted contact terms between bodies (`contact_adhesion`) run on the CPU backend only"));
 }

@@ -10,8 +10,8 @@
 //! - The implicit integrator (step clamp, the barrier's and the cells' stiffness blocks)
 //!   and FIRE (step clamp) squeeze meshed cells together between plates
 //!   without interpenetration, and settle.
-//! - Runs are bit-identical on 1 and 2 threads; the GPU backend refuses
-//!   `contact` lines.
+//! - Runs are bit-identical on 1 and 2 threads; the GPU backend takes
+//!   `contact_barrier` (tests/gpu.rs compares it with the CPU).
 //! - `topologies/cell_contact.top` is two `cellmd build icosphere` cells merged.
 
 mod common;
@@ -260,11 +260,11 @@ fn fire_relaxes_squeezed_cells_without_interpenetration() {
 }
 
 #[test]
-fn the_gpu_refuses_contact_terms() {
-    // Bodies with contact terms only (no `body` lines), so contact is the CPU-only feature named.
+fn the_gpu_takes_the_barrier() {
+    // Bodies with contact terms only (no `body` lines), so contact is the only feature that could be refused.
     let case = case_with(BARRIER, 1.0, "temperature 0\ntimestep 1e-3\nrun 0\n");
     let sim = Simulation::before_first_run(&case.plan(), RunOptions::default()).unwrap();
-    assert_eq!(sim.cpu_only_feature(), Some("contact terms between bodies (`contact` lines) run on the CPU backend only"));
+    assert_eq!(sim.cpu_only_feature(), None);
 }
 
 /// `topologies/cell_contact.top` is two `cellmd build icosphere` cells merged

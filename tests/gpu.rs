@@ -954,3 +954,134 @@ fn device_auto_announces_its_choice_and_runs_on_it() {
     assert!(!auto_files.is_empty());
     assert!(auto_files == announced_files, "the auto run differs from the run on the device it announced");
 }
+
+/// Two 162-node icosphere cells (R = 2 µm, `gap` apart, nodes of drag 1)
+/// with force-field lines `ff`, pushed together by `push` pN per node, in a
+/// box periodic along x with the cells straddling its boundary (so the
+/// contact search works across it).
+fn contact_case(ff: &str, gap: f64, push: f64, settings: &str) -> common::Case {
+    let top = common::two_cells(2, 2.0, gap);
+    let deck = format!(
+        "units cell\ntopology cells.top\nforcefield cells.ff\nbox x 0 20 p y -10 10 f z -10 10 f\n\
+         group left id 1:162\ngroup right id 163:324\n\
+         external push_left left constant_force fx {push}\nexternal push_right right constant_force fx -{push}\n{settings}"
+    );
+    common::Case::new(&[("cells.top", &top), ("cells.ff", &format!("particle node drag 1\n{ff}")), ("deck.in", &deck)])
+}
+
+const CONTACT_BARRIER: &str = "contact cell cell contact_barrier dhat 0.1 kappa 200\n";
+const CONTACT_SHELLS: &str = "body cell turgor k 1000 dp0 100 v0 32.4\nbody cell surface_tension gamma 100\n";
+
+/// `contact_barrier` on the GPU (src/gpu/contact.rs) against the CPU f64
+/// backend: two cells 0.03 µm apart (many node–face pairs within d̂ = 0.1 µm,
+/// in every Voronoi region), the barrier alone and with the cells' surface
+/// terms. Tolerance from f32 arithmetic (u = 2⁻²⁴ ≈ 6e-8): a pair's
+/// separations from the face's first corner (≤ ℓ + d̂ ≈ 0.6 µm) are rounded
+/// once, the closest point and d take ≈ 10 more roundings, so d is off by
+/// ≈ 10u·0.6 µm ≈ 4e-7 µm, 1.2e-5 of the smallest d (0.03 µm); the force
+/// b′(d) changes by d·|b″/b′| ≤ 3 times that relative change, ≈ 4e-5; the
+/// energy by d·|b′/b| ≤ 3 times, also ≈ 4e-5. A particle sums a few pairs of
+/// the same sign, so relative to the largest force and the total energy: 1e-4.
+const CONTACT_GPU_EPSILON: f64 = 1e-4;
+
+#[test]
+fn contact_barrier_forces_match_the_cpu() {
+    // The kernel's step clamp is the CPU's.
+    let step = cellmd::backend::CONTACT_STEP_FRACTION;
+    assert!(cellmd::gpu::shader::compose().contains(&format!("const STEP_FRACTION: f32 = {step};")));
+    for ff in [CONTACT_BARRIER.to_string(), format!("{CONTACT_SHELLS}{CONTACT_BARRIER}")] {
+        let case = contact_case(&ff, 0.03, 1.0, "timestep 1e-3\nrun 0\n");
+        let plan = case.plan();
+        let model = Simulation::before_first_run(&plan, RunOptions::default()).unwrap().model;
+        let state = initial_state(&plan);
+        let mut cpu = CpuBackend::new(&model, &state, &plan.sim_box, 0.3).unwrap();
+        let mut forces = Forces::default();
+        cpu.compute(&model, &state, &plan.sim_box, &mut forces);
+        let pairs = forces.forces.iter().filter(|f| f.length() > 0.0).count();
+        let mut gpu = GpuBackend::new(&context(), &model, &state, &plan.sim_box, &settings(0.3, 1e-3, 0.0)).unwrap();
+        gpu.evaluate().unwrap();
+        let (force_error, energy_error) = compare_forces(&forces, &gpu.forces_and_energies());
+        println!("{} force-field lines: {pairs} particles with a force; force error {force_error:.2e}, energy error {energy_error:.2e}", ff.lines().count());
+        assert!(pairs > 20, "only {pairs} particles feel a force: the test would be vacuous");
+        assert!(force_error <= CONTACT_GPU_EPSILON && energy_error <= CONTACT_GPU_EPSILON, "force {force_error:e}, energy {energy_error:e}");
+    }
+}
+
+/// The contact step clamp on the GPU: cells pushed together by 50 pN per
+/// node at dt = 1e-2 s (0.5 µm a step unclamped, five times d̂), 10 steps.
+/// At kT = 0 the GPU clamps the same steps as the CPU, its clock advances by
+/// the same shortened steps, and its positions follow the CPU's within 1e-4
+/// of the distance travelled (each step's s and displacement carry the
+/// forces' and distances' relative error, ≤ CONTACT_GPU_EPSILON); the cells
+/// never interpenetrate. (Longer runs at this dt chatter against the barrier
+/// and amplify any difference: measured GPU − CPU 6.7e-7 µm after 10 steps,
+/// 1.8e-4 after 20, 1.7e-2 after 40, every step clamped.) With noise, the
+/// same GPU run twice (60 steps) gives the same bits.
+#[test]
+fn the_contact_step_clamp_runs_on_the_gpu_like_on_the_cpu() {
+    let run = |device: DevicePreference, kt: f64, steps: u64| {
+        let case = contact_case(&format!("{CONTACT_SHELLS}{CONTACT_BARRIER}"), 0.1, 50.0, &format!("temperature {kt}\nseed 7\ntimestep 1e-2\nrun 0\n"));
+        let options = RunOptions { output_dir: case.output_dir().to_path_buf(), device: Some(device), ..Default::default() };
+        let mut sim = Simulation::before_first_run(&case.plan(), options).unwrap();
+        let start = sim.state.clone();
+        sim.run(steps).unwrap();
+        (start, sim)
+    };
+    let (start, cpu) = run(DevicePreference::Cpu, 0.0, 10);
+    let (_, gpu) = run(DevicePreference::Gpu, 0.0, 10);
+    let sim_box = cpu.sim_box;
+    let unwrap = |s: &State, i: usize| sim_box.unwrap(s.positions[i], s.images[i]);
+    let travelled = (0..start.len()).map(|i| (unwrap(&cpu.state, i) - unwrap(&start, i)).length()).fold(0.0, f64::max);
+    let deviation = (0..start.len()).map(|i| (unwrap(&cpu.state, i) - unwrap(&gpu.state, i)).length()).fold(0.0, f64::max);
+    println!(
+        "CPU: {} clamped steps, t = {:.6e} s, mindist {:.4e}; GPU: {} clamped, t = {:.6e} s, mindist {:.4e}; GPU − CPU {deviation:.3e} after {travelled:.3e}",
+        cpu.contact_clamps, cpu.state.time, cpu.min_contact_distance(), gpu.contact_clamps, gpu.state.time, gpu.min_contact_distance()
+    );
+    assert!(cpu.contact_clamps > 5, "the clamp hardly acted: {} steps", cpu.contact_clamps);
+    assert_eq!(gpu.contact_clamps, cpu.contact_clamps);
+    assert!((gpu.state.time - cpu.state.time).abs() <= CONTACT_GPU_EPSILON * cpu.state.time, "{} vs {}", gpu.state.time, cpu.state.time);
+    assert!(deviation <= CONTACT_GPU_EPSILON * travelled, "GPU − CPU {deviation:e} > {CONTACT_GPU_EPSILON:e} × {travelled:e}");
+    assert!(gpu.min_contact_distance() > 0.0 && gpu.min_contact_distance() < 0.1);
+    let (_, a) = run(DevicePreference::Gpu, 0.0041, 60);
+    let (_, b) = run(DevicePreference::Gpu, 0.0041, 60);
+    let bits = |s: &Simulation| s.state.positions.iter().map(|x| x.to_array().map(f64::to_bits)).collect::<Vec<_>>();
+    assert!(bits(&a) == bits(&b) && a.state.time == b.state.time && a.contact_clamps == b.contact_clamps, "two GPU runs differ");
+    assert!(a.contact_clamps > 0);
+}
+
+/// A GPU blow-up near a contact names the step, the particle and the
+/// contact term as the CPU does: cells 0.01 µm apart, where the barrier
+/// pushes with ≈ 250 pN and even the clamped step (0.4 × 0.01 µm) exceeds
+/// `max_displacement` 1e-3 µm.
+#[test]
+fn a_contact_blowup_on_the_gpu_names_the_step_particle_and_term() {
+    let settings = "integrator overdamped max_displacement 1e-3\ntemperature 0\ntimestep 1e-3\nrun 50\n";
+    let [cpu, gpu] = [DevicePreference::Cpu, DevicePreference::Gpu].map(|device| {
+        let case = contact_case(CONTACT_BARRIER, 0.01, 1.0, settings);
+        let options = RunOptions { output_dir: case.output_dir().to_path_buf(), device: Some(device), ..Default::default() };
+        match Simulation::execute(case.plan(), options) {
+            Ok(_) => panic!("{device:?}: the run should blow up"),
+            Err(e) => e,
+        }
+    });
+    println!("CPU: {cpu}\nGPU: {gpu}");
+    let cellmd::run::RunError::Blowup { step, particle_id, culprit, .. } = &gpu else { panic!("{gpu}") };
+    let cellmd::run::RunError::Blowup { step: cpu_step, particle_id: cpu_particle, .. } = &cpu else { panic!("{cpu}") };
+    assert_eq!((step, particle_id), (cpu_step, cpu_particle), "GPU: {gpu}\nCPU: {cpu}");
+    let culprit = culprit.as_ref().unwrap();
+    assert_eq!((culprit.kind, culprit.interaction), ("contact", "contact_barrier"), "{gpu}");
+}
+
+/// A face edge that grows past the contact search's reach (1.5 × the
+/// longest edge at the start) stops a GPU run with a message rather than
+/// letting contacts go unseen: one node of a cell without edge springs is
+/// pulled away by 100 pN (0.1 µm a step).
+#[test]
+fn a_face_that_outgrows_the_contact_search_stops_the_gpu_run() {
+    let settings = "group tip id 1\nexternal pull tip constant_force fx -100\ntemperature 0\ntimestep 1e-3\nrun 40\n";
+    let case = contact_case(CONTACT_BARRIER, 0.1, 0.0, settings);
+    let options = RunOptions { output_dir: case.output_dir().to_path_buf(), device: Some(DevicePreference::Gpu), ..Default::default() };
+    let error = Simulation::execute(case.plan(), options).err().map(|e| e.to_string()).unwrap_or_default();
+    println!("{error}");
+    assert!(error.starts_with("device gpu at step ") && error.contains("longer than"), "{error}");
+}

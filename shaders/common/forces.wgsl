@@ -22,9 +22,12 @@ fn forces(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index)
 
     // Pairs.
     let row = nlist_row(i);
-    let count = min(nlist[row], P.nlist_cap);
+    // No pair rules (a list kept for the contact search only): no pair loop.
+    let pair_rules = topo[P.off_pair_start + P.n_types * P.n_types];
+    let count = select(0u, min(nlist[row], P.nlist_cap), pair_rules > 0u);
     for (var k = 0u; k < count; k++) {
         let j = nlist[row + 1u + k];
+        if j >= CONTACT_ONLY { continue; } // an excluded pair kept for the contact search
         let pair = ti * P.n_types + topo[j];
         let d = separation(i, j);
         let r2 = dot(d, d);

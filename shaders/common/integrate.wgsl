@@ -12,23 +12,34 @@ fn current_step() -> vec2<u32> {
     return vec2<u32>(lo, P.step_hi + select(0u, 1u, lo < P.step_lo));
 }
 
+// Particle i's drift dt·F/γ.
+fn drift(i: u32) -> vec3<f32> {
+    return force[i].xyz * fparams[P.off_mobility + topo[i]];
+}
+
+// Particle i's noise √(2kT·dt/γ)·ξ of this step.
+fn noise(i: u32) -> vec3<f32> {
+    let amplitude = fparams[P.off_amplitude + topo[i]];
+    if amplitude == 0.0 {
+        return vec3<f32>(0.0);
+    }
+    let seed = vec2<u32>(P.seed_lo, P.seed_hi);
+    if P.gaussian == 1u {
+        return amplitude * gaussian3(seed, current_step(), i);
+    }
+    return amplitude * noise3(seed, current_step(), i);
+}
+
+// The step takes s·dt (s < 1 only where the contact step clamp shortened
+// it, src/gpu/contact.rs): drift s·a, noise √s·b (exactly a + b at s = 1).
 @compute @workgroup_size(256)
 fn integrate(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) local: u32) {
     let i = linear_index(wg, local);
     if i >= P.n || halted() {
         return;
     }
-    let t = topo[i];
-    var dx = force[i].xyz * fparams[P.off_mobility + t];
-    let amplitude = fparams[P.off_amplitude + t];
-    if amplitude > 0.0 {
-        let seed = vec2<u32>(P.seed_lo, P.seed_hi);
-        if P.gaussian == 1u {
-            dx += amplitude * gaussian3(seed, current_step(), i);
-        } else {
-            dx += amplitude * noise3(seed, current_step(), i);
-        }
-    }
+    let s = bitcast<f32>(atomicLoad(&status[ST_FRACTION]));
+    let dx = s * drift(i) + sqrt(s) * noise(i);
     let d2 = dot(dx, dx);
     if !(d2 <= P.max_disp2) {
         atomicMin(&status[ST_BLOWUP_PARTICLE], i);
@@ -72,9 +83,15 @@ fn commit(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index)
     state[2u * P.n + i] = next[2u * P.n + i];
 }
 
+// Counts the step; with contact, records its fraction s in the ring the
+// host reads (src/gpu/contact.rs) and resets s to 1 for the next step.
 @compute @workgroup_size(1)
 fn advance() {
     if !halted() {
-        atomicAdd(&status[ST_STEPS_DONE], 1u);
+        let done = atomicAdd(&status[ST_STEPS_DONE], 1u);
+        if P.n_cfaces > 0u {
+            surf[P.off_fractions + done % FRACTION_SLOTS] = vec4<f32>(bitcast<f32>(atomicLoad(&status[ST_FRACTION])), 0.0, 0.0, 0.0);
+        }
+        atomicStore(&status[ST_FRACTION], 0x3f800000u);
     }
 }

@@ -14,7 +14,7 @@
 // Before every step `kin_room` halts the run (HALT_EVENTS) when the event
 // buffer could not take one more step's events; the host drains it and goes on.
 
-const HALT_EVENTS: u32 = 8u;
+const HALT_EVENTS: u32 = 16u;
 
 // Header words of `kin`.
 const KIN_BONDS: u32 = 0u;   // offset of the bond records (KIN_BOND_WORDS each)

@@ -38,6 +38,11 @@ struct Params {
     off_node_slot_offsets: u32, off_node_slots: u32, off_edges: u32, off_node_body: u32,
     off_node_edge_offsets: u32, off_node_edges: u32, off_node_face_offsets: u32, off_node_faces: u32,
     n_faces: u32, n_bodies: u32, n_edges: u32, n_body_nodes: u32,
+    // contact between bodies (src/gpu/contact.rs): sections of `topo`, then faces, body types, d̂, ℓ², fraction ring in `surf`
+    off_cfaces: u32, off_first_start: u32, off_first_faces: u32, off_corner_start: u32,
+    off_corner_faces: u32, off_cbody: u32, off_cbody_type: u32, off_crule_start: u32,
+    off_crule_list: u32, off_cany: u32, off_crules: u32, n_cfaces: u32,
+    n_body_types: u32, contact_dhat: f32, contact_edge2: f32, off_fractions: u32,
     // bond kinetics on the device (shaders/common/kinetics.wgsl): kinetic bonds, their first term, event capacity, bond types
     kin_bonds: u32, kin_first_term: u32, kin_capacity: u32, kin_types: u32,
 }
@@ -96,6 +101,9 @@ const ST_SPAN_BODY: u32 = 7u;     // lowest packed body wider than half the peri
 const HALT_OVERFLOW: u32 = 1u;
 const HALT_BLOWUP: u32 = 2u;
 const HALT_SPAN: u32 = 4u;
+const ST_FRACTION: u32 = 8u;      // bits of this step's fraction s of dt (contact step clamp; 1.0 without)
+const HALT_REACH: u32 = 8u;       // a face edge outgrew the contact search (src/gpu/contact.rs)
+const CONTACT_ONLY: u32 = 0x80000000u; // neighbour-list entry kept for the contact search only
 
 const WORKGROUP: u32 = 256u;
 

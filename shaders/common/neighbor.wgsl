@@ -191,6 +191,18 @@ fn nb_sort(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index
     }
 }
 
+const NO_ENTRY: u32 = 0xffffffffu;
+
+// Whether i and j are nodes of two different contact bodies.
+fn contact_pair_kept(i: u32, j: u32) -> bool {
+    if P.n_cfaces == 0u {
+        return false;
+    }
+    let bi = topo[P.off_cbody + i];
+    let bj = topo[P.off_cbody + j];
+    return bi != NO_ENTRY && bj != NO_ENTRY && bi != bj;
+}
+
 fn is_excluded(i: u32, j: u32) -> bool {
     let first = topo[P.off_excl_offsets + i];
     let end = topo[P.off_excl_offsets + i + 1u];
@@ -251,11 +263,18 @@ fn nb_build(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_inde
                     let j = cell_data[off_members() + m];
                     if j == i { continue; }
                     let d = separation(i, j);
-                    if dot(d, d) < P.range2 && !is_excluded(i, j) {
-                        if count < P.nlist_cap {
-                            nlist[row + 1u + count] = j;
+                    if dot(d, d) < P.range2 {
+                        // An excluded pair of different contact bodies stays, marked (src/gpu/contact.rs).
+                        var entry = j;
+                        if is_excluded(i, j) {
+                            entry = select(NO_ENTRY, j | CONTACT_ONLY, contact_pair_kept(i, j));
                         }
-                        count++;
+                        if entry != NO_ENTRY {
+                            if count < P.nlist_cap {
+                                nlist[row + 1u + count] = entry;
+                            }
+                            count++;
+                        }
                     }
                 }
             }

@@ -22,6 +22,7 @@
 use glam::DVec3;
 use wgpu::util::DeviceExt;
 
+use super::contact::{reach_message, ContactPack, CONTACT_ONLY, FRACTION_SLOTS};
 use super::context::GpuContext;
 use super::kinetics::{KinKernels, KinLayout};
 use super::nlist::NeighbourStorage;
@@ -32,7 +33,7 @@ use crate::neighbor::Exclusions;
 use crate::system::{BondState, Model, SimBox, State};
 
 const WORKGROUP: u32 = 256;
-const STATUS_WORDS: usize = 8;
+const STATUS_WORDS: usize = 9;
 const ST_HALTED: usize = 0;
 const ST_OVERFLOW_NEED: usize = 1;
 const ST_BUILDS: usize = 3;
@@ -43,7 +44,11 @@ const ST_SPAN_BODY: usize = 7;
 const HALT_OVERFLOW: u32 = 1;
 const HALT_BLOWUP: u32 = 2;
 const HALT_SPAN: u32 = 4;
-const HALT_EVENTS: u32 = 8;
+const HALT_EVENTS: u32 = 16;
+/// This step's fraction of dt (f32 bits; the contact step clamp, src/gpu/contact.rs).
+const ST_FRACTION: usize = 8;
+/// A face edge outgrew the contact search (src/gpu/contact.rs).
+const HALT_REACH: u32 = 8;
 /// Steps per command buffer.
 const STEPS_PER_SUBMIT: u64 = 64;
 
@@ -72,6 +77,8 @@ pub struct PhaseTimes {
     pub integrate: f64,
     /// Reading positions back to the host (thermo, dump, end of run).
     pub readback: f64,
+    /// Node–face contact and the step clamp (0 without contact), apart from `forces`.
+    pub contact: f64,
 }
 
 /// Settings the kernels need besides the model.
@@ -106,6 +113,8 @@ struct Kernels {
     integrate: wgpu::ComputePipeline,
     commit: wgpu::ComputePipeline,
     advance: wgpu::ComputePipeline,
+    /// Node–face contact and the step clamp (src/gpu/contact.rs).
+    contact_forces: wgpu::ComputePipeline,
 }
 
 /// The GPU force engine and integrator for one model.
@@ -142,6 +151,10 @@ pub struct GpuBackend {
     settings: StepSettings,
     /// The next `run` or `evaluate` rebuilds the neighbour list first.
     pending_rebuild: bool,
+    /// The contact bodies' faces and rules (src/gpu/contact.rs).
+    contact: ContactPack,
+    /// The fraction of dt each step of the last `run` took (with contact).
+    fractions: Vec<f32>,
     /// Bond kinetics on the device (src/gpu/kinetics.rs): its buffer (binding 13), layout and kernels.
     kin: wgpu::Buffer,
     kinetics: Option<(KinLayout, KinKernels)>,
@@ -220,9 +233,9 @@ impl GpuBackend {
         if !model.tetras.is_empty() {
             return Err("the GPU backend has no kernels for volume elements (`[ tetrahedra ]`) yet; use `device cpu`".into());
         }
-        if model.has_contact_terms() {
+        if model.contact_rules.iter().any(|r| !r.interaction.law().runs_on_gpu()) {
             return Err(
-                "the GPU backend has no kernels for contact terms between bodies yet; use `device cpu` for decks with `contact` lines"
+                "the GPU backend has no kernels for area-weighted contact terms between bodies (`contact_adhesion`) yet; use `device cpu`"
                     .into(),
             );
         }
@@ -230,7 +243,8 @@ impl GpuBackend {
         if n == 0 {
             return Err("the GPU backend needs at least one particle".into());
         }
-        let (packed, exclusions) = pack_state(model, state, settings, device_kinetics.is_some())?;
+        let contact = ContactPack::new(model, &state.positions, sim_box);
+        let (packed, exclusions, contact_fields) = pack_state(model, state, settings, device_kinetics.is_some(), &contact)?;
         let kin_words = match (device_kinetics, state.bonds.as_ref()) {
             (Some(warned), Some(bonds)) => {
                 let (c, kt) = (settings.context.dt, settings.context.kt);
@@ -239,8 +253,10 @@ impl GpuBackend {
             _ => None,
         };
         let cutoff = model.max_pair_cutoff();
-        let has_pairs = !model.pair_rules.is_empty() && cutoff > 0.0;
-        let range = cutoff + settings.skin;
+        // The list also serves the contact search (src/gpu/contact.rs).
+        let has_pairs = (!model.pair_rules.is_empty() && cutoff > 0.0) || contact.faces() > 0;
+        let skin = settings.skin.max(contact.skin());
+        let range = cutoff.max(contact.reach()) + skin;
         let (grid, inv_width) = if has_pairs { cell_grid(sim_box, range, n) } else { ([1, 1, 1], [0.0; 3]) };
         let cells = grid.iter().product::<u32>();
         let scan_blocks = cells.div_ceil(WORKGROUP);
@@ -261,7 +277,7 @@ impl GpuBackend {
             n_types: model.type_names.len() as u32,
             steps_wanted: 0,
             range2: (range * range) as f32,
-            half_skin2: (0.25 * settings.skin * settings.skin) as f32,
+            half_skin2: (0.25 * skin * skin) as f32,
             max_disp2: (settings.context.max_displacement * settings.context.max_displacement) as f32,
             neighbor_every: settings.neighbor_every.max(1) as u32,
             seed_lo: settings.context.seed as u32,
@@ -275,6 +291,7 @@ impl GpuBackend {
             topo_offsets: packed.topo_offsets,
             fparam_offsets: packed.fparam_offsets,
             surface_offsets: packed.surface_offsets,
+            contact: contact_fields,
             kin_bonds: kin_words.as_ref().map_or(0, |(_, l)| l.bonds()),
             kin_first_term: kin_words.as_ref().map_or(0, |(_, l)| l.first_term),
             kin_capacity: kin_words.as_ref().map_or(0, |(_, l)| l.capacity),
@@ -305,7 +322,7 @@ impl GpuBackend {
         let nlist = NeighbourStorage::new(ctx, n as u32, params.nlist_cap, nlist_binding_limit)?;
         let force = zeros("force", 16 * n as u64, rw);
         let status = zeros("status", 4 * STATUS_WORDS as u64, rw);
-        let surf_bytes = 16 * packed.surf_entries;
+        let surf_bytes = 16 * (packed.surf_entries + contact.surf_entries());
         check_binding(ctx, "the surface terms' face and body values", surf_bytes)?;
         let surf = zeros("surf", surf_bytes, rw);
         let args = zeros("dispatch_args", 4 * 12, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT);
@@ -390,6 +407,7 @@ impl GpuBackend {
             integrate: pipeline("integrate", &main_layout),
             commit: pipeline("commit", &main_layout),
             advance: pipeline("advance", &main_layout),
+            contact_forces: pipeline("contact_forces", &main_layout),
         };
         let kinetics = kin_words.map(|(_, layout)| (layout, KinKernels::new(|entry| pipeline(entry, &main_layout))));
         let main_group = bind_main(
@@ -427,6 +445,8 @@ impl GpuBackend {
             settings: *settings,
             pending_rebuild: true,
             ctx: ctx.clone(),
+            contact,
+            fractions: Vec::new(),
             kin,
             kinetics,
             reads: Default::default(),
@@ -521,7 +541,7 @@ impl GpuBackend {
         if self.kinetics.is_some() {
             return Err("the bond state of device kinetics lives on the device".into());
         }
-        let (packed, _) = pack_state(model, state, &self.settings, false)?;
+        let (packed, _, contact_fields) = pack_state(model, state, &self.settings, false, &self.contact)?;
         let (topo, fparams) = (pad16(packed.topo), pad16(packed.fparams));
         let fits = |buffer: &wgpu::Buffer, bytes: usize| bytes as u64 <= buffer.size();
         if fits(&self.topo, 4 * topo.len()) && fits(&self.fparams, 4 * fparams.len()) {
@@ -540,6 +560,7 @@ impl GpuBackend {
         self.params.topo_offsets = packed.topo_offsets;
         self.params.fparam_offsets = packed.fparam_offsets;
         self.params.surface_offsets = packed.surface_offsets;
+        self.params.contact = contact_fields;
         self.pending_rebuild |= rebuild;
         Ok(())
     }
@@ -549,6 +570,7 @@ impl GpuBackend {
         status[ST_BLOWUP_PARTICLE] = u32::MAX;
         status[ST_SPAN_BODY] = u32::MAX;
         status[ST_FORCE_REBUILD] = force_rebuild as u32;
+        status[ST_FRACTION] = 1f32.to_bits();
         self.ctx.queue.write_buffer(&self.status, 0, words(&status));
     }
 
@@ -586,6 +608,8 @@ impl GpuBackend {
             .map(|i| {
                 let start = i * (1 + cap);
                 let mut row = data[start + 1..start + 1 + (data[start] as usize).min(cap)].to_vec();
+                // Excluded pairs kept for the contact search only are no neighbours.
+                row.retain(|&j| j & CONTACT_ONLY == 0);
                 row.sort_unstable();
                 row
             })
@@ -690,6 +714,7 @@ impl GpuBackend {
         let mut force_pass = self.surface_passes();
         force_pass.push((&k.forces, Over::Chunks));
         let forces = time(self, &force_pass, false);
+        let contact = if self.has_contact() { time(self, &[(&k.contact_forces, Over::Chunks)], false) } else { 0.0 };
         let integrate = time(self, &[(&k.integrate, particles), (&k.commit, particles), (&k.advance, Over::Groups(1))], false);
         let started = std::time::Instant::now();
         for _ in 0..repetitions {
@@ -698,7 +723,7 @@ impl GpuBackend {
         let readback = started.elapsed().as_secs_f64() / repetitions as f64;
         self.ctx.queue.write_buffer(&self.state, 0, &saved);
         self.pending_rebuild = true;
-        Ok(PhaseTimes { check, neighbor_build, forces, integrate, readback })
+        Ok(PhaseTimes { check, neighbor_build, forces, integrate, readback, contact })
     }
 
     /// Dispatches `pipeline` over `over`: wider than the dispatch width,
@@ -759,6 +784,9 @@ impl GpuBackend {
             self.dispatch(pass, pipeline, over);
         }
         self.dispatch(pass, &k.forces, Over::Chunks);
+        if self.has_contact() {
+            self.dispatch(pass, &k.contact_forces, Over::Chunks);
+        }
         if integrate {
             if let Some((bonds, kin)) = kinetics {
                 self.dispatch(pass, &kin.measure, bonds);
@@ -795,9 +823,24 @@ impl GpuBackend {
         passes
     }
 
-    /// The message of a body-span halt (see [`super::surface`]), if there was one.
+    /// The message of a body-span halt (see [`super::surface`]) or of a
+    /// face that outgrew the contact search ([`super::contact`]), if there was one.
     fn span_halt(&self, status: &[u32; STATUS_WORDS]) -> Option<String> {
+        if status[ST_HALTED] & HALT_REACH != 0 {
+            return Some(reach_message(self.contact.edge_bound()));
+        }
         (status[ST_HALTED] & HALT_SPAN != 0).then(|| super::surface::span_message(self.body_ids[status[ST_SPAN_BODY] as usize]))
+    }
+
+    /// Whether node–face contact runs ([`super::contact`]).
+    fn has_contact(&self) -> bool {
+        self.contact.faces() > 0
+    }
+
+    /// The fraction of dt each step of the last [`Self::run`] took (below 1
+    /// where the contact step clamp shortened it; empty without contact).
+    pub fn step_fractions(&self) -> &[f32] {
+        &self.fractions
     }
 
     /// Handles an overflow: grows the list and clears the halt. Returns
@@ -844,9 +887,12 @@ impl GpuBackend {
     pub fn run(&mut self, first_step: u64, steps: u64) -> Result<u64, GpuHalt> {
         let mut done = 0u64;
         let mut force_rebuild = std::mem::take(&mut self.pending_rebuild);
+        self.fractions.clear();
         while done < steps {
             let step = first_step + done;
-            let chunk = (steps - done).min(u32::MAX as u64 / 2);
+            // With contact, the ring of step fractions bounds a chunk.
+            let most = if self.has_contact() { FRACTION_SLOTS as u64 } else { u32::MAX as u64 / 2 };
+            let chunk = (steps - done).min(most);
             self.params.step_lo = step as u32;
             self.params.step_hi = (step >> 32) as u32;
             self.params.steps_wanted = chunk as u32;
@@ -871,6 +917,12 @@ impl GpuBackend {
             // A rebuild the last step asked for (device kinetics changed the exclusions) carries over.
             let requested = status[ST_FORCE_REBUILD] != 0;
             self.pending_rebuild = requested;
+            if self.has_contact() && status[ST_STEPS_DONE] > 0 {
+                let ring = 16 * self.params.contact[15] as u64;
+                let entries: Vec<[f32; 4]> =
+                    bytemuck::cast_slice(&self.read_at(&self.surf, ring, 16 * status[ST_STEPS_DONE] as u64)).to_vec();
+                self.fractions.extend(entries.iter().map(|e| e[0]));
+            }
             if status[ST_HALTED] & HALT_BLOWUP != 0 {
                 return Err(GpuHalt::Blowup { step: first_step + done, particle: status[ST_BLOWUP_PARTICLE] as usize });
             }
@@ -935,12 +987,21 @@ fn initial_capacity(n: usize, sim_box: &SimBox, range: f64, has_pairs: bool) -> 
 /// [`pack`] for the model at `state`: with bond state, only the bound bonds
 /// (with their own rest lengths and scales) and the exclusions they make.
 /// With `device_kinetics`, every bond is packed as bound with its
-/// exclusions (the device's bound flags switch them off).
-fn pack_state(model: &Model, state: &State, settings: &StepSettings, device_kinetics: bool) -> Result<(Packed, Exclusions), String> {
+/// exclusions (the device's bound flags switch them off). The contact
+/// sections follow the others in `topo`, the fraction ring the surface
+/// entries in `surf`; returns the layout's contact fields too.
+fn pack_state(
+    model: &Model,
+    state: &State,
+    settings: &StepSettings,
+    device_kinetics: bool,
+    contact: &ContactPack,
+) -> Result<(Packed, Exclusions, [u32; 16]), String> {
     let all_bound = state.bonds.as_ref().filter(|_| device_kinetics).map(|b| BondState { bound: vec![true; b.len()], ..b.clone() });
     let bonds = all_bound.as_ref().or(state.bonds.as_ref());
     let bound = bonds.map(|b| b.bound.as_slice());
     let exclusions = Exclusions::from_pairs(model.len(), &model.excluded_pairs(bound));
-    let packed = pack(model, &exclusions, settings.context.dt, settings.context.kt, bonds)?;
-    Ok((packed, exclusions))
+    let mut packed = pack(model, &exclusions, settings.context.dt, settings.context.kt, bonds)?;
+    let fields = contact.append(&mut packed.topo, packed.surf_entries);
+    Ok((packed, exclusions, fields))
 }

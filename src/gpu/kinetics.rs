@@ -67,6 +67,11 @@ pub fn refusal(model: &Model) -> Option<String> {
     if !model.bind_rules.is_empty() {
         return Some("`bind` formation".into());
     }
+    if model.has_contact_terms() {
+        // The contact step clamp shortens steps, and the device's ages and
+        // break probabilities take the full dt.
+        return Some("contact terms between bodies (the step clamp shortens steps)".into());
+    }
     for (t, kinetics) in model.bond_kinetics.iter().enumerate() {
         let label = &model.bond_types[t].label.text;
         if kinetics.rules.len() > RULES_PER_TYPE {

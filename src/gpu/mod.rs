@@ -10,6 +10,8 @@
 //!   where it exceeds the adapter's largest storage binding.
 //! - [`surface`]: surface (body) terms: face, body, edge and node passes,
 //!   deterministic (no float atomics).
+//! - [`contact`]: node–face contact between bodies (`Law::Contact`) and
+//!   the explicit step clamp as a device reduction.
 //! - [`kinetics`]: bond breaking and rebinding decided on the device, events
 //!   compacted in bond order and drained by the host at synchronisations.
 //!
@@ -30,10 +32,10 @@
 //!
 //! Not on the GPU (refused by [`GpuBackend::new`], and by `device gpu`
 //! before a run; `device auto` falls back to the CPU): custom surface terms
-//! of bodies and contact
-//! terms between bodies (`Law::Contact`, `Law::ContactArea`), which have no
-//! kernel yet. Bond kinetics are decided on the device for the rules
-//! [`kinetics`] ports, else on the host after every step (see [`backend`]).
+//! of bodies and area-weighted contact terms between bodies
+//! (`Law::ContactArea`: adhesion), which have no kernel yet. Bond kinetics
+//! are decided on the device for the rules [`kinetics`] ports, else on the
+//! host after every step (see [`backend`]).
 //!
 //! # Precision
 //!
@@ -50,6 +52,7 @@
 //! rounding (relative ≈ 1e-7 per step), measured in `tests/gpu.rs`.
 
 pub mod backend;
+pub mod contact;
 pub mod context;
 pub mod custom;
 pub mod kinetics;

@@ -69,6 +69,8 @@ pub struct Params {
     /// ([`super::surface::SurfacePack::sections`]), then the numbers of
     /// faces, bodies, edges and body nodes.
     pub surface_offsets: [u32; 16],
+    /// Node–face contact: layout.wgsl's `off_cfaces` … (src/gpu/contact.rs).
+    pub contact: [u32; 16],
     /// Bond kinetics on the device (src/gpu/kinetics.rs): its bonds, their first term, event capacity, bond types.
     pub kin_bonds: u32,
     pub kin_first_term: u32,

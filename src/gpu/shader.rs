@@ -10,12 +10,15 @@
 //! form, dispatched by `surface_law` and `node_law` from the surface
 //! kernels (src/gpu/surface.rs).
 //!
+//! Node–face contact laws ([`Law::Contact`]) define `NAME_contact(p, d)`,
+//! b(d) as a `Radial` of the node–face distance, dispatched by
+//! `contact_law` from the contact kernel (src/gpu/contact.rs).
+//!
 //! Only laws with a GPU kernel take part ([`Law::runs_on_gpu`]). Custom
-//! body terms and contact laws ([`Law::Contact`], [`Law::ContactArea`]:
-//! node–face barriers and adhesion between bodies) have none yet: they have
-//! no evaluator file, no dispatch case, and the GPU backend refuses decks
-//! that use them, so such a deck never runs on the GPU without those
-//! forces. A WGSL file for a law without the kernel to call it is refused
+//! body terms and area-weighted contact laws ([`Law::ContactArea`]:
+//! adhesion between bodies) have none yet: they have no evaluator file, no
+//! dispatch case, and the GPU backend refuses decks that use them, so such a
+//! deck never runs on the GPU without those forces. A WGSL file for a law without the kernel to call it is refused
 //! by a test, so a shader cannot pretend to cover one.
 //!
 //! Parameter names: an evaluator receives its parameters as `p: array<f32,
@@ -39,7 +42,7 @@ mod embedded {
 pub use embedded::{COMMON_SHADERS, INTERACTION_SHADERS};
 
 /// The common files in the order they must appear (declarations first).
-const COMMON_ORDER: [&str; 7] = ["layout", "philox", "neighbor", "forces", "surface", "integrate", "kinetics"];
+const COMMON_ORDER: [&str; 8] = ["layout", "philox", "neighbor", "forces", "surface", "integrate", "contact", "kinetics"];
 
 fn common(name: &str) -> &'static str {
     COMMON_SHADERS.iter().find(|(stem, _)| *stem == name).map(|(_, src)| *src).unwrap_or_else(|| panic!("shaders/common/{name}.wgsl"))
@@ -61,6 +64,8 @@ fn dispatch(custom: &CustomSource) -> String {
         "fn surface_law(kind: u32, p: array<f32, 8>, body: BodyTotals, g: FaceGeometry) -> SurfaceFace {\n    switch kind {\n",
     );
     let mut node = String::from("fn node_law(kind: u32, p: array<f32, 8>, m: f32, a: f32) -> NodeCurvature {\n    switch kind {\n");
+    // Node–face contact laws (src/gpu/contact.rs): b(d) as a Radial of the distance.
+    let mut contact = String::from("fn contact_law(kind: u32, p: array<f32, 8>, d: f32) -> Radial {\n    switch kind {\n");
     for (index, interaction) in REGISTRY.iter().enumerate() {
         let name = interaction.name();
         let (out, call) = match interaction.law() {
@@ -69,7 +74,8 @@ fn dispatch(custom: &CustomSource) -> String {
             Law::OneBody(_) => (&mut one, format!("{name}_one(p, x)")),
             Law::Surface { gpu: SurfaceGpu::PerFace, .. } => (&mut surface, format!("{name}_face(p, body, g)")),
             Law::Surface { gpu: SurfaceGpu::NodeCurvature, .. } => (&mut node, format!("{name}_node(p, m, a)")),
-            Law::Surface { .. } | Law::Contact { .. } | Law::ContactArea { .. } | Law::Tetra(_) => continue,
+            Law::Contact { .. } => (&mut contact, format!("{name}_contact(p, d)")),
+            Law::Surface { .. } | Law::ContactArea { .. } | Law::Tetra(_) => continue,
         };
         writeln!(out, "        case {index}u: {{ return {call}; }}").unwrap();
     }
@@ -81,7 +87,8 @@ fn dispatch(custom: &CustomSource) -> String {
     one.push_str("        default: { return OneBody(0.0, vec3<f32>(0.0)); }\n    }\n}\n");
     surface.push_str("        default: { return SurfaceFace(0.0, vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0)); }\n    }\n}\n");
     node.push_str("        default: { return NodeCurvature(0.0, 0.0, 0.0); }\n    }\n}\n");
-    radial + &three + &one + &surface + &node
+    contact.push_str("        default: { return RADIAL_ZERO; }\n    }\n}\n");
+    radial + &three + &one + &surface + &node + &contact
 }
 
 /// The whole program for models without custom terms.

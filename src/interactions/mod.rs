@@ -332,7 +332,8 @@ pub enum Law {
     },
     /// b(d) of the distance d from a node of one body to a face of another
     /// (E ≡ 0 for d ≥ `range`); the CPU backend finds the node–face pairs
-    /// and spreads the force with [`node_face_forces`]. No GPU kernel yet.
+    /// and spreads the force with [`node_face_forces`]; the GPU backend's
+    /// contact kernel evaluates `shaders/interactions/NAME.wgsl` (src/gpu/contact.rs).
     Contact { eval: fn(&[f64], f64) -> Radial, range: fn(&[f64]) -> f64 },
     /// Adhesion-like terms weighted by area: E = ε·Σ_t A_t·s_a·s_b·s_c over
     /// the faces t of a body, ε = `density` (energy per area, negative for
@@ -459,11 +460,12 @@ impl KindLaw for TetraLaw {
 impl Law {
     /// Whether the GPU backend has a kernel for this law (and so its
     /// interaction a `shaders/interactions/NAME.wgsl` evaluator): every law
-    /// but the surface laws without a GPU form and the contact laws.
+    /// but the surface laws without a GPU form, the area-weighted contact
+    /// laws and the volume elements.
     pub fn runs_on_gpu(&self) -> bool {
         match self {
             Law::Surface { gpu, .. } => *gpu != SurfaceGpu::None,
-            Law::Contact { .. } | Law::ContactArea { .. } | Law::Tetra(_) => false,
+            Law::ContactArea { .. } | Law::Tetra(_) => false,
             _ => true,
         }
     }

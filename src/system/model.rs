@@ -373,7 +373,7 @@ impl Model {
         (0..self.bodies.len()).any(|b| self.rules_of_body(b).any(|r| !self.body_rules[r].interaction.law().runs_on_gpu()))
     }
 
-    /// Whether any contact term acts between bodies (CPU only, explicit steps only).
+    /// Whether any contact term acts between bodies.
     pub fn has_contact_terms(&self) -> bool {
         !self.contact_rules.is_empty()
     }

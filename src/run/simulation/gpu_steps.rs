@@ -74,11 +74,14 @@ impl Stepper for GpuSteps {
             Ok(done) => *done,
             Err(GpuHalt::Blowup { step, .. } | GpuHalt::Capacity { step, .. }) => step - sim.state.step,
         };
-        // Every GPU step takes the full dt (no contact clamp on the GPU).
+        // Each step took s·dt: below 1 where the contact step clamp shortened it (src/gpu/contact.rs).
         let mut taken = Taken { steps: done, last: None };
+        let fractions = self.gpu.step_fractions();
         let mut clocks = Vec::new();
-        for _ in 0..done {
-            let clock = sim.step_context().advance(&mut sim.state, 1.0);
+        for k in 0..done as usize {
+            let fraction = fractions.get(k).map_or(1.0, |&s| f64::from(s));
+            sim.contact_clamps += u64::from(fraction < 1.0);
+            let clock = sim.step_context().advance(&mut sim.state, fraction);
             clocks.extend(Some(clock).filter(|_| self.device_kinetics));
             taken.last = Some(clock);
         }
@@ -198,8 +201,8 @@ impl Simulation {
             Some("custom surface terms of bodies (`custom` body lines) run on the CPU backend only")
         } else if !self.model.tetras.is_empty() {
             Some("volume elements (`[ tetrahedra ]`, `tetra` lines) run on the CPU backend only")
-        } else if self.model.has_contact_terms() {
-            Some("contact terms between bodies (`contact` lines) run on the CPU backend only")
+        } else if self.model.contact_rules.iter().any(|r| !r.interaction.law().runs_on_gpu()) {
+            Some("area-weighted contact terms between bodies (`contact_adhesion`) run on the CPU backend only")
         } else if self.model.special_bonds.is_fractional() && !self.model.pair_rules.is_empty() {
             Some("fractional `special_bonds` weights run on the CPU backend only")
         } else if self.model.externals.iter().any(|e| !e.expressions.is_empty()) {

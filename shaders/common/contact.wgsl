@@ -1,0 +1,201 @@
+// Node–face contact between bodies and the step clamp (the pass order, the
+// equations and the determinism argument: src/gpu/contact.rs). One
+// invocation per contact node, dispatched per neighbour-list chunk after
+// `forces`; `contact_law` dispatches on the registry index of the rule's
+// interaction type to `NAME_contact` (shaders/interactions/NAME.wgsl).
+
+const NO_BODY: u32 = 0xffffffffu;
+const CONTACT_RULE_WORDS: u32 = 9u;
+// The step clamp: a particle moves at most this fraction of its closest contact distance.
+const STEP_FRACTION: f32 = 0.4;
+// Entries of the ring of step fractions in `surf` (FRACTION_SLOTS in src/gpu/contact.rs).
+const FRACTION_SLOTS: u32 = 1024u;
+
+fn contact_body(i: u32) -> u32 {
+    return topo[P.off_cbody + i];
+}
+
+// Word k of contact face f: corners 0–2 (particles), 3 its packed body.
+fn contact_face(f: u32, k: u32) -> u32 {
+    return topo[P.off_cfaces + 4u * f + k];
+}
+
+// The (node body type, face body type) index of the rule tables.
+fn contact_types(node_body: u32, face_body: u32) -> u32 {
+    return topo[P.off_cbody_type + node_body] * P.n_body_types + topo[P.off_cbody_type + face_body];
+}
+
+fn contact_rule_params(rule: u32) -> array<f32, 8> {
+    var p: array<f32, 8>;
+    let base = P.off_crules + CONTACT_RULE_WORDS * rule + 1u;
+    for (var k = 0u; k < 8u; k++) {
+        p[k] = bitcast<f32>(topo[base + k]);
+    }
+    return p;
+}
+
+// b(d) summed over the node–face rules of type pair `types`, in rule order.
+fn contact_radial(types: u32, d: f32) -> Radial {
+    var out = RADIAL_ZERO;
+    let end = topo[P.off_crule_start + types + 1u];
+    for (var q = topo[P.off_crule_start + types]; q < end; q++) {
+        let rule = topo[P.off_crule_list + q];
+        let b = contact_law(topo[P.off_crules + CONTACT_RULE_WORDS * rule], contact_rule_params(rule), d);
+        out.energy += b.energy;
+        out.de_dr += b.de_dr;
+    }
+    return out;
+}
+
+// Barycentric weights of the point of triangle (a, b, c) closest to p, by
+// Voronoi region (src/mesh.rs, `closest_weights`).
+fn closest_weights(p: vec3<f32>, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> vec3<f32> {
+    let ab = b - a;
+    let ac = c - a;
+    let ap = p - a;
+    let d1 = dot(ab, ap);
+    let d2 = dot(ac, ap);
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return vec3<f32>(1.0, 0.0, 0.0);
+    }
+    let bp = p - b;
+    let d3 = dot(ab, bp);
+    let d4 = dot(ac, bp);
+    if d3 >= 0.0 && d4 <= d3 {
+        return vec3<f32>(0.0, 1.0, 0.0);
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        let v = d1 / (d1 - d3);
+        return vec3<f32>(1.0 - v, v, 0.0);
+    }
+    let cp = p - c;
+    let d5 = dot(ab, cp);
+    let d6 = dot(ac, cp);
+    if d6 >= 0.0 && d5 <= d6 {
+        return vec3<f32>(0.0, 0.0, 1.0);
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        let w = d2 / (d2 - d6);
+        return vec3<f32>(1.0 - w, 0.0, w);
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return vec3<f32>(0.0, 1.0 - w, w);
+    }
+    let denom = 1.0 / (va + vb + vc);
+    let v = vb * denom;
+    let w = vc * denom;
+    return vec3<f32>(1.0 - v - w, v, w);
+}
+
+// Node k against face f: the distance d, the weights w of the closest
+// point and the unit normal n̂ from it to the node. Computed relative to the
+// face's first corner, so every participant gets the same bits.
+struct ContactPair {
+    d: f32,
+    w: vec3<f32>,
+    n: vec3<f32>,
+}
+
+fn contact_pair(k: u32, f: u32) -> ContactPair {
+    let a = contact_face(f, 0u);
+    let p = separation(a, k);
+    let b = separation(a, contact_face(f, 1u));
+    let c = separation(a, contact_face(f, 2u));
+    let w = closest_weights(p, vec3<f32>(0.0), b, c);
+    let gap = p - (w.y * b + w.z * c);
+    let d = length(gap);
+    return ContactPair(d, w, gap / d);
+}
+
+// Whether an edge of face f is longer than the contact search covers.
+fn face_outgrew_search(f: u32) -> bool {
+    let a = contact_face(f, 0u);
+    let b = separation(a, contact_face(f, 1u));
+    let c = separation(a, contact_face(f, 2u));
+    let bc = c - b;
+    return max(max(dot(b, b), dot(c, c)), dot(bc, bc)) > P.contact_edge2;
+}
+
+// The largest s ∈ (0, 1] with s·a + √s·b ≤ limit (src/integrate/overdamped.rs, `step_fraction`).
+fn contact_step_fraction(a: f32, b: f32, limit: f32) -> f32 {
+    if a + b <= limit {
+        return 1.0;
+    }
+    let u = 2.0 * limit / (b + sqrt(b * b + 4.0 * a * limit));
+    return u * u;
+}
+
+@compute @workgroup_size(256)
+fn contact_forces(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    let i = chunk_particle(wg, local);
+    if !in_chunk(i) || halted() {
+        return;
+    }
+    let body = contact_body(i);
+    if body == NO_BODY {
+        return;
+    }
+    var f = vec3<f32>(0.0);
+    var e = 0.0;
+    var closest = P.contact_dhat;
+    let row = nlist_row(i);
+    let count = min(nlist[row], P.nlist_cap);
+    // As a node: the faces whose first corner is a neighbour of another body.
+    for (var k = 0u; k < count; k++) {
+        let j = nlist[row + 1u + k] & ~CONTACT_ONLY;
+        let other = contact_body(j);
+        if other == NO_BODY || other == body {
+            continue;
+        }
+        let types = contact_types(body, other);
+        if topo[P.off_cany + types] == 0u {
+            continue;
+        }
+        let faces_end = topo[P.off_first_start + j + 1u];
+        for (var q = topo[P.off_first_start + j]; q < faces_end; q++) {
+            let pair = contact_pair(i, topo[P.off_first_faces + q]);
+            closest = min(closest, pair.d);
+            let b = contact_radial(types, pair.d);
+            if b.de_dr != 0.0 {
+                f -= b.de_dr * pair.n;
+                e += b.energy;
+            }
+        }
+    }
+    // As a corner: each of its faces against the neighbours of other bodies.
+    let corner_end = topo[P.off_corner_start + i + 1u];
+    for (var q = topo[P.off_corner_start + i]; q < corner_end; q++) {
+        let slot = topo[P.off_corner_faces + q];
+        let face = slot / 4u;
+        let role = slot % 4u;
+        if role == 0u && face_outgrew_search(face) {
+            atomicOr(&status[ST_HALTED], HALT_REACH);
+        }
+        for (var k = 0u; k < count; k++) {
+            let node = nlist[row + 1u + k] & ~CONTACT_ONLY;
+            let other = contact_body(node);
+            if other == NO_BODY || other == body {
+                continue;
+            }
+            let types = contact_types(other, body);
+            if topo[P.off_cany + types] == 0u {
+                continue;
+            }
+            let pair = contact_pair(node, face);
+            closest = min(closest, pair.d);
+            let b = contact_radial(types, pair.d);
+            if b.de_dr != 0.0 {
+                f += b.de_dr * pair.w[role] * pair.n;
+            }
+        }
+    }
+    let total = force[i] + vec4<f32>(f, e);
+    force[i] = total;
+    // The step clamp: this particle's largest s, min-reduced through the bits.
+    let s = contact_step_fraction(length(drift(i)), length(noise(i)), STEP_FRACTION * closest);
+    atomicMin(&status[ST_FRACTION], bitcast<u32>(s));
+}
