@@ -139,7 +139,9 @@ fn relax(deck: &str, text: &str, vars: &[(&str, String)], columns: &[&str], load
         plan.actions.iter().rev().find_map(|a| if let Action::Thermo { columns, .. } = a { Some(columns.clone()) } else { None }).unwrap();
     let wanted: Vec<ThermoColumn> = columns
         .iter()
-        .map(|name| thermo.iter().find(|c| column_label(c, &plan.model) == *name).cloned().unwrap_or_else(|| panic!("no thermo column {name}")))
+        .map(|name| {
+            thermo.iter().find(|c| column_label(c, &plan.model) == *name).cloned().unwrap_or_else(|| panic!("no thermo column {name}"))
+        })
         .collect();
     let read = |sim: &mut Simulation| -> Vec<f64> { wanted.iter().map(|c| sim.thermo_value(c).unwrap()).collect() };
     let mut stages = Vec::new();

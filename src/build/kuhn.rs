@@ -50,7 +50,10 @@ pub(super) fn graded(option: &str, extent: f64, n: usize, spacing: Option<f64>, 
     // The grown spacings h·q, h·q², …, h·q^g add up to `rest`.
     let sum = |q: f64| (1..=grown).map(|i| h * q.powi(i as i32)).sum::<f64>();
     if rest < sum(1.0) * (1.0 - 1e-12) {
-        return Err(format!("expected {option} ≥ --cells × --spacing = {} (the spacings cannot shrink outwards), found {extent}", n as f64 * h));
+        return Err(format!(
+            "expected {option} ≥ {n} × --spacing = {} (the spacings cannot shrink outwards), found {extent}",
+            n as f64 * h
+        ));
     }
     if sum(MAX_RATIO) < rest {
         return Err(format!(
