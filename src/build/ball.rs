@@ -33,8 +33,8 @@ use std::path::PathBuf;
 
 use glam::DVec3;
 
-use super::kuhn::{cell_tetrahedra, graded, orient, quality};
-use super::{min_mean_max, positive, vec3, Built, Writer};
+use super::kuhn::{graded, Elements};
+use super::{positive, vec3, Built, Writer};
 
 /// Command-line options of `cellmd build ball`.
 #[derive(clap::Args, Clone, Debug)]
@@ -137,30 +137,26 @@ pub fn ball(args: &BallArgs) -> Result<Built, String> {
             }
         }
     }
-    let (mut qualities, mut volumes) = (Vec::new(), Vec::new());
+    let mut elements = Elements::default();
     for i in low..n {
         for j in low..n {
             for k in low..n {
                 // Along each axis, from the cell's side nearer the centre outwards.
-                for corners in cell_tetrahedra([i, j, k], [i, j, k].map(|c| 2 * c >= n)) {
-                    let mut nodes = corners.map(|[a, b, c]| index(a, b, c));
-                    let mut at = nodes.map(|v| x[v]);
-                    volumes.push(orient(&mut nodes, &mut at));
-                    qualities.push(quality(at));
-                    writer.tetra(&args.tetra_type, nodes.map(|v| id[v]));
-                }
+                let upward = [i, j, k].map(|c| 2 * c >= n);
+                elements.cell(&mut writer, &args.tetra_type, ([i, j, k], upward), |[a, b, c]| index(a, b, c), (&x, &id));
             }
         }
     }
-    let [q_lo, q_mean, _] = min_mean_max(&qualities);
-    let [v_lo, v_mean, v_hi] = min_mean_max(&volumes);
-    let total: f64 = volumes.iter().sum();
+    let total = elements.total_volume();
     let (part, share, exact) = if args.octant { ("octant of a ball", 8.0, "πR³/6") } else { ("ball", 1.0, "4πR³/3") };
     let sphere = 4.0 / 3.0 * PI * radius.powi(3) / share;
     let mut lines = vec![
-        format!("{part} of radius {radius} at {centre}: {count} nodes, {} tetrahedra (cubed-sphere map of a {n}³ lattice, 6 per cell)", volumes.len()),
+        format!(
+            "{part} of radius {radius} at {centre}: {count} nodes, {} tetrahedra (cubed-sphere map of a {n}³ lattice, 6 per cell)",
+            elements.count()
+        ),
         format!("volume {total:.6e} ({:.3} % below {exact}, the sphere inscribed by the surface faces)", 100.0 * (sphere - total) / sphere),
-        format!("element volume min {v_lo:.3e} mean {v_mean:.3e} max {v_hi:.3e}; quality 6√2·V/ℓ_rms³ min {q_lo:.3} mean {q_mean:.3} (regular: 1)"),
+        elements.summary(),
         format!("force field: tetra {} neo_hookean e E nu ν   (or linear_elastic; E in pN/µm²)", args.tetra_type),
     ];
     if args.octant {

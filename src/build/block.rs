@@ -30,8 +30,8 @@ use std::path::PathBuf;
 
 use glam::DVec3;
 
-use super::kuhn::{cell_tetrahedra, graded, orient, quality};
-use super::{min_mean_max, positive, vec3, Built, Writer};
+use super::kuhn::{graded, Elements};
+use super::{positive, vec3, Built, Writer};
 
 /// Command-line options of `cellmd build block`.
 #[derive(clap::Args, Clone, Debug)]
@@ -110,24 +110,16 @@ pub fn block(args: &BlockArgs) -> Result<Built, String> {
             }
         }
     }
-    let (mut qualities, mut volumes) = (Vec::new(), Vec::new());
+    let mut elements = Elements::default();
     for i in low..2 * n {
         for j in low..2 * n {
             for k in 0..n {
                 // Mirrored about the centre planes along x and y; the same way along z.
-                for corners in cell_tetrahedra([i, j, k], [i >= n, j >= n, true]) {
-                    let mut nodes = corners.map(|[a, b, c]| index(a, b, c));
-                    let mut at = nodes.map(|v| x[v]);
-                    volumes.push(orient(&mut nodes, &mut at));
-                    qualities.push(quality(at));
-                    writer.tetra(&args.tetra_type, nodes.map(|v| id[v]));
-                }
+                elements.cell(&mut writer, &args.tetra_type, ([i, j, k], [i >= n, j >= n, true]), |[a, b, c]| index(a, b, c), (&x, &id));
             }
         }
     }
-    let [q_lo, q_mean, _] = min_mean_max(&qualities);
-    let [v_lo, v_mean, v_hi] = min_mean_max(&volumes);
-    let total: f64 = volumes.iter().sum();
+    let total = elements.total_volume();
     let share = if args.quarter { 1.0 } else { 4.0 };
     let exact = share * half_width * half_width * depth;
     let part = if args.quarter { "quarter (x, y ≥ centre) of a block" } else { "block" };
@@ -136,7 +128,7 @@ pub fn block(args: &BlockArgs) -> Result<Built, String> {
             "{part} {}×{}×{depth} below the top face centred at {centre}: {count} nodes, {} tetrahedra (6 per lattice cell)",
             2.0 * half_width,
             2.0 * half_width,
-            volumes.len()
+            elements.count()
         ),
         format!(
             "spacings from the top face's centre: {:.4e} at the centre, {:.4e} at the sides, {:.4e} at the base; growth ratio {q_side:.4} across, {q_depth:.4} down",
@@ -145,7 +137,7 @@ pub fn block(args: &BlockArgs) -> Result<Built, String> {
             down[n] - down[n - 1]
         ),
         format!("volume {total:.6e} (exact {exact:.6e})"),
-        format!("element volume min {v_lo:.3e} mean {v_mean:.3e} max {v_hi:.3e}; quality 6√2·V/ℓ_rms³ min {q_lo:.3} mean {q_mean:.3} (regular: 1)"),
+        elements.summary(),
         format!("force field: tetra {} neo_hookean e E nu ν   (or linear_elastic; E in pN/µm²)", args.tetra_type),
         format!("base: hold {t}_base along x y z (`freeze`)"),
     ];

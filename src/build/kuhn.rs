@@ -10,6 +10,7 @@
 
 use glam::DVec3;
 
+use super::{min_mean_max, Writer};
 use crate::mesh::tetra_edges;
 
 /// The orders in which a diagonal path takes the axes: one tetrahedron each.
@@ -19,7 +20,7 @@ const ORDERS: [[usize; 3]; 6] = [[0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2,
 /// corner is `cell`: each diagonal path starts on the cell's low side along
 /// the axes where `upward` holds (and steps up) and on its high side along
 /// the others (and steps down).
-pub(super) fn cell_tetrahedra(cell: [usize; 3], upward: [bool; 3]) -> [[[usize; 3]; 4]; 6] {
+fn cell_tetrahedra(cell: [usize; 3], upward: [bool; 3]) -> [[[usize; 3]; 4]; 6] {
     let start: [usize; 3] = std::array::from_fn(|a| if upward[a] { cell[a] } else { cell[a] + 1 });
     ORDERS.map(|order| {
         let mut corner = start;
@@ -81,7 +82,7 @@ pub(super) fn graded(option: &str, extent: f64, n: usize, spacing: Option<f64>, 
 
 /// Puts a tetrahedron's corners in positive orientation (swapping the last
 /// two where the signed volume is negative) and returns its volume.
-pub(super) fn orient<T>(nodes: &mut [T; 4], at: &mut [DVec3; 4]) -> f64 {
+fn orient<T>(nodes: &mut [T; 4], at: &mut [DVec3; 4]) -> f64 {
     if tetra_edges(*at).determinant() < 0.0 {
         nodes.swap(2, 3);
         at.swap(2, 3);
@@ -90,8 +91,53 @@ pub(super) fn orient<T>(nodes: &mut [T; 4], at: &mut [DVec3; 4]) -> f64 {
 }
 
 /// Mesh quality 6√2·V/ℓ_rms³ of a tetrahedron (1: regular).
-pub(super) fn quality(x: [DVec3; 4]) -> f64 {
+fn quality(x: [DVec3; 4]) -> f64 {
     let volume = tetra_edges(x).determinant().abs() / 6.0;
     let sum: f64 = (0..4).flat_map(|a| (a + 1..4).map(move |b| (a, b))).map(|(a, b)| (x[a] - x[b]).length_squared()).sum();
     6.0 * 2f64.sqrt() * volume / (sum / 6.0).powf(1.5)
+}
+
+/// The elements a solid mesh writes, cell by cell, with their volumes and
+/// qualities for its summary.
+#[derive(Default)]
+pub(super) struct Elements {
+    volumes: Vec<f64>,
+    qualities: Vec<f64>,
+}
+
+impl Elements {
+    /// Writes the six Kuhn tetrahedra of lattice cell `cell` (see
+    /// [`cell_tetrahedra`]) in positive orientation: `node` maps a lattice
+    /// corner to its index in the positions `x` and the particle ids `id`.
+    pub(super) fn cell(
+        &mut self,
+        writer: &mut Writer,
+        tetra_type: &str,
+        (cell, upward): ([usize; 3], [bool; 3]),
+        node: impl Fn([usize; 3]) -> usize,
+        (x, id): (&[DVec3], &[u64]),
+    ) {
+        for corners in cell_tetrahedra(cell, upward) {
+            let mut nodes = corners.map(&node);
+            let mut at = nodes.map(|v| x[v]);
+            self.volumes.push(orient(&mut nodes, &mut at));
+            self.qualities.push(quality(at));
+            writer.tetra(tetra_type, nodes.map(|v| id[v]));
+        }
+    }
+
+    pub(super) fn count(&self) -> usize {
+        self.volumes.len()
+    }
+
+    pub(super) fn total_volume(&self) -> f64 {
+        self.volumes.iter().sum()
+    }
+
+    /// The summary line of the element volumes and qualities.
+    pub(super) fn summary(&self) -> String {
+        let [q_lo, q_mean, _] = min_mean_max(&self.qualities);
+        let [v_lo, v_mean, v_hi] = min_mean_max(&self.volumes);
+        format!("element volume min {v_lo:.3e} mean {v_mean:.3e} max {v_hi:.3e}; quality 6√2·V/ℓ_rms³ min {q_lo:.3} mean {q_mean:.3} (regular: 1)")
+    }
 }
