@@ -265,6 +265,11 @@ fn bad_options_exit_with_status_2_and_say_what_was_expected() {
         ),
         (&["lattice", "--radius", "2", "--spacing", "1"][..], "expected --radius at least 3 spacings"),
         (&["lattice", "--radius", "1", "--spacing", "1e-300"][..], "expected --radius at most 2000 spacings"),
+        (&["block", "--half-width", "0", "--cells", "4"][..], "expected --half-width > 0, found 0"),
+        (&["block", "--half-width", "10", "--cells", "4", "--spacing", "3"][..], "the spacings cannot shrink outwards"),
+        (&["block", "--half-width", "100", "--cells", "4", "--spacing", "0.01"][..], "expected a growth ratio of the spacings ≤ 4"),
+        (&["block", "--half-width", "10", "--cells", "4", "--spacing", "1", "--core-cells", "4"][..], "expected --core-cells < --cells 4"),
+        (&["block", "--half-width", "10", "--cells", "200"][..], "expected --cells in [1, 128], found 200"),
         (
             &[
                 "collagen",

@@ -33,8 +33,8 @@ use std::path::PathBuf;
 
 use glam::DVec3;
 
-use super::{min_mean_max, positive, vec3, Built, Writer};
-use crate::mesh::tetra_edges;
+use super::kuhn::{graded, Elements};
+use super::{positive, vec3, Built, Writer};
 
 /// Command-line options of `cellmd build ball`.
 #[derive(clap::Args, Clone, Debug)]
@@ -54,6 +54,15 @@ pub struct BallArgs {
     /// Keep one octant (x, y, z ≥ centre) and type the nodes on its symmetry planes TYPE_x, TYPE_xy, …
     #[arg(long)]
     pub octant: bool,
+    /// The radial spacing of the shells next to the centre; the spacings beyond the core grow by a constant ratio (default: uniform shells).
+    #[arg(allow_negative_numbers = true, long)]
+    pub spacing: Option<f64>,
+    /// How many shells from the centre keep --spacing (a uniform core) before the growth starts.
+    #[arg(long, default_value_t = 0, requires = "spacing")]
+    pub core_cells: u32,
+    /// Particle type of the nodes on the sphere (default: --particle-type, or the symmetry plane's).
+    #[arg(long)]
+    pub surface_type: Option<String>,
     /// Tetra type of the elements (what a `tetra` line of the force field names).
     #[arg(long, default_value = "solid")]
     pub tetra_type: String,
@@ -82,17 +91,6 @@ fn cube_to_ball(p: DVec3) -> DVec3 {
     s * d.normalize()
 }
 
-/// The six Kuhn tetrahedra of a cube around one of its diagonals: one per
-/// order in which the path along the diagonal takes the axes.
-const KUHN: [[usize; 3]; 6] = [[0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]];
-
-/// Mesh quality 6√2·V/ℓ_rms³ of a tetrahedron (1: regular).
-fn quality(x: [DVec3; 4]) -> f64 {
-    let volume = tetra_edges(x).determinant().abs() / 6.0;
-    let sum: f64 = (0..4).flat_map(|a| (a + 1..4).map(move |b| (a, b))).map(|(a, b)| (x[a] - x[b]).length_squared()).sum();
-    6.0 * 2f64.sqrt() * volume / (sum / 6.0).powf(1.5)
-}
-
 /// Builds the ball (see the module docs).
 pub fn ball(args: &BallArgs) -> Result<Built, String> {
     let radius = positive("--radius", args.radius)?;
@@ -101,6 +99,12 @@ pub fn ball(args: &BallArgs) -> Result<Built, String> {
     if n < 2 || n % 2 != 0 || n > 256 {
         return Err(format!("expected --cells an even number in [2, 256], found {n}"));
     }
+    let spacing = args.spacing.map(|h| positive("--spacing", h)).transpose()?;
+    let core = args.core_cells as usize;
+    if spacing.is_some() && core >= n / 2 {
+        return Err(format!("expected --core-cells < --cells/2 = {} (the shells beyond the core reach the sphere), found {core}", n / 2));
+    }
+    let (shells, ratio) = graded("--radius", radius, n / 2, spacing, core)?;
     let side = n + 1;
     let index = |i: usize, j: usize, k: usize| (i * side + j) * side + k;
     // The octant keeps lattice indices ≥ n/2 along every axis.
@@ -114,63 +118,74 @@ pub fn ball(args: &BallArgs) -> Result<Built, String> {
             for k in low..side {
                 let p = DVec3::new(i as f64, j as f64, k as f64) * (2.0 / n as f64) - DVec3::ONE;
                 let v = index(i, j, k);
-                x[v] = centre + radius * cube_to_ball(p);
+                // The lattice shell: max |p_a| in lattice steps.
+                let shell = [i, j, k].map(|c| c.abs_diff(n / 2)).into_iter().max().unwrap();
+                x[v] = match spacing {
+                    None => centre + radius * cube_to_ball(p),
+                    Some(_) if shell == 0 => centre,
+                    Some(_) => centre + shells[shell] * cube_to_ball(p).normalize(),
+                };
                 let held: String =
                     [(i, 'x'), (j, 'y'), (k, 'z')].iter().filter(|&&(c, _)| args.octant && c == n / 2).map(|&(_, a)| a).collect();
-                let type_name = if held.is_empty() { args.particle_type.clone() } else { format!("{}_{held}", args.particle_type) };
+                let type_name = match (&args.surface_type, held.is_empty()) {
+                    (Some(surface), _) if shell == n / 2 => surface.clone(),
+                    (_, true) => args.particle_type.clone(),
+                    (_, false) => format!("{}_{held}", args.particle_type),
+                };
                 id[v] = writer.particle(&type_name, x[v], None);
                 count += 1;
             }
         }
     }
-    let (mut qualities, mut volumes) = (Vec::new(), Vec::new());
+    let mut elements = Elements::default();
     for i in low..n {
         for j in low..n {
             for k in low..n {
                 // Along each axis, from the cell's side nearer the centre outwards.
-                let outward = [i, j, k].map(|c| 2 * c >= n);
-                let start = [i, j, k].map(|c| if 2 * c >= n { c } else { c + 1 });
-                for order in KUHN {
-                    let mut corner = start;
-                    let mut nodes = [index(start[0], start[1], start[2]); 4];
-                    for (step, &axis) in order.iter().enumerate() {
-                        corner[axis] = if outward[axis] { corner[axis] + 1 } else { corner[axis] - 1 };
-                        nodes[step + 1] = index(corner[0], corner[1], corner[2]);
-                    }
-                    let mut at = nodes.map(|v| x[v]);
-                    if tetra_edges(at).determinant() < 0.0 {
-                        nodes.swap(2, 3);
-                        at.swap(2, 3);
-                    }
-                    qualities.push(quality(at));
-                    volumes.push(tetra_edges(at).determinant() / 6.0);
-                    writer.tetra(&args.tetra_type, nodes.map(|v| id[v]));
-                }
+                let upward = [i, j, k].map(|c| 2 * c >= n);
+                elements.cell(&mut writer, &args.tetra_type, ([i, j, k], upward), |[a, b, c]| index(a, b, c), (&x, &id));
             }
         }
     }
-    let [q_lo, q_mean, _] = min_mean_max(&qualities);
-    let [v_lo, v_mean, v_hi] = min_mean_max(&volumes);
-    let total: f64 = volumes.iter().sum();
+    let total = elements.total_volume();
     let (part, share, exact) = if args.octant { ("octant of a ball", 8.0, "πR³/6") } else { ("ball", 1.0, "4πR³/3") };
     let sphere = 4.0 / 3.0 * PI * radius.powi(3) / share;
     let mut lines = vec![
-        format!("{part} of radius {radius} at {centre}: {count} nodes, {} tetrahedra (cubed-sphere map of a {n}³ lattice, 6 per cell)", volumes.len()),
+        format!(
+            "{part} of radius {radius} at {centre}: {count} nodes, {} tetrahedra (cubed-sphere map of a {n}³ lattice, 6 per cell)",
+            elements.count()
+        ),
         format!("volume {total:.6e} ({:.3} % below {exact}, the sphere inscribed by the surface faces)", 100.0 * (sphere - total) / sphere),
-        format!("element volume min {v_lo:.3e} mean {v_mean:.3e} max {v_hi:.3e}; quality 6√2·V/ℓ_rms³ min {q_lo:.3} mean {q_mean:.3} (regular: 1)"),
+        elements.summary(),
         format!("force field: tetra {} neo_hookean e E nu ν   (or linear_elastic; E in pN/µm²)", args.tetra_type),
     ];
     if args.octant {
         let t = &args.particle_type;
         lines.push(format!("symmetry planes: hold {t}_x {t}_xy {t}_xz {t}_xyz along x, {t}_y {t}_xy {t}_yz {t}_xyz along y, {t}_z {t}_xz {t}_yz {t}_xyz along z (`freeze`)"));
     }
-    let command = format!("ball --radius {radius} --cells {n}{}", if args.octant { " --octant" } else { "" });
+    if let Some(h) = spacing {
+        lines.push(format!(
+            "shells graded from the centre: {core} of spacing {h}, then growing by {ratio:.4} to {:.4e} at the sphere",
+            shells[n / 2] - shells[n / 2 - 1]
+        ));
+    }
+    if let Some(surface) = &args.surface_type {
+        lines.push(format!("the nodes on the sphere: type {surface}"));
+    }
+    let mut command = format!("ball --radius {radius} --cells {n}{}", if args.octant { " --octant" } else { "" });
+    if let Some(h) = spacing {
+        command += &format!(" --spacing {h} --core-cells {core}");
+    }
+    if let Some(surface) = &args.surface_type {
+        command += &format!(" --surface-type {surface}");
+    }
     Ok(writer.finish("Elastic ball of linear tetrahedra", &command, lines))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mesh::tetra_edges;
 
     fn args(cells: u32) -> BallArgs {
         BallArgs {
@@ -179,6 +194,9 @@ mod tests {
             centre: vec![0.5, 0.0, -1.0],
             particle_type: "node".into(),
             octant: false,
+            spacing: None,
+            core_cells: 0,
+            surface_type: None,
             tetra_type: "solid".into(),
             output: "ball.top".into(),
         }
@@ -255,6 +273,25 @@ mod tests {
             line.split('(').nth(1).unwrap().split(' ').next().unwrap().parse().unwrap()
         };
         assert!(gap(16) < gap(8) / 3.0 && gap(16) < 1.0, "{} vs {}", gap(16), gap(8));
+    }
+
+    #[test]
+    fn graded_shells_keep_the_core_grow_outwards_and_type_the_sphere() {
+        let graded_args = BallArgs { octant: true, spacing: Some(0.1), core_cells: 2, surface_type: Some("rim".into()), ..args(8) };
+        let built = ball(&graded_args).unwrap();
+        let top = crate::topology::parse_topology(&crate::input::SourceFile::new("ball.top", &built.text)).unwrap();
+        let centre = DVec3::new(0.5, 0.0, -1.0);
+        let (shells, _) = graded("--radius", 2.0, 4, Some(0.1), 2).unwrap();
+        assert_eq!((shells[1], shells[2], shells[4]), (0.1, 0.2, 2.0));
+        for (p, x) in top.positions.iter().enumerate() {
+            let r = (*x - centre).length();
+            let k = shells.iter().position(|t| (t - r).abs() < 1e-12).unwrap_or_else(|| panic!("node {p} at r = {r} off the shells"));
+            assert_eq!(top.type_names[p].text == "rim", k == 4, "node {p} at r = {r}");
+        }
+        for t in &top.tetrahedra {
+            assert!(tetra_edges(t.particles.map(|p| top.positions[p as usize])).determinant() > 0.0, "inverted element {:?}", t.particles);
+        }
+        assert!(ball(&BallArgs { core_cells: 4, ..graded_args }).unwrap_err().contains("expected --core-cells < --cells/2 = 4"));
     }
 
     #[test]

@@ -26,6 +26,7 @@
 //! | [`lattice()`] | `lattice` | a diluted triangular lattice of fibres in a disc with a clamped rim (Broedersz et al. 2011), optionally with a contractile force dipole |
 //! | [`collagen()`] | `collagen` | a planar collagen fibre network (Ouyang et al. 2022): crosslinks as shared nodes, holes under cells that are rings of nodes with a hub |
 //! | [`ball()`] | `ball` | an elastic ball meshed with linear tetrahedra (`[ tetrahedra ]`, for `neo_hookean`/`linear_elastic`) |
+//! | [`block()`] | `block` | an elastic block meshed with linear tetrahedra, graded towards its top face's centre (a half-space for contact; optionally a symmetric quarter) |
 //! | [`merge()`] | `merge` | several topology files composed into one by the deck's rule for several `topology` lines |
 //!
 //! **Rest lengths** (`--rest-from-geometry`, every generator): by default a
@@ -72,6 +73,7 @@
 
 mod aster;
 mod ball;
+mod block;
 mod branched;
 mod cells;
 mod collagen;
@@ -79,6 +81,7 @@ mod cortex;
 mod filament;
 mod filopodium;
 mod icosphere;
+mod kuhn;
 mod lattice;
 mod merge;
 mod network;
@@ -92,11 +95,12 @@ use std::path::PathBuf;
 
 use glam::{DQuat, DVec3};
 
-use crate::rng::{block, open_unit_52};
+use crate::rng::{self, open_unit_52};
 use crate::units::BOLTZMANN_PN_UM_PER_K;
 
 pub use self::aster::{aster, AsterArgs};
 pub use self::ball::{ball, BallArgs};
+pub use self::block::{block, BlockArgs};
 pub use self::branched::{branched, BranchedArgs};
 pub use self::cells::{cells, CellsArgs, Layout};
 pub use self::collagen::{collagen, CellLayout, CollagenArgs};
@@ -155,6 +159,10 @@ pub enum Generator {
     /// An elastic ball of radius RADIUS meshed with linear tetrahedra (a cubed-sphere
     /// map of a lattice of CELLS³ cubes, six tetrahedra each), for `tetra` volume laws.
     Ball(BallArgs),
+    /// An elastic block meshed with linear tetrahedra, its spacings graded
+    /// towards the centre of its top face (a half-space for a contact there),
+    /// base nodes typed for holding; optionally the symmetric quarter.
+    Block(BlockArgs),
     /// Several topology files composed into one by the rule of a deck with
     /// several `topology` lines (ids shifted by --offset, by default the
     /// largest so far; body ids follow; shared type names; the first box).
@@ -178,6 +186,7 @@ impl Generator {
             Self::Lattice(a) => lattice(a),
             Self::Collagen(a) => collagen(a),
             Self::Ball(a) => ball(a),
+            Self::Block(a) => block(a),
             Self::Merge(a) => merge(a),
         }
     }
@@ -198,6 +207,7 @@ impl Generator {
             Self::Lattice(a) => a.common.output.as_path(),
             Self::Collagen(a) => a.common.output.as_path(),
             Self::Ball(a) => a.output.as_path(),
+            Self::Block(a) => a.output.as_path(),
             Self::Merge(a) => a.output.as_path(),
         }
     }
@@ -542,7 +552,7 @@ impl Draws {
 
     /// Two independent uniforms in the open interval (0, 1) (52 bits each).
     pub fn uniform2(&self, item: u64, purpose: u32) -> [f64; 2] {
-        let b = block(self.seed, item, purpose, self.stream);
+        let b = rng::block(self.seed, item, purpose, self.stream);
         [open_unit_52(b[0], b[1]), open_unit_52(b[2], b[3])]
     }
 
