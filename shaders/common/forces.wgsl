@@ -2,9 +2,10 @@
 // write conflicts; the order is fixed by the data, so a run repeats bit for
 // bit): pairs from the neighbour list, its bonds from its own side, its
 // angle slots, the external fields acting on it, and its slots of the
-// surface terms (shaders/common/surface.wgsl). `force[i].w` is the
-// particle's share of the potential energy (half of each pair and bond,
-// a third of each angle, all of its externals, its surface slots' shares).
+// surface terms (shaders/common/surface.wgsl) and of its volume elements
+// (shaders/common/tetra.wgsl). `force[i].w` is the particle's share of the
+// potential energy (half of each pair and bond, a third of each angle, all
+// of its externals, its surface and element slots' shares).
 //
 // `radial_law`, `three_body_law` and `one_body_law` dispatch on the
 // registry index of the term's interaction type; they are generated from the
@@ -40,6 +41,11 @@ fn forces(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index)
             e += 0.5 * radial.energy;
         }
     }
+
+    // Bonded neighbours of fractional `special_bonds` weight (shaders/common/special.wgsl).
+    let special = special_pair_forces(i, ti);
+    f += special.xyz;
+    e += special.w;
 
     // Bonds, from this particle's side.
     let bonds_end = topo[P.off_bond_offsets + i + 1u];
@@ -90,6 +96,13 @@ fn forces(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index)
     let slots_end = topo[P.off_node_slot_offsets + i + 1u];
     for (var s = topo[P.off_node_slot_offsets + i]; s < slots_end; s++) {
         let slot = surf[topo[P.off_node_slots + s]];
+        f += slot.xyz;
+        e += slot.w;
+    }
+    // Volume elements: this particle's corner slots (shaders/common/tetra.wgsl), ascending element.
+    let tetra_end = topo[P.off_tetra_slot_offsets + i + 1u];
+    for (var s = topo[P.off_tetra_slot_offsets + i]; s < tetra_end; s++) {
+        let slot = surf[topo[P.off_tetra_slots + s]];
         f += slot.xyz;
         e += slot.w;
     }

@@ -38,6 +38,13 @@ struct Params {
     off_node_slot_offsets: u32, off_node_slots: u32, off_edges: u32, off_node_body: u32,
     off_node_edge_offsets: u32, off_node_edges: u32, off_node_face_offsets: u32, off_node_faces: u32,
     n_faces: u32, n_bodies: u32, n_edges: u32, n_body_nodes: u32,
+    // volume elements (src/gpu/tetra.rs): `topo` and `fparams` sections, their first `surf` slot, their number
+    off_tetras: u32, off_tetra_rest: u32, off_tetra_slot_offsets: u32, off_tetra_slots: u32,
+    tetra_surf_base: u32, n_tetras: u32, tetra_pad0: u32, tetra_pad1: u32,
+    // simulated time at this call's first step (f32 high part + remainder), dt (for `sim_time`)
+    time_hi: f32, time_lo: f32, dt: f32, clock_pad: f32,
+    // fractional `special_bonds` partners (src/gpu/special.rs): `topo` offsets (CSR by particle), entries
+    off_special_offsets: u32, off_special: u32, special_pad0: u32, special_pad1: u32,
 }
 
 @group(0) @binding(0) var<uniform> P: Params;

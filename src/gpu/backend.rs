@@ -102,6 +102,8 @@ struct Kernels {
     integrate: wgpu::ComputePipeline,
     commit: wgpu::ComputePipeline,
     advance: wgpu::ComputePipeline,
+    /// Volume elements' corner forces (src/gpu/tetra.rs).
+    tetra_forces: wgpu::ComputePipeline,
 }
 
 /// The GPU force engine and integrator for one model.
@@ -138,6 +140,8 @@ pub struct GpuBackend {
     settings: StepSettings,
     /// The next `run` or `evaluate` rebuilds the neighbour list first.
     pending_rebuild: bool,
+    /// Simulated time at the next step (see [`GpuBackend::set_time`]).
+    time: f64,
 }
 
 /// Refuses a storage buffer the adapter cannot bind (wgpu would abort).
@@ -179,9 +183,6 @@ impl GpuBackend {
             return Err(
                 "the GPU backend has no kernels for custom surface terms of bodies (`custom` body lines) yet; use `device cpu`".into()
             );
-        }
-        if !model.tetras.is_empty() {
-            return Err("the GPU backend has no kernels for volume elements (`[ tetrahedra ]`) yet; use `device cpu`".into());
         }
         if model.has_contact_terms() {
             return Err(
@@ -231,6 +232,9 @@ impl GpuBackend {
             topo_offsets: packed.topo_offsets,
             fparam_offsets: packed.fparam_offsets,
             surface_offsets: packed.surface_offsets,
+            tetra_offsets: packed.tetra_offsets,
+            clock: [0.0, 0.0, settings.context.dt as f32, 0.0],
+            special_offsets: packed.special_offsets,
         };
         let device = &ctx.device;
         let init = |label: &str, contents: &[u8], usage: wgpu::BufferUsages| {
@@ -334,6 +338,7 @@ impl GpuBackend {
             integrate: pipeline("integrate", &main_layout),
             commit: pipeline("commit", &main_layout),
             advance: pipeline("advance", &main_layout),
+            tetra_forces: pipeline("tetra_forces", &main_layout),
         };
         let main_group = bind_main(
             device,
@@ -370,7 +375,9 @@ impl GpuBackend {
             settings: *settings,
             pending_rebuild: true,
             ctx: ctx.clone(),
+            time: settings.context.time,
         };
+        backend.set_clock(settings.context.time);
         backend.upload(state);
         Ok(backend)
     }
@@ -465,6 +472,8 @@ impl GpuBackend {
         self.params.topo_offsets = packed.topo_offsets;
         self.params.fparam_offsets = packed.fparam_offsets;
         self.params.surface_offsets = packed.surface_offsets;
+        self.params.tetra_offsets = packed.tetra_offsets;
+        self.params.special_offsets = packed.special_offsets;
         self.pending_rebuild |= rebuild;
         Ok(())
     }
@@ -534,6 +543,20 @@ impl GpuBackend {
         let out = slice.get_mapped_range().expect("mapped readback").to_vec();
         staging.unmap();
         out
+    }
+
+    /// Sets the simulated time of the next step (`t` of externals with
+    /// expression parameters); `run` advances it by dt per step taken.
+    pub fn set_time(&mut self, time: f64) {
+        self.time = time;
+        self.set_clock(time);
+    }
+
+    /// Writes `time` into the parameters as an f32 high part and remainder.
+    fn set_clock(&mut self, time: f64) {
+        let high = time as f32;
+        self.params.clock[0] = high;
+        self.params.clock[1] = (time - high as f64) as f32;
     }
 
     fn write_params(&self) {
@@ -667,7 +690,8 @@ impl GpuBackend {
     }
 
     /// The surface kernels in order (none without surface terms; the
-    /// curvature passes only with a curvature law), see [`super::surface`].
+    /// curvature passes only with a curvature law), see [`super::surface`],
+    /// then the volume elements' kernel (none without elements).
     fn surface_passes(&self) -> Vec<(&wgpu::ComputePipeline, Over)> {
         let k = &self.kernels;
         let [faces, bodies, edges, nodes] = [12, 13, 14, 15].map(|c| self.params.surface_offsets[c]);
@@ -679,6 +703,10 @@ impl GpuBackend {
                 passes.extend([(&k.surface_edges, over(edges)), (&k.surface_nodes, over(nodes)), (&k.surface_edge_forces, over(edges))]);
             }
             passes.push((&k.surface_forces, over(faces)));
+        }
+        // Then the volume elements' pass (src/gpu/tetra.rs).
+        if self.params.tetra_offsets[5] > 0 {
+            passes.push((&k.tetra_forces, over(self.params.tetra_offsets[5])));
         }
         passes
     }
@@ -709,6 +737,7 @@ impl GpuBackend {
         loop {
             self.pending_rebuild = false;
             self.reset_status(true);
+            self.set_clock(self.time);
             self.write_params();
             let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
             {
@@ -738,6 +767,7 @@ impl GpuBackend {
             self.params.step_lo = step as u32;
             self.params.step_hi = (step >> 32) as u32;
             self.params.steps_wanted = chunk as u32;
+            self.set_clock(self.time + done as f64 * self.settings.context.dt);
             self.write_params();
             self.reset_status(force_rebuild);
             let mut encoded = 0;
@@ -764,6 +794,7 @@ impl GpuBackend {
             }
             force_rebuild = self.grow_if_overflowed(&status).map_err(|message| GpuHalt::Capacity { step: first_step + done, message })?;
         }
+        self.time += done as f64 * self.settings.context.dt;
         Ok(done)
     }
 }

@@ -10,11 +10,15 @@
 //!   where it exceeds the adapter's largest storage binding.
 //! - [`surface`]: surface (body) terms: face, body, edge and node passes,
 //!   deterministic (no float atomics).
+//! - [`special`]: pairs of bonded neighbours with a fractional
+//!   `special_bonds` weight, each particle's own list.
+//! - [`tetra`]: volume elements (`[ tetrahedra ]`): one pass per element
+//!   into corner slots, gathered per particle.
 //!
-//! One file-level circle, on purpose: `pack.rs` ↔ `surface.rs`. `pack.rs`
-//! lays out the whole topology, the surface sections included, and
-//! `surface.rs` builds those sections' CSR lists with pack's `push_csr`, the
-//! one CSR builder of the GPU buffers.
+//! File-level circles, on purpose: `pack.rs` ↔ `surface.rs`, `tetra.rs`
+//! and `special.rs`. `pack.rs` lays out the whole topology, their sections
+//! included, and they build those sections' CSR lists with pack's
+//! `push_csr`, the one CSR builder of the GPU buffers.
 //!
 //! What runs where: each step — neighbour-list check and (when due) rebuild,
 //! forces, overdamped integration — runs on the GPU without reading anything
@@ -48,7 +52,9 @@ pub mod custom;
 mod nlist;
 pub mod pack;
 pub mod shader;
+mod special;
 pub mod surface;
+pub mod tetra;
 
 pub use backend::{GpuBackend, GpuHalt};
 pub use context::{DevicePreference, GpuContext};

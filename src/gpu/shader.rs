@@ -8,7 +8,9 @@
 //! (neighbour list, forces, integrator). One module holds every entry point.
 //! Surface laws define `NAME_face` or `NAME_node` by their [`SurfaceGpu`]
 //! form, dispatched by `surface_law` and `node_law` from the surface
-//! kernels (src/gpu/surface.rs).
+//! kernels (src/gpu/surface.rs). Volume-element laws define `NAME_tetra`
+//! (W and P at F), dispatched by `tetra_law` from the element kernel
+//! (src/gpu/tetra.rs).
 //!
 //! Only laws with a GPU kernel take part ([`Law::runs_on_gpu`]). Custom
 //! body terms and contact laws ([`Law::Contact`], [`Law::ContactArea`]:
@@ -39,7 +41,7 @@ mod embedded {
 pub use embedded::{COMMON_SHADERS, INTERACTION_SHADERS};
 
 /// The common files in the order they must appear (declarations first).
-const COMMON_ORDER: [&str; 6] = ["layout", "philox", "neighbor", "forces", "surface", "integrate"];
+const COMMON_ORDER: [&str; 8] = ["layout", "philox", "neighbor", "forces", "surface", "integrate", "tetra", "special"];
 
 fn common(name: &str) -> &'static str {
     COMMON_SHADERS.iter().find(|(stem, _)| *stem == name).map(|(_, src)| *src).unwrap_or_else(|| panic!("shaders/common/{name}.wgsl"))
@@ -61,6 +63,9 @@ fn dispatch(custom: &CustomSource) -> String {
         "fn surface_law(kind: u32, p: array<f32, 8>, body: BodyTotals, g: FaceGeometry) -> SurfaceFace {\n    switch kind {\n",
     );
     let mut node = String::from("fn node_law(kind: u32, p: array<f32, 8>, m: f32, a: f32) -> NodeCurvature {\n    switch kind {\n");
+    let mut tetra = String::from(
+        "fn tetra_law(kind: u32, p: array<f32, 8>, f: mat3x3<f32>, j: f32, f_inv_t: mat3x3<f32>) -> TetraDensity {\n    switch kind {\n",
+    );
     for (index, interaction) in REGISTRY.iter().enumerate() {
         let name = interaction.name();
         let (out, call) = match interaction.law() {
@@ -69,7 +74,8 @@ fn dispatch(custom: &CustomSource) -> String {
             Law::OneBody(_) => (&mut one, format!("{name}_one(p, x)")),
             Law::Surface { gpu: SurfaceGpu::PerFace, .. } => (&mut surface, format!("{name}_face(p, body, g)")),
             Law::Surface { gpu: SurfaceGpu::NodeCurvature, .. } => (&mut node, format!("{name}_node(p, m, a)")),
-            Law::Surface { .. } | Law::Contact { .. } | Law::ContactArea { .. } | Law::Tetra(_) => continue,
+            Law::Tetra(_) => (&mut tetra, format!("{name}_tetra(p, f, j, f_inv_t)")),
+            Law::Surface { .. } | Law::Contact { .. } | Law::ContactArea { .. } => continue,
         };
         writeln!(out, "        case {index}u: {{ return {call}; }}").unwrap();
     }
@@ -81,7 +87,8 @@ fn dispatch(custom: &CustomSource) -> String {
     one.push_str("        default: { return OneBody(0.0, vec3<f32>(0.0)); }\n    }\n}\n");
     surface.push_str("        default: { return SurfaceFace(0.0, vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0)); }\n    }\n}\n");
     node.push_str("        default: { return NodeCurvature(0.0, 0.0, 0.0); }\n    }\n}\n");
-    radial + &three + &one + &surface + &node
+    tetra.push_str("        default: { return TetraDensity(0.0, mat3x3<f32>()); }\n    }\n}\n");
+    radial + &three + &one + &surface + &node + &tetra
 }
 
 /// The whole program for models without custom terms.
@@ -162,6 +169,11 @@ mod tests {
         }
         for name in form(SurfaceGpu::NodeCurvature) {
             assert!(compose().contains(&format!("return {name}_node(p, m, a);")), "{name} has no `node_law` case");
+        }
+        let tetra: Vec<&str> = REGISTRY.iter().filter(|i| matches!(i.law(), Law::Tetra(_))).map(|i| i.name()).collect();
+        assert_eq!(tetra, ["neo_hookean", "linear_elastic"]);
+        for name in tetra {
+            assert!(compose().contains(&format!("return {name}_tetra(p, f, j, f_inv_t);")), "{name} has no `tetra_law` case");
         }
     }
 

@@ -463,7 +463,7 @@ impl Law {
     pub fn runs_on_gpu(&self) -> bool {
         match self {
             Law::Surface { gpu, .. } => *gpu != SurfaceGpu::None,
-            Law::Contact { .. } | Law::ContactArea { .. } | Law::Tetra(_) => false,
+            Law::Contact { .. } | Law::ContactArea { .. } => false,
             _ => true,
         }
     }
