@@ -129,8 +129,8 @@ fn gpu_forces_match_cpu_on_the_mixed_random_system() {
 /// weight, from each particle's own list on the GPU. Forces and energies
 /// within 1e-5 of the CPU's, relative to the largest force (as for the
 /// mixed random system: the same f32 pair evaluators, plus one rounding of
-/// w), periodic and not; the weighted pairs matter: with weights 0 0 0 the
-/// CPU's forces differ by more than 1e-2 of the largest.
+/// w); the weighted pairs matter: with weights 0 0 0 the CPU's forces
+/// differ by more than 1e-2 of the largest.
 #[test]
 fn fractional_special_bonds_weights_run_on_the_gpu_like_on_the_cpu() {
     let mut next = common::uniform(0x5BEC1A1);
@@ -153,31 +153,28 @@ fn fractional_special_bonds_weights_run_on_the_gpu_like_on_the_cpu() {
     top += &bonds;
     let ff = "particle a drag 1\nparticle b drag 2\nbond s harmonic k 2 r0 0.45\n\
               pair a a soft A 1 rc 0.9\npair a b soft_repulsion k 5 sigma 0.5\npair b b soft A 2 rc 0.8\n";
-    for periodic in [true, false] {
-        let b = if periodic { "p" } else { "f" };
-        let cpu_forces = |special: &str| {
-            let deck = format!("units lj\n{special}topology t.top\nforcefield f.ff\nbox x 0 8 {b} y 0 8 {b} z 0 8 {b}\nneighbor skin 0.4\n");
-            let plan = common::Case::new(&[("t.top", &top), ("f.ff", ff), ("deck.in", &deck)]).plan();
-            let state = initial_state(&plan);
-            let mut cpu = CpuBackend::new(&plan.model, &state, &plan.sim_box, 0.4).unwrap();
-            let mut forces = Forces::default();
-            cpu.compute(&plan.model, &state, &plan.sim_box, &mut forces);
-            (plan, state, forces)
-        };
-        let (plan, state, forces) = cpu_forces("special_bonds lj 0.5 0.25 0.8\n");
-        let sim = Simulation::before_first_run(&plan, RunOptions::default()).unwrap();
-        assert_eq!(sim.cpu_only_feature(), None);
-        let mut gpu = GpuBackend::new(&context(), &plan.model, &state, &plan.sim_box, &settings(0.4, 1e-3, 0.0)).unwrap();
-        gpu.evaluate().unwrap();
-        let (force_error, energy_error) = compare_forces(&forces, &gpu.forces_and_energies());
-        println!("special_bonds, periodic {periodic}: force error {force_error:e}, energy error {energy_error:e}");
-        assert!(force_error < 1e-5 && energy_error < 1e-5, "force error {force_error:e}, energy error {energy_error:e}");
-        let (_, _, without) = cpu_forces("special_bonds lj 0 0 0\n");
-        let scale = forces.forces.iter().map(|f| f.length()).fold(0.0, f64::max);
-        let change = forces.forces.iter().zip(&without.forces).map(|(a, b)| (*a - *b).length()).fold(0.0, f64::max);
-        println!("special_bonds, periodic {periodic}: the weighted pairs change the forces by {:.3e} of the largest", change / scale);
-        assert!(change > 1e-2 * scale, "the weighted pairs change the forces by only {change:e}: the test would be vacuous");
-    }
+    let cpu_forces = |special: &str| {
+        let deck = format!("units lj\n{special}topology t.top\nforcefield f.ff\nbox x 0 8 f y 0 8 f z 0 8 f\nneighbor skin 0.4\n");
+        let plan = common::Case::new(&[("t.top", &top), ("f.ff", ff), ("deck.in", &deck)]).plan();
+        let state = initial_state(&plan);
+        let mut cpu = CpuBackend::new(&plan.model, &state, &plan.sim_box, 0.4).unwrap();
+        let mut forces = Forces::default();
+        cpu.compute(&plan.model, &state, &plan.sim_box, &mut forces);
+        (plan, state, forces)
+    };
+    let (plan, state, forces) = cpu_forces("special_bonds lj 0.5 0.25 0.8\n");
+    let sim = Simulation::before_first_run(&plan, RunOptions::default()).unwrap();
+    assert_eq!(sim.cpu_only_feature(), None);
+    let mut gpu = GpuBackend::new(&context(), &plan.model, &state, &plan.sim_box, &settings(0.4, 1e-3, 0.0)).unwrap();
+    gpu.evaluate().unwrap();
+    let (force_error, energy_error) = compare_forces(&forces, &gpu.forces_and_energies());
+    println!("special_bonds: force error {force_error:e}, energy error {energy_error:e}");
+    assert!(force_error < 1e-5 && energy_error < 1e-5, "force error {force_error:e}, energy error {energy_error:e}");
+    let (_, _, without) = cpu_forces("special_bonds lj 0 0 0\n");
+    let scale = forces.forces.iter().map(|f| f.length()).fold(0.0, f64::max);
+    let change = forces.forces.iter().zip(&without.forces).map(|(a, b)| (*a - *b).length()).fold(0.0, f64::max);
+    println!("special_bonds: the weighted pairs change the forces by {:.3e} of the largest", change / scale);
+    assert!(change > 1e-2 * scale, "the weighted pairs change the forces by only {change:e}: the test would be vacuous");
 }
 
 /// The `field` external with constant parameters runs on the GPU (its
@@ -680,6 +677,7 @@ fn every_input_deck_runs_on_the_gpu_like_on_the_cpu() {
             let options = RunOptions { output_dir: dir.path().to_path_buf(), device: Some(DevicePreference::Gpu), ..Default::default() };
             let refusal = Simulation::execute(plan.clone(), options).err().map(|e| e.to_string()).unwrap_or_default();
             assert!(refusal.contains(why), "{}: expected the GPU to refuse with {why:?}, got {refusal:?}", deck.display());
+            println!("{:40} refused: {why}", deck.display());
             refused += 1;
             continue;
         }
@@ -710,6 +708,7 @@ fn every_input_deck_runs_on_the_gpu_like_on_the_cpu() {
             // A CPU-only feature that starts after the first run (a `ramp`
             // between runs): the GPU must refuse that run with its reason.
             Err(e) if e.starts_with("device gpu: ") && e.ends_with("run on the CPU backend only; use `device cpu` or `device auto`") => {
+                println!("{:40} refused at a later run: {e}", deck.display());
                 refused += 1
             }
             Err(e) => panic!("{}: {e}", deck.display()),

@@ -11,6 +11,28 @@
 // registry index of the term's interaction type; they are generated from the
 // registry when the shader is composed.
 
+// Every pair rule between particles i (of type ti) and j: the force on i
+// (xyz) and the pair's energy (w); zero beyond the type pair's reach.
+fn pair_rules_at(i: u32, j: u32, ti: u32) -> vec4<f32> {
+    let pair = ti * P.n_types + topo[j];
+    let d = separation(i, j);
+    let r2 = dot(d, d);
+    var f = vec3<f32>(0.0);
+    var e = 0.0;
+    if r2 >= fparams[P.off_skip2 + pair] {
+        return vec4<f32>(f, e);
+    }
+    let r = sqrt(r2);
+    let rules_end = topo[P.off_pair_start + pair + 1u];
+    for (var q = topo[P.off_pair_start + pair]; q < rules_end; q++) {
+        let term = topo[P.off_pair_terms + q];
+        let radial = radial_law(topo[P.off_term_kind + term], term_params(term), r);
+        f += force_along(radial, d, r);
+        e += radial.energy;
+    }
+    return vec4<f32>(f, e);
+}
+
 @compute @workgroup_size(256)
 fn forces(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) local: u32) {
     let i = chunk_particle(wg, local);
@@ -25,21 +47,9 @@ fn forces(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index)
     let row = nlist_row(i);
     let count = min(nlist[row], P.nlist_cap);
     for (var k = 0u; k < count; k++) {
-        let j = nlist[row + 1u + k];
-        let pair = ti * P.n_types + topo[j];
-        let d = separation(i, j);
-        let r2 = dot(d, d);
-        if r2 >= fparams[P.off_skip2 + pair] {
-            continue;
-        }
-        let r = sqrt(r2);
-        let rules_end = topo[P.off_pair_start + pair + 1u];
-        for (var q = topo[P.off_pair_start + pair]; q < rules_end; q++) {
-            let term = topo[P.off_pair_terms + q];
-            let radial = radial_law(topo[P.off_term_kind + term], term_params(term), r);
-            f += force_along(radial, d, r);
-            e += 0.5 * radial.energy;
-        }
+        let rules = pair_rules_at(i, nlist[row + 1u + k], ti);
+        f += rules.xyz;
+        e += 0.5 * rules.w;
     }
 
     // Bonded neighbours of fractional `special_bonds` weight (shaders/common/special.wgsl).

@@ -8,22 +8,10 @@ fn special_pair_forces(i: u32, ti: u32) -> vec4<f32> {
     var e = 0.0;
     let end = topo[P.off_special_offsets + i + 1u];
     for (var s = topo[P.off_special_offsets + i]; s < end; s++) {
-        let j = topo[P.off_special + 2u * s];
         let w = bitcast<f32>(topo[P.off_special + 2u * s + 1u]);
-        let pair = ti * P.n_types + topo[j];
-        let d = separation(i, j);
-        let r2 = dot(d, d);
-        if r2 >= fparams[P.off_skip2 + pair] {
-            continue;
-        }
-        let r = sqrt(r2);
-        let rules_end = topo[P.off_pair_start + pair + 1u];
-        for (var q = topo[P.off_pair_start + pair]; q < rules_end; q++) {
-            let term = topo[P.off_pair_terms + q];
-            let radial = radial_law(topo[P.off_term_kind + term], term_params(term), r);
-            f += w * force_along(radial, d, r);
-            e += 0.5 * w * radial.energy;
-        }
+        let rules = pair_rules_at(i, topo[P.off_special + 2u * s], ti);
+        f += w * rules.xyz;
+        e += 0.5 * w * rules.w;
     }
     return vec4<f32>(f, e);
 }
