@@ -104,6 +104,17 @@ fn compare_forces(cpu: &Forces, gpu: &[(DVec3, f64)]) -> (f64, f64) {
     (worst / scale, (energy - total).abs() / total.abs().max(1e-300))
 }
 
+/// CPU (f64) and GPU forces of `model` at `state` against each other:
+/// (largest force difference, energy difference), relative as in [`compare_forces`].
+fn gpu_vs_cpu(model: &cellmd::system::Model, state: &State, sim_box: &cellmd::system::SimBox, skin: f64) -> (f64, f64) {
+    let mut cpu = CpuBackend::new(model, state, sim_box, skin).unwrap();
+    let mut forces = Forces::default();
+    cpu.compute(model, state, sim_box, &mut forces);
+    let mut gpu = GpuBackend::new(&context(), model, state, sim_box, &settings(skin, 1e-3, 0.0)).unwrap();
+    gpu.evaluate().unwrap();
+    compare_forces(&forces, &gpu.forces_and_energies())
+}
+
 #[test]
 fn gpu_forces_match_cpu_on_the_mixed_random_system() {
     for periodic in [true, false] {
@@ -165,9 +176,7 @@ fn fractional_special_bonds_weights_run_on_the_gpu_like_on_the_cpu() {
     let (plan, state, forces) = cpu_forces("special_bonds lj 0.5 0.25 0.8\n");
     let sim = Simulation::before_first_run(&plan, RunOptions::default()).unwrap();
     assert_eq!(sim.cpu_only_feature(), None);
-    let mut gpu = GpuBackend::new(&context(), &plan.model, &state, &plan.sim_box, &settings(0.4, 1e-3, 0.0)).unwrap();
-    gpu.evaluate().unwrap();
-    let (force_error, energy_error) = compare_forces(&forces, &gpu.forces_and_energies());
+    let (force_error, energy_error) = gpu_vs_cpu(&plan.model, &state, &plan.sim_box, 0.4);
     println!("special_bonds: force error {force_error:e}, energy error {energy_error:e}");
     assert!(force_error < 1e-5 && energy_error < 1e-5, "force error {force_error:e}, energy error {energy_error:e}");
     let (_, _, without) = cpu_forces("special_bonds lj 0 0 0\n");
@@ -188,13 +197,7 @@ fn a_field_external_runs_on_the_gpu_like_on_the_cpu() {
     let sim = Simulation::before_first_run(&plan, RunOptions::default()).unwrap();
     assert_eq!(sim.model.externals.len(), 1);
     assert_eq!(sim.cpu_only_feature(), None);
-    let state = initial_state(&plan);
-    let mut cpu = CpuBackend::new(&sim.model, &state, &plan.sim_box, 0.4).unwrap();
-    let mut forces = Forces::default();
-    cpu.compute(&sim.model, &state, &plan.sim_box, &mut forces);
-    let mut gpu = GpuBackend::new(&context(), &sim.model, &state, &plan.sim_box, &settings(0.4, 1e-3, 0.0)).unwrap();
-    gpu.evaluate().unwrap();
-    let (force_error, energy_error) = compare_forces(&forces, &gpu.forces_and_energies());
+    let (force_error, energy_error) = gpu_vs_cpu(&sim.model, &initial_state(&plan), &plan.sim_box, 0.4);
     eprintln!("field external: force error {force_error:e}, energy error {energy_error:e}");
     assert!(force_error < 1e-5 && energy_error < 1e-5, "force error {force_error:e}, energy error {energy_error:e}");
 }
@@ -228,13 +231,7 @@ fn externals_with_expression_parameters_run_on_the_gpu_like_on_the_cpu() {
     let sim = Simulation::before_first_run(&plan, RunOptions::default()).unwrap();
     assert_eq!(sim.cpu_only_feature(), None);
     assert!(sim.model.externals.iter().all(|e| !e.expressions.is_empty()), "every external has an expression parameter");
-    let state = initial_state(&plan);
-    let mut cpu = CpuBackend::new(&sim.model, &state, &plan.sim_box, 0.3).unwrap();
-    let mut forces = Forces::default();
-    cpu.compute(&sim.model, &state, &plan.sim_box, &mut forces);
-    let mut gpu = GpuBackend::new(&context(), &sim.model, &state, &plan.sim_box, &settings(0.3, 1e-3, 0.0)).unwrap();
-    gpu.evaluate().unwrap();
-    let (force_error, energy_error) = compare_forces(&forces, &gpu.forces_and_energies());
+    let (force_error, energy_error) = gpu_vs_cpu(&sim.model, &initial_state(&plan), &plan.sim_box, 0.3);
     println!("expression externals at t = 0: force error {force_error:e}, energy error {energy_error:e}");
     assert!(force_error < 1e-5 && energy_error < 1e-5, "force error {force_error:e}, energy error {energy_error:e}");
 
