@@ -187,7 +187,7 @@ fn fractional_special_bonds_weigh_the_pair_terms_of_bonded_neighbours() {
 }
 
 #[test]
-fn fractional_special_bonds_export_unchanged_and_stay_on_the_cpu() {
+fn fractional_special_bonds_export_unchanged_and_may_run_on_the_gpu() {
     let deck = "units lj\nspecial_bonds lj 0.0 0.0 0.5\ntopology t.top\nforcefield f.ff\nbox x -10 10 f y -10 10 f z -10 10 f\n\
                 timestep 0.001\nrun 1\n";
     let top = "[ particles ]\n1 p 0 0 0\n2 p 1 0 0\n3 p 2 0 0\n4 p 3 0 0\n[ bonds ]\nb 1 2\nb 2 3\nb 3 4\n";
@@ -197,5 +197,5 @@ fn fractional_special_bonds_export_unchanged_and_stay_on_the_cpu() {
     let input = export(&plan, ExportOptions::default()).unwrap().input;
     assert!(input.lines().any(|l| l == "special_bonds lj 0.0 0.0 0.5"), "{input}");
     let sim = Simulation::new(&plan, Default::default());
-    assert_eq!(sim.cpu_only_feature(), Some("fractional `special_bonds` weights run on the CPU backend only"));
+    assert_eq!(sim.cpu_only_feature(), None);
 }

@@ -104,6 +104,17 @@ fn compare_forces(cpu: &Forces, gpu: &[(DVec3, f64)]) -> (f64, f64) {
     (worst / scale, (energy - total).abs() / total.abs().max(1e-300))
 }
 
+/// CPU (f64) and GPU forces of `model` at `state` against each other:
+/// (largest force difference, energy difference), relative as in [`compare_forces`].
+fn gpu_vs_cpu(model: &cellmd::system::Model, state: &State, sim_box: &cellmd::system::SimBox, skin: f64) -> (f64, f64) {
+    let mut cpu = CpuBackend::new(model, state, sim_box, skin).unwrap();
+    let mut forces = Forces::default();
+    cpu.compute(model, state, sim_box, &mut forces);
+    let mut gpu = GpuBackend::new(&context(), model, state, sim_box, &settings(skin, 1e-3, 0.0)).unwrap();
+    gpu.evaluate().unwrap();
+    compare_forces(&forces, &gpu.forces_and_energies())
+}
+
 #[test]
 fn gpu_forces_match_cpu_on_the_mixed_random_system() {
     for periodic in [true, false] {
@@ -122,11 +133,63 @@ fn gpu_forces_match_cpu_on_the_mixed_random_system() {
     }
 }
 
-/// The `field` external with constant parameters runs on the GPU (its
-/// evaluator `shaders/interactions/field.wgsl`) like on the CPU; with an
-/// expression parameter the GPU refuses the deck with the CPU-only reason.
+/// Fractional `special_bonds` weights with pair rules: on five random-walk
+/// chains of 40 beads (steps of 0.45, so 1-2, 1-3 and most 1-4 neighbours
+/// lie within the pair cutoffs), bonded neighbours (1-2 at 0.5, 1-3 at
+/// 0.25, 1-4 at 0.8) interact through their pair rules scaled by the
+/// weight, from each particle's own list on the GPU. Forces and energies
+/// within 1e-5 of the CPU's, relative to the largest force (as for the
+/// mixed random system: the same f32 pair evaluators, plus one rounding of
+/// w); the weighted pairs matter: with weights 0 0 0 the CPU's forces
+/// differ by more than 1e-2 of the largest.
 #[test]
-fn a_field_external_runs_on_the_gpu_with_constant_parameters_only() {
+fn fractional_special_bonds_weights_run_on_the_gpu_like_on_the_cpu() {
+    let mut next = common::uniform(0x5BEC1A1);
+    let mut top = String::from("[ particles ]\n");
+    let mut bonds = String::from("[ bonds ]\n");
+    for chain in 0..5 {
+        let mut x = DVec3::new(4.0, 4.0, 4.0) + DVec3::new(next(), next(), next()) * 2.0 - 1.0;
+        for bead in 1..=40 {
+            let id = 40 * chain + bead;
+            let ty = if bead % 4 == 0 { "b" } else { "a" };
+            top += &format!("{id} {ty} {} {} {}\n", x.x, x.y, x.z);
+            if bead > 1 {
+                bonds += &format!("s {} {id}\n", id - 1);
+            }
+            let step = DVec3::new(next() - 0.5, next() - 0.5, next() - 0.5).normalize() * 0.45;
+            // Reflected at 0.5 from the box faces.
+            x = (x + step).to_array().map(|c| if !(0.5..=7.5).contains(&c) { c - 2.0 * (c - c.clamp(0.5, 7.5)) } else { c }).into();
+        }
+    }
+    top += &bonds;
+    let ff = "particle a drag 1\nparticle b drag 2\nbond s harmonic k 2 r0 0.45\n\
+              pair a a soft A 1 rc 0.9\npair a b soft_repulsion k 5 sigma 0.5\npair b b soft A 2 rc 0.8\n";
+    let cpu_forces = |special: &str| {
+        let deck = format!("units lj\n{special}topology t.top\nforcefield f.ff\nbox x 0 8 f y 0 8 f z 0 8 f\nneighbor skin 0.4\n");
+        let plan = common::Case::new(&[("t.top", &top), ("f.ff", ff), ("deck.in", &deck)]).plan();
+        let state = initial_state(&plan);
+        let mut cpu = CpuBackend::new(&plan.model, &state, &plan.sim_box, 0.4).unwrap();
+        let mut forces = Forces::default();
+        cpu.compute(&plan.model, &state, &plan.sim_box, &mut forces);
+        (plan, state, forces)
+    };
+    let (plan, state, forces) = cpu_forces("special_bonds lj 0.5 0.25 0.8\n");
+    let sim = Simulation::before_first_run(&plan, RunOptions::default()).unwrap();
+    assert_eq!(sim.cpu_only_feature(), None);
+    let (force_error, energy_error) = gpu_vs_cpu(&plan.model, &state, &plan.sim_box, 0.4);
+    println!("special_bonds: force error {force_error:e}, energy error {energy_error:e}");
+    assert!(force_error < 1e-5 && energy_error < 1e-5, "force error {force_error:e}, energy error {energy_error:e}");
+    let (_, _, without) = cpu_forces("special_bonds lj 0 0 0\n");
+    let scale = forces.forces.iter().map(|f| f.length()).fold(0.0, f64::max);
+    let change = forces.forces.iter().zip(&without.forces).map(|(a, b)| (*a - *b).length()).fold(0.0, f64::max);
+    println!("special_bonds: the weighted pairs change the forces by {:.3e} of the largest", change / scale);
+    assert!(change > 1e-2 * scale, "the weighted pairs change the forces by only {change:e}: the test would be vacuous");
+}
+
+/// The `field` external with constant parameters runs on the GPU (its
+/// evaluator `shaders/interactions/field.wgsl`) like on the CPU.
+#[test]
+fn a_field_external_runs_on_the_gpu_like_on_the_cpu() {
     let case = random_case(false, "");
     let deck = std::fs::read_to_string(case.path("deck.in")).unwrap();
     std::fs::write(case.path("deck.in"), format!("{deck}external trap all field fx 0.5 fy -0.25 fz 1 e 2\n")).unwrap();
@@ -134,23 +197,53 @@ fn a_field_external_runs_on_the_gpu_with_constant_parameters_only() {
     let sim = Simulation::before_first_run(&plan, RunOptions::default()).unwrap();
     assert_eq!(sim.model.externals.len(), 1);
     assert_eq!(sim.cpu_only_feature(), None);
-    let state = initial_state(&plan);
-    let mut cpu = CpuBackend::new(&sim.model, &state, &plan.sim_box, 0.4).unwrap();
-    let mut forces = Forces::default();
-    cpu.compute(&sim.model, &state, &plan.sim_box, &mut forces);
-    let mut gpu = GpuBackend::new(&context(), &sim.model, &state, &plan.sim_box, &settings(0.4, 1e-3, 0.0)).unwrap();
-    gpu.evaluate().unwrap();
-    let (force_error, energy_error) = compare_forces(&forces, &gpu.forces_and_energies());
+    let (force_error, energy_error) = gpu_vs_cpu(&sim.model, &initial_state(&plan), &plan.sim_box, 0.4);
     eprintln!("field external: force error {force_error:e}, energy error {energy_error:e}");
     assert!(force_error < 1e-5 && energy_error < 1e-5, "force error {force_error:e}, energy error {energy_error:e}");
+}
 
-    std::fs::write(case.path("deck.in"), format!("{deck}external trap all field fx \"-x\"\ntimestep 1e-3\nrun 1\n")).unwrap();
+/// Externals with expression parameters (formulas of x, y, z and t): a
+/// `field` trap whose centre moves with t, a `wall` whose offset `d` moves
+/// with t and a `custom` external that reads t, on 60 free particles for
+/// 2000 steps (t from 0 to 2). Forces and energies at the start within
+/// 1e-5 of the CPU's (f32: a formula takes ≤ 6 roundings of terms ≤ 10,
+/// relative to forces ≥ 1), and positions within 1e-5 of the distance
+/// travelled: each step's force carries ≈ 10·u·|x| ≈ 6e-6 (x and t rounded
+/// to f32 once, u = 2⁻²⁴, |x| ≤ 10), the traps contract, so the error stays
+/// at that level instead of adding up, while the particles travel ≥ 1.
+/// The time must reach the kernels: a GPU without it would lag the moving
+/// traps by up to 1 (tested: the deviation bound is 1e-5 × the path).
+#[test]
+fn externals_with_expression_parameters_run_on_the_gpu_like_on_the_cpu() {
+    let mut next = common::uniform(0x51F15E);
+    let mut top = String::from("[ particles ]\n");
+    for id in 1..=60 {
+        top += &format!("{id} a {} {} {}\n", 4.0 * next() - 2.0, 4.0 * next() - 2.0, 4.0 * next());
+    }
+    let ff = "particle a drag 1\n";
+    let deck = "units lj\ntopology t.top\nforcefield f.ff\nbox x -10 10 f y -10 10 f z -10 10 f\n\
+                external trap all field fx \"-2*(x - 1 - 0.5*t)\" fy \"-2*y\" fz 0 e \"(x - 1 - 0.5*t)^2 + y^2\"\n\
+                external floor all wall nz 1 d \"0.5 + 1.5*t\" k 20\n\
+                external spin all custom \"0.5*(z - 2 + t*t/4)^2*k\" k 3\n\
+                timestep 1e-3\nthermo 0 step pe\nrun 2000\n";
+    let case = common::Case::new(&[("t.top", &top), ("f.ff", ff), ("deck.in", deck)]);
     let plan = case.plan();
-    let why = Simulation::before_first_run(&plan, RunOptions::default()).unwrap().cpu_only_feature().unwrap();
-    let dir = tempfile::tempdir().unwrap();
-    let options = RunOptions { output_dir: dir.path().to_path_buf(), device: Some(DevicePreference::Gpu), ..Default::default() };
-    let refusal = Simulation::execute(plan, options).err().map(|e| e.to_string()).unwrap_or_default();
-    assert!(refusal.contains(why) && why.contains("expression parameters"), "{refusal}");
+    let sim = Simulation::before_first_run(&plan, RunOptions::default()).unwrap();
+    assert_eq!(sim.cpu_only_feature(), None);
+    assert!(sim.model.externals.iter().all(|e| !e.expressions.is_empty()), "every external has an expression parameter");
+    let (force_error, energy_error) = gpu_vs_cpu(&sim.model, &initial_state(&plan), &plan.sim_box, 0.3);
+    println!("expression externals at t = 0: force error {force_error:e}, energy error {energy_error:e}");
+    assert!(force_error < 1e-5 && energy_error < 1e-5, "force error {force_error:e}, energy error {energy_error:e}");
+
+    let path = case.path("deck.in");
+    let (start, gpu) = run_deck_deterministic(&path, DevicePreference::Gpu, 2000, false).unwrap();
+    let (_, cpu) = run_deck_deterministic(&path, DevicePreference::Cpu, 2000, false).unwrap();
+    assert!((gpu.time - 2.0).abs() < 1e-9 && gpu.time == cpu.time, "t = {} on the GPU, {} on the CPU", gpu.time, cpu.time);
+    let travelled = (0..start.len()).map(|i| (cpu.positions[i] - start.positions[i]).length()).fold(0.0, f64::max);
+    let deviation = (0..start.len()).map(|i| (cpu.positions[i] - gpu.positions[i]).length()).fold(0.0, f64::max);
+    println!("expression externals: GPU − CPU {deviation:.3e} after travelling up to {travelled:.3e}");
+    assert!(travelled > 1.0, "the traps did not move the particles ({travelled:e})");
+    assert!(deviation <= 1e-5 * travelled, "GPU − CPU {deviation:e} > 1e-5 × {travelled:e}");
 }
 
 /// `custom` bonds, angles, pairs and an external run on the GPU from WGSL
@@ -211,6 +304,20 @@ const SURFACE_GPU_EPSILON: f64 = 5e-5;
 /// (θ·∂ℓ) and through ∂E/∂M_i: 1e-3.
 const HELFRICH_GPU_EPSILON: f64 = 1e-3;
 
+/// The GPU tolerance of the volume-element laws (their golden files,
+/// written by reference/openmm_solids.py, declare none), relative to the
+/// largest force (and energy), from f32 arithmetic with u = 2⁻²⁴ ≈ 6e-8:
+/// the edge matrix D_s is rounded once and D_m⁻¹ once (its condition number
+/// is ≤ 10 on the golden meshes), so F = D_s·D_m⁻¹ carries ≈ 3·10·u ≈ 2e-6;
+/// J, F⁻ᵀ (cross products) and P take a few more roundings each, and
+/// μ(F − F⁻ᵀ) loses the digits of its cancellation, ≈ 1/strain ≤ 10 on the
+/// golden cases (strains ≥ 0.1) → ≈ 2e-5 on an element's force; a node sums
+/// its elements (≤ 24), whose forces exceed their sum by a factor of a few
+/// on the golden meshes, but the errors are independent and add in
+/// quadrature; with margin: 1e-4. The energy, V_0·W summed in f32 over the
+/// elements, is well within that.
+const TETRA_GPU_EPSILON: f64 = 1e-4;
+
 /// The GPU tolerance of a deck with surface terms.
 fn surface_gpu_epsilon(plan: &Plan) -> f64 {
     if plan.model.body_rules.iter().any(|t| t.interaction.name() == "helfrich_bending") {
@@ -223,7 +330,8 @@ fn surface_gpu_epsilon(plan: &Plan) -> f64 {
 /// Every interaction type's golden cases (LAMMPS-checked configurations):
 /// GPU forces and energies against the CPU f64 backend within the
 /// `gpu_epsilon` declared in its reference file ([`SURFACE_GPU_EPSILON`]
-/// and [`HELFRICH_GPU_EPSILON`] for the surface laws).
+/// and [`HELFRICH_GPU_EPSILON`] for the surface laws,
+/// [`TETRA_GPU_EPSILON`] for the volume elements).
 #[test]
 fn gpu_matches_cpu_on_every_golden_case() {
     let context = context();
@@ -239,24 +347,21 @@ fn gpu_matches_cpu_on_every_golden_case() {
             assert!(doc.get("gpu_epsilon").is_none(), "{}: a kinetics case declares a gpu_epsilon", path.display());
             continue;
         }
-        if !plan.model.tetras.is_empty() {
-            // Volume elements: the GPU backend has no kernel and refuses them.
-            assert!(doc.get("gpu_epsilon").is_none(), "{}: a volume-element case declares a gpu_epsilon", path.display());
-            let state = initial_state(&plan);
-            let refusal =
-                GpuBackend::new(&context, &plan.model, &state, &plan.sim_box, &settings(0.3, 1e-3, 0.0)).err().unwrap_or_default();
-            assert!(refusal.contains("no kernels for volume elements"), "{}: {refusal}", deck.display());
-            continue;
-        }
-        let epsilon = if plan.model.has_surface_terms() {
+        let epsilon = if !plan.model.tetras.is_empty() {
+            assert!(doc.get("gpu_epsilon").is_none(), "{}: declares a gpu_epsilon besides the volume-element tolerance", path.display());
+            TETRA_GPU_EPSILON
+        } else if plan.model.has_surface_terms() {
             assert!(doc.get("gpu_epsilon").is_none(), "{}: declares a gpu_epsilon besides the surface tolerances", path.display());
             surface_gpu_epsilon(&plan)
         } else {
             assert!(doc.get("gpu_epsilon_reason").is_some_and(|r| !r.is_empty()), "{}: no gpu_epsilon_reason", path.display());
             doc.get("gpu_epsilon").unwrap_or_else(|| panic!("{}: no gpu_epsilon", path.display())).parse().unwrap()
         };
-        let model = Simulation::before_first_run(&plan, RunOptions::default()).unwrap().model;
-        let state = initial_state(&plan);
+        let sim = Simulation::before_first_run(&plan, RunOptions::default()).unwrap();
+        // The volume-element decks deform their rest-shape topology with
+        // `displace_atoms` (at rest, both backends' forces are round-off).
+        let state = if plan.model.tetras.is_empty() { initial_state(&plan) } else { sim.state.clone() };
+        let model = sim.model;
         let mut cpu = CpuBackend::new(&model, &state, &plan.sim_box, 0.3).unwrap();
         let mut forces = Forces::default();
         cpu.compute(&model, &state, &plan.sim_box, &mut forces);
@@ -271,7 +376,7 @@ fn gpu_matches_cpu_on_every_golden_case() {
         );
         compared += 1;
     }
-    assert!(compared >= 40, "only {compared} golden cases compared: expected two for each of 20 interaction types");
+    assert!(compared >= 44, "only {compared} golden cases compared: expected two for each of 22 interaction types");
 }
 
 #[test]
@@ -426,6 +531,45 @@ fn the_same_surface_run_twice_gives_the_same_bits() {
         .all(|(x, y)| x.0.to_array().map(f64::to_bits) == y.0.to_array().map(f64::to_bits) && x.1.to_bits() == y.1.to_bits()));
 }
 
+/// An elastic ball (`cellmd build ball`, 125 nodes, 384 linear tetrahedra)
+/// squeezed between two walls for 2000 explicit steps, once per volume law:
+/// the GPU's positions stay within [`TETRA_GPU_EPSILON`] of the distance
+/// the nodes travelled (each step's displacement carries the force's
+/// relative error; the relaxation contracts, so the errors add up to at
+/// most epsilon × the path). The same GPU run twice gives the same bits.
+#[test]
+fn a_squeezed_ball_runs_on_the_gpu_like_on_the_cpu() {
+    let args = cellmd::build::BallArgs {
+        radius: 5.0,
+        cells: 4,
+        centre: vec![0.0, 0.0, 0.0],
+        particle_type: "node".into(),
+        octant: false,
+        tetra_type: "solid".into(),
+        output: "ball.top".into(),
+    };
+    let top = cellmd::build::ball(&args).unwrap().text;
+    let deck = "units cell\ntopology ball.top\nforcefield ball.ff\nbox x -8 8 f y -8 8 f z -8 8 f\n\
+                external bottom all wall nz 1 d -4.6 k 1000\nexternal top all wall nz -1 d -4.6 k 1000\n\
+                integrator overdamped\ntimestep 1e-4\nthermo 0 step pe\nrun 2000\n";
+    for law in ["neo_hookean", "linear_elastic"] {
+        let ff = format!("particle node drag 1\ntetra solid {law} e 1000 nu 0.3\n");
+        let case = common::Case::new(&[("ball.top", &top), ("ball.ff", &ff), ("deck.in", deck)]);
+        let path = case.path("deck.in");
+        let (start, gpu) = run_deck_deterministic(&path, DevicePreference::Gpu, 2000, false).unwrap();
+        let (_, again) = run_deck_deterministic(&path, DevicePreference::Gpu, 2000, false).unwrap();
+        let (_, cpu) = run_deck_deterministic(&path, DevicePreference::Cpu, 2000, false).unwrap();
+        assert_eq!(start.len(), 125);
+        let travelled = (0..start.len()).map(|i| (cpu.positions[i] - start.positions[i]).length()).fold(0.0, f64::max);
+        let deviation = (0..start.len()).map(|i| (cpu.positions[i] - gpu.positions[i]).length()).fold(0.0, f64::max);
+        println!("ball, {law}: GPU − CPU {deviation:.3e} after travelling up to {travelled:.3e}");
+        assert!(travelled > 0.1, "{law}: the walls did not squeeze the ball ({travelled:e})");
+        assert!(deviation <= TETRA_GPU_EPSILON * travelled, "{law}: GPU − CPU {deviation:e} > {TETRA_GPU_EPSILON:e} × {travelled:e}");
+        let bits = |s: &State| s.positions.iter().flat_map(|x| x.to_array().map(f64::to_bits)).collect::<Vec<_>>();
+        assert_eq!(bits(&gpu), bits(&again), "{law}: two GPU runs differ");
+    }
+}
+
 /// A custom body term has no GPU kernel: the GPU backend and `device gpu`
 /// refuse it with the reason.
 #[test]
@@ -530,6 +674,7 @@ fn every_input_deck_runs_on_the_gpu_like_on_the_cpu() {
             let options = RunOptions { output_dir: dir.path().to_path_buf(), device: Some(DevicePreference::Gpu), ..Default::default() };
             let refusal = Simulation::execute(plan.clone(), options).err().map(|e| e.to_string()).unwrap_or_default();
             assert!(refusal.contains(why), "{}: expected the GPU to refuse with {why:?}, got {refusal:?}", deck.display());
+            println!("{:40} refused: {why}", deck.display());
             refused += 1;
             continue;
         }
@@ -560,6 +705,7 @@ fn every_input_deck_runs_on_the_gpu_like_on_the_cpu() {
             // A CPU-only feature that starts after the first run (a `ramp`
             // between runs): the GPU must refuse that run with its reason.
             Err(e) if e.starts_with("device gpu: ") && e.ends_with("run on the CPU backend only; use `device cpu` or `device auto`") => {
+                println!("{:40} refused at a later run: {e}", deck.display());
                 refused += 1
             }
             Err(e) => panic!("{}: {e}", deck.display()),

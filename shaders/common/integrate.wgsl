@@ -12,6 +12,13 @@ fn current_step() -> vec2<u32> {
     return vec2<u32>(lo, P.step_hi + select(0u, 1u, lo < P.step_lo));
 }
 
+// The simulated time at the start of the current step, as the CPU's clock:
+// the call's start time (two f32 words, host-computed in f64) plus the steps
+// done in this call times dt (externals with expression parameters read it).
+fn sim_time() -> f32 {
+    return P.time_hi + (P.time_lo + f32(atomicLoad(&status[ST_STEPS_DONE])) * P.dt);
+}
+
 // Particle i's drift dt·F/γ.
 fn drift(i: u32) -> vec3<f32> {
     return force[i].xyz * fparams[P.off_mobility + topo[i]];

@@ -45,6 +45,13 @@ struct Params {
     n_body_types: u32, contact_dhat: f32, contact_edge2: f32, off_fractions: u32,
     // bond kinetics on the device (shaders/common/kinetics.wgsl): kinetic bonds, their first term, event capacity, bond types
     kin_bonds: u32, kin_first_term: u32, kin_capacity: u32, kin_types: u32,
+    // volume elements (src/gpu/tetra.rs): `topo` and `fparams` sections, their first `surf` slot, their number
+    off_tetras: u32, off_tetra_rest: u32, off_tetra_slot_offsets: u32, off_tetra_slots: u32,
+    tetra_surf_base: u32, n_tetras: u32, tetra_pad0: u32, tetra_pad1: u32,
+    // simulated time at this call's first step (f32 high part + remainder), dt (for `sim_time`)
+    time_hi: f32, time_lo: f32, dt: f32, clock_pad: f32,
+    // fractional `special_bonds` partners (src/gpu/special.rs): `topo` offsets (CSR by particle), entries
+    off_special_offsets: u32, off_special: u32, special_pad0: u32, special_pad1: u32,
 }
 
 @group(0) @binding(0) var<uniform> P: Params;

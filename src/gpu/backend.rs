@@ -115,6 +115,8 @@ struct Kernels {
     advance: wgpu::ComputePipeline,
     /// Node–face contact and the step clamp (src/gpu/contact.rs).
     contact_forces: wgpu::ComputePipeline,
+    /// Volume elements' corner forces (src/gpu/tetra.rs).
+    tetra_forces: wgpu::ComputePipeline,
 }
 
 /// The GPU force engine and integrator for one model.
@@ -160,6 +162,8 @@ pub struct GpuBackend {
     kinetics: Option<(KinLayout, KinKernels)>,
     /// Read-backs so far (each waits for the GPU): tests count the synchronisations.
     reads: std::cell::Cell<u64>,
+    /// Simulated time at the next step (see [`GpuBackend::set_time`]).
+    time: f64,
 }
 
 /// Refuses a storage buffer the adapter cannot bind (wgpu would abort).
@@ -230,9 +234,6 @@ impl GpuBackend {
                 "the GPU backend has no kernels for custom surface terms of bodies (`custom` body lines) yet; use `device cpu`".into()
             );
         }
-        if !model.tetras.is_empty() {
-            return Err("the GPU backend has no kernels for volume elements (`[ tetrahedra ]`) yet; use `device cpu`".into());
-        }
         if model.contact_rules.iter().any(|r| !r.interaction.law().runs_on_gpu()) {
             return Err(
                 "the GPU backend has no kernels for area-weighted contact terms between bodies (`contact_adhesion`) yet; use `device cpu`"
@@ -296,6 +297,9 @@ impl GpuBackend {
             kin_first_term: kin_words.as_ref().map_or(0, |(_, l)| l.first_term),
             kin_capacity: kin_words.as_ref().map_or(0, |(_, l)| l.capacity),
             kin_types: model.bond_types.len() as u32,
+            tetra_offsets: packed.tetra_offsets,
+            clock: [0.0, 0.0, settings.context.dt as f32, 0.0],
+            special_offsets: packed.special_offsets,
         };
         let device = &ctx.device;
         let init = |label: &str, contents: &[u8], usage: wgpu::BufferUsages| {
@@ -408,6 +412,7 @@ impl GpuBackend {
             commit: pipeline("commit", &main_layout),
             advance: pipeline("advance", &main_layout),
             contact_forces: pipeline("contact_forces", &main_layout),
+            tetra_forces: pipeline("tetra_forces", &main_layout),
         };
         let kinetics = kin_words.map(|(_, layout)| (layout, KinKernels::new(|entry| pipeline(entry, &main_layout))));
         let main_group = bind_main(
@@ -450,7 +455,9 @@ impl GpuBackend {
             kin,
             kinetics,
             reads: Default::default(),
+            time: settings.context.time,
         };
+        backend.set_clock(settings.context.time);
         backend.upload(state);
         Ok(backend)
     }
@@ -561,6 +568,8 @@ impl GpuBackend {
         self.params.fparam_offsets = packed.fparam_offsets;
         self.params.surface_offsets = packed.surface_offsets;
         self.params.contact = contact_fields;
+        self.params.tetra_offsets = packed.tetra_offsets;
+        self.params.special_offsets = packed.special_offsets;
         self.pending_rebuild |= rebuild;
         Ok(())
     }
@@ -658,6 +667,20 @@ impl GpuBackend {
         let out = slice.get_mapped_range().expect("mapped readback").to_vec();
         staging.unmap();
         out
+    }
+
+    /// Sets the simulated time of the next step (`t` of externals with
+    /// expression parameters); `run` advances it by dt per step taken.
+    pub fn set_time(&mut self, time: f64) {
+        self.time = time;
+        self.set_clock(time);
+    }
+
+    /// Writes `time` into the parameters as an f32 high part and remainder.
+    fn set_clock(&mut self, time: f64) {
+        let high = time as f32;
+        self.params.clock[0] = high;
+        self.params.clock[1] = (time - high as f64) as f32;
     }
 
     fn write_params(&self) {
@@ -807,7 +830,8 @@ impl GpuBackend {
     }
 
     /// The surface kernels in order (none without surface terms; the
-    /// curvature passes only with a curvature law), see [`super::surface`].
+    /// curvature passes only with a curvature law), see [`super::surface`],
+    /// then the volume elements' kernel (none without elements).
     fn surface_passes(&self) -> Vec<(&wgpu::ComputePipeline, Over)> {
         let k = &self.kernels;
         let [faces, bodies, edges, nodes] = [12, 13, 14, 15].map(|c| self.params.surface_offsets[c]);
@@ -819,6 +843,10 @@ impl GpuBackend {
                 passes.extend([(&k.surface_edges, over(edges)), (&k.surface_nodes, over(nodes)), (&k.surface_edge_forces, over(edges))]);
             }
             passes.push((&k.surface_forces, over(faces)));
+        }
+        // Then the volume elements' pass (src/gpu/tetra.rs).
+        if self.params.tetra_offsets[5] > 0 {
+            passes.push((&k.tetra_forces, over(self.params.tetra_offsets[5])));
         }
         passes
     }
@@ -864,6 +892,7 @@ impl GpuBackend {
         loop {
             self.pending_rebuild = false;
             self.reset_status(true);
+            self.set_clock(self.time);
             self.write_params();
             let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
             {
@@ -896,6 +925,7 @@ impl GpuBackend {
             self.params.step_lo = step as u32;
             self.params.step_hi = (step >> 32) as u32;
             self.params.steps_wanted = chunk as u32;
+            self.set_clock(self.time + done as f64 * self.settings.context.dt);
             self.write_params();
             self.reset_status(force_rebuild);
             let mut encoded = 0;
@@ -936,6 +966,7 @@ impl GpuBackend {
             force_rebuild =
                 self.grow_if_overflowed(&status).map_err(|message| GpuHalt::Capacity { step: first_step + done, message })? || requested;
         }
+        self.time += done as f64 * self.settings.context.dt;
         Ok(done)
     }
 }

@@ -8,8 +8,13 @@
 //! ([`gpu_kinds`]). The composed program (`shader::compose_with`)
 //! holds them beside the registered evaluators; naga validates it.
 //!
-//! An external that reads `t` has an expression parameter (its time slot),
-//! which the CPU-only check of externals already keeps off the GPU.
+//! An external with expression parameters (`field fx "-k*x"`, a wall
+//! whose `d` is a formula of `t`; a custom external that reads `t` has one
+//! too, its time slot) gets its own dispatch index past the custom terms'
+//! and a function `external_m_one` that evaluates each expression at the
+//! particle's unwrapped position `x` and the step's time `t` (`sim_time()`,
+//! shaders/common/integrate.wgsl), puts the values in the parameter slots
+//! and calls the law's evaluator, as `External::at` does on the CPU.
 
 use std::fmt::Write;
 
@@ -30,9 +35,25 @@ fn terms(model: &Model) -> impl Iterator<Item = &TermType> {
     bonds.map(Typed::term).chain(angles.map(Typed::term)).chain(pairs.map(Typed::term)).chain(model.externals.iter().map(|e| e.term.term()))
 }
 
-/// The dispatch index of every packed term: its registry index, or for the
-/// k-th custom term `REGISTRY.len() + k`.
+/// The dispatch index of every packed term: its registry index, for the
+/// k-th custom term `REGISTRY.len() + k`, and for the m-th external with
+/// expression parameters `REGISTRY.len() + customs + m`.
 pub fn gpu_kinds(model: &Model) -> Vec<u32> {
+    let mut kinds = law_kinds(model);
+    let mut next = (REGISTRY.len() + terms(model).filter(|t| is_custom(t)).count()) as u32;
+    let first_external = kinds.len() - model.externals.len();
+    for (kind, external) in kinds[first_external..].iter_mut().zip(&model.externals) {
+        if !external.expressions.is_empty() {
+            *kind = next;
+            next += 1;
+        }
+    }
+    kinds
+}
+
+/// The dispatch index of every packed term's law: its registry index, or
+/// for the k-th custom term `REGISTRY.len() + k`.
+fn law_kinds(model: &Model) -> Vec<u32> {
     let mut custom = 0;
     terms(model)
         .map(|t| {
@@ -121,6 +142,32 @@ pub fn source(model: &Model) -> Result<CustomSource, String> {
             }
             Kind::Body | Kind::Contact | Kind::Tetra => unreachable!("surface, contact and volume terms are not packed"),
         }
+    }
+    let laws = law_kinds(model);
+    let (kinds, first_external) = (gpu_kinds(model), laws.len() - model.externals.len());
+    for (e, external) in model.externals.iter().enumerate().filter(|(_, e)| !e.expressions.is_empty()) {
+        let (law, index) = (laws[first_external + e] as usize, kinds[first_external + e]);
+        let call = match REGISTRY.get(law) {
+            Some(interaction) => format!("{}_one(q, x)", interaction.name()),
+            None => format!("custom_{}_one(q, x)", law - REGISTRY.len()),
+        };
+        let name = |n: &str| match n {
+            "x" | "y" | "z" => Some(format!("x.{n}")),
+            "t" => Some("t".to_string()),
+            _ => None,
+        };
+        let label = &external.term.term().label.text;
+        let mut body = String::new();
+        for (k, expr) in &external.expressions {
+            let code = wgsl(expr, &name).map_err(|e| format!("the external `{label}` on the GPU: {}", e.message))?;
+            writeln!(body, "    q[{k}] = {code};").unwrap();
+        }
+        writeln!(
+            out.functions,
+            "fn external_{index}_one(p: array<f32, 8>, x: vec3<f32>) -> OneBody {{\n    let t = sim_time();\n    var q = p;\n{body}    return {call};\n}}"
+        )
+        .unwrap();
+        writeln!(out.one_cases, "        case {index}u: {{ return external_{index}_one(p, x); }}").unwrap();
     }
     Ok(out)
 }

@@ -14,15 +14,19 @@
 //!   the explicit step clamp as a device reduction.
 //! - [`kinetics`]: bond breaking and rebinding decided on the device, events
 //!   compacted in bond order and drained by the host at synchronisations.
+//! - [`special`]: pairs of bonded neighbours with a fractional
+//!   `special_bonds` weight, each particle's own list.
+//! - [`tetra`]: volume elements (`[ tetrahedra ]`): one pass per element
+//!   into corner slots, gathered per particle.
 //!
-//! Two file-level circles, on purpose: `pack.rs` ↔ `surface.rs`. `pack.rs`
-//! lays out the whole topology, the surface sections included, and
-//! `surface.rs` builds those sections' CSR lists with pack's `push_csr`, the
-//! one CSR builder of the GPU buffers. And `backend.rs` ↔ `kinetics.rs`:
-//! the backend owns the device kinetics' buffer and dispatches its kernels
-//! in each step, and `kinetics.rs` lays that buffer out and adds to
-//! `GpuBackend` the methods that read its events and bond state back, so
-//! the buffer's layout has one home.
+//! File-level circles, on purpose: `pack.rs` ↔ `surface.rs`, `tetra.rs`
+//! and `special.rs`. `pack.rs` lays out the whole topology, their sections
+//! included, and they build those sections' CSR lists with pack's
+//! `push_csr`, the one CSR builder of the GPU buffers. And `backend.rs` ↔
+//! `kinetics.rs`: the backend owns the device kinetics' buffer and
+//! dispatches its kernels in each step, and `kinetics.rs` lays that buffer
+//! out and adds to `GpuBackend` the methods that read its events and bond
+//! state back, so the buffer's layout has one home.
 //!
 //! What runs where: each step — neighbour-list check and (when due) rebuild,
 //! forces, overdamped integration — runs on the GPU without reading anything
@@ -59,7 +63,9 @@ pub mod kinetics;
 mod nlist;
 pub mod pack;
 pub mod shader;
+mod special;
 pub mod surface;
+pub mod tetra;
 
 pub use backend::{GpuBackend, GpuHalt};
 pub use context::{DevicePreference, GpuContext};

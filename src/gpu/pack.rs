@@ -12,8 +12,14 @@
 //!   (faces, bodies' faces and terms, each particle's slots, edges and body
 //!   nodes), at `surface_offsets`.
 //!
+//! - `topo` also holds each particle's partners of fractional
+//!   `special_bonds` weight ([`super::special`]), at `special_offsets`.
+//! - `topo` and `fparams` also hold the volume elements' sections of
+//!   [`super::tetra::TetraPack`] (elements, each particle's corner slots;
+//!   rest shapes), at `tetra_offsets`.
+//!
 //! Terms are numbered bond types, then angle types, then pair rules, then
-//! externals, then surface (body) terms, then — with bond state — one term per bound bond of a type
+//! externals, then surface (body) terms, then volume-element (`tetra`) types, then — with bond state — one term per bound bond of a type
 //! with kinetic rules or with a rest length of its own (the topology's
 //! per-bond r0), holding that bond's own rest length. Each term also has
 //! a force scale (`fparams`, at `topo_offsets[11]`): a kinetic bond's
@@ -76,6 +82,13 @@ pub struct Params {
     pub kin_first_term: u32,
     pub kin_capacity: u32,
     pub kin_types: u32,
+    /// Volume elements (tetra.wgsl): `topo` elements, `fparams` rest shapes,
+    /// `topo` slot CSR (offsets, slots), first `surf` slot, count, 2 × padding.
+    pub tetra_offsets: [u32; 8],
+    /// Simulated time at the call's first step (f32 high part, remainder), dt, padding.
+    pub clock: [f32; 4],
+    /// Fractional `special_bonds` partners (special.wgsl): `topo` offsets, entries, 2 × padding.
+    pub special_offsets: [u32; 4],
 }
 
 /// The GPU's 64-bit fixed point (layout.wgsl): a length x is the integer
@@ -111,6 +124,8 @@ pub struct Packed {
     pub topo_offsets: [u32; 12],
     pub fparam_offsets: [u32; 4],
     pub surface_offsets: [u32; 16],
+    pub tetra_offsets: [u32; 8],
+    pub special_offsets: [u32; 4],
     /// Entries of the `surf` buffer.
     pub surf_entries: u64,
     /// The user id of each packed body (in packing order).
@@ -143,11 +158,13 @@ pub fn pack(model: &Model, exclusions: &Exclusions, dt: f64, kt: f64, bonds: Opt
         .chain(model.pair_rules.iter().map(Typed::term))
         .chain(model.externals.iter().map(|e| e.term.term()))
         .chain(model.body_rules.iter().map(Typed::term))
+        .chain(model.tetra_types.iter().map(Typed::term))
         .collect();
     let angle_base = model.bond_types.len();
     let pair_base = angle_base + model.angle_types.len();
     let external_base = pair_base + model.pair_rules.len();
     let body_base = external_base + model.externals.len();
+    let tetra_base = body_base + model.body_rules.len();
     // Bonds with their own parameters (bound, and of a type with kinetic
     // rules or with a rest length of their own): (bond, own term).
     let kinetic: Vec<usize> = match bonds {
@@ -207,6 +224,7 @@ pub fn pack(model: &Model, exclusions: &Exclusions, dt: f64, kt: f64, bonds: Opt
     offsets[0] = topo.len() as u32;
     let mut kinds = super::custom::gpu_kinds(model);
     kinds.extend(model.body_rules.iter().map(|t| crate::system::registry_index(t) as u32));
+    kinds.extend(model.tetra_types.iter().map(|t| crate::system::registry_index(t) as u32));
     topo.extend(&kinds);
     topo.extend(kinetic.iter().map(|&b| kinds[model.bond_type[b] as usize]));
     // Pair rules per type pair.
@@ -262,6 +280,22 @@ pub fn pack(model: &Model, exclusions: &Exclusions, dt: f64, kt: f64, bonds: Opt
         topo.extend(section);
     }
     surface_offsets[12..].copy_from_slice(&surfaces.counts());
+    let tetras = super::tetra::pack_tetras(model, tetra_base, surfaces.surf_entries());
+    let mut tetra_offsets = [0u32; 8];
+    tetra_offsets[0] = topo.len() as u32;
+    topo.extend(&tetras.elements);
+    tetra_offsets[1] = fparams.len() as u32;
+    fparams.extend(&tetras.rest);
+    tetra_offsets[2] = topo.len() as u32;
+    topo.extend(&tetras.slot_offsets);
+    tetra_offsets[3] = topo.len() as u32;
+    topo.extend(&tetras.slots);
+    tetra_offsets[4] = surfaces.surf_entries() as u32;
+    tetra_offsets[5] = tetras.elements();
+    let (special_rows, special) = super::special::pack_special(model, bonds.map(|b| b.bound.as_slice()));
+    let special_offsets = [topo.len() as u32, (topo.len() + special_rows.len()) as u32, 0, 0];
+    topo.extend(&special_rows);
+    topo.extend(&special);
     if topo.len() > u32::MAX as usize / 2 {
         return Err(format!("the model needs {} words of GPU topology, more than the u32 index range", topo.len()));
     }
@@ -271,7 +305,9 @@ pub fn pack(model: &Model, exclusions: &Exclusions, dt: f64, kt: f64, bonds: Opt
         topo_offsets: offsets,
         fparam_offsets: [0, skip2_offset as u32, mobility_offset as u32, amplitude_offset as u32],
         surface_offsets,
-        surf_entries: surfaces.surf_entries(),
+        tetra_offsets,
+        special_offsets,
+        surf_entries: surfaces.surf_entries() + tetras.surf_entries(),
         body_ids: surfaces.body_ids,
         own_bonds: kinetic.iter().map(|&b| b as u32).collect(),
         first_own_term: terms.len() as u32,

@@ -8,7 +8,9 @@
 //! (neighbour list, forces, integrator). One module holds every entry point.
 //! Surface laws define `NAME_face` or `NAME_node` by their [`SurfaceGpu`]
 //! form, dispatched by `surface_law` and `node_law` from the surface
-//! kernels (src/gpu/surface.rs).
+//! kernels (src/gpu/surface.rs). Volume-element laws define `NAME_tetra`
+//! (W and P at F), dispatched by `tetra_law` from the element kernel
+//! (src/gpu/tetra.rs).
 //!
 //! Node–face contact laws ([`Law::Contact`]) define `NAME_contact(p, d)`,
 //! b(d) as a `Radial` of the node–face distance, dispatched by
@@ -42,7 +44,8 @@ mod embedded {
 pub use embedded::{COMMON_SHADERS, INTERACTION_SHADERS};
 
 /// The common files in the order they must appear (declarations first).
-const COMMON_ORDER: [&str; 8] = ["layout", "philox", "neighbor", "forces", "surface", "integrate", "contact", "kinetics"];
+const COMMON_ORDER: [&str; 10] =
+    ["layout", "philox", "neighbor", "forces", "surface", "integrate", "contact", "kinetics", "tetra", "special"];
 
 fn common(name: &str) -> &'static str {
     COMMON_SHADERS.iter().find(|(stem, _)| *stem == name).map(|(_, src)| *src).unwrap_or_else(|| panic!("shaders/common/{name}.wgsl"))
@@ -66,6 +69,9 @@ fn dispatch(custom: &CustomSource) -> String {
     let mut node = String::from("fn node_law(kind: u32, p: array<f32, 8>, m: f32, a: f32) -> NodeCurvature {\n    switch kind {\n");
     // Node–face contact laws (src/gpu/contact.rs): b(d) as a Radial of the distance.
     let mut contact = String::from("fn contact_law(kind: u32, p: array<f32, 8>, d: f32) -> Radial {\n    switch kind {\n");
+    let mut tetra = String::from(
+        "fn tetra_law(kind: u32, p: array<f32, 8>, f: mat3x3<f32>, j: f32, f_inv_t: mat3x3<f32>) -> TetraDensity {\n    switch kind {\n",
+    );
     for (index, interaction) in REGISTRY.iter().enumerate() {
         let name = interaction.name();
         let (out, call) = match interaction.law() {
@@ -75,7 +81,8 @@ fn dispatch(custom: &CustomSource) -> String {
             Law::Surface { gpu: SurfaceGpu::PerFace, .. } => (&mut surface, format!("{name}_face(p, body, g)")),
             Law::Surface { gpu: SurfaceGpu::NodeCurvature, .. } => (&mut node, format!("{name}_node(p, m, a)")),
             Law::Contact { .. } => (&mut contact, format!("{name}_contact(p, d)")),
-            Law::Surface { .. } | Law::ContactArea { .. } | Law::Tetra(_) => continue,
+            Law::Tetra(_) => (&mut tetra, format!("{name}_tetra(p, f, j, f_inv_t)")),
+            Law::Surface { .. } | Law::ContactArea { .. } => continue,
         };
         writeln!(out, "        case {index}u: {{ return {call}; }}").unwrap();
     }
@@ -88,7 +95,8 @@ fn dispatch(custom: &CustomSource) -> String {
     surface.push_str("        default: { return SurfaceFace(0.0, vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0)); }\n    }\n}\n");
     node.push_str("        default: { return NodeCurvature(0.0, 0.0, 0.0); }\n    }\n}\n");
     contact.push_str("        default: { return RADIAL_ZERO; }\n    }\n}\n");
-    radial + &three + &one + &surface + &node + &contact
+    tetra.push_str("        default: { return TetraDensity(0.0, mat3x3<f32>()); }\n    }\n}\n");
+    radial + &three + &one + &surface + &node + &contact + &tetra
 }
 
 /// The whole program for models without custom terms.
@@ -169,6 +177,11 @@ mod tests {
         }
         for name in form(SurfaceGpu::NodeCurvature) {
             assert!(compose().contains(&format!("return {name}_node(p, m, a);")), "{name} has no `node_law` case");
+        }
+        let tetra: Vec<&str> = REGISTRY.iter().filter(|i| matches!(i.law(), Law::Tetra(_))).map(|i| i.name()).collect();
+        assert_eq!(tetra, ["neo_hookean", "linear_elastic"]);
+        for name in tetra {
+            assert!(compose().contains(&format!("return {name}_tetra(p, f, j, f_inv_t);")), "{name} has no `tetra_law` case");
         }
     }
 

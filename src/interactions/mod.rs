@@ -345,7 +345,8 @@ pub enum Law {
     /// the distance gradients. No GPU kernel yet.
     ContactArea { switch: fn(&[f64], f64) -> Radial, density: fn(&[f64]) -> f64, range: fn(&[f64]) -> f64 },
     /// E(x_0 … x_3) of one linear tetrahedron with rest shape `TetraRest`;
-    /// positions are image-consistent (around x_0). No GPU kernel yet.
+    /// positions are image-consistent (around x_0). On the GPU its
+    /// interaction's `NAME_tetra` evaluator gives W and P at F (src/gpu/tetra.rs).
     Tetra(fn(&[f64], &TetraRest, [DVec3; 4]) -> FourBody),
 }
 
@@ -465,7 +466,7 @@ impl Law {
     pub fn runs_on_gpu(&self) -> bool {
         match self {
             Law::Surface { gpu, .. } => *gpu != SurfaceGpu::None,
-            Law::ContactArea { .. } | Law::Tetra(_) => false,
+            Law::ContactArea { .. } => false,
             _ => true,
         }
     }

@@ -69,6 +69,7 @@ impl Stepper for GpuSteps {
         let kinetics = sim.model.has_kinetics() && !self.device_kinetics;
         let next_output = sim.next_output_step(last).min(sim.state.step + GPU_SYNC_STEPS).min(until);
         let steps = if kinetics { 1 } else { next_output - sim.state.step };
+        self.gpu.set_time(sim.state.time);
         let outcome = self.gpu.run(sim.state.step, steps);
         let done = match &outcome {
             Ok(done) => *done,
@@ -199,14 +200,8 @@ impl Simulation {
             Some("constrained bonds (`constrain`) run on the CPU backend only")
         } else if self.model.has_cpu_only_surface_terms() {
             Some("custom surface terms of bodies (`custom` body lines) run on the CPU backend only")
-        } else if !self.model.tetras.is_empty() {
-            Some("volume elements (`[ tetrahedra ]`, `tetra` lines) run on the CPU backend only")
         } else if self.model.contact_rules.iter().any(|r| !r.interaction.law().runs_on_gpu()) {
             Some("area-weighted contact terms between bodies (`contact_adhesion`) run on the CPU backend only")
-        } else if self.model.special_bonds.is_fractional() && !self.model.pair_rules.is_empty() {
-            Some("fractional `special_bonds` weights run on the CPU backend only")
-        } else if self.model.externals.iter().any(|e| !e.expressions.is_empty()) {
-            Some("externals with expression parameters (`field`, or a quoted formula of x, y, z, t) run on the CPU backend only")
         } else {
             None
         }
