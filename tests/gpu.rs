@@ -545,6 +545,9 @@ fn a_squeezed_ball_runs_on_the_gpu_like_on_the_cpu() {
         centre: vec![0.0, 0.0, 0.0],
         particle_type: "node".into(),
         octant: false,
+        spacing: None,
+        core_cells: 0,
+        surface_type: None,
         tetra_type: "solid".into(),
         output: "ball.top".into(),
     };
