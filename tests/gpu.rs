@@ -661,7 +661,9 @@ fn run_deck_deterministic(
 /// refuses with the message of `Simulation::cpu_only_feature`): at kT = 0, GPU positions stay within
 /// 1e-5 of the distance the particles travelled, after 10⁴ steps per `run`
 /// (measured on llvmpipe: ≤ 2.7e-6, about the spread between two CPU runs
-/// whose starts differ by f32 rounding).
+/// whose starts differ by f32 rounding); over 10³ or 10² steps where that
+/// spread itself exceeds the bound (a chaotic deck: cell_contact.in, whose
+/// CPU runs part by 7.9e-2 µm in 10⁴ clamped steps).
 #[test]
 fn every_input_deck_runs_on_the_gpu_like_on_the_cpu() {
     let mut decks: Vec<_> =
@@ -691,18 +693,31 @@ fn every_input_deck_runs_on_the_gpu_like_on_the_cpu() {
             continue;
         }
         match run_deck_deterministic(&deck, DevicePreference::Gpu, 10_000, false) {
-            Ok((_, gpu)) => {
-                let (start, cpu) = run_deck_deterministic(&deck, DevicePreference::Cpu, 10_000, false).unwrap();
-                let (_, cpu32) = run_deck_deterministic(&deck, DevicePreference::Cpu, 10_000, true).unwrap();
-                let sim_box = cellmd::deck::validate_file(&deck, &[("steps".into(), "10".into())]).unwrap().sim_box;
-                let unwrap = |s: &State, i: usize| sim_box.unwrap(s.positions[i], s.images[i]);
-                let travelled = (0..start.len()).map(|i| (unwrap(&cpu, i) - unwrap(&start, i)).length()).fold(0.0, f64::max);
-                let deviation = (0..start.len()).map(|i| (unwrap(&cpu, i) - unwrap(&gpu, i)).length()).fold(0.0, f64::max);
-                let sensitivity = (0..start.len()).map(|i| (unwrap(&cpu, i) - unwrap(&cpu32, i)).length()).fold(0.0, f64::max);
-                println!("{:40} {} particles: GPU − CPU {deviation:.3e} after travelling up to {travelled:.3e}; CPU from f32-rounded start − CPU {sensitivity:.3e}", deck.display(), start.len());
-                assert_eq!(cpu.step, gpu.step);
-                assert!(travelled > 0.0, "{}: nothing moved", deck.display());
-                assert!(deviation <= 1e-5 * travelled, "{}: GPU − CPU {deviation:e} > 1e-5 × {travelled:e}", deck.display());
+            Ok((_, mut gpu)) => {
+                // A deck whose CPU run itself moves more than the bound when its start is
+                // rounded to f32 is chaotic over that horizon (cell_contact.in: the
+                // contact step clamp makes every clamped step's length hinge on one
+                // pair); it is compared over a tenth of the steps, down to 100.
+                let mut steps = 10_000;
+                loop {
+                    let (start, cpu) = run_deck_deterministic(&deck, DevicePreference::Cpu, steps, false).unwrap();
+                    let (_, cpu32) = run_deck_deterministic(&deck, DevicePreference::Cpu, steps, true).unwrap();
+                    let sim_box = cellmd::deck::validate_file(&deck, &[("steps".into(), "10".into())]).unwrap().sim_box;
+                    let unwrap = |s: &State, i: usize| sim_box.unwrap(s.positions[i], s.images[i]);
+                    let travelled = (0..start.len()).map(|i| (unwrap(&cpu, i) - unwrap(&start, i)).length()).fold(0.0, f64::max);
+                    let deviation = (0..start.len()).map(|i| (unwrap(&cpu, i) - unwrap(&gpu, i)).length()).fold(0.0, f64::max);
+                    let sensitivity = (0..start.len()).map(|i| (unwrap(&cpu, i) - unwrap(&cpu32, i)).length()).fold(0.0, f64::max);
+                    println!("{:40} {} particles, {steps} steps: GPU − CPU {deviation:.3e} after travelling up to {travelled:.3e}; CPU from f32-rounded start − CPU {sensitivity:.3e}", deck.display(), start.len());
+                    if sensitivity > 1e-5 * travelled && steps > 100 {
+                        steps /= 10;
+                        gpu = run_deck_deterministic(&deck, DevicePreference::Gpu, steps, false).unwrap().1;
+                        continue;
+                    }
+                    assert_eq!(cpu.step, gpu.step);
+                    assert!(travelled > 0.0, "{}: nothing moved", deck.display());
+                    assert!(deviation <= 1e-5 * travelled, "{}: GPU − CPU {deviation:e} > 1e-5 × {travelled:e}", deck.display());
+                    break;
+                }
                 compared += 1;
             }
             // A CPU-only feature that starts after the first run (a `ramp`

@@ -175,6 +175,16 @@ fn contact_forces(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocatio
         if role == 0u && face_outgrew_search(face) {
             atomicOr(&status[ST_HALTED], HALT_REACH);
         }
+        // The face's bounding sphere (centre c, radius r, relative to this
+        // corner): a node within d̂ of the face is within d̂ + r of c. The
+        // test only skips pairs farther than d̂ (zero force, above the clamp's
+        // cap), with a margin of 1e-3 for f32 rounding.
+        let xa = separation(i, contact_face(face, 0u));
+        let xb = separation(i, contact_face(face, 1u));
+        let xc = separation(i, contact_face(face, 2u));
+        let centre = (xa + xb + xc) / 3.0;
+        let radius2 = max(max(dot(xa - centre, xa - centre), dot(xb - centre, xb - centre)), dot(xc - centre, xc - centre));
+        let reach = 1.001 * (P.contact_dhat + sqrt(radius2));
         for (var k = 0u; k < count; k++) {
             let node = nlist[row + 1u + k] & ~CONTACT_ONLY;
             let other = contact_body(node);
@@ -183,6 +193,10 @@ fn contact_forces(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocatio
             }
             let types = contact_types(other, body);
             if topo[P.off_cany + types] == 0u {
+                continue;
+            }
+            let off_centre = separation(i, node) - centre;
+            if dot(off_centre, off_centre) >= reach * reach {
                 continue;
             }
             let pair = contact_pair(node, face);
