@@ -865,10 +865,16 @@ impl GpuBackend {
         self.contact.faces() > 0
     }
 
-    /// The fraction of dt each step of the last [`Self::run`] took (below 1
-    /// where the contact step clamp shortened it; empty without contact).
-    pub fn step_fractions(&self) -> &[f32] {
-        &self.fractions
+    /// The fraction of dt step `k` of the last [`Self::run`] took (below 1
+    /// where the contact step clamp shortened it; 1 without contact).
+    pub fn step_fraction(&self, k: u64) -> f64 {
+        self.fractions.get(k as usize).map_or(1.0, |&s| f64::from(s))
+    }
+
+    /// The simulated time the first `steps` steps of the last [`Self::run`]
+    /// took: each step its own fraction of dt.
+    fn elapsed(&self, steps: u64) -> f64 {
+        (0..steps).map(|k| self.step_fraction(k)).sum::<f64>() * self.settings.context.dt
     }
 
     /// Handles an overflow: grows the list and clears the halt. Returns
@@ -925,7 +931,7 @@ impl GpuBackend {
             self.params.step_lo = step as u32;
             self.params.step_hi = (step >> 32) as u32;
             self.params.steps_wanted = chunk as u32;
-            self.set_clock(self.time + done as f64 * self.settings.context.dt);
+            self.set_clock(self.time + self.elapsed(done));
             self.write_params();
             self.reset_status(force_rebuild);
             let mut encoded = 0;
@@ -961,12 +967,12 @@ impl GpuBackend {
             }
             if status[ST_HALTED] & HALT_EVENTS != 0 {
                 // The event buffer is full: the host drains it and goes on.
-                return Ok(done);
+                break;
             }
             force_rebuild =
                 self.grow_if_overflowed(&status).map_err(|message| GpuHalt::Capacity { step: first_step + done, message })? || requested;
         }
-        self.time += done as f64 * self.settings.context.dt;
+        self.time += self.elapsed(done);
         Ok(done)
     }
 }

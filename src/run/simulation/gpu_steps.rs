@@ -77,10 +77,9 @@ impl Stepper for GpuSteps {
         };
         // Each step took s·dt: below 1 where the contact step clamp shortened it (src/gpu/contact.rs).
         let mut taken = Taken { steps: done, last: None };
-        let fractions = self.gpu.step_fractions();
         let mut clocks = Vec::new();
-        for k in 0..done as usize {
-            let fraction = fractions.get(k).map_or(1.0, |&s| f64::from(s));
+        for k in 0..done {
+            let fraction = self.gpu.step_fraction(k);
             sim.contact_clamps += u64::from(fraction < 1.0);
             let clock = sim.step_context().advance(&mut sim.state, fraction);
             clocks.extend(Some(clock).filter(|_| self.device_kinetics));
