@@ -1171,9 +1171,15 @@ fn contact_barrier_forces_match_the_cpu() {
         let mut gpu = GpuBackend::new(&context(), &model, &state, &plan.sim_box, &settings(0.3, 1e-3, 0.0)).unwrap();
         gpu.evaluate().unwrap();
         let (force_error, energy_error) = compare_forces(&forces, &gpu.forces_and_energies());
-        println!("{} force-field lines: {pairs} particles with a force; force error {force_error:.2e}, energy error {energy_error:.2e}", ff.lines().count());
+        println!(
+            "{} force-field lines: {pairs} particles with a force; force error {force_error:.2e}, energy error {energy_error:.2e}",
+            ff.lines().count()
+        );
         assert!(pairs > 20, "only {pairs} particles feel a force: the test would be vacuous");
-        assert!(force_error <= CONTACT_GPU_EPSILON && energy_error <= CONTACT_GPU_EPSILON, "force {force_error:e}, energy {energy_error:e}");
+        assert!(
+            force_error <= CONTACT_GPU_EPSILON && energy_error <= CONTACT_GPU_EPSILON,
+            "force {force_error:e}, energy {energy_error:e}"
+        );
     }
 }
 
@@ -1190,7 +1196,12 @@ fn contact_barrier_forces_match_the_cpu() {
 #[test]
 fn the_contact_step_clamp_runs_on_the_gpu_like_on_the_cpu() {
     let run = |device: DevicePreference, kt: f64, steps: u64| {
-        let case = contact_case(&format!("{CONTACT_SHELLS}{CONTACT_BARRIER}"), 0.1, 50.0, &format!("temperature {kt}\nseed 7\ntimestep 1e-2\nrun 0\n"));
+        let case = contact_case(
+            &format!("{CONTACT_SHELLS}{CONTACT_BARRIER}"),
+            0.1,
+            50.0,
+            &format!("temperature {kt}\nseed 7\ntimestep 1e-2\nrun 0\n"),
+        );
         let options = RunOptions { output_dir: case.output_dir().to_path_buf(), device: Some(device), ..Default::default() };
         let mut sim = Simulation::before_first_run(&case.plan(), options).unwrap();
         let start = sim.state.clone();
