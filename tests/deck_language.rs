@@ -64,6 +64,24 @@ fn a_run_time_if_breaks_a_loop_when_a_thermo_value_crosses() {
 }
 
 #[test]
+fn previous_reads_a_column_at_the_ifs_last_decision_so_a_loop_stops_at_rest() {
+    // In the trap F = −2(x − 1) from x = 0 the bead moves 0.98^{50(k−1)}·(1 − 0.98^50)
+    // in the k-th run of 50 steps: 0.231, 0.084, 0.031, 0.011, then 0.0041 < 0.01 at k = 6.
+    let case = bead(
+        "external trap all field fx \"-2*(x - 1)\"\nloop k 1 100\n  run 50\n  \
+         if abs(thermo(xu/all) - previous(xu/all)) < 0.01 then\n    break\n  endif\nendloop\n",
+    );
+    assert_eq!(case.run().state.step, 300);
+    // At its first decision the condition has no earlier value and does not hold, whatever it says.
+    let case = bead("loop k 1 5\n  run 10\n  if !(previous(step) < 0) then\n    break\n  endif\nendloop\n");
+    assert_eq!(case.run().state.step, 20);
+    // An `if` is one place in the deck: in a nested loop its earlier decision may be from the outer loop's
+    // previous iteration (steps 10, 20: break; then 30, where step 20 is previous: break).
+    let case = bead("loop i 1 2\n  loop k 1 5\n    run 10\n    if previous(step) > 0 then\n      break\n    endif\n  endloop\nendloop\n");
+    assert_eq!(case.run().state.step, 30);
+}
+
+#[test]
 fn pe_leaves_out_the_work_of_constant_forces_and_externals_have_their_own_columns() {
     let case = bead(
         "external pull all constant_force fx 2 fy -1\nexternal floor all wall nx 1 d 0.5 k 4\nthermo 0 pe work pe/pull fx/pull fy/pull \

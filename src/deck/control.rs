@@ -279,9 +279,11 @@ impl Validator {
             let located = |message: String| condition.error(&crate::expr::ExprError { span, message });
             match r {
                 Ref::Name(name) => names.push((name.to_string(), self.vars.number(name).map_err(located)?)),
-                Ref::Thermo(text) => {
+                Ref::Thermo(text) | Ref::Previous(text) => {
                     let column = self.thermo_columns(&[at.with_text(text.to_string())]).map_err(|e| located(e.message))?;
-                    columns.push((text.to_string(), column[0].clone()));
+                    if !columns.iter().any(|(t, _)| t == text) {
+                        columns.push((text.to_string(), column[0].clone()));
+                    }
                 }
             }
         }

@@ -3,7 +3,9 @@
 //!
 //! A name in a deck expression is a deck variable holding a number (`i` of
 //! a `loop`, or any `variable … equal`); `thermo(COLUMN)` reads a thermo
-//! column of the current state and is only allowed where the expression is
+//! column of the current state and `previous(COLUMN)` its value when the
+//! same `if` (the same place in the deck, in any iteration) was last
+//! decided; both are only allowed where the expression is
 //! decided during the run (an `if` condition, see [`Condition`]).
 
 use crate::expr::{parse, Expr, ExprError, Ref};
@@ -47,16 +49,14 @@ impl DeckExpr {
         self.expr
             .eval(&mut |r| match r {
                 Ref::Name(name) => vars.number(name),
-                Ref::Thermo(column) => {
-                    Err(format!("found `thermo({column})`, which is known only during a run; expected it in an `if` condition"))
-                }
+                thermo => Err(format!("found {}, which is known only during a run; expected it in an `if` condition", thermo.quoted())),
             })
             .map_err(|e| self.error(&e))
     }
 
     /// Whether the expression reads thermo columns (is decided during the run).
     pub fn reads_thermo(&self) -> bool {
-        self.expr.refs().iter().any(|(r, _)| matches!(r, Ref::Thermo(_)))
+        self.expr.refs().iter().any(|(r, _)| r.is_thermo())
     }
 }
 
@@ -68,7 +68,8 @@ fn locate(pieces: &[(usize, Token)], e: &ExprError) -> InputError {
 }
 
 /// An `if` condition decided during the run: the tree, the values its deck
-/// variables had where the `if` stands, and the thermo columns it reads.
+/// variables had where the `if` stands, and the thermo columns it reads
+/// (each once, whether as `thermo(…)` or `previous(…)`).
 #[derive(Clone, Debug)]
 pub struct Condition {
     pub(super) expr: Expr,
@@ -79,14 +80,33 @@ pub struct Condition {
 }
 
 impl Condition {
-    /// Whether the condition holds; `column` measures a thermo column now.
-    /// A value outside a function's domain is an error at the `if`, never
-    /// silently false.
-    pub fn holds(&self, column: &mut dyn FnMut(&ThermoColumn) -> Result<f64, String>) -> Result<bool, String> {
+    /// `file:line:col` of the condition: the same for every iteration of
+    /// an unrolled `loop`, so it names the `if` whose decisions `previous`
+    /// remembers.
+    pub fn place(&self) -> &str {
+        &self.at
+    }
+
+    /// Whether the condition holds; `column` measures a thermo column now,
+    /// and `last` holds the columns' values at this condition's previous
+    /// decision (empty before the first), which this decision replaces.
+    /// A condition that reads `previous(…)` does not hold at its first
+    /// decision: there is no earlier value. A value outside a function's
+    /// domain is an error at the `if`, never silently false.
+    pub fn holds(&self, column: &mut dyn FnMut(&ThermoColumn) -> Result<f64, String>, last: &mut Vec<f64>) -> Result<bool, String> {
+        let failed = |message: String| format!("{}: the `if` condition: {message}", self.at);
+        let now = self.columns.iter().map(|(_, c)| column(c)).collect::<Result<Vec<f64>, String>>().map_err(failed)?;
+        let earlier = std::mem::replace(last, now.clone());
+        let reads_previous = self.expr.refs().iter().any(|(r, _)| matches!(r, Ref::Previous(_)));
+        if reads_previous && earlier.is_empty() {
+            return Ok(false);
+        }
+        let slot = |text: &str| self.columns.iter().position(|(t, _)| t == text).expect("resolved when validated");
         let value = self.expr.eval(&mut |r| match r {
             Ref::Name(name) => Ok(self.names.iter().find(|(n, _)| n == name).expect("resolved when validated").1),
-            Ref::Thermo(text) => column(&self.columns.iter().find(|(t, _)| t == text).expect("resolved when validated").1),
+            Ref::Thermo(text) => Ok(now[slot(text)]),
+            Ref::Previous(text) => Ok(earlier[slot(text)]),
         });
-        value.map(|v| v != 0.0).map_err(|e| format!("{}: the `if` condition: {}", self.at, e.message))
+        value.map(|v| v != 0.0).map_err(|e| failed(e.message))
     }
 }

@@ -24,7 +24,9 @@ pub fn lammps_formula(expr: &Expr) -> Result<String, String> {
             "t" => "time".into(),
             other => return Err(format!("the name `{other}` has no LAMMPS equivalent")),
         },
-        Expr::Thermo(c, _) => return Err(format!("`thermo({c})` has no LAMMPS equivalent in an atom-style variable")),
+        Expr::Thermo(..) | Expr::Previous(..) => {
+            return Err(format!("{} has no LAMMPS equivalent in an atom-style variable", expr.refs()[0].0.quoted()))
+        }
         Expr::Unary { op, arg, .. } => {
             let a = lammps_formula(arg)?;
             match op {

@@ -97,7 +97,7 @@ impl Expr {
         let square = |a: Expr| pow(a, number(2.0, span));
         let indicator = |op: BinaryOp, a: &Expr, b: &Expr| binary(op, a.clone(), b.clone(), span);
         match self {
-            Expr::Number(..) | Expr::Thermo(..) => zero(),
+            Expr::Number(..) | Expr::Thermo(..) | Expr::Previous(..) => zero(),
             Expr::Name(..) => number(1.0, span),
             Expr::Unary { op: UnaryOp::Neg, arg, .. } => negate(arg.derivative(var), span),
             Expr::Unary { op: UnaryOp::Not, .. } => zero(),
@@ -185,7 +185,7 @@ mod tests {
     fn at<'a>(vars: &'a [(&'static str, f64)]) -> impl FnMut(Ref) -> Result<f64, String> + Clone + 'a {
         move |r| match r {
             Ref::Name(n) => vars.iter().find(|(k, _)| *k == n).map(|(_, v)| *v).ok_or(format!("unknown {n}")),
-            Ref::Thermo(_) => Err("thermo".into()),
+            Ref::Thermo(_) | Ref::Previous(_) => Err("thermo".into()),
         }
     }
 

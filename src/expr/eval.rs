@@ -25,6 +25,7 @@ impl Expr {
             Expr::Number(v, _) => *v,
             Expr::Name(name, span) => lookup(Ref::Name(name)).map_err(|m| ExprError::new(*span, m))?,
             Expr::Thermo(column, span) => lookup(Ref::Thermo(column)).map_err(|m| ExprError::new(*span, m))?,
+            Expr::Previous(column, span) => lookup(Ref::Previous(column)).map_err(|m| ExprError::new(*span, m))?,
             Expr::Unary { op, arg, .. } => {
                 let a = arg.eval(lookup)?;
                 match op {

@@ -17,7 +17,7 @@
 //! product := unary (("*" | "/") unary)*
 //! unary   := ("-" | "+" | "!") unary | power
 //! power   := atom ("^" unary)?            (right-associative: 2^3^2 = 512, -2^2 = -4)
-//! atom    := number | "pi" | NAME | NAME "(" expr ("," expr)* ")" | "thermo(" COLUMN ")" | "(" expr ")"
+//! atom    := number | "pi" | NAME | NAME "(" expr ("," expr)* ")" | "thermo(" COLUMN ")" | "previous(" COLUMN ")" | "(" expr ")"
 //! ```
 //! Comparisons and logical operators give 1 (true) or 0 (false); `&&`, `||`
 //! and `!` read any non-zero value as true, as LAMMPS does. Every function of
@@ -91,11 +91,30 @@ pub enum BinaryOp {
 }
 
 /// A name an expression reads: a plain name (a deck variable, or `x`, `t`
-/// where the caller defines them) or a thermo column (`thermo(fx/plate)`).
+/// where the caller defines them), a thermo column (`thermo(fx/plate)`), or
+/// a thermo column's earlier value (`previous(fx/plate)`, whose meaning the
+/// caller defines: a deck `if` gives the value at its last decision).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Ref<'a> {
     Name(&'a str),
     Thermo(&'a str),
+    Previous(&'a str),
+}
+
+impl Ref<'_> {
+    /// The reference as written, quoted: `` `x` ``, `` `thermo(pe)` ``, `` `previous(pe)` ``.
+    pub fn quoted(&self) -> String {
+        match self {
+            Ref::Name(name) => format!("`{name}`"),
+            Ref::Thermo(column) => format!("`thermo({column})`"),
+            Ref::Previous(column) => format!("`previous({column})`"),
+        }
+    }
+
+    /// Whether it reads a thermo column (now or earlier).
+    pub fn is_thermo(&self) -> bool {
+        !matches!(self, Ref::Name(_))
+    }
 }
 
 /// An expression tree; every node knows its span.
@@ -104,6 +123,7 @@ pub enum Expr {
     Number(f64, Span),
     Name(String, Span),
     Thermo(String, Span),
+    Previous(String, Span),
     Unary { op: UnaryOp, arg: Box<Expr>, span: Span },
     Binary { op: BinaryOp, lhs: Box<Expr>, rhs: Box<Expr>, span: Span },
     Call { function: &'static Function, args: Vec<Expr>, span: Span },
@@ -112,7 +132,7 @@ pub enum Expr {
 impl Expr {
     pub fn span(&self) -> Span {
         match self {
-            Expr::Number(_, span) | Expr::Name(_, span) | Expr::Thermo(_, span) => *span,
+            Expr::Number(_, span) | Expr::Name(_, span) | Expr::Thermo(_, span) | Expr::Previous(_, span) => *span,
             Expr::Unary { span, .. } | Expr::Binary { span, .. } | Expr::Call { span, .. } => *span,
         }
     }
@@ -129,7 +149,7 @@ impl Expr {
     pub fn substitute(&self, value: &dyn Fn(&str) -> Option<f64>) -> Expr {
         match self {
             Expr::Name(name, span) => value(name).map_or_else(|| self.clone(), |v| Expr::Number(v, *span)),
-            Expr::Number(..) | Expr::Thermo(..) => self.clone(),
+            Expr::Number(..) | Expr::Thermo(..) | Expr::Previous(..) => self.clone(),
             Expr::Unary { op, arg, span } => Expr::Unary { op: *op, arg: Box::new(arg.substitute(value)), span: *span },
             Expr::Binary { op, lhs, rhs, span } => {
                 Expr::Binary { op: *op, lhs: Box::new(lhs.substitute(value)), rhs: Box::new(rhs.substitute(value)), span: *span }
@@ -145,6 +165,7 @@ impl Expr {
             Expr::Number(..) => {}
             Expr::Name(name, span) => out.push((Ref::Name(name), *span)),
             Expr::Thermo(column, span) => out.push((Ref::Thermo(column), *span)),
+            Expr::Previous(column, span) => out.push((Ref::Previous(column), *span)),
             Expr::Unary { arg, .. } => arg.collect_refs(out),
             Expr::Binary { lhs, rhs, .. } => {
                 lhs.collect_refs(out);

@@ -13,6 +13,7 @@ enum Tok {
     Number(f64),
     Name(String),
     Thermo(String),
+    Previous(String),
     Op(&'static str),
     Open,
     Close,
@@ -58,17 +59,17 @@ fn tokenize(text: &str) -> Result<Vec<(Tok, Span)>, ExprError> {
                 i += 1;
             }
             let name = &text[start..i];
-            if name == "thermo" && bytes.get(i) == Some(&b'(') {
-                let close = text[i..]
-                    .find(')')
-                    .map(|k| i + k)
-                    .ok_or_else(|| ExprError::new(Span { start, end: text.len() }, "unterminated `thermo(`; expected `thermo(COLUMN)`"))?;
-                let column = text[i + 1..close].trim();
+            if (name == "thermo" || name == "previous") && bytes.get(i) == Some(&b'(') {
+                let close = text[i..].find(')').map(|k| i + k).ok_or_else(|| {
+                    ExprError::new(Span { start, end: text.len() }, format!("unterminated `{name}(`; expected `{name}(COLUMN)`"))
+                })?;
+                let column = text[i + 1..close].trim().to_string();
                 if column.is_empty() {
-                    return Err(ExprError::new(Span { start, end: close + 1 }, "found `thermo()`, expected `thermo(COLUMN)`"));
+                    return Err(ExprError::new(Span { start, end: close + 1 }, format!("found `{name}()`, expected `{name}(COLUMN)`")));
                 }
+                let tok = if name == "thermo" { Tok::Thermo(column) } else { Tok::Previous(column) };
                 i = close + 1;
-                out.push((Tok::Thermo(column.to_string()), Span { start, end: i }));
+                out.push((tok, Span { start, end: i }));
             } else {
                 out.push((Tok::Name(name.to_string()), Span { start, end: i }));
             }
@@ -125,6 +126,7 @@ fn describe(tok: &Tok) -> String {
         Tok::Number(v) => format!("the number {v}"),
         Tok::Name(n) => format!("`{n}`"),
         Tok::Thermo(c) => format!("`thermo({c})`"),
+        Tok::Previous(c) => format!("`previous({c})`"),
         Tok::Op(op) => format!("`{op}`"),
         Tok::Open => "`(`".into(),
         Tok::Close => "`)`".into(),
@@ -218,7 +220,7 @@ impl Parser {
     fn atom(&mut self) -> Result<Expr, ExprError> {
         const OPERAND: &str = "a number, a name, a function call or `(`";
         let (tok, span) = self.peek().clone();
-        if matches!(tok, Tok::Number(_) | Tok::Name(_) | Tok::Thermo(_)) {
+        if matches!(tok, Tok::Number(_) | Tok::Name(_) | Tok::Thermo(_) | Tok::Previous(_)) {
             self.operands += 1;
             if self.operands > MAX_OPERANDS {
                 return Err(ExprError::new(
@@ -236,6 +238,10 @@ impl Parser {
                 self.next();
                 Ok(Expr::Thermo(column, span))
             }
+            Tok::Previous(column) => {
+                self.next();
+                Ok(Expr::Previous(column, span))
+            }
             Tok::Open => {
                 self.next();
                 let mut inner = self.binary(0)?;
@@ -246,7 +252,7 @@ impl Parser {
                 // The parentheses belong to the node: errors underline them too.
                 let whole = Span { start: span.start, end: close.end };
                 match &mut inner {
-                    Expr::Number(_, s) | Expr::Name(_, s) | Expr::Thermo(_, s) => *s = whole,
+                    Expr::Number(_, s) | Expr::Name(_, s) | Expr::Thermo(_, s) | Expr::Previous(_, s) => *s = whole,
                     Expr::Unary { span: s, .. } | Expr::Binary { span: s, .. } | Expr::Call { span: s, .. } => *s = whole,
                 }
                 Ok(inner)

@@ -103,8 +103,9 @@ impl Emitter<'_> {
                 }
                 self.grow(1, e)?;
             }
-            Expr::Thermo(column, span) => {
-                return Err(ExprError::new(*span, format!("found `thermo({column})`, expected no thermo column in a compiled expression")))
+            Expr::Thermo(_, span) | Expr::Previous(_, span) => {
+                let found = e.refs()[0].0.quoted();
+                return Err(ExprError::new(*span, format!("found {found}, expected no thermo column in a compiled expression")));
             }
             Expr::Unary { op, arg, .. } => {
                 self.emit(arg)?;

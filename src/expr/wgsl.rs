@@ -29,7 +29,9 @@ pub fn wgsl(expr: &Expr, name: &dyn Fn(&str) -> Option<String>) -> Result<String
     Ok(match expr {
         Expr::Number(v, _) => literal(*v, expr)?,
         Expr::Name(n, span) => name(n).ok_or_else(|| ExprError::new(*span, format!("found unknown name `{n}`")))?,
-        Expr::Thermo(c, span) => return Err(ExprError::new(*span, format!("found `thermo({c})`, expected no thermo column on the GPU"))),
+        Expr::Thermo(_, span) | Expr::Previous(_, span) => {
+            return Err(ExprError::new(*span, format!("found {}, expected no thermo column on the GPU", expr.refs()[0].0.quoted())))
+        }
         Expr::Unary { op: UnaryOp::Neg, arg, .. } => format!("(-{})", go(arg)?),
         Expr::Unary { op: UnaryOp::Not, arg, .. } => select(format!("{} == 0.0", go(arg)?)),
         Expr::Binary { op: BinaryOp::Pow, lhs, rhs, .. } if matches!(**rhs, Expr::Number(n, _) if n.fract() == 0.0 && n.abs() <= 16.0) => {

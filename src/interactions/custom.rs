@@ -99,14 +99,11 @@ impl CustomLaw {
         for (r, span) in energy.refs() {
             let known = match r {
                 crate::expr::Ref::Name(n) => vars.iter().any(|(v, _)| *v == n) || names.contains(&n),
-                crate::expr::Ref::Thermo(_) => false,
+                crate::expr::Ref::Thermo(_) | crate::expr::Ref::Previous(_) => false,
             };
             if !known {
                 let listed: Vec<&str> = vars.iter().map(|(v, _)| *v).chain(names.iter().copied()).collect();
-                let found = match r {
-                    crate::expr::Ref::Name(n) => format!("`{n}`"),
-                    crate::expr::Ref::Thermo(c) => format!("`thermo({c})`"),
-                };
+                let found = r.quoted();
                 return Err(CustomError::Expression(ExprError::new(
                     span,
                     format!(

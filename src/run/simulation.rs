@@ -7,6 +7,7 @@
 //! (checkpoints, stops, blow-ups) and `stepping` (driving a run from outside
 //! a deck).
 
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use glam::DVec3;
@@ -126,6 +127,10 @@ pub struct Simulation {
     log: Option<RunLog>,
     /// Ramps, moved and frozen groups in force.
     protocols: Protocols,
+    /// The thermo values each run-time `if` (by its place in the deck, so
+    /// across the iterations of a loop) read at its last decision, for its
+    /// `previous(…)`.
+    decisions: HashMap<String, Vec<f64>>,
 }
 
 impl Simulation {
@@ -182,6 +187,7 @@ impl Simulation {
             times: PhaseTimes::default(),
             log: None,
             protocols: Protocols::default(),
+            decisions: HashMap::new(),
         }
     }
 
@@ -249,7 +255,10 @@ impl Simulation {
             self.stop_if_requested()?;
             next += 1 + match action {
                 Action::Branch { condition, skip } => {
-                    let holds = condition.holds(&mut |c| self.thermo_value(c).map_err(|e| e.to_string())).map_err(RunError::Setup)?;
+                    let mut last = self.decisions.remove(condition.place()).unwrap_or_default();
+                    let holds = condition.holds(&mut |c| self.thermo_value(c).map_err(|e| e.to_string()), &mut last);
+                    self.decisions.insert(condition.place().to_string(), last);
+                    let holds = holds.map_err(RunError::Setup)?;
                     if holds {
                         0
                     } else {

@@ -48,7 +48,7 @@ pub fn position_or_time(r: crate::expr::Ref, x: glam::DVec3, t: f64) -> Result<f
         crate::expr::Ref::Name("z") => Ok(x.z),
         crate::expr::Ref::Name("t") => Ok(t),
         crate::expr::Ref::Name(other) => Err(format!("found `{other}`, expected x, y, z, t or a numeric deck variable")),
-        crate::expr::Ref::Thermo(c) => Err(format!("found `thermo({c})`, expected x, y, z, t or a numeric deck variable")),
+        thermo => Err(format!("found {}, expected x, y, z, t or a numeric deck variable", thermo.quoted())),
     }
 }
 

@@ -28,7 +28,7 @@ pub fn lepton(expr: &Expr, value: &dyn Fn(&str) -> Option<f64>) -> Result<String
     Ok(match expr {
         Expr::Number(v, _) => format!("({})", num(*v)),
         Expr::Name(name, _) => value(name).map_or_else(|| name.clone(), |v| format!("({})", num(v))),
-        Expr::Thermo(c, _) => return Err(format!("`thermo({c})` has no Lepton equivalent")),
+        Expr::Thermo(..) | Expr::Previous(..) => return Err(format!("{} has no Lepton equivalent", expr.refs()[0].0.quoted())),
         Expr::Unary { op: UnaryOp::Neg, arg, .. } => format!("(-{})", go(arg)?),
         Expr::Unary { op: UnaryOp::Not, arg, .. } => format!("delta({})", go(arg)?),
         Expr::Binary { op, lhs, rhs, .. } => {
