@@ -4,7 +4,9 @@
 For each cell count N, builds a spheroid of N shell cells on a flat substrate
 of fixed ligand sites (`cellmd build cells --layout spheroid --count N
 --substrate flat`, lowered so that the substrate lies at z = 0), runs
-inputs/spheroid_spreading.in (20 000 steps, a thermo row every 2000) and reads
+inputs/spheroid_spreading.in (20 000 steps, a thermo row every 2000; with
+--rest, up to --steps, stopping once A changed by less than that fraction
+over a window of 4000 steps) and reads
 its thermo file: the spheroid's radius R = √(A0/π) from the top-down
 silhouette (the convex hull of the nodes projected on xy) at the start, and
 A/A0 at the end, A the mean of the last three rows (the silhouette fluctuates
@@ -41,7 +43,7 @@ CELL_RADIUS = 8.0
 TAIL = 3
 
 
-def spread(cellmd, out, count, adhesion, seed, reuse):
+def spread(cellmd, out, count, adhesion, seed, reuse, steps, rest):
     d = out / f"n{count}_adh{adhesion:g}_s{seed}"
     d.mkdir(parents=True, exist_ok=True)
     csv_path = d / "spheroid_spreading.thermo.csv"
@@ -54,7 +56,7 @@ def spread(cellmd, out, count, adhesion, seed, reuse):
         # Built around z = 0 first; then lowered so that the substrate lies at z = 0, the deck's dish.
         floor = float(run_command(build).split("touching z = ")[1].split()[0])
         run_command(build + ["--centre", 0, 0, -floor])
-        wall = run_deck(cellmd, DECK, d, {"topology": top, "adhesion": adhesion, "seed": seed})
+        wall = run_deck(cellmd, DECK, d, {"topology": top, "adhesion": adhesion, "seed": seed, "steps": steps, "rest": rest})
         (d / "runtime_s.txt").write_text(f"{wall:.1f}\n")
     rows = thermo_rows(csv_path)
     area = np.array([r["hullarea/cells"] for r in rows])
@@ -63,7 +65,7 @@ def spread(cellmd, out, count, adhesion, seed, reuse):
     late, earlier = area[-TAIL:].mean(), area[-2 * TAIL:-TAIL].mean()
     runtime = d / "runtime_s.txt"
     return {"count": count, "adhesion": adhesion, "seed": seed, "R": float(np.sqrt(area[0] / np.pi)),
-            "A_over_A0": float(late / area[0]), "drift": float(late / earlier - 1), "time": rows[-1]["time"],
+            "A_over_A0": float(late / area[0]), "drift": float(late / earlier - 1), "steps": int(rows[-1]["step"]), "time": rows[-1]["time"],
             "clutches": int(rows[-1]["nbound/clutch"]), "runtime_s": float(runtime.read_text()) if runtime.exists() else float("nan")}
 
 
@@ -84,21 +86,23 @@ def main():
     a.add_argument("--seeds", type=int, default=1)
     a.add_argument("--workers", type=int, default=os.cpu_count())
     a.add_argument("--reuse", action="store_true", help="read the runs already in OUT instead of running them again")
+    a.add_argument("--steps", type=int, default=20000, help="steps per run (at most, with --rest)")
+    a.add_argument("--rest", type=float, default=0.0, help="stop a run once |ΔA|/A over 4000 steps is below this (0: never)")
     o = a.parse_args()
     out = Path(o.out).resolve()
     out.mkdir(parents=True, exist_ok=True)
     jobs = [(n, adh, s) for n in o.counts for adh in (1, 0) for s in range(1, o.seeds + 1) if adh or n in o.control_counts]
     jobs.sort(key=lambda j: -j[0])
     with ThreadPoolExecutor(o.workers) as pool:
-        rows = list(pool.map(lambda j: spread(o.cellmd, out, *j, o.reuse), jobs))
+        rows = list(pool.map(lambda j: spread(o.cellmd, out, *j, o.reuse, o.steps, o.rest), jobs))
     rows.sort(key=lambda r: (r["count"], -r["adhesion"], r["seed"]))
     with open(out / "spheroid_spreading.csv", "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=list(rows[0]))
         w.writeheader()
         w.writerows(rows)
-    lines = [f"{'N':>4} {'adh':>3} {'seed':>4} {'R/µm':>7} {'A/A0':>7} {'drift':>8} {'t/s':>7} {'clutches':>8} {'wall/s':>7}"]
+    lines = [f"{'N':>4} {'adh':>3} {'seed':>4} {'R/µm':>7} {'A/A0':>7} {'drift':>8} {'steps':>7} {'t/s':>7} {'clutches':>8} {'wall/s':>7}"]
     lines += [f"{r['count']:>4} {r['adhesion']:>3g} {r['seed']:>4} {r['R']:>7.2f} {r['A_over_A0']:>7.3f} {r['drift']:>+8.3f} "
-              f"{r['time']:>7.1f} {r['clutches']:>8} {r['runtime_s']:>7.1f}" for r in rows]
+              f"{r['steps']:>7} {r['time']:>7.1f} {r['clutches']:>8} {r['runtime_s']:>7.1f}" for r in rows]
     adhered = [r for r in rows if r["adhesion"] == 1]
     R = np.array([r["R"] for r in adhered])
     y = np.array([r["A_over_A0"] for r in adhered])
