@@ -231,7 +231,12 @@ fn device_kinetics_with_contact_take_the_clamped_step_lengths() {
     for b in 0..bonds.len() {
         assert_eq!(bonds.bound[b], broke_at[b].is_none(), "bond {b}");
         let expected = aged(broke_at[b].unwrap_or(steps - 1));
-        assert_eq!(bonds.age[b].to_bits(), expected.to_bits(), "bond {b}: age {} on the device, {expected} on the host clock", bonds.age[b]);
+        assert_eq!(
+            bonds.age[b].to_bits(),
+            expected.to_bits(),
+            "bond {b}: age {} on the device, {expected} on the host clock",
+            bonds.age[b]
+        );
     }
     let total: f64 = lengths.iter().sum();
     let survival = |t: f64| (-5.0 * t).exp();
