@@ -219,20 +219,6 @@ fn f64_add(a: vec2<u32>, b: vec2<u32>) -> vec2<u32> {
     return vec2<u32>((e << 20u) | (s.x & 0xFFFFFu), s.y);
 }
 
-// The 64-bit product of two u32 (high, low words), from 16-bit halves.
-fn u32_mul_wide(a: u32, b: u32) -> vec2<u32> {
-    let a0 = a & 0xFFFFu;
-    let a1 = a >> 16u;
-    let b0 = b & 0xFFFFu;
-    let b1 = b >> 16u;
-    let cross_a = a0 * b1;
-    let cross_b = a1 * b0;
-    let lo_a = a0 * b0 + (cross_a << 16u);
-    let lo = lo_a + (cross_b << 16u);
-    let carries = select(0u, 1u, lo_a < (cross_a << 16u)) + select(0u, 1u, lo < lo_a);
-    return vec2<u32>(a1 * b1 + (cross_a >> 16u) + (cross_b >> 16u) + carries, lo);
-}
-
 // The f64 product f64(s)·x of a positive normal f64 x (high, low words) and
 // a normal f32 s in (0, 1], rounded to nearest even as IEEE 754 does, in
 // integer arithmetic: the CPU's step length `fraction * dt` (the fraction
@@ -250,8 +236,8 @@ fn f64_scale(x: vec2<u32>, s: f32) -> vec2<u32> {
     let ms = (bits & 0x7FFFFFu) | 0x800000u; // 24 bits
     let mh = (x.x & 0xFFFFFu) | 0x100000u;   // the high 21 of 53 bits
     // ms · (mh·2³² + x.y) in three words w2:w1:w0, in [2⁷⁵, 2⁷⁷).
-    let low = u32_mul_wide(ms, x.y);
-    let high = u32_mul_wide(ms, mh);
+    let low = mulhilo(ms, x.y); // philox.wgsl
+    let high = mulhilo(ms, mh);
     let w0 = low.y;
     let w1 = low.x + high.y;
     let w2 = high.x + select(0u, 1u, w1 < low.x);
