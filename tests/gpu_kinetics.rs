@@ -142,6 +142,8 @@ fn unported_rules_keep_kinetics_on_the_host() {
     assert_eq!(reason("inputs/catch_slip_sweep.in"), None);
     let motor = reason("inputs/contractile_network.in").unwrap();
     assert!(motor.contains("motor"), "{motor}");
+    let bind = reason("inputs/aggregate.in").unwrap();
+    assert!(bind.contains("`bind`"), "{bind}");
 }
 
 /// A broken bond stops excluding its pair, also across GPU segments: 30
