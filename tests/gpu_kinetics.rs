@@ -142,6 +142,8 @@ fn unported_rules_keep_kinetics_on_the_host() {
     assert_eq!(reason("inputs/catch_slip_sweep.in"), None);
     let motor = reason("inputs/contractile_network.in").unwrap();
     assert!(motor.contains("motor"), "{motor}");
+    let bind = reason("inputs/aggregate.in").unwrap();
+    assert!(bind.contains("`bind`"), "{bind}");
 }
 
 /// A broken bond stops excluding its pair, also across GPU segments: 30
@@ -173,4 +175,85 @@ fn a_broken_bond_releases_its_pair_on_the_device() {
     println!("GPU − CPU {deviation:.3e} after travelling up to {travelled:.3e}");
     assert!(travelled > 0.003, "the pairs barely moved: {travelled}");
     assert!(deviation <= 1e-5 * travelled, "GPU − CPU {deviation:e} > 1e-5 × {travelled:e}");
+}
+
+/// Device kinetics with contact (the step clamp of src/gpu/contact.rs): two
+/// level-2 cells 0.1 µm apart pushed together by 50 pN per node at
+/// dt = 1e-2 s (0.5 µm a step unclamped, five times d̂), so the clamp
+/// shortens steps to s·dt; their 960 mesh edges are slip bonds with a
+/// force-free rate k0 = 5/s (x_beta 0), and every node feels a field force
+/// 10·t pN along x. Over 20 steps:
+/// - every age the device reports, at each break and after the run, is the
+///   host clock's sum of step lengths f64(s_k)·dt over the steps the bond
+///   was bound, bit for bit (the device's integer f64 product and sum);
+/// - bond b survives with probability exp(−k0·T), T = Σ s_k·dt the run's
+///   actual length, so the break count is binomial: within 4.5σ (+1) of
+///   n·(1 − exp(−k0·T)), and that mean is more than 9σ from the one with
+///   whole steps (T = 20·dt), so a device that ignored the clamp fails;
+/// - the kernels' time at the last force pass (step 19) is Σ_{k<19} s_k·dt:
+///   ΣF_x = 324·10·t, since every other force sums to zero (pairs, closed
+///   shells and opposite pushes; f32 round-off ≈ 1e-2 pN of ΣF_x ≳ 300 pN),
+///   within 1e-3·t, while 19·dt is off by more than ten times that.
+#[test]
+fn device_kinetics_with_contact_take_the_clamped_step_lengths() {
+    let top = common::two_cells_with_edges(2, 2.0, 0.1, Some("edge"));
+    let ff = "particle node drag 1\nbond edge harmonic k 20 r0 0.6 kinetics slip k0 5 x_beta 0\n\
+              body cell turgor k 1000 dp0 100 v0 32.4\nbody cell surface_tension gamma 100\n\
+              contact cell cell contact_barrier dhat 0.1 kappa 200\n";
+    let deck = "units cell\ntopology cells.top\nforcefield cells.ff\nbox x 0 20 p y -10 10 f z -10 10 f\n\
+                group left id 1:162\ngroup right id 163:324\n\
+                external push_left left constant_force fx 50\nexternal push_right right constant_force fx -50\n\
+                external clock all field fx \"10*t\" fy 0 fz 0 e \"-10*t*x\"\n\
+                temperature 0.0041\nseed 7\ntimestep 1e-2\nrun 0\n";
+    let case = common::Case::new(&[("cells.top", &top), ("cells.ff", ff), ("deck.in", deck)]);
+    let sim = Simulation::before_first_run(&case.plan(), RunOptions::default()).unwrap();
+    assert!(sim.model.has_contact_terms());
+    let settings = StepSettings {
+        context: sim.step_context(),
+        skin: sim.neighbor.skin,
+        neighbor_every: sim.neighbor.every,
+        neighbor_check: sim.neighbor.check,
+    };
+    let steps = 20u64;
+    let mut gpu = GpuBackend::with_device_kinetics(&context(), &sim.model, &sim.state, &sim.sim_box, &settings, &[]).unwrap();
+    assert_eq!(gpu.run(0, steps), Ok(steps));
+    let decided = gpu.drain_kinetics();
+    let mut bonds = sim.state.bonds.clone().unwrap();
+    gpu.download_bond_state(&mut bonds);
+    let dt = settings.context.dt;
+    let lengths: Vec<f64> = (0..steps).map(|k| gpu.step_fraction(k) * dt).collect();
+    let clamped = (0..steps).filter(|&k| gpu.step_fraction(k) < 1.0).count();
+    let aged = |last: u64| lengths[..=last as usize].iter().fold(0.0, |age, l| age + l);
+    let mut broke_at = vec![None; bonds.len()];
+    for e in &decided.events {
+        assert_eq!(e.kind, EventKind::Break);
+        assert_eq!(e.age.to_bits(), aged(e.step).to_bits(), "bond {} broke at step {} with age {}", e.bond, e.step, e.age);
+        broke_at[e.bond] = Some(e.step);
+    }
+    for b in 0..bonds.len() {
+        assert_eq!(bonds.bound[b], broke_at[b].is_none(), "bond {b}");
+        let expected = aged(broke_at[b].unwrap_or(steps - 1));
+        assert_eq!(
+            bonds.age[b].to_bits(),
+            expected.to_bits(),
+            "bond {b}: age {} on the device, {expected} on the host clock",
+            bonds.age[b]
+        );
+    }
+    let total: f64 = lengths.iter().sum();
+    let survival = |t: f64| (-5.0 * t).exp();
+    let n = bonds.len() as f64;
+    let (mean, sigma) = (n * (1.0 - survival(total)), (n * survival(total) * (1.0 - survival(total))).sqrt());
+    let whole = n * (1.0 - survival(steps as f64 * dt));
+    let breaks = decided.events.len() as f64;
+    println!("{clamped} of {steps} steps clamped, T = {total:.4e} s; {breaks} breaks of {n} bonds, expected {mean:.1} ± {sigma:.1} ({whole:.1} with whole steps)");
+    assert!(clamped >= 10, "the clamp hardly acted: {clamped} steps");
+    assert!((whole - mean).abs() > 9.0 * sigma, "the clamp changes the expected breaks too little for the test to tell");
+    assert!((breaks - mean).abs() <= 4.5 * sigma + 1.0, "{breaks} breaks, expected {mean:.1} ± {sigma:.1}");
+    let force_x: f64 = gpu.forces_and_energies().iter().map(|(f, _)| f.x).sum();
+    let time = force_x / (10.0 * sim.model.len() as f64);
+    let expected = lengths[..steps as usize - 1].iter().sum::<f64>();
+    println!("kernel time at the last force pass {time:.6e} s, host clock {expected:.6e} s, whole steps {:.6e} s", (steps - 1) as f64 * dt);
+    assert!(((steps - 1) as f64 * dt - expected).abs() > 1e-2 * expected, "the clamp shortened the run too little for the test to tell");
+    assert!((time - expected).abs() <= 1e-3 * expected, "kernel time {time:e}, host clock {expected:e}");
 }

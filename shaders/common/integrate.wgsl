@@ -13,10 +13,22 @@ fn current_step() -> vec2<u32> {
 }
 
 // The simulated time at the start of the current step, as the CPU's clock:
-// the call's start time (two f32 words, host-computed in f64) plus the steps
-// done in this call times dt (externals with expression parameters read it).
+// the call's start time (two f32 words, host-computed in f64) plus the
+// fractions of dt the steps done in this call took, times dt (externals with
+// expression parameters read it). Without contact every step is whole; with
+// contact `advance` keeps the running sum of the fractions beside each
+// step's own in the ring (a call takes at most FRACTION_SLOTS steps).
 fn sim_time() -> f32 {
-    return P.time_hi + (P.time_lo + f32(atomicLoad(&status[ST_STEPS_DONE])) * P.dt);
+    let done = atomicLoad(&status[ST_STEPS_DONE]);
+    return P.time_hi + (P.time_lo + fractions_before(done) * P.dt);
+}
+
+// The sum of the fractions of dt of this call's first `done` steps.
+fn fractions_before(done: u32) -> f32 {
+    if P.n_cfaces == 0u || done == 0u {
+        return f32(done);
+    }
+    return surf[P.off_fractions + (done - 1u) % FRACTION_SLOTS].y;
 }
 
 // Particle i's drift dt·F/γ.
@@ -90,14 +102,16 @@ fn commit(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index)
     state[2u * P.n + i] = next[2u * P.n + i];
 }
 
-// Counts the step; with contact, records its fraction s in the ring the
-// host reads (src/gpu/contact.rs) and resets s to 1 for the next step.
+// Counts the step; with contact, records its fraction s (and the running
+// sum of this call's fractions, for `sim_time`) in the ring the host reads
+// (src/gpu/contact.rs) and resets s to 1 for the next step.
 @compute @workgroup_size(1)
 fn advance() {
     if !halted() {
         let done = atomicAdd(&status[ST_STEPS_DONE], 1u);
         if P.n_cfaces > 0u {
-            surf[P.off_fractions + done % FRACTION_SLOTS] = vec4<f32>(bitcast<f32>(atomicLoad(&status[ST_FRACTION])), 0.0, 0.0, 0.0);
+            let s = bitcast<f32>(atomicLoad(&status[ST_FRACTION]));
+            surf[P.off_fractions + done % FRACTION_SLOTS] = vec4<f32>(s, fractions_before(done) + s, 0.0, 0.0);
         }
         atomicStore(&status[ST_FRACTION], 0x3f800000u);
     }

@@ -4,8 +4,10 @@
 // after `commit` (so a refused step changes nothing):
 //   kin_decide   each bond's break or rebind with the CPU's Philox key
 //                (seed, s, bond, stream 2), its bound flag and its f64 age
-//                (advanced by dt with an exact integer f64 addition, so ages
-//                are the CPU's bits); per-block event counts;
+//                (advanced by the step's length f64(s)·dt — s the contact
+//                clamp's fraction, 1 without — with an exact integer f64
+//                product and addition, so ages are the CPU's bits);
+//                per-block event counts;
 //   kin_scan     one workgroup: exclusive scan of the block counts into the
 //                event buffer's cursor, coarse-step warnings;
 //   kin_emit     each event written at its block base + its rank in the block,
@@ -217,6 +219,44 @@ fn f64_add(a: vec2<u32>, b: vec2<u32>) -> vec2<u32> {
     return vec2<u32>((e << 20u) | (s.x & 0xFFFFFu), s.y);
 }
 
+// The f64 product f64(s)·x of a positive normal f64 x (high, low words) and
+// a normal f32 s in (0, 1], rounded to nearest even as IEEE 754 does, in
+// integer arithmetic: the CPU's step length `fraction * dt` (the fraction
+// widened from the device's f32 s), so ages advance by the CPU's bits.
+// The product's exponent stays normal for any dt ≥ 1e-270; s = 0 (a node
+// on a face: the clamp stops the step) gives 0.
+fn f64_scale(x: vec2<u32>, s: f32) -> vec2<u32> {
+    if s == 1.0 {
+        return x;
+    }
+    if s <= 0.0 {
+        return vec2<u32>(0u);
+    }
+    let bits = bitcast<u32>(s);
+    let ms = (bits & 0x7FFFFFu) | 0x800000u; // 24 bits
+    let mh = (x.x & 0xFFFFFu) | 0x100000u;   // the high 21 of 53 bits
+    // ms · (mh·2³² + x.y) in three words w2:w1:w0, in [2⁷⁵, 2⁷⁷).
+    let low = mulhilo(ms, x.y); // philox.wgsl
+    let high = mulhilo(ms, mh);
+    let w0 = low.y;
+    let w1 = low.x + high.y;
+    let w2 = high.x + select(0u, 1u, w1 < low.x);
+    // Keep 53 bits: shift out 23 or 24, rounding to nearest even.
+    let sh = select(23u, 24u, (w2 >> 12u) != 0u);
+    var m = vec2<u32>((w1 >> sh) | (w2 << (32u - sh)), (w0 >> sh) | (w1 << (32u - sh)));
+    let half = 1u << (sh - 1u);
+    let rest = w0 & ((half << 1u) - 1u);
+    var e = sh + ((bits >> 23u) & 0xFFu) + ((x.x >> 20u) & 0x7FFu) - 150u;
+    if rest > half || (rest == half && (m.y & 1u) == 1u) {
+        m = u64_add(m, vec2<u32>(0u, 1u));
+        if (m.x >> 21u) != 0u {
+            m = u64_shr(m, 1u);
+            e += 1u;
+        }
+    }
+    return vec2<u32>((e << 20u) | (m.x & 0xFFFFFu), m.y);
+}
+
 var<workgroup> kin_block_events: atomic<u32>;
 
 @compute @workgroup_size(256)
@@ -253,7 +293,10 @@ fn kin_decide_bond(k: u32) -> u32 {
     let m = kin_word(KIN_MEASURE) + 3u * k;
     let force = kin_f32(m);
     let len = kin_f32(m + 1u);
-    let dt = kin_f32(KIN_DT);
+    // The step took s·dt (s < 1 where the contact step clamp shortened it):
+    // rates act over it and ages advance by it, as on the CPU.
+    let s = bitcast<f32>(atomicLoad(&status[ST_FRACTION]));
+    let dt = s * kin_f32(KIN_DT);
     let kt = kin_f32(KIN_KT);
     let seed = vec2<u32>(P.seed_lo, P.seed_hi);
     let x = philox4x32_10(vec4<u32>(bond, STREAM_KINETICS, current_step()), seed).x;
@@ -299,7 +342,8 @@ fn kin_decide_bond(k: u32) -> u32 {
     if rate_dt > COARSE_RATE_DT && kin_word(trec + 1u) == 0u {
         atomicMin(&kin[trec + 2u], k);
     }
-    let age = f64_add(vec2<u32>(kin_word(age_at), kin_word(age_at + 1u)), vec2<u32>(kin_word(KIN_DT_HI), kin_word(KIN_DT_LO)));
+    let step_length = f64_scale(vec2<u32>(kin_word(KIN_DT_HI), kin_word(KIN_DT_LO)), s);
+    let age = f64_add(vec2<u32>(kin_word(age_at), kin_word(age_at + 1u)), step_length);
     atomicStore(&kin[age_at], age.x);
     atomicStore(&kin[age_at + 1u], age.y);
     if immediate || (rate > 0.0 && draws_below(x, one_minus_exp(rate_dt))) {

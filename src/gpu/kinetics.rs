@@ -6,10 +6,14 @@
 //! rebinds are decided on the GPU, with no read-back: the tension dE/dr and
 //! length of every kinetic bond are measured at x_s after the force pass, and
 //! after the step each bond draws the CPU's Philox number (seed, s, bond
-//! index, stream 2) and compares it with 1 − exp(−k(F)·dt) (f32; the CPU's
-//! decision differs only where the uniform falls within ~1e-7·p of p). Bound
-//! flags and ages (f64 bits, advanced by an exact integer f64 addition, so
-//! the CPU's bits) live in device buffers; unbound bonds exert no force and
+//! index, stream 2) and compares it with 1 − exp(−k(F)·Δt) (f32; the CPU's
+//! decision differs only where the uniform falls within ~1e-7·p of p), Δt =
+//! s·dt the step's actual length (s < 1 where the contact step clamp of
+//! src/gpu/contact.rs shortened it, read from the clamp's reduction word).
+//! Bound flags and ages live in device buffers: ages as f64 bits, advanced by
+//! the CPU's step length `fraction * dt` (the fraction widened from the
+//! device's f32 s) with an exact integer f64 product and addition, so they
+//! are the bits the host's clock gives; unbound bonds exert no force and
 //! stop excluding their pair, and a step with events has the neighbour list
 //! rebuilt. Events (step, bond, kind, tension, length, age) are compacted in
 //! bond order by a per-block count, a one-workgroup scan and a ranked write,
@@ -66,11 +70,6 @@ fn rule_code(name: &str) -> Option<u32> {
 pub fn refusal(model: &Model) -> Option<String> {
     if !model.bind_rules.is_empty() {
         return Some("`bind` formation".into());
-    }
-    if model.has_contact_terms() {
-        // The contact step clamp shortens steps, and the device's ages and
-        // break probabilities take the full dt.
-        return Some("contact terms between bodies (the step clamp shortens steps)".into());
     }
     for (t, kinetics) in model.bond_kinetics.iter().enumerate() {
         let label = &model.bond_types[t].label.text;
