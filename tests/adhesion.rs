@@ -256,10 +256,3 @@ fn adhesion_runs_are_bit_identical_on_one_and_two_threads() {
     let index = REGISTRY.iter().position(|i| i.name() == "contact_adhesion").unwrap();
     assert!(one.forces.energy_by_interaction[index] < 0.0, "the cells never adhered");
 }
-
-#[test]
-fn the_gpu_refuses_adhesion() {
-    let case = cells_case(ADHESION, "temperature 0\ntimestep 1e-3\nrun 0\n");
-    let sim = Simulation::before_first_run(&case.plan(), RunOptions::default()).unwrap();
-    assert_eq!(sim.cpu_only_feature(), Some("area-weighted contact terms between bodies (`contact_adhesion`) run on the CPU backend only"));
-}
