@@ -950,8 +950,9 @@ fn kinetics_decks_give_the_same_events_on_the_gpu() {
     for deck in decks {
         let steps = |n: u32| [("steps".into(), n.to_string()), ("fire_iterations".into(), "10".into())];
         let mut plan = cellmd::deck::validate_file(&deck, &steps(400)).unwrap();
-        if plan.model.len() > 4000 {
-            // aggregate (8 100 particles) steps one GPU step per segment on
+        if plan.model.len() > 3000 {
+            // aggregate (8 100 particles) and spheroid_spreading (3 805; measured
+            // 2.4 s a GPU step on loaded llvmpipe) step one GPU step per segment on
             // llvmpipe (host kinetics, `bind`): 50 steps keep CI time in
             // bounds and still cross the contact, step and sync paths.
             plan = cellmd::deck::validate_file(&deck, &steps(50)).unwrap();
