@@ -22,7 +22,6 @@ use cellmd::deck::Plan;
 use cellmd::interactions::testing::assert_checks_of;
 use cellmd::interactions::REGISTRY;
 use cellmd::mesh::{point_triangle, triangle_area, PointTriangle};
-use cellmd::run::{RunOptions, Simulation};
 use cellmd::system::State;
 use common::{position_bits, two_cells, Case};
 use faer::{Mat, Side};
