@@ -463,7 +463,7 @@ fn profile_gpu(plan: &crate::deck::Plan, repetitions: u32, rebuild_rate: Option<
         }
     };
     let t = gpu.profile(repetitions)?;
-    let step = t.check + rate * t.neighbor_build + t.forces + t.integrate + t.contact;
+    let step = t.check + rate * t.neighbor_build + t.forces + t.integrate + t.contact + t.adhesion;
     let n = sim.model.len() as f64;
     let mut table = String::new();
     table += &format!("device: {}\n", context.describe());
@@ -475,6 +475,7 @@ fn profile_gpu(plan: &crate::deck::Plan, repetitions: u32, rebuild_rate: Option<
         ("forces", t.forces, t.forces),
         ("integration", t.integrate, t.integrate),
         ("contact and step clamp", t.contact, t.contact),
+        ("adhesion node/weight", t.adhesion, t.adhesion),
     ];
     for (name, per_call, per_step) in rows {
         table += &format!("{name:<26} {:>14.1} {:>11.1}%\n", per_call * 1e6, 100.0 * per_step / step);

@@ -22,7 +22,6 @@ use cellmd::deck::Plan;
 use cellmd::interactions::testing::assert_checks_of;
 use cellmd::interactions::REGISTRY;
 use cellmd::mesh::{point_triangle, triangle_area, PointTriangle};
-use cellmd::run::{RunOptions, Simulation};
 use cellmd::system::State;
 use common::{position_bits, two_cells, Case};
 use faer::{Mat, Side};
@@ -255,11 +254,4 @@ fn adhesion_runs_are_bit_identical_on_one_and_two_threads() {
     assert_eq!(one.forces.virial.map(f64::to_bits), two.forces.virial.map(f64::to_bits));
     let index = REGISTRY.iter().position(|i| i.name() == "contact_adhesion").unwrap();
     assert!(one.forces.energy_by_interaction[index] < 0.0, "the cells never adhered");
-}
-
-#[test]
-fn the_gpu_refuses_adhesion() {
-    let case = cells_case(ADHESION, "temperature 0\ntimestep 1e-3\nrun 0\n");
-    let sim = Simulation::before_first_run(&case.plan(), RunOptions::default()).unwrap();
-    assert_eq!(sim.cpu_only_feature(), Some("area-weighted contact terms between bodies (`contact_adhesion`) run on the CPU backend only"));
 }

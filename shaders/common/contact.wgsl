@@ -129,22 +129,21 @@ fn contact_step_fraction(a: f32, b: f32, limit: f32) -> f32 {
     return u * u;
 }
 
-@compute @workgroup_size(256)
-fn contact_forces(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) local: u32) {
-    let i = chunk_particle(wg, local);
-    if !in_chunk(i) || halted() {
-        return;
-    }
-    let body = contact_body(i);
-    if body == NO_BODY {
-        return;
-    }
-    var f = vec3<f32>(0.0);
-    var e = 0.0;
-    var closest = P.contact_dhat;
+// What the faces near node i do to it (the node part of the contact pass):
+// the node–face terms' force and energy, and its closest face distance
+// (at most d̂); with `track`, each area-weighted rule's nearest face too
+// (shaders/common/adhesion.wgsl).
+struct ContactNode {
+    f: vec3<f32>,
+    e: f32,
+    closest: f32,
+}
+
+fn contact_node_part(i: u32, body: u32, track: bool) -> ContactNode {
+    var out = ContactNode(vec3<f32>(0.0), 0.0, P.contact_dhat);
     let row = nlist_row(i);
     let count = min(nlist[row], P.nlist_cap);
-    // As a node: the faces whose first corner is a neighbour of another body.
+    // The faces whose first corner is a neighbour of another body.
     for (var k = 0u; k < count; k++) {
         let j = nlist[row + 1u + k] & ~CONTACT_ONLY;
         let other = contact_body(j);
@@ -157,15 +156,46 @@ fn contact_forces(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocatio
         }
         let faces_end = topo[P.off_first_start + j + 1u];
         for (var q = topo[P.off_first_start + j]; q < faces_end; q++) {
-            let pair = contact_pair(i, topo[P.off_first_faces + q]);
-            closest = min(closest, pair.d);
+            let face = topo[P.off_first_faces + q];
+            let pair = contact_pair(i, face);
+            out.closest = min(out.closest, pair.d);
             let b = contact_radial(types, pair.d);
             if b.de_dr != 0.0 {
-                f -= b.de_dr * pair.n;
-                e += b.energy;
+                out.f -= b.de_dr * pair.n;
+                out.e += b.energy;
+            }
+            if track && pair.d < P.contact_dhat {
+                adhesion_track(i, types, face, pair.d);
             }
         }
     }
+    return out;
+}
+
+@compute @workgroup_size(256)
+fn contact_forces(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    let i = chunk_particle(wg, local);
+    if !in_chunk(i) || halted() {
+        return;
+    }
+    let body = contact_body(i);
+    if body == NO_BODY {
+        return;
+    }
+    // As a node (with area-weighted rules: done by `adhesion_nodes`, which
+    // left the closest distance), then its own adhesion forces.
+    var part = ContactNode(vec3<f32>(0.0), 0.0, 0.0);
+    if P.n_arules == 0u {
+        part = contact_node_part(i, body, false);
+    } else {
+        let own = adhesion_own(i);
+        part = ContactNode(own.xyz, own.w, surf[adhesion_closest(i)].x);
+    }
+    var f = part.f;
+    var e = part.e;
+    var closest = part.closest;
+    let row = nlist_row(i);
+    let count = min(nlist[row], P.nlist_cap);
     // As a corner: each of its faces against the neighbours of other bodies.
     let corner_end = topo[P.off_corner_start + i + 1u];
     for (var q = topo[P.off_corner_start + i]; q < corner_end; q++) {
@@ -204,6 +234,9 @@ fn contact_forces(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocatio
             let b = contact_radial(types, pair.d);
             if b.de_dr != 0.0 {
                 f += b.de_dr * pair.w[role] * pair.n;
+            }
+            if P.n_arules > 0u {
+                f += adhesion_corner(node, face, role, types, pair);
             }
         }
     }

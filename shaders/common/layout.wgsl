@@ -52,6 +52,9 @@ struct Params {
     time_hi: f32, time_lo: f32, dt: f32, clock_pad: f32,
     // fractional `special_bonds` partners (src/gpu/special.rs): `topo` offsets (CSR by particle), entries
     off_special_offsets: u32, off_special: u32, special_pad0: u32, special_pad1: u32,
+    // area-weighted contact (src/gpu/adhesion.rs): `topo` sections (rule slots per type pair: CSR; each slot's rule), slots, then `surf` regions
+    off_arule_start: u32, off_arule_list: u32, off_arules: u32, n_arules: u32,
+    off_aclosest: u32, off_aswitch: u32, off_apull: u32, adhesion_pad: u32,
 }
 
 @group(0) @binding(0) var<uniform> P: Params;

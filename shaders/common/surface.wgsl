@@ -49,12 +49,16 @@ fn surf_node_energy(k: u32) -> u32 {
     return 4u * P.n_faces + P.n_bodies + 5u * P.n_edges + P.n_body_nodes + k;
 }
 
-// Face f's geometry from its edge vectors (each an exact fixed-point
-// minimum-image difference rounded once to f32).
+// Face f's geometry (`triangle_geometry` of its corners).
 fn face_geometry(f: u32) -> FaceGeometry {
-    let a = face_word(f, 0u);
-    let x1 = separation(a, face_word(f, 1u));
-    let x2 = separation(a, face_word(f, 2u));
+    return triangle_geometry(face_word(f, 0u), face_word(f, 1u), face_word(f, 2u));
+}
+
+// The geometry of triangle (a, b, c) (particles) from its edge vectors
+// (each an exact fixed-point minimum-image difference rounded once to f32).
+fn triangle_geometry(a: u32, b: u32, c: u32) -> FaceGeometry {
+    let x1 = separation(a, b);
+    let x2 = separation(a, c);
     let n = cross(x1, x2);
     let twice = length(n);
     let unit = n / twice;

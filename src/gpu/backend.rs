@@ -22,6 +22,7 @@
 use glam::DVec3;
 use wgpu::util::DeviceExt;
 
+use super::adhesion::AdhesionPack;
 use super::contact::{reach_message, ContactPack, CONTACT_ONLY, FRACTION_SLOTS};
 use super::context::GpuContext;
 use super::kinetics::{KinKernels, KinLayout};
@@ -79,6 +80,8 @@ pub struct PhaseTimes {
     pub readback: f64,
     /// Node–face contact and the step clamp (0 without contact), apart from `forces`.
     pub contact: f64,
+    /// The area-weighted contact terms' node and weight passes (0 without them), apart from `contact`.
+    pub adhesion: f64,
 }
 
 /// Settings the kernels need besides the model.
@@ -117,6 +120,9 @@ struct Kernels {
     contact_forces: wgpu::ComputePipeline,
     /// Volume elements' corner forces (src/gpu/tetra.rs).
     tetra_forces: wgpu::ComputePipeline,
+    /// Area-weighted contact's node and weight passes (src/gpu/adhesion.rs).
+    adhesion_nodes: wgpu::ComputePipeline,
+    adhesion_weights: wgpu::ComputePipeline,
 }
 
 /// The GPU force engine and integrator for one model.
@@ -164,6 +170,8 @@ pub struct GpuBackend {
     reads: std::cell::Cell<u64>,
     /// Simulated time at the next step (see [`GpuBackend::set_time`]).
     time: f64,
+    /// The area-weighted contact rules (src/gpu/adhesion.rs).
+    adhesion: AdhesionPack,
 }
 
 /// Refuses a storage buffer the adapter cannot bind (wgpu would abort).
@@ -234,18 +242,14 @@ impl GpuBackend {
                 "the GPU backend has no kernels for custom surface terms of bodies (`custom` body lines) yet; use `device cpu`".into()
             );
         }
-        if model.contact_rules.iter().any(|r| !r.interaction.law().runs_on_gpu()) {
-            return Err(
-                "the GPU backend has no kernels for area-weighted contact terms between bodies (`contact_adhesion`) yet; use `device cpu`"
-                    .into(),
-            );
-        }
         let n = model.len();
         if n == 0 {
             return Err("the GPU backend needs at least one particle".into());
         }
         let contact = ContactPack::new(model, &state.positions, sim_box);
-        let (packed, exclusions, contact_fields) = pack_state(model, state, settings, device_kinetics.is_some(), &contact)?;
+        let adhesion = AdhesionPack::new(model, contact.faces())?;
+        let (packed, exclusions, contact_fields, adhesion_fields) =
+            pack_state(model, state, settings, device_kinetics.is_some(), &contact, &adhesion)?;
         let kin_words = match (device_kinetics, state.bonds.as_ref()) {
             (Some(warned), Some(bonds)) => {
                 let (c, kt) = (settings.context.dt, settings.context.kt);
@@ -300,6 +304,7 @@ impl GpuBackend {
             tetra_offsets: packed.tetra_offsets,
             clock: [0.0, 0.0, settings.context.dt as f32, 0.0],
             special_offsets: packed.special_offsets,
+            adhesion: adhesion_fields,
         };
         let device = &ctx.device;
         let init = |label: &str, contents: &[u8], usage: wgpu::BufferUsages| {
@@ -326,7 +331,7 @@ impl GpuBackend {
         let nlist = NeighbourStorage::new(ctx, n as u32, params.nlist_cap, nlist_binding_limit)?;
         let force = zeros("force", 16 * n as u64, rw);
         let status = zeros("status", 4 * STATUS_WORDS as u64, rw);
-        let surf_bytes = 16 * (packed.surf_entries + contact.surf_entries());
+        let surf_bytes = 16 * (packed.surf_entries + contact.surf_entries() + adhesion.surf_entries(n as u32));
         check_binding(ctx, "the surface terms' face and body values", surf_bytes)?;
         let surf = zeros("surf", surf_bytes, rw);
         let args = zeros("dispatch_args", 4 * 12, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT);
@@ -413,6 +418,8 @@ impl GpuBackend {
             advance: pipeline("advance", &main_layout),
             contact_forces: pipeline("contact_forces", &main_layout),
             tetra_forces: pipeline("tetra_forces", &main_layout),
+            adhesion_nodes: pipeline("adhesion_nodes", &main_layout),
+            adhesion_weights: pipeline("adhesion_weights", &main_layout),
         };
         let kinetics = kin_words.map(|(_, layout)| (layout, KinKernels::new(|entry| pipeline(entry, &main_layout))));
         let main_group = bind_main(
@@ -456,6 +463,7 @@ impl GpuBackend {
             kinetics,
             reads: Default::default(),
             time: settings.context.time,
+            adhesion,
         };
         backend.set_clock(settings.context.time);
         backend.upload(state);
@@ -548,7 +556,7 @@ impl GpuBackend {
         if self.kinetics.is_some() {
             return Err("the bond state of device kinetics lives on the device".into());
         }
-        let (packed, _, contact_fields) = pack_state(model, state, &self.settings, false, &self.contact)?;
+        let (packed, _, contact_fields, adhesion_fields) = pack_state(model, state, &self.settings, false, &self.contact, &self.adhesion)?;
         let (topo, fparams) = (pad16(packed.topo), pad16(packed.fparams));
         let fits = |buffer: &wgpu::Buffer, bytes: usize| bytes as u64 <= buffer.size();
         if fits(&self.topo, 4 * topo.len()) && fits(&self.fparams, 4 * fparams.len()) {
@@ -570,6 +578,7 @@ impl GpuBackend {
         self.params.contact = contact_fields;
         self.params.tetra_offsets = packed.tetra_offsets;
         self.params.special_offsets = packed.special_offsets;
+        self.params.adhesion = adhesion_fields;
         self.pending_rebuild |= rebuild;
         Ok(())
     }
@@ -738,6 +747,11 @@ impl GpuBackend {
         force_pass.push((&k.forces, Over::Chunks));
         let forces = time(self, &force_pass, false);
         let contact = if self.has_contact() { time(self, &[(&k.contact_forces, Over::Chunks)], false) } else { 0.0 };
+        let adhesion = if self.adhesion.rules() > 0 {
+            time(self, &[(&k.adhesion_nodes, Over::Chunks), (&k.adhesion_weights, Over::Particles)], false)
+        } else {
+            0.0
+        };
         let integrate = time(self, &[(&k.integrate, particles), (&k.commit, particles), (&k.advance, Over::Groups(1))], false);
         let started = std::time::Instant::now();
         for _ in 0..repetitions {
@@ -746,7 +760,7 @@ impl GpuBackend {
         let readback = started.elapsed().as_secs_f64() / repetitions as f64;
         self.ctx.queue.write_buffer(&self.state, 0, &saved);
         self.pending_rebuild = true;
-        Ok(PhaseTimes { check, neighbor_build, forces, integrate, readback, contact })
+        Ok(PhaseTimes { check, neighbor_build, forces, integrate, readback, contact, adhesion })
     }
 
     /// Dispatches `pipeline` over `over`: wider than the dispatch width,
@@ -808,6 +822,11 @@ impl GpuBackend {
         }
         self.dispatch(pass, &k.forces, Over::Chunks);
         if self.has_contact() {
+            // Area-weighted contact's node and weight passes first (src/gpu/adhesion.rs).
+            if self.adhesion.rules() > 0 {
+                self.dispatch(pass, &k.adhesion_nodes, Over::Chunks);
+                self.dispatch(pass, &k.adhesion_weights, Over::Particles);
+            }
             self.dispatch(pass, &k.contact_forces, Over::Chunks);
         }
         if integrate {
@@ -1026,19 +1045,22 @@ fn initial_capacity(n: usize, sim_box: &SimBox, range: f64, has_pairs: bool) -> 
 /// With `device_kinetics`, every bond is packed as bound with its
 /// exclusions (the device's bound flags switch them off). The contact
 /// sections follow the others in `topo`, the fraction ring the surface
-/// entries in `surf`; returns the layout's contact fields too.
+/// entries in `surf`; returns the layout's contact fields too. The
+/// area-weighted contact sections and `surf` regions follow those.
 fn pack_state(
     model: &Model,
     state: &State,
     settings: &StepSettings,
     device_kinetics: bool,
     contact: &ContactPack,
-) -> Result<(Packed, Exclusions, [u32; 16]), String> {
+    adhesion: &AdhesionPack,
+) -> Result<(Packed, Exclusions, [u32; 16], [u32; 8]), String> {
     let all_bound = state.bonds.as_ref().filter(|_| device_kinetics).map(|b| BondState { bound: vec![true; b.len()], ..b.clone() });
     let bonds = all_bound.as_ref().or(state.bonds.as_ref());
     let bound = bonds.map(|b| b.bound.as_slice());
     let exclusions = Exclusions::from_pairs(model.len(), &model.excluded_pairs(bound));
     let mut packed = pack(model, &exclusions, settings.context.dt, settings.context.kt, bonds)?;
     let fields = contact.append(&mut packed.topo, packed.surf_entries);
-    Ok((packed, exclusions, fields))
+    let adhesion_fields = adhesion.append(&mut packed.topo, packed.surf_entries + contact.surf_entries(), model.len() as u32);
+    Ok((packed, exclusions, fields, adhesion_fields))
 }

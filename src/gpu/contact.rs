@@ -1,6 +1,7 @@
 //! Node–face contact between bodies on the GPU (`contact` lines with a
 //! node–face law: `contact_barrier`), with the explicit step clamp as a
-//! device reduction. Kernels in shaders/common/contact.wgsl; the CPU oracle
+//! device reduction; the area-weighted terms (`contact_adhesion`) join its
+//! pass ([`super::adhesion`]). Kernels in shaders/common/contact.wgsl; the CPU oracle
 //! is src/backend/contact.rs, whose equations these follow:
 //!
 //! - a node p of one body and a face (x_0, x_1, x_2) of another, at the
@@ -32,7 +33,9 @@
 //!
 //! After `forces` (per neighbour-list chunk), `contact_forces` runs once per
 //! contact node i: as a node, over its row in order and each neighbour's
-//! faces (CSR by first corner, in face order); then as a corner, over its
+//! faces (CSR by first corner, in face order; with area-weighted rules this
+//! node part runs in the pass before, `adhesion_nodes`, which also finds the
+//! nearest faces); then as a corner, over its
 //! faces (CSR, in face order) and its row in order. It adds the sum to
 //! `force[i]` (and the node's pair energies to `force[i].w`), so each
 //! particle gathers its own contributions in an order fixed by the data (no
@@ -94,10 +97,10 @@ pub struct ContactPack {
 }
 
 impl ContactPack {
-    /// Packs the bodies some contact rule names (empty without node–face rules).
+    /// Packs the bodies some contact rule names (empty without contact rules).
     pub fn new(model: &Model, x: &[glam::DVec3], sim_box: &crate::system::SimBox) -> Self {
         let node_face = |r: usize| matches!(model.contact_rules[r].law, ContactLaw::NodeFace { .. });
-        if !(0..model.contact_rules.len()).any(node_face) {
+        if model.contact_rules.is_empty() {
             return Self::default();
         }
         let types = model.body_type_names.len();

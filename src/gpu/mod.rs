@@ -12,6 +12,8 @@
 //!   deterministic (no float atomics).
 //! - [`contact`]: node–face contact between bodies (`Law::Contact`) and
 //!   the explicit step clamp as a device reduction.
+//! - [`adhesion`]: area-weighted contact between bodies
+//!   (`Law::ContactArea`: adhesion), in passes around the contact pass.
 //! - [`kinetics`]: bond breaking and rebinding decided on the device, events
 //!   compacted in bond order and drained by the host at synchronisations.
 //! - [`special`]: pairs of bonded neighbours with a fractional
@@ -36,8 +38,7 @@
 //!
 //! Not on the GPU (refused by [`GpuBackend::new`], and by `device gpu`
 //! before a run; `device auto` falls back to the CPU): custom surface terms
-//! of bodies and area-weighted contact terms between bodies
-//! (`Law::ContactArea`: adhesion), which have no kernel yet. Bond kinetics
+//! of bodies, which have no kernel yet. Bond kinetics
 //! are decided on the device for the rules [`kinetics`] ports, else on the
 //! host after every step (see [`backend`]).
 //!
@@ -55,6 +56,7 @@
 //! remaining difference from the CPU is the f32 force and displacement
 //! rounding (relative ≈ 1e-7 per step), measured in `tests/gpu.rs`.
 
+pub mod adhesion;
 pub mod backend;
 pub mod contact;
 pub mod context;

@@ -89,6 +89,8 @@ pub struct Params {
     pub clock: [f32; 4],
     /// Fractional `special_bonds` partners (special.wgsl): `topo` offsets, entries, 2 × padding.
     pub special_offsets: [u32; 4],
+    /// Area-weighted contact (adhesion.wgsl): layout.wgsl's `off_arule_start` … (src/gpu/adhesion.rs).
+    pub adhesion: [u32; 8],
 }
 
 /// The GPU's 64-bit fixed point (layout.wgsl): a length x is the integer

@@ -15,10 +15,13 @@
 //! Node–face contact laws ([`Law::Contact`]) define `NAME_contact(p, d)`,
 //! b(d) as a `Radial` of the node–face distance, dispatched by
 //! `contact_law` from the contact kernel (src/gpu/contact.rs).
+//! Area-weighted contact laws ([`Law::ContactArea`]: adhesion) define
+//! `NAME_switch(p, d)` (s and s′ as a `Radial`) and `NAME_density(p)` (ε),
+//! dispatched by `contact_area_switch` and `contact_area_density` from the
+//! adhesion kernels (src/gpu/adhesion.rs).
 //!
 //! Only laws with a GPU kernel take part ([`Law::runs_on_gpu`]). Custom
-//! body terms and area-weighted contact laws ([`Law::ContactArea`]:
-//! adhesion between bodies) have none yet: they have no evaluator file, no
+//! body terms have none yet: they have no evaluator file, no
 //! dispatch case, and the GPU backend refuses decks that use them, so such a
 //! deck never runs on the GPU without those forces. A WGSL file for a law without the kernel to call it is refused
 //! by a test, so a shader cannot pretend to cover one.
@@ -44,8 +47,8 @@ mod embedded {
 pub use embedded::{COMMON_SHADERS, INTERACTION_SHADERS};
 
 /// The common files in the order they must appear (declarations first).
-const COMMON_ORDER: [&str; 10] =
-    ["layout", "philox", "neighbor", "forces", "surface", "integrate", "contact", "kinetics", "tetra", "special"];
+const COMMON_ORDER: [&str; 11] =
+    ["layout", "philox", "neighbor", "forces", "surface", "integrate", "contact", "kinetics", "tetra", "special", "adhesion"];
 
 fn common(name: &str) -> &'static str {
     COMMON_SHADERS.iter().find(|(stem, _)| *stem == name).map(|(_, src)| *src).unwrap_or_else(|| panic!("shaders/common/{name}.wgsl"))
@@ -69,6 +72,9 @@ fn dispatch(custom: &CustomSource) -> String {
     let mut node = String::from("fn node_law(kind: u32, p: array<f32, 8>, m: f32, a: f32) -> NodeCurvature {\n    switch kind {\n");
     // Node–face contact laws (src/gpu/contact.rs): b(d) as a Radial of the distance.
     let mut contact = String::from("fn contact_law(kind: u32, p: array<f32, 8>, d: f32) -> Radial {\n    switch kind {\n");
+    // Area-weighted contact laws (src/gpu/adhesion.rs): the switch s(d), s′(d) and the density ε.
+    let mut area_switch = String::from("fn contact_area_switch(kind: u32, p: array<f32, 8>, d: f32) -> Radial {\n    switch kind {\n");
+    let mut area_density = String::from("fn contact_area_density(kind: u32, p: array<f32, 8>) -> f32 {\n    switch kind {\n");
     let mut tetra = String::from(
         "fn tetra_law(kind: u32, p: array<f32, 8>, f: mat3x3<f32>, j: f32, f_inv_t: mat3x3<f32>) -> TetraDensity {\n    switch kind {\n",
     );
@@ -82,7 +88,11 @@ fn dispatch(custom: &CustomSource) -> String {
             Law::Surface { gpu: SurfaceGpu::NodeCurvature, .. } => (&mut node, format!("{name}_node(p, m, a)")),
             Law::Contact { .. } => (&mut contact, format!("{name}_contact(p, d)")),
             Law::Tetra(_) => (&mut tetra, format!("{name}_tetra(p, f, j, f_inv_t)")),
-            Law::Surface { .. } | Law::ContactArea { .. } => continue,
+            Law::ContactArea { .. } => {
+                writeln!(area_switch, "        case {index}u: {{ return {name}_switch(p, d); }}").unwrap();
+                (&mut area_density, format!("{name}_density(p)"))
+            }
+            Law::Surface { .. } => continue,
         };
         writeln!(out, "        case {index}u: {{ return {call}; }}").unwrap();
     }
@@ -96,7 +106,9 @@ fn dispatch(custom: &CustomSource) -> String {
     node.push_str("        default: { return NodeCurvature(0.0, 0.0, 0.0); }\n    }\n}\n");
     contact.push_str("        default: { return RADIAL_ZERO; }\n    }\n}\n");
     tetra.push_str("        default: { return TetraDensity(0.0, mat3x3<f32>()); }\n    }\n}\n");
-    radial + &three + &one + &surface + &node + &contact + &tetra
+    area_switch.push_str("        default: { return RADIAL_ZERO; }\n    }\n}\n");
+    area_density.push_str("        default: { return 0.0; }\n    }\n}\n");
+    radial + &three + &one + &surface + &node + &contact + &tetra + &area_switch + &area_density
 }
 
 /// The whole program for models without custom terms.
@@ -182,6 +194,12 @@ mod tests {
         assert_eq!(tetra, ["neo_hookean", "linear_elastic"]);
         for name in tetra {
             assert!(compose().contains(&format!("return {name}_tetra(p, f, j, f_inv_t);")), "{name} has no `tetra_law` case");
+        }
+        let area: Vec<&str> = REGISTRY.iter().filter(|i| matches!(i.law(), Law::ContactArea { .. })).map(|i| i.name()).collect();
+        assert_eq!(area, ["contact_adhesion"]);
+        for name in area {
+            assert!(compose().contains(&format!("return {name}_switch(p, d);")), "{name} has no `contact_area_switch` case");
+            assert!(compose().contains(&format!("return {name}_density(p);")), "{name} has no `contact_area_density` case");
         }
     }
 

@@ -461,12 +461,10 @@ impl KindLaw for TetraLaw {
 impl Law {
     /// Whether the GPU backend has a kernel for this law (and so its
     /// interaction a `shaders/interactions/NAME.wgsl` evaluator): every law
-    /// but the surface laws without a GPU form, the area-weighted contact
-    /// laws and the volume elements.
+    /// but the surface laws without a GPU form (custom body terms).
     pub fn runs_on_gpu(&self) -> bool {
         match self {
             Law::Surface { gpu, .. } => *gpu != SurfaceGpu::None,
-            Law::ContactArea { .. } => false,
             _ => true,
         }
     }

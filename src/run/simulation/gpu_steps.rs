@@ -199,8 +199,6 @@ impl Simulation {
             Some("constrained bonds (`constrain`) run on the CPU backend only")
         } else if self.model.has_cpu_only_surface_terms() {
             Some("custom surface terms of bodies (`custom` body lines) run on the CPU backend only")
-        } else if self.model.contact_rules.iter().any(|r| !r.interaction.law().runs_on_gpu()) {
-            Some("area-weighted contact terms between bodies (`contact_adhesion`) run on the CPU backend only")
         } else {
             None
         }
