@@ -89,6 +89,8 @@ pub struct Params {
     pub clock: [f32; 4],
     /// Fractional `special_bonds` partners (special.wgsl): `topo` offsets, entries, 2 × padding.
     pub special_offsets: [u32; 4],
+    /// Protocols (protocol.wgsl): held words present, ramped slots, the ramp table's first step, `protocol` offsets, 2 × padding.
+    pub protocol: [u32; 8],
 }
 
 /// The GPU's 64-bit fixed point (layout.wgsl): a length x is the integer

@@ -44,8 +44,8 @@ mod embedded {
 pub use embedded::{COMMON_SHADERS, INTERACTION_SHADERS};
 
 /// The common files in the order they must appear (declarations first).
-const COMMON_ORDER: [&str; 10] =
-    ["layout", "philox", "neighbor", "forces", "surface", "integrate", "contact", "kinetics", "tetra", "special"];
+const COMMON_ORDER: [&str; 11] =
+    ["layout", "philox", "neighbor", "forces", "surface", "integrate", "contact", "kinetics", "tetra", "special", "protocol"];
 
 fn common(name: &str) -> &'static str {
     COMMON_SHADERS.iter().find(|(stem, _)| *stem == name).map(|(_, src)| *src).unwrap_or_else(|| panic!("shaders/common/{name}.wgsl"))
@@ -96,7 +96,12 @@ fn dispatch(custom: &CustomSource) -> String {
     node.push_str("        default: { return NodeCurvature(0.0, 0.0, 0.0); }\n    }\n}\n");
     contact.push_str("        default: { return RADIAL_ZERO; }\n    }\n}\n");
     tetra.push_str("        default: { return TetraDensity(0.0, mat3x3<f32>()); }\n    }\n}\n");
-    radial + &three + &one + &surface + &node + &contact + &tetra
+    // Velocity fields of moving groups (src/gpu/protocol.rs).
+    let movers = format!(
+        "fn mover_velocity(m: u32, x: vec3<f32>, t: f32) -> vec3<f32> {{\n    switch m {{\n{}        default: {{ return vec3<f32>(0.0); }}\n    }}\n}}\n",
+        custom.mover_cases
+    );
+    radial + &three + &one + &surface + &node + &contact + &tetra + &movers
 }
 
 /// The whole program for models without custom terms.
