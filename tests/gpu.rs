@@ -1421,8 +1421,8 @@ fn formulas_of_t_see_the_clamped_clock_inside_a_gpu_chunk() {
 /// springs, with thermo every 100 steps, until its load reaches 20. The
 /// device sums the load over the members after every step's forces (f32,
 /// relative error ≈ 1e-6) and stops where the CPU does: the load grows by
-/// ≈ 1 % a step near the target, so a crossing within f32 of it would need a
-/// coincidence the test prints the margin of. The centre ends bit-identical
+/// ≈ 1 % a step near the target, so only a crossing within ≈ 1e-6 of the
+/// target (odds ≈ 1e-4) could stop a step apart. The centre ends bit-identical
 /// (the same f64 sums, the same number of them); positions within 1e-5 of
 /// the distance travelled. The stop is neither the first step nor the last.
 #[test]

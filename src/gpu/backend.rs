@@ -255,7 +255,7 @@ impl GpuBackend {
         sim_box: &SimBox,
         settings: &StepSettings,
         device_kinetics: Option<&[bool]>,
-        protocol: Option<&DeviceProtocol>,
+        device_protocol: Option<&DeviceProtocol>,
     ) -> Result<Self, String> {
         if model.has_cpu_only_surface_terms() {
             return Err(
@@ -359,11 +359,15 @@ impl GpuBackend {
         check_binding(ctx, "the surface terms' face and body values", surf_bytes)?;
         let surf = zeros("surf", surf_bytes, rw);
         let args = zeros("dispatch_args", 4 * 12, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT);
-        let mut protocol_pack = protocol.map(|p| ProtocolPack::new(p, model, settings.context.dt, &fixed));
+        let mut protocol_pack = device_protocol.map(|p| ProtocolPack::new(p, model, settings.context.dt, &fixed));
         let mut params = params;
-        let protocol_buffer = match &mut protocol_pack {
+        let protocol = match &mut protocol_pack {
             Some(pack) => {
-                let slots = pack.slots(model, &packed_terms(&packed.fparam_offsets, &packed.own_bonds, packed.first_own_term), state.bonds.as_ref());
+                let slots = pack.slots(
+                    model,
+                    &packed_terms(&packed.fparam_offsets, &packed.own_bonds, packed.first_own_term),
+                    state.bonds.as_ref(),
+                );
                 let at = pack.fields[4] as usize;
                 pack.words[at..at + slots.len()].copy_from_slice(&slots);
                 params.protocol = pack.fields;
@@ -411,7 +415,7 @@ impl GpuBackend {
             entries: &[wgpu::BindGroupEntry { binding: 0, resource: args.as_entire_binding() }],
         });
         let mut custom = super::custom::source(model)?;
-        custom.mover_cases = protocol.map(super::protocol::mover_cases).transpose()?.unwrap_or_default();
+        custom.mover_cases = device_protocol.map(super::protocol::mover_cases).transpose()?.unwrap_or_default();
         let program = shader::compose_with(&custom);
         let module = device
             .create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("cellmd"), source: wgpu::ShaderSource::Wgsl(program.into()) });
@@ -466,7 +470,7 @@ impl GpuBackend {
         let main_group = bind_main(
             device,
             &layout,
-            [&uniform, &state_buffer, &next, &reference, &topo, &fparams, &cell_count, &cell_data, &force, &status, &surf, &kin, &protocol_buffer],
+            [&uniform, &state_buffer, &next, &reference, &topo, &fparams, &cell_count, &cell_data, &force, &status, &surf, &kin, &protocol],
             &nlist,
         );
         let mut backend = Self {
@@ -504,7 +508,7 @@ impl GpuBackend {
             kinetics,
             reads: Default::default(),
             time: settings.context.time,
-            protocol_buffer,
+            protocol_buffer: protocol,
             protocol: protocol_pack,
         };
         backend.set_clock(settings.context.time);
@@ -623,7 +627,8 @@ impl GpuBackend {
         self.params.special_offsets = packed.special_offsets;
         if let Some(pack) = &mut self.protocol {
             // Bonds with their own terms were renumbered: the ramped slots follow.
-            let slots = pack.slots(model, &packed_terms(&packed.fparam_offsets, &packed.own_bonds, packed.first_own_term), state.bonds.as_ref());
+            let slots =
+                pack.slots(model, &packed_terms(&packed.fparam_offsets, &packed.own_bonds, packed.first_own_term), state.bonds.as_ref());
             self.ctx.queue.write_buffer(&self.protocol_buffer, 4 * pack.fields[4] as u64, words(&slots));
             self.params.protocol = pack.fields;
         }

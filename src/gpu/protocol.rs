@@ -170,7 +170,9 @@ impl ProtocolPack {
         let slot_capacity = protocol
             .ramps
             .iter()
-            .map(|(term, _)| 1 + if let TermRef::BondType(t) = term { model.bond_type.iter().filter(|&&b| b as usize == *t).count() } else { 0 })
+            .map(|(term, _)| {
+                1 + if let TermRef::BondType(t) = term { model.bond_type.iter().filter(|&&b| b as usize == *t).count() } else { 0 }
+            })
             .sum::<usize>() as u32;
         let off_ramp_slots = words.len() as u32;
         let off_ramp_table = off_ramp_slots + slot_capacity;
@@ -190,7 +192,8 @@ impl ProtocolPack {
             let table = words.len() as u32;
             words.resize(words.len() + 3 * (RAMP_ROWS as usize + 1), 0);
             let until = drive.until.unwrap_or(f64::INFINITY);
-            let record = [term, members, members + external.members.len() as u32, 0, 0, u32::from(drive.until.is_some()), (until as f32).to_bits()];
+            let record =
+                [term, members, members + external.members.len() as u32, 0, 0, u32::from(drive.until.is_some()), (until as f32).to_bits()];
             let at = off_drives + DRIVE_WORDS * d;
             words[at..at + 7].copy_from_slice(&record);
             words[at + 7..at + 10].copy_from_slice(&centre);

@@ -61,7 +61,8 @@ impl GpuSteps {
         let (model, state, sim_box) = (&sim.model, &sim.state, &sim.sim_box);
         let protocol = sim.protocols.for_device(model);
         let warned = device_kinetics.then(|| sim.kinetics.warned(model));
-        let gpu = GpuBackend::with_protocol(context, model, state, sim_box, &settings, warned.as_deref(), &protocol).map_err(RunError::Setup)?;
+        let gpu =
+            GpuBackend::with_protocol(context, model, state, sim_box, &settings, warned.as_deref(), &protocol).map_err(RunError::Setup)?;
         let evolving = sim.model.bond_kinetics.iter().flat_map(|k| &k.rules).any(|r| r.rule.evolves_every_step());
         Ok(Self { context: context.clone(), settings, gpu, evolving, resets: 0, stopping: false, device_kinetics, protocol })
     }
