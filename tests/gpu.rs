@@ -692,13 +692,25 @@ fn every_input_deck_runs_on_the_gpu_like_on_the_cpu() {
             // quasi-static stages: the deck takes no step for the GPU to take.
             continue;
         }
-        match run_deck_deterministic(&deck, DevicePreference::Gpu, 10_000, false) {
+        // A deck whose prescribed motion leaves its box within 10⁴ steps fails
+        // on the CPU too (tensegrity_substrate.in: its adhesions slide 1 µm per
+        // 50-step stage); it is compared over a tenth of the steps, down to 100.
+        let mut steps = 10_000;
+        let mut first = run_deck_deterministic(&deck, DevicePreference::Gpu, steps, false);
+        while let Err(e) = &first {
+            if steps == 100 || run_deck_deterministic(&deck, DevicePreference::Cpu, steps, false).is_ok() {
+                break;
+            }
+            println!("{:40} fails within {steps} steps on both backends (GPU: {e})", deck.display());
+            steps /= 10;
+            first = run_deck_deterministic(&deck, DevicePreference::Gpu, steps, false);
+        }
+        match first {
             Ok((_, mut gpu)) => {
                 // A deck whose CPU run itself moves more than the bound when its start is
                 // rounded to f32 is chaotic over that horizon (cell_contact.in: the
                 // contact step clamp makes every clamped step's length hinge on one
                 // pair); it is compared over a tenth of the steps, down to 100.
-                let mut steps = 10_000;
                 loop {
                     let (start, cpu) = run_deck_deterministic(&deck, DevicePreference::Cpu, steps, false).unwrap();
                     let (_, cpu32) = run_deck_deterministic(&deck, DevicePreference::Cpu, steps, true).unwrap();
