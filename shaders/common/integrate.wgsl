@@ -14,26 +14,16 @@ fn current_step() -> vec2<u32> {
 
 // The simulated time at the start of the current step, as the CPU's clock:
 // the call's start time (two f32 words, host-computed in f64) plus the
-// fractions of dt the steps done in this call took, times dt (externals with
-// expression parameters read it). Without contact every step is whole; with
-// contact `advance` keeps the running sum of the fractions beside each
-// step's own in the ring (a call takes at most FRACTION_SLOTS steps).
+// fractions of dt the steps done in this call took (`advance` sums them; each
+// is 1 unless the contact clamp shortened the step) times dt (externals with
+// expression parameters and velocity fields of moved groups read it).
 fn sim_time() -> f32 {
-    let done = atomicLoad(&status[ST_STEPS_DONE]);
-    return P.time_hi + (P.time_lo + fractions_before(done) * P.dt);
-}
-
-// The sum of the fractions of dt of this call's first `done` steps.
-fn fractions_before(done: u32) -> f32 {
-    if P.n_cfaces == 0u || done == 0u {
-        return f32(done);
-    }
-    return surf[P.off_fractions + (done - 1u) % FRACTION_SLOTS].y;
+    return P.time_hi + (P.time_lo + bitcast<f32>(atomicLoad(&status[ST_ELAPSED])) * P.dt);
 }
 
 // Particle i's drift dt·F/γ.
 fn drift(i: u32) -> vec3<f32> {
-    return force[i].xyz * fparams[P.off_mobility + topo[i]];
+    return free_axes(i) * force[i].xyz * fparams[P.off_mobility + topo[i]];
 }
 
 // Particle i's noise √(2kT·dt/γ)·ξ of this step.
@@ -47,6 +37,40 @@ fn noise(i: u32) -> vec3<f32> {
         return amplitude * gaussian3(seed, current_step(), i);
     }
     return amplitude * noise3(seed, current_step(), i);
+}
+
+// A displacement in fixed point: q is a power of two, so |dx|/q is exact
+// in f32 and splits exactly into an integer and a 32-bit fraction (bits
+// below q·2⁻³² of very small steps are dropped: < 1e-15 of the box); the
+// sign is applied in fixed point, so no rounding depends on it.
+fn fixed_of_length(dx: vec3<f32>) -> Fixed3 {
+    let v = abs(dx) / P.box_len.w;
+    let whole = floor(v);
+    let magnitude = Fixed3(vec3<i32>(whole), vec3<u32>((v - whole) * 4294967296.0));
+    let negated = fixed_sub(Fixed3(vec3<i32>(0), vec3<u32>(0u)), magnitude);
+    let negative = dx < vec3<f32>(0.0);
+    return Fixed3(select(magnitude.h, negated.h, negative), select(magnitude.f, negated.f, negative));
+}
+
+// A position and its image counters; `ok` false: the step is refused.
+struct Placed {
+    x: Fixed3,
+    img: vec3<i32>,
+    ok: bool,
+}
+
+// Wraps x into the box on periodic axes (in fixed point), counting images.
+fn wrap_into_box(x0: Fixed3, img0: vec3<i32>) -> Placed {
+    var x = x0;
+    let l = box_fixed();
+    let zero = vec3<i32>(0);
+    let per = P.periodic.xyz == vec3<u32>(1u);
+    let from_top = fixed_sub(x, l);
+    let wrap_down = per & (from_top.h >= zero); // x ≥ L
+    let wrap_up = per & (x.h < zero); // x < 0
+    let from_bottom = fixed_add(x, l);
+    x = Fixed3(select(select(x.h, from_bottom.h, wrap_up), from_top.h, wrap_down), select(select(x.f, from_bottom.f, wrap_up), from_top.f, wrap_down));
+    return Placed(x, img0 + vec3<i32>(wrap_down) - vec3<i32>(wrap_up), true);
 }
 
 // The step takes s·dt (s < 1 only where the contact step clamp shortened
@@ -65,27 +89,14 @@ fn integrate(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_ind
         atomicOr(&status[ST_HALTED], HALT_BLOWUP);
         return;
     }
-    // The displacement in fixed point: q is a power of two, so |dx|/q is exact
-    // in f32 and splits exactly into an integer and a 32-bit fraction (bits
-    // below q·2⁻³² of very small steps are dropped: < 1e-15 of the box); the
-    // sign is applied in fixed point, so no rounding depends on it.
-    let v = abs(dx) / P.box_len.w;
-    let whole = floor(v);
-    let magnitude = Fixed3(vec3<i32>(whole), vec3<u32>((v - whole) * 4294967296.0));
-    let negated = fixed_sub(Fixed3(vec3<i32>(0), vec3<u32>(0u)), magnitude);
-    let negative = dx < vec3<f32>(0.0);
-    let step = Fixed3(select(magnitude.h, negated.h, negative), select(magnitude.f, negated.f, negative));
-    var x = fixed_add(fixed_of(i), step);
-    var img = image_of(i);
-    let l = box_fixed();
-    let zero = vec3<i32>(0);
-    let per = P.periodic.xyz == vec3<u32>(1u);
-    let from_top = fixed_sub(x, l);
-    let wrap_down = per & (from_top.h >= zero); // x ≥ L
-    let wrap_up = per & (x.h < zero); // x < 0
-    let from_bottom = fixed_add(x, l);
-    x = Fixed3(select(select(x.h, from_bottom.h, wrap_up), from_top.h, wrap_down), select(select(x.f, from_bottom.f, wrap_up), from_top.f, wrap_down));
-    img += vec3<i32>(wrap_down) - vec3<i32>(wrap_up);
+    let placed = prescribe(i, wrap_into_box(fixed_add(fixed_of(i), fixed_of_length(dx)), image_of(i)));
+    if !placed.ok {
+        atomicMin(&status[ST_BLOWUP_PARTICLE], i);
+        atomicOr(&status[ST_HALTED], HALT_BLOWUP);
+        return;
+    }
+    let x = placed.x;
+    let img = placed.img;
     next[i] = vec4<u32>(bitcast<vec3<u32>>(x.h), 0u);
     next[P.n + i] = vec4<u32>(x.f, 0u);
     next[2u * P.n + i] = vec4<u32>(bitcast<vec3<u32>>(img), 0u);
@@ -102,17 +113,18 @@ fn commit(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index)
     state[2u * P.n + i] = next[2u * P.n + i];
 }
 
-// Counts the step; with contact, records its fraction s (and the running
-// sum of this call's fractions, for `sim_time`) in the ring the host reads
-// (src/gpu/contact.rs) and resets s to 1 for the next step.
+// Counts the step and adds its fraction s to the call's elapsed fractions
+// (`sim_time`); with contact, records s in the ring the host reads
+// (src/gpu/contact.rs); resets s to 1 for the next step.
 @compute @workgroup_size(1)
 fn advance() {
     if !halted() {
         let done = atomicAdd(&status[ST_STEPS_DONE], 1u);
         if P.n_cfaces > 0u {
-            let s = bitcast<f32>(atomicLoad(&status[ST_FRACTION]));
-            surf[P.off_fractions + done % FRACTION_SLOTS] = vec4<f32>(s, fractions_before(done) + s, 0.0, 0.0);
+            surf[P.off_fractions + done % FRACTION_SLOTS] = vec4<f32>(bitcast<f32>(atomicLoad(&status[ST_FRACTION])), 0.0, 0.0, 0.0);
         }
+        let elapsed = bitcast<f32>(atomicLoad(&status[ST_ELAPSED])) + bitcast<f32>(atomicLoad(&status[ST_FRACTION]));
+        atomicStore(&status[ST_ELAPSED], bitcast<u32>(elapsed));
         atomicStore(&status[ST_FRACTION], 0x3f800000u);
     }
 }

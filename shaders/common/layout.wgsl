@@ -55,6 +55,8 @@ struct Params {
     // area-weighted contact (src/gpu/adhesion.rs): `topo` sections (rule slots per type pair: CSR; each slot's rule), slots, then `surf` regions
     off_arule_start: u32, off_arule_list: u32, off_arules: u32, n_arules: u32,
     off_aclosest: u32, off_aswitch: u32, off_apull: u32, adhesion_pad: u32,
+    // protocols (shaders/common/protocol.wgsl): held-coordinate words present, ramped slots, the ramp table's first step, `protocol` offsets, driven indenters
+    protocol_held: u32, n_ramp_slots: u32, ramp_first_lo: u32, off_movers: u32, off_ramp_slots: u32, off_ramp_table: u32, n_drives: u32, off_drives: u32,
 }
 
 @group(0) @binding(0) var<uniform> P: Params;
@@ -62,7 +64,8 @@ struct Params {
 @group(0) @binding(2) var<storage, read_write> next: array<vec4<u32>>;
 @group(0) @binding(3) var<storage, read_write> reference: array<vec4<u32>>;
 @group(0) @binding(4) var<storage, read> topo: array<u32>;
-@group(0) @binding(5) var<storage, read> fparams: array<f32>;
+// Read-write: ramps write their parameters' values per step (shaders/common/protocol.wgsl).
+@group(0) @binding(5) var<storage, read_write> fparams: array<f32>;
 @group(0) @binding(6) var<storage, read_write> cell_count: array<atomic<u32>>;
 @group(0) @binding(7) var<storage, read_write> cell_data: array<u32>;
 // The neighbour-list rows of the bound chunk of particles (src/gpu/nlist.rs):
@@ -75,6 +78,8 @@ struct Params {
 @group(0) @binding(12) var<storage, read_write> surf: array<vec4<f32>>;
 // Bond kinetics on the device (shaders/common/kinetics.wgsl; layout in src/gpu/kinetics.rs).
 @group(0) @binding(13) var<storage, read_write> kin: array<atomic<u32>>;
+// Protocols on the device: held coordinates, moving groups, ramps (shaders/common/protocol.wgsl).
+@group(0) @binding(14) var<storage, read_write> protocol: array<u32>;
 
 struct Chunk {
     first: u32,  // first particle of the chunk
@@ -113,6 +118,7 @@ const HALT_BLOWUP: u32 = 2u;
 const HALT_SPAN: u32 = 4u;
 const ST_FRACTION: u32 = 8u;      // bits of this step's fraction s of dt (contact step clamp; 1.0 without)
 const HALT_REACH: u32 = 8u;       // a face edge outgrew the contact search (src/gpu/contact.rs)
+const ST_ELAPSED: u32 = 9u;       // bits of the fractions of dt the steps of this call took, summed (f32; `sim_time`)
 const CONTACT_ONLY: u32 = 0x80000000u; // neighbour-list entry kept for the contact search only
 
 const WORKGROUP: u32 = 256u;

@@ -28,13 +28,14 @@ use super::context::GpuContext;
 use super::kinetics::{KinKernels, KinLayout};
 use super::nlist::NeighbourStorage;
 use super::pack::{cell_grid, pack, FixedPoint, Packed, Params};
+use super::protocol::{DeviceProtocol, PackedTerms, ProtocolPack, RAMP_ROWS};
 use super::shader;
 use crate::integrate::context::StepContext;
 use crate::neighbor::Exclusions;
 use crate::system::{BondState, Model, SimBox, State};
 
 const WORKGROUP: u32 = 256;
-const STATUS_WORDS: usize = 9;
+const STATUS_WORDS: usize = 10;
 const ST_HALTED: usize = 0;
 const ST_OVERFLOW_NEED: usize = 1;
 const ST_BUILDS: usize = 3;
@@ -48,6 +49,8 @@ const HALT_SPAN: u32 = 4;
 const HALT_EVENTS: u32 = 16;
 /// This step's fraction of dt (f32 bits; the contact step clamp, src/gpu/contact.rs).
 const ST_FRACTION: usize = 8;
+/// The fractions of dt of this call's steps, summed (f32 bits; `sim_time` in integrate.wgsl).
+const ST_ELAPSED: usize = 9;
 /// A face edge outgrew the contact search (src/gpu/contact.rs).
 const HALT_REACH: u32 = 8;
 /// Steps per command buffer.
@@ -123,6 +126,10 @@ struct Kernels {
     /// Area-weighted contact's node and weight passes (src/gpu/adhesion.rs).
     adhesion_nodes: wgpu::ComputePipeline,
     adhesion_weights: wgpu::ComputePipeline,
+    /// Ramped parameters' values of the step, driven indenters' load check and advance (src/gpu/protocol.rs).
+    protocol_ramps: wgpu::ComputePipeline,
+    protocol_drive_check: wgpu::ComputePipeline,
+    protocol_drive_advance: wgpu::ComputePipeline,
 }
 
 /// The GPU force engine and integrator for one model.
@@ -172,6 +179,9 @@ pub struct GpuBackend {
     time: f64,
     /// The area-weighted contact rules (src/gpu/adhesion.rs).
     adhesion: AdhesionPack,
+    /// The run's protocols (src/gpu/protocol.rs): their buffer (binding 14) and layout.
+    protocol_buffer: wgpu::Buffer,
+    protocol: Option<ProtocolPack>,
 }
 
 /// Refuses a storage buffer the adapter cannot bind (wgpu would abort).
@@ -209,7 +219,24 @@ fn words<T: bytemuck::Pod>(data: &[T]) -> &[u8] {
 impl GpuBackend {
     /// Uploads the model and state and compiles the kernels.
     pub fn new(ctx: &GpuContext, model: &Model, state: &State, sim_box: &SimBox, settings: &StepSettings) -> Result<Self, String> {
-        Self::build(ctx, model, state, sim_box, settings, None)
+        Self::build(ctx, model, state, sim_box, settings, None, None)
+    }
+
+    /// As [`Self::new`] (or [`Self::with_device_kinetics`] with `warned`),
+    /// with the run's protocols on the device (src/gpu/protocol.rs).
+    pub fn with_protocol(
+        ctx: &GpuContext,
+        model: &Model,
+        state: &State,
+        sim_box: &SimBox,
+        settings: &StepSettings,
+        warned: Option<&[bool]>,
+        protocol: &DeviceProtocol,
+    ) -> Result<Self, String> {
+        if let Some(why) = warned.and_then(|_| super::kinetics::refusal(model)) {
+            return Err(format!("bond kinetics on the device: {why} is decided on the host"));
+        }
+        Self::build(ctx, model, state, sim_box, settings, warned, Some(protocol))
     }
 
     /// As [`Self::new`], with the bond kinetics decided on the device
@@ -226,7 +253,7 @@ impl GpuBackend {
         if let Some(why) = super::kinetics::refusal(model) {
             return Err(format!("bond kinetics on the device: {why} is decided on the host"));
         }
-        Self::build(ctx, model, state, sim_box, settings, Some(warned))
+        Self::build(ctx, model, state, sim_box, settings, Some(warned), None)
     }
 
     fn build(
@@ -236,6 +263,7 @@ impl GpuBackend {
         sim_box: &SimBox,
         settings: &StepSettings,
         device_kinetics: Option<&[bool]>,
+        device_protocol: Option<&DeviceProtocol>,
     ) -> Result<Self, String> {
         if model.has_cpu_only_surface_terms() {
             return Err(
@@ -305,6 +333,7 @@ impl GpuBackend {
             clock: [0.0, 0.0, settings.context.dt as f32, 0.0],
             special_offsets: packed.special_offsets,
             adhesion: adhesion_fields,
+            protocol: [0; 8],
         };
         let device = &ctx.device;
         let init = |label: &str, contents: &[u8], usage: wgpu::BufferUsages| {
@@ -335,6 +364,23 @@ impl GpuBackend {
         check_binding(ctx, "the surface terms' face and body values", surf_bytes)?;
         let surf = zeros("surf", surf_bytes, rw);
         let args = zeros("dispatch_args", 4 * 12, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT);
+        let mut protocol_pack = device_protocol.map(|p| ProtocolPack::new(p, model, settings.context.dt, &fixed));
+        let mut params = params;
+        let protocol = match &mut protocol_pack {
+            Some(pack) => {
+                let slots = pack.slots(
+                    model,
+                    &packed_terms(&packed.fparam_offsets, &packed.own_bonds, packed.first_own_term),
+                    state.bonds.as_ref(),
+                );
+                let at = pack.fields[4] as usize;
+                pack.words[at..at + slots.len()].copy_from_slice(&slots);
+                params.protocol = pack.fields;
+                check_binding(ctx, "the protocols' held coordinates and ramp table", 4 * pack.words.len() as u64)?;
+                init("protocol", words(&pad16(pack.words.clone())), rw)
+            }
+            None => zeros("protocol", 16, rw),
+        };
         let kin = match &kin_words {
             Some((words_, _)) => {
                 check_binding(ctx, "the bond kinetics' state and event buffer", 4 * words_.len() as u64)?;
@@ -349,7 +395,7 @@ impl GpuBackend {
             ty: wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Uniform, has_dynamic_offset: false, min_binding_size: None },
             count: None,
         }];
-        entries.extend((1..=10).map(|b| storage_entry(b, b == 4 || b == 5)));
+        entries.extend((1..=10).map(|b| storage_entry(b, b == 4)));
         // The neighbour list and its chunk's uniform are bound per chunk (nlist.rs).
         entries[8].ty = wgpu::BindingType::Buffer {
             ty: wgpu::BufferBindingType::Storage { read_only: false },
@@ -364,6 +410,7 @@ impl GpuBackend {
         });
         entries.push(storage_entry(12, false));
         entries.push(storage_entry(13, false));
+        entries.push(storage_entry(14, false));
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("cellmd main"), entries: &entries });
         let args_layout = device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("cellmd args"), entries: &[storage_entry(0, false)] });
@@ -372,7 +419,9 @@ impl GpuBackend {
             layout: &args_layout,
             entries: &[wgpu::BindGroupEntry { binding: 0, resource: args.as_entire_binding() }],
         });
-        let program = shader::compose_with(&super::custom::source(model)?);
+        let mut custom = super::custom::source(model)?;
+        custom.mover_cases = device_protocol.map(super::protocol::mover_cases).transpose()?.unwrap_or_default();
+        let program = shader::compose_with(&custom);
         let module = device
             .create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("cellmd"), source: wgpu::ShaderSource::Wgsl(program.into()) });
         let main_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -420,12 +469,15 @@ impl GpuBackend {
             tetra_forces: pipeline("tetra_forces", &main_layout),
             adhesion_nodes: pipeline("adhesion_nodes", &main_layout),
             adhesion_weights: pipeline("adhesion_weights", &main_layout),
+            protocol_ramps: pipeline("protocol_ramps", &main_layout),
+            protocol_drive_check: pipeline("protocol_drive_check", &main_layout),
+            protocol_drive_advance: pipeline("protocol_drive_advance", &main_layout),
         };
         let kinetics = kin_words.map(|(_, layout)| (layout, KinKernels::new(|entry| pipeline(entry, &main_layout))));
         let main_group = bind_main(
             device,
             &layout,
-            [&uniform, &state_buffer, &next, &reference, &topo, &fparams, &cell_count, &cell_data, &force, &status, &surf, &kin],
+            [&uniform, &state_buffer, &next, &reference, &topo, &fparams, &cell_count, &cell_data, &force, &status, &surf, &kin, &protocol],
             &nlist,
         );
         let mut backend = Self {
@@ -464,6 +516,8 @@ impl GpuBackend {
             reads: Default::default(),
             time: settings.context.time,
             adhesion,
+            protocol_buffer: protocol,
+            protocol: protocol_pack,
         };
         backend.set_clock(settings.context.time);
         backend.upload(state);
@@ -485,6 +539,7 @@ impl GpuBackend {
             &s.status,
             &s.surf,
             &s.kin,
+            &s.protocol_buffer,
         ];
         bind_main(&self.ctx.device, &self.layout, buffers, &s.nlist)
     }
@@ -579,6 +634,13 @@ impl GpuBackend {
         self.params.tetra_offsets = packed.tetra_offsets;
         self.params.special_offsets = packed.special_offsets;
         self.params.adhesion = adhesion_fields;
+        if let Some(pack) = &mut self.protocol {
+            // Bonds with their own terms were renumbered: the ramped slots follow.
+            let slots =
+                pack.slots(model, &packed_terms(&packed.fparam_offsets, &packed.own_bonds, packed.first_own_term), state.bonds.as_ref());
+            self.ctx.queue.write_buffer(&self.protocol_buffer, 4 * pack.fields[4] as u64, words(&slots));
+            self.params.protocol = pack.fields;
+        }
         self.pending_rebuild |= rebuild;
         Ok(())
     }
@@ -589,6 +651,7 @@ impl GpuBackend {
         status[ST_SPAN_BODY] = u32::MAX;
         status[ST_FORCE_REBUILD] = force_rebuild as u32;
         status[ST_FRACTION] = 1f32.to_bits();
+        status[ST_ELAPSED] = 0f32.to_bits();
         self.ctx.queue.write_buffer(&self.status, 0, words(&status));
     }
 
@@ -683,6 +746,30 @@ impl GpuBackend {
     pub fn set_time(&mut self, time: f64) {
         self.time = time;
         self.set_clock(time);
+    }
+
+    /// The ramps' values, one row per step in the protocol's ramp order, from
+    /// `first_step`: they must cover every step of the next [`Self::run`]
+    /// (src/gpu/protocol.rs; nothing without ramps).
+    pub fn set_ramps(&mut self, first_step: u64, rows: Vec<Vec<f64>>) {
+        if let Some(pack) = &mut self.protocol {
+            pack.set_values(first_step, rows);
+        }
+    }
+
+    /// Starts the drives of the next [`Self::run`] (src/gpu/protocol.rs):
+    /// per driven indenter (in the protocol's order) its centres from the
+    /// current one, one per step of the run and one, and whether it holds.
+    pub fn set_drives(&mut self, drives: Vec<(Vec<DVec3>, bool)>) {
+        if let Some(pack) = &mut self.protocol {
+            pack.set_drives(drives);
+        }
+    }
+
+    /// Per driven indenter: how many steps of the last [`Self::run`] moved
+    /// it, and whether it holds now.
+    pub fn drive_states(&self) -> Vec<(u64, bool)> {
+        self.protocol.as_ref().map_or_else(Vec::new, ProtocolPack::drive_states)
     }
 
     /// Writes `time` into the parameters as an f32 high part and remainder.
@@ -796,6 +883,9 @@ impl GpuBackend {
         let k = &self.kernels;
         pass.set_bind_group(0, &self.main_group, &self.nlist.offsets(0));
         let kinetics = self.kinetics.as_ref().map(|(layout, kernels)| (Over::Groups(layout.bonds().div_ceil(WORKGROUP)), kernels));
+        if integrate && self.params.protocol[1] > 0 {
+            self.dispatch(pass, &k.protocol_ramps, Over::Groups(self.params.protocol[1].div_ceil(WORKGROUP)));
+        }
         if let Some((_, kin)) = kinetics.filter(|_| integrate) {
             self.dispatch(pass, &kin.room, Over::Groups(1));
         }
@@ -829,12 +919,19 @@ impl GpuBackend {
             }
             self.dispatch(pass, &k.contact_forces, Over::Chunks);
         }
+        let drives = integrate && self.params.protocol[6] > 0;
+        if drives {
+            self.dispatch(pass, &k.protocol_drive_check, Over::Groups(1));
+        }
         if integrate {
             if let Some((bonds, kin)) = kinetics {
                 self.dispatch(pass, &kin.measure, bonds);
             }
             self.dispatch(pass, &k.integrate, Over::Particles);
             self.dispatch(pass, &k.commit, Over::Particles);
+            if drives {
+                self.dispatch(pass, &k.protocol_drive_advance, Over::Groups(1));
+            }
             if let Some((bonds, kin)) = kinetics {
                 self.dispatch(pass, &kin.decide, bonds);
                 self.dispatch(pass, &kin.scan, Over::Groups(1));
@@ -946,7 +1043,20 @@ impl GpuBackend {
             let step = first_step + done;
             // With contact, the ring of step fractions bounds a chunk.
             let most = if self.has_contact() { FRACTION_SLOTS as u64 } else { u32::MAX as u64 / 2 };
-            let chunk = (steps - done).min(most);
+            // With ramps or drives, so do the tables of their values (src/gpu/protocol.rs).
+            let ramped = self.protocol.as_ref().is_some_and(ProtocolPack::ramps);
+            let driven = self.protocol.as_ref().is_some_and(ProtocolPack::drives);
+            let chunk = (steps - done).min(if ramped || driven { most.min(RAMP_ROWS) } else { most });
+            if let Some(pack) = self.protocol.as_mut() {
+                if ramped {
+                    let rows = pack.rows(step, chunk);
+                    self.ctx.queue.write_buffer(&self.protocol_buffer, 4 * pack.fields[5] as u64, words(&rows));
+                }
+                for (at, data) in pack.drive_words(chunk) {
+                    self.ctx.queue.write_buffer(&self.protocol_buffer, 4 * at as u64, words(&data));
+                }
+                self.params.protocol = pack.fields;
+            }
             self.params.step_lo = step as u32;
             self.params.step_hi = (step >> 32) as u32;
             self.params.steps_wanted = chunk as u32;
@@ -969,6 +1079,11 @@ impl GpuBackend {
             let status = self.status();
             self.builds += status[ST_BUILDS] as u64;
             done += status[ST_STEPS_DONE] as u64;
+            if driven {
+                let (at, count) = self.protocol.as_ref().map(ProtocolPack::drive_state_range).expect("drives");
+                let state: Vec<u32> = bytemuck::cast_slice(&self.read_at(&self.protocol_buffer, 4 * at as u64, 4 * count as u64)).to_vec();
+                self.protocol.as_mut().expect("drives").follow_drives(&state);
+            }
             // A rebuild the last step asked for (device kinetics changed the exclusions) carries over.
             let requested = status[ST_FORCE_REBUILD] != 0;
             self.pending_rebuild = requested;
@@ -1011,16 +1126,21 @@ enum Over {
 fn bind_main(
     device: &wgpu::Device,
     layout: &wgpu::BindGroupLayout,
-    buffers: [&wgpu::Buffer; 12],
+    buffers: [&wgpu::Buffer; 13],
     nlist: &NeighbourStorage,
 ) -> wgpu::BindGroup {
     let mut entries: Vec<wgpu::BindGroupEntry> = buffers
         .iter()
-        .zip((0..8).chain(9..11).chain(12..14))
+        .zip((0..8).chain(9..11).chain(12..15))
         .map(|(buf, b)| wgpu::BindGroupEntry { binding: b, resource: buf.as_entire_binding() })
         .collect();
     entries.extend(nlist.entries());
     device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("cellmd main"), layout, entries: &entries })
+}
+
+/// What the protocols' ramped slots depend on in a packing (src/gpu/protocol.rs).
+fn packed_terms<'a>(fparam_offsets: &[u32; 4], own_bonds: &'a [u32], first_own_term: u32) -> PackedTerms<'a> {
+    PackedTerms { params: fparam_offsets[0], own_bonds, first_own_term }
 }
 
 fn pad16<T: bytemuck::Pod + Default>(mut v: Vec<T>) -> Vec<T> {

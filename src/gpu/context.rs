@@ -31,7 +31,7 @@ impl DevicePreference {
 }
 
 /// Storage buffers bound by the kernels at once (see shaders/common/layout.wgsl).
-pub const STORAGE_BINDINGS: u32 = 12;
+pub const STORAGE_BINDINGS: u32 = 13;
 
 /// An open device and its queue (cheap to clone: handles are shared).
 #[derive(Clone)]

@@ -83,6 +83,8 @@ pub struct CustomSource {
     pub radial_cases: String,
     pub three_cases: String,
     pub one_cases: String,
+    /// `mover_velocity` cases of moving groups with velocity fields (src/gpu/protocol.rs).
+    pub mover_cases: String,
 }
 
 /// The WGSL of every custom term of `model`.

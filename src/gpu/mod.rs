@@ -20,6 +20,9 @@
 //!   `special_bonds` weight, each particle's own list.
 //! - [`tetra`]: volume elements (`[ tetrahedra ]`): one pass per element
 //!   into corner slots, gathered per particle.
+//! - [`protocol`]: `freeze`, `move` and `ramp` on the device: held
+//!   coordinates and moving groups in the integrator, ramped parameters
+//!   written per step from a table.
 //!
 //! File-level circles, on purpose: `pack.rs` ↔ `surface.rs`, `tetra.rs`
 //! and `special.rs`. `pack.rs` lays out the whole topology, their sections
@@ -64,6 +67,7 @@ pub mod custom;
 pub mod kinetics;
 mod nlist;
 pub mod pack;
+pub mod protocol;
 pub mod shader;
 mod special;
 pub mod surface;

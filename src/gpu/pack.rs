@@ -91,6 +91,8 @@ pub struct Params {
     pub special_offsets: [u32; 4],
     /// Area-weighted contact (adhesion.wgsl): layout.wgsl's `off_arule_start` … (src/gpu/adhesion.rs).
     pub adhesion: [u32; 8],
+    /// Protocols (protocol.wgsl): held words present, ramped slots, the ramp table's first step, `protocol` offsets, 2 × padding.
+    pub protocol: [u32; 8],
 }
 
 /// The GPU's 64-bit fixed point (layout.wgsl): a length x is the integer

@@ -47,8 +47,8 @@ mod embedded {
 pub use embedded::{COMMON_SHADERS, INTERACTION_SHADERS};
 
 /// The common files in the order they must appear (declarations first).
-const COMMON_ORDER: [&str; 11] =
-    ["layout", "philox", "neighbor", "forces", "surface", "integrate", "contact", "kinetics", "tetra", "special", "adhesion"];
+const COMMON_ORDER: [&str; 12] =
+    ["layout", "philox", "neighbor", "forces", "surface", "integrate", "contact", "kinetics", "tetra", "special", "adhesion", "protocol"];
 
 fn common(name: &str) -> &'static str {
     COMMON_SHADERS.iter().find(|(stem, _)| *stem == name).map(|(_, src)| *src).unwrap_or_else(|| panic!("shaders/common/{name}.wgsl"))
@@ -108,7 +108,12 @@ fn dispatch(custom: &CustomSource) -> String {
     tetra.push_str("        default: { return TetraDensity(0.0, mat3x3<f32>()); }\n    }\n}\n");
     area_switch.push_str("        default: { return RADIAL_ZERO; }\n    }\n}\n");
     area_density.push_str("        default: { return 0.0; }\n    }\n}\n");
-    radial + &three + &one + &surface + &node + &contact + &tetra + &area_switch + &area_density
+    // Velocity fields of moving groups (src/gpu/protocol.rs).
+    let movers = format!(
+        "fn mover_velocity(m: u32, x: vec3<f32>, t: f32) -> vec3<f32> {{\n    switch m {{\n{}        default: {{ return vec3<f32>(0.0); }}\n    }}\n}}\n",
+        custom.mover_cases
+    );
+    radial + &three + &one + &surface + &node + &contact + &tetra + &area_switch + &area_density + &movers
 }
 
 /// The whole program for models without custom terms.

@@ -4,10 +4,18 @@
 //! on their prescription after every step (noise and constraints included),
 //! so a frozen z stays bit-identical at any kT. `minimize` sees the same
 //! masked forces, so held particles stay put there too.
+//!
+//! On the GPU backend ([`Protocols::for_device`], src/gpu/protocol.rs) the
+//! held coordinates and moving groups are applied by the integration kernel
+//! with the same semantics; ramped parameters and driven indenters' centres
+//! take the values [`Protocols::ramp_rows`] and [`Protocols::drive_centres`]
+//! compute here (the same f64 arithmetic), rounded to f32, and the device
+//! checks the indenters' loads after every step as the CPU does.
 
 use glam::DVec3;
 
-use crate::deck::{Protocol, Ramp, Velocity};
+use crate::deck::{CoeffTarget, Protocol, Ramp, Velocity};
+use crate::gpu::protocol::{DeviceDrive, DeviceProtocol, DeviceVelocity, HeldCoordinates, TermRef};
 use crate::integrate::context::StepContext;
 use crate::interactions::{param_index, ExternalLaw};
 use crate::system::{Model, SimBox, State};
@@ -107,10 +115,90 @@ impl Protocols {
         self.drives.retain(|d| d.external != external);
     }
 
-    /// Why the GPU backend cannot run the next run (None: no protocol in force).
-    pub(super) fn cpu_only(&self) -> Option<&'static str> {
-        (!self.ramps.is_empty() || !self.held.is_empty() || !self.drives.is_empty())
-            .then_some("ramps, `move`, `freeze` and `indent` run on the CPU backend only")
+    /// The protocols in force, as the GPU backend takes them (src/gpu/protocol.rs).
+    pub(super) fn for_device(&self, model: &Model) -> DeviceProtocol {
+        let term = |target: &CoeffTarget| match target {
+            CoeffTarget::BondType(k) => TermRef::BondType(*k),
+            CoeffTarget::AngleType(k) => TermRef::AngleType(*k),
+            CoeffTarget::PairRule(k) => TermRef::PairRule(*k),
+            CoeffTarget::BodyRule(k) => TermRef::BodyRule(*k),
+            CoeffTarget::External(name) => TermRef::External(
+                model.externals.iter().position(|e| e.term.label.text == *name).expect("the deck checked the external is active"),
+            ),
+        };
+        DeviceProtocol {
+            held: self.held.iter().map(|h| HeldCoordinates { particle: h.particle, axes: h.axes, mover: h.mover }).collect(),
+            movers: self
+                .moves
+                .iter()
+                .map(|(_, _, velocity)| match velocity {
+                    Velocity::Constant(v) => DeviceVelocity::Constant(*v),
+                    Velocity::Field(field) => DeviceVelocity::Field(field.clone()),
+                })
+                .collect(),
+            ramps: self.ramps.iter().map(|r| (term(&r.target), r.param)).collect(),
+            drives: self.driven(model).map(|(d, external)| DeviceDrive { external, until: self.drives[d].until }).collect(),
+        }
+    }
+
+    /// The drives whose external is active, with its index in the model's externals.
+    fn driven<'a>(&'a self, model: &'a Model) -> impl Iterator<Item = (usize, usize)> + 'a {
+        self.drives
+            .iter()
+            .enumerate()
+            .filter_map(|(d, drive)| model.externals.iter().position(|e| e.term.label.text == drive.external).map(|e| (d, e)))
+    }
+
+    /// The centre of the active external `e`.
+    fn centre(model: &Model, e: usize) -> [usize; 3] {
+        let term = &model.externals[e].term;
+        ["x", "y", "z"].map(|name| param_index(term.interaction, name).expect("the deck checked the indenter has a centre"))
+    }
+
+    /// Per drive of [`Self::for_device`]: its centres over `steps` steps from
+    /// now (the current one, then as [`Self::advance_drives`] moves it), and
+    /// whether it holds.
+    pub(super) fn drive_centres(&self, model: &Model, dt: f64, steps: u64) -> Vec<(Vec<DVec3>, bool)> {
+        self.driven(model)
+            .map(|(d, e)| {
+                let (k, params) = (Self::centre(model, e), &model.externals[e].term.params);
+                let mut c = k.map(|k| params[k]);
+                let mut centres = vec![DVec3::from_array(c)];
+                for _ in 0..steps {
+                    (0..3).for_each(|a| c[a] += self.drives[d].velocity[a] * dt);
+                    centres.push(DVec3::from_array(c));
+                }
+                (centres, self.drives[d].holding)
+            })
+            .collect()
+    }
+
+    /// After a GPU call: each drive of [`Self::for_device`] moved `states[d].0`
+    /// steps along `centres[d]` and holds if `states[d].1`; the model follows.
+    pub(super) fn follow_device_drives(&mut self, model: &mut Model, centres: &[(Vec<DVec3>, bool)], states: &[(u64, bool)]) {
+        let driven: Vec<(usize, usize)> = self.driven(model).collect();
+        for (((d, e), (path, _)), &(advanced, holding)) in driven.into_iter().zip(centres).zip(states) {
+            let k = Self::centre(model, e);
+            let at = path[advanced as usize];
+            (0..3).for_each(|a| model.externals[e].term.params_mut()[k[a]] = at[a]);
+            self.drives[d].holding = holding;
+        }
+    }
+
+    /// Whether a ramp is in force.
+    pub(super) fn has_ramps(&self) -> bool {
+        !self.ramps.is_empty()
+    }
+
+    /// The ramps' values at each of `steps` steps from `first` (a row per step, in ramp order).
+    pub(super) fn ramp_rows(&self, first: u64, steps: u64) -> Vec<Vec<f64>> {
+        (first..first + steps).map(|step| self.ramps.iter().map(|ramp| self.ramp_value(ramp, step)).collect()).collect()
+    }
+
+    /// A ramp's value at `step` of the run (the end value from the last step on).
+    fn ramp_value(&self, ramp: &Ramp, step: u64) -> f64 {
+        let (first, last) = self.span;
+        ramp.value(if last > first { (step - first) as f64 / (last - first) as f64 } else { 1.0 })
     }
 
     /// Moves every driven indenter that has not reached its load by v·dt.
@@ -143,10 +231,8 @@ impl Protocols {
     /// Sets every ramped parameter to its value at `step` of the run (the
     /// end value from the last step on); returns whether any was set.
     pub(super) fn set_ramps(&self, model: &mut Model, step: u64) -> bool {
-        let (first, last) = self.span;
-        let fraction = if last > first { (step - first) as f64 / (last - first) as f64 } else { 1.0 };
         for ramp in &self.ramps {
-            ramp.target.set(model, ramp.param, ramp.value(fraction));
+            ramp.target.set(model, ramp.param, self.ramp_value(ramp, step));
         }
         !self.ramps.is_empty()
     }

@@ -4,6 +4,7 @@
 use super::step_loop::{Stepper, Taken};
 use super::Simulation;
 use crate::gpu::backend::StepSettings;
+use crate::gpu::protocol::DeviceProtocol;
 use crate::gpu::{DevicePreference, GpuBackend, GpuContext, GpuHalt};
 use crate::integrate::Integrator;
 use crate::run::RunError;
@@ -26,7 +27,11 @@ const GPU_SYNC_STEPS: u64 = 1000;
 /// events exactly as on the CPU, and uploads the changed bond state as one
 /// batch (a new GPU backend when bonds formed). A segment that ends at
 /// `until` before `last` reads the positions back and leaves the CPU
-/// forces current there.
+/// forces current there. Held coordinates, moving groups, ramps and driven
+/// indenters run on the device (src/gpu/protocol.rs): the host hands each
+/// segment the ramps' values and the drives' centres of its steps, and at
+/// the segment's end sets the ramps' values and the centres the drives
+/// reached in the model (and whether they hold), for the outputs.
 pub(super) struct GpuSteps {
     context: GpuContext,
     settings: StepSettings,
@@ -39,6 +44,8 @@ pub(super) struct GpuSteps {
     stopping: bool,
     /// Bond kinetics are decided on the device.
     device_kinetics: bool,
+    /// The protocols in force, as the device takes them.
+    protocol: DeviceProtocol,
 }
 
 impl GpuSteps {
@@ -52,14 +59,12 @@ impl GpuSteps {
         };
         let device_kinetics = sim.model.has_kinetics() && crate::gpu::kinetics::refusal(&sim.model).is_none();
         let (model, state, sim_box) = (&sim.model, &sim.state, &sim.sim_box);
-        let gpu = if device_kinetics {
-            GpuBackend::with_device_kinetics(context, model, state, sim_box, &settings, &sim.kinetics.warned(model))
-        } else {
-            GpuBackend::new(context, model, state, sim_box, &settings)
-        }
-        .map_err(RunError::Setup)?;
+        let protocol = sim.protocols.for_device(model);
+        let warned = device_kinetics.then(|| sim.kinetics.warned(model));
+        let gpu =
+            GpuBackend::with_protocol(context, model, state, sim_box, &settings, warned.as_deref(), &protocol).map_err(RunError::Setup)?;
         let evolving = sim.model.bond_kinetics.iter().flat_map(|k| &k.rules).any(|r| r.rule.evolves_every_step());
-        Ok(Self { context: context.clone(), settings, gpu, evolving, resets: 0, stopping: false, device_kinetics })
+        Ok(Self { context: context.clone(), settings, gpu, evolving, resets: 0, stopping: false, device_kinetics, protocol })
     }
 }
 
@@ -70,7 +75,13 @@ impl Stepper for GpuSteps {
         let next_output = sim.next_output_step(last).min(sim.state.step + GPU_SYNC_STEPS).min(until);
         let steps = if kinetics { 1 } else { next_output - sim.state.step };
         self.gpu.set_time(sim.state.time);
+        if sim.protocols.has_ramps() {
+            self.gpu.set_ramps(sim.state.step, sim.protocols.ramp_rows(sim.state.step, steps));
+        }
+        let centres = sim.protocols.drive_centres(&sim.model, sim.dt, steps);
+        self.gpu.set_drives(centres.clone());
         let outcome = self.gpu.run(sim.state.step, steps);
+        sim.protocols.follow_device_drives(&mut sim.model, &centres, &self.gpu.drive_states());
         let done = match &outcome {
             Ok(done) => *done,
             Err(GpuHalt::Blowup { step, .. } | GpuHalt::Capacity { step, .. }) => step - sim.state.step,
@@ -88,6 +99,8 @@ impl Stepper for GpuSteps {
         if self.device_kinetics {
             self.record_device_kinetics(sim, &clocks)?;
         }
+        // The outputs here see the ramps' values of this step, as on the CPU.
+        sim.protocols.set_ramps(&mut sim.model, sim.state.step);
         sim.forces_current = false;
         let segment_end = sim.state.step == until;
         let thermo_due = sim.thermo.every > 0 && sim.state.step.is_multiple_of(sim.thermo.every);
@@ -129,7 +142,9 @@ impl Stepper for GpuSteps {
         if !sim.cpu.is_built() {
             // Bonds formed: both backends are rebuilt for the new bond list.
             sim.ensure_forces()?;
-            self.gpu = GpuBackend::new(&self.context, &sim.model, &sim.state, &sim.sim_box, &self.settings).map_err(RunError::Setup)?;
+            let (model, state, sim_box) = (&sim.model, &sim.state, &sim.sim_box);
+            self.gpu = GpuBackend::with_protocol(&self.context, model, state, sim_box, &self.settings, None, &self.protocol)
+                .map_err(RunError::Setup)?;
         } else if changed || self.evolving || sim.kinetics.resets != self.resets {
             self.gpu.update_bonds(&sim.model, &sim.state, changed).map_err(RunError::Setup)?;
         }
@@ -191,9 +206,7 @@ impl Simulation {
     /// Why the next `run` cannot use the GPU backend: the first feature in
     /// use that only the CPU backend has (None when the GPU can run it).
     pub fn cpu_only_feature(&self) -> Option<&'static str> {
-        if let Some(why) = self.protocols.cpu_only() {
-            Some(why)
-        } else if matches!(self.integrator, Integrator::Implicit(..)) {
+        if matches!(self.integrator, Integrator::Implicit(..)) {
             Some("`integrator implicit` runs on the CPU backend only")
         } else if !self.constraints.list.is_empty() {
             Some("constrained bonds (`constrain`) run on the CPU backend only")
