@@ -18,6 +18,8 @@
 //!   `special_bonds` weight, each particle's own list.
 //! - [`tetra`]: volume elements (`[ tetrahedra ]`): one pass per element
 //!   into corner slots, gathered per particle.
+//! - [`implicit`]: `integrator implicit`: per-term stiffness blocks and
+//!   Jacobi-preconditioned conjugate gradients in one workgroup, matrix-free.
 //!
 //! File-level circles, on purpose: `pack.rs` ↔ `surface.rs`, `tetra.rs`
 //! and `special.rs`. `pack.rs` lays out the whole topology, their sections
@@ -37,7 +39,8 @@
 //! Not on the GPU (refused by [`GpuBackend::new`], and by `device gpu`
 //! before a run; `device auto` falls back to the CPU): custom surface terms
 //! of bodies and area-weighted contact terms between bodies
-//! (`Law::ContactArea`: adhesion), which have no kernel yet. Bond kinetics
+//! (`Law::ContactArea`: adhesion), which have no kernel yet; the implicit
+//! step of the models [`implicit::refusal`] names. Bond kinetics
 //! are decided on the device for the rules [`kinetics`] ports, else on the
 //! host after every step (see [`backend`]).
 //!
@@ -59,6 +62,7 @@ pub mod backend;
 pub mod contact;
 pub mod context;
 pub mod custom;
+pub mod implicit;
 pub mod kinetics;
 mod nlist;
 pub mod pack;

@@ -54,6 +54,16 @@ impl GpuSteps {
         let (model, state, sim_box) = (&sim.model, &sim.state, &sim.sim_box);
         let gpu = if device_kinetics {
             GpuBackend::with_device_kinetics(context, model, state, sim_box, &settings, &sim.kinetics.warned(model))
+        } else if let Integrator::Implicit(_, implicit) = &sim.integrator {
+            // The implicit step on the device (src/gpu/implicit.rs): f32 CG has a tolerance floor.
+            if implicit.tolerance < crate::gpu::implicit::F32_TOLERANCE {
+                sim.say(&format!(
+                    "device gpu: integrator implicit solves to relative residual {:e} in f32 (the deck asks for {:e})",
+                    crate::gpu::implicit::F32_TOLERANCE,
+                    implicit.tolerance
+                ));
+            }
+            GpuBackend::with_implicit(context, model, state, sim_box, &settings, implicit)
         } else {
             GpuBackend::new(context, model, state, sim_box, &settings)
         }
@@ -77,6 +87,9 @@ impl Stepper for GpuSteps {
         };
         // Each step took s·dt: below 1 where the contact step clamp shortened it (src/gpu/contact.rs).
         let mut taken = Taken { steps: done, last: None };
+        if let Some(report) = self.gpu.implicit_report() {
+            sim.last_solve = report;
+        }
         let mut clocks = Vec::new();
         for k in 0..done {
             let fraction = self.gpu.step_fraction(k);
@@ -193,8 +206,8 @@ impl Simulation {
     pub fn cpu_only_feature(&self) -> Option<&'static str> {
         if let Some(why) = self.protocols.cpu_only() {
             Some(why)
-        } else if matches!(self.integrator, Integrator::Implicit(..)) {
-            Some("`integrator implicit` runs on the CPU backend only")
+        } else if let Some(why) = self.implicit_refusal() {
+            Some(why)
         } else if !self.constraints.list.is_empty() {
             Some("constrained bonds (`constrain`) run on the CPU backend only")
         } else if self.model.has_cpu_only_surface_terms() {
@@ -203,6 +216,14 @@ impl Simulation {
             Some("area-weighted contact terms between bodies (`contact_adhesion`) run on the CPU backend only")
         } else {
             None
+        }
+    }
+
+    /// Why the implicit step cannot run on the device (src/gpu/implicit.rs).
+    fn implicit_refusal(&self) -> Option<&'static str> {
+        match &self.integrator {
+            Integrator::Implicit(_, implicit) => crate::gpu::implicit::refusal(&self.model, implicit),
+            Integrator::Overdamped(_) => None,
         }
     }
 
