@@ -115,3 +115,20 @@ fn implicit_decks_the_device_cannot_solve_are_refused_with_the_reason() {
     let refused = Simulation::execute(case.plan(), options).err().map(|e| e.to_string()).unwrap_or_default();
     assert!(refused.contains("has no GPU stiffness block"), "{refused}");
 }
+
+/// Wall-clock time of `inputs/buckling_filament.in` (1500 implicit steps) on
+/// the CPU and on the GPU: `cargo test --test gpu_implicit buckling -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn buckling_filament_timing() {
+    let deck = std::path::Path::new("inputs/buckling_filament.in");
+    for device in [DevicePreference::Cpu, DevicePreference::Gpu] {
+        let dir = tempfile::tempdir().unwrap();
+        let plan = cellmd::deck::validate_file(deck, &[]).unwrap();
+        let options = RunOptions { output_dir: dir.path().to_path_buf(), device: Some(device), ..Default::default() };
+        let started = std::time::Instant::now();
+        let sim = Simulation::execute(plan, options).unwrap();
+        let seconds = started.elapsed().as_secs_f64();
+        println!("{device:?}: {} steps in {seconds:.2} s, last solve {} iterations", sim.state.step, sim.last_solve.iterations);
+    }
+}
