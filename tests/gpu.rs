@@ -7,6 +7,7 @@ mod common;
 use cellmd::backend::{CpuBackend, Forces};
 use cellmd::deck::{Action, Plan};
 use cellmd::gpu::backend::StepSettings;
+use cellmd::gpu::implicit::F32_TOLERANCE;
 use cellmd::gpu::{DevicePreference, GpuBackend, GpuContext};
 use cellmd::integrate::context::StepContext;
 use cellmd::integrate::overdamped::OverdampedSettings;
@@ -656,6 +657,24 @@ fn run_deck_deterministic(
     Ok((start, sim.state))
 }
 
+/// An upper bound on the condition number of the implicit step's matrix
+/// A = γ/dt·I + K̃ at the deck's start (Gershgorin: λ_max ≤ the largest row
+/// sum of |A|; λ_min ≥ the smallest γ/dt of a mobile particle, K̃ ⪰ 0).
+fn implicit_condition_bound(sim: &Simulation) -> f64 {
+    let (model, state, sim_box) = (&sim.model, &sim.state, &sim.sim_box);
+    let mut backend = CpuBackend::new(model, state, sim_box, 0.0).unwrap();
+    backend.compute(model, state, sim_box, &mut Forces::default());
+    let mut rows = vec![0.0f64; 3 * model.len()];
+    for b in &backend.stiffness(model, state, sim_box).blocks {
+        for (r, row) in rows[3 * b.i as usize..3 * b.i as usize + 3].iter_mut().enumerate() {
+            *row += (0..3).map(|c| b.block.col(c)[r].abs()).sum::<f64>();
+        }
+    }
+    let drag = model.types.iter().map(|&t| model.type_drag[t as usize] / sim.dt).filter(|d| d.is_finite());
+    let (lo, hi) = drag.fold((f64::INFINITY, 0.0f64), |(lo, hi), d| (lo.min(d), hi.max(d)));
+    (hi + rows.iter().copied().fold(0.0, f64::max)) / lo
+}
+
 /// Every `inputs/` deck without bond kinetics that the GPU runs (all but those
 /// with constraints, `contact_adhesion`, custom body terms, or an implicit step
 /// the device cannot solve (src/gpu/implicit.rs), which it refuses with the
@@ -664,7 +683,10 @@ fn run_deck_deterministic(
 /// (measured on llvmpipe: ≤ 2.7e-6, about the spread between two CPU runs
 /// whose starts differ by f32 rounding); over 10³ or 10² steps where that
 /// spread itself exceeds the bound (a chaotic deck: cell_contact.in, whose
-/// CPU runs part by 7.9e-2 µm in 10⁴ clamped steps).
+/// CPU runs part by 7.9e-2 µm in 10⁴ clamped steps). An implicit deck
+/// (buckling_filament.in) is compared over 10² steps, within κ(A)·(the device's
+/// CG tolerance + 8ε_f32) of the distance travelled ([`implicit_condition_bound`]):
+/// its f32 solve is only that exact (measured: 1.5e-3 of the path).
 #[test]
 fn every_input_deck_runs_on_the_gpu_like_on_the_cpu() {
     let mut decks: Vec<_> =
@@ -696,6 +718,12 @@ fn every_input_deck_runs_on_the_gpu_like_on_the_cpu() {
         // An implicit deck's GPU step solves in one workgroup with ~10² CG iterations
         // (0.15 s a step on llvmpipe, src/gpu/implicit.rs): compared over 10² steps (CI time).
         let horizon = if matches!(setup.integrator, Integrator::Implicit(..)) { 100 } else { 10_000 };
+        // An implicit step's f32 solve is exact to about κ(A)·(its tolerance + 8ε_f32)
+        // relative (src/gpu/implicit.rs), its explicit steps to the 1e-5 below.
+        let bound = match setup.integrator {
+            Integrator::Implicit(..) => (implicit_condition_bound(&setup) * (F32_TOLERANCE + 8.0 * f32::EPSILON as f64)).max(1e-5),
+            Integrator::Overdamped(_) => 1e-5,
+        };
         match run_deck_deterministic(&deck, DevicePreference::Gpu, horizon, false) {
             Ok((_, mut gpu)) => {
                 // A deck whose CPU run itself moves more than the bound when its start is
@@ -729,7 +757,7 @@ fn every_input_deck_runs_on_the_gpu_like_on_the_cpu() {
                     }
                     assert_eq!(cpu.step, gpu.step);
                     assert!(travelled > 0.0, "{}: nothing moved", deck.display());
-                    assert!(deviation <= 1e-5 * travelled, "{}: GPU − CPU {deviation:e} > 1e-5 × {travelled:e}", deck.display());
+                    assert!(deviation <= bound * travelled, "{}: GPU − CPU {deviation:e} > {bound:e} × {travelled:e}", deck.display());
                     break;
                 }
                 compared += usize::from(comparable);
