@@ -28,7 +28,10 @@
 //! `kinetics.rs`: the backend owns the device kinetics' buffer and
 //! dispatches its kernels in each step, and `kinetics.rs` lays that buffer
 //! out and adds to `GpuBackend` the methods that read its events and bond
-//! state back, so the buffer's layout has one home.
+//! state back, so the buffer's layout has one home. And `shader.rs` ↔
+//! `implicit.rs`: the composer appends the implicit step's stiffness
+//! dispatch, and `implicit.rs` compiles the composed program and reads the
+//! evaluator files to tell which laws have a device stiffness block.
 //!
 //! What runs where: each step — neighbour-list check and (when due) rebuild,
 //! forces, overdamped integration — runs on the GPU without reading anything
