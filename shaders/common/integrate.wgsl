@@ -32,11 +32,17 @@ fn noise(i: u32) -> vec3<f32> {
     if amplitude == 0.0 {
         return vec3<f32>(0.0);
     }
+    return amplitude * unit_noise(i);
+}
+
+// Particle i's ξ of this step (unit variance per axis; the implicit step
+// scales it too, shaders/common/implicit.wgsl).
+fn unit_noise(i: u32) -> vec3<f32> {
     let seed = vec2<u32>(P.seed_lo, P.seed_hi);
     if P.gaussian == 1u {
-        return amplitude * gaussian3(seed, current_step(), i);
+        return gaussian3(seed, current_step(), i);
     }
-    return amplitude * noise3(seed, current_step(), i);
+    return noise3(seed, current_step(), i);
 }
 
 // A displacement in fixed point: q is a power of two, so |dx|/q is exact
@@ -82,7 +88,12 @@ fn integrate(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_ind
         return;
     }
     let s = bitcast<f32>(atomicLoad(&status[ST_FRACTION]));
-    let dx = s * drift(i) + sqrt(s) * noise(i);
+    step_particle(i, s * drift(i) + sqrt(s) * noise(i));
+}
+
+// Moves particle i by dx into `next` (the implicit step's move too), or
+// refuses the step: non-finite, or longer than max_displacement.
+fn step_particle(i: u32, dx: vec3<f32>) {
     let d2 = dot(dx, dx);
     if !(d2 <= P.max_disp2) {
         atomicMin(&status[ST_BLOWUP_PARTICLE], i);

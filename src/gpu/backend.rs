@@ -25,12 +25,14 @@ use wgpu::util::DeviceExt;
 use super::adhesion::AdhesionPack;
 use super::contact::{reach_message, ContactPack, CONTACT_ONLY, FRACTION_SLOTS};
 use super::context::GpuContext;
+use super::implicit::ImplicitSolver;
 use super::kinetics::{KinKernels, KinLayout};
 use super::nlist::NeighbourStorage;
 use super::pack::{cell_grid, pack, FixedPoint, Packed, Params};
 use super::protocol::{DeviceProtocol, PackedTerms, ProtocolPack, RAMP_ROWS};
 use super::shader;
 use crate::integrate::context::StepContext;
+use crate::integrate::implicit::{ImplicitSettings, SolveReport};
 use crate::neighbor::Exclusions;
 use crate::system::{BondState, Model, SimBox, State};
 
@@ -53,6 +55,8 @@ const ST_FRACTION: usize = 8;
 const ST_ELAPSED: usize = 9;
 /// A face edge outgrew the contact search (src/gpu/contact.rs).
 const HALT_REACH: u32 = 8;
+/// The implicit step's solve did not converge (src/gpu/implicit.rs).
+const HALT_SOLVE: u32 = 32;
 /// Steps per command buffer.
 const STEPS_PER_SUBMIT: u64 = 64;
 
@@ -63,7 +67,8 @@ pub enum GpuHalt {
     /// state is that of `step`.
     Blowup { step: u64, particle: usize },
     /// The neighbour list had to grow beyond what the adapter can bind, or a
-    /// body spans more than half the periodic box; the state is that of `step`.
+    /// body spans more than half the periodic box, or the implicit step's
+    /// solve did not converge; the state is that of `step`.
     Capacity { step: u64, message: String },
 }
 
@@ -182,6 +187,8 @@ pub struct GpuBackend {
     /// The run's protocols (src/gpu/protocol.rs): their buffer (binding 14) and layout.
     protocol_buffer: wgpu::Buffer,
     protocol: Option<ProtocolPack>,
+    /// The implicit step on the device (src/gpu/implicit.rs), in place of `integrate`.
+    implicit: Option<ImplicitSolver>,
 }
 
 /// Refuses a storage buffer the adapter cannot bind (wgpu would abort).
@@ -254,6 +261,27 @@ impl GpuBackend {
             return Err(format!("bond kinetics on the device: {why} is decided on the host"));
         }
         Self::build(ctx, model, state, sim_box, settings, Some(warned), None)
+    }
+
+    /// Steps by the linearly implicit step on the device from now on, in
+    /// place of the explicit one (src/gpu/implicit.rs; the model must pass
+    /// its `refusal`).
+    pub fn step_implicitly(
+        &mut self,
+        ctx: &GpuContext,
+        model: &Model,
+        settings: &StepSettings,
+        implicit: &ImplicitSettings,
+    ) -> Result<(), String> {
+        self.implicit = Some(ImplicitSolver::new(ctx, &self.layout, model, (settings.context.dt, settings.context.kt), implicit)?);
+        Ok(())
+    }
+
+    /// The last implicit step's iterations and relative residual (one small
+    /// read-back; None without the implicit step).
+    pub fn implicit_report(&self) -> Option<SolveReport> {
+        let solver = self.implicit.as_ref()?;
+        Some(solver.report(&self.read_at(&solver.buffer, solver.report_at, 16)))
     }
 
     fn build(
@@ -518,6 +546,7 @@ impl GpuBackend {
             adhesion,
             protocol_buffer: protocol,
             protocol: protocol_pack,
+            implicit: None,
         };
         backend.set_clock(settings.context.time);
         backend.upload(state);
@@ -927,7 +956,18 @@ impl GpuBackend {
             if let Some((bonds, kin)) = kinetics {
                 self.dispatch(pass, &kin.measure, bonds);
             }
-            self.dispatch(pass, &k.integrate, Over::Particles);
+            if let Some(solver) = &self.implicit {
+                // The implicit step (src/gpu/implicit.rs) in place of `integrate`.
+                pass.set_bind_group(1, &solver.group, &[]);
+                if solver.angle_groups(WORKGROUP) > 0 {
+                    self.dispatch(pass, &solver.angles, Over::Groups(solver.angle_groups(WORKGROUP)));
+                }
+                self.dispatch(pass, &solver.blocks, Over::Particles);
+                self.dispatch(pass, &solver.solve, Over::Groups(1));
+                self.dispatch(pass, &solver.moves, Over::Particles);
+            } else {
+                self.dispatch(pass, &k.integrate, Over::Particles);
+            }
             self.dispatch(pass, &k.commit, Over::Particles);
             if drives {
                 self.dispatch(pass, &k.protocol_drive_advance, Over::Groups(1));
@@ -1097,6 +1137,10 @@ impl GpuBackend {
                 return Err(GpuHalt::Blowup { step: first_step + done, particle: status[ST_BLOWUP_PARTICLE] as usize });
             }
             if let Some(message) = self.span_halt(&status) {
+                return Err(GpuHalt::Capacity { step: first_step + done, message });
+            }
+            if let Some(solver) = self.implicit.as_ref().filter(|_| status[ST_HALTED] & HALT_SOLVE != 0) {
+                let message = solver.failure(&self.implicit_report().unwrap_or_default());
                 return Err(GpuHalt::Capacity { step: first_step + done, message });
             }
             if status[ST_HALTED] & HALT_EVENTS != 0 {

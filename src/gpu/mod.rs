@@ -23,6 +23,8 @@
 //! - [`protocol`]: `freeze`, `move` and `ramp` on the device: held
 //!   coordinates and moving groups in the integrator, ramped parameters
 //!   written per step from a table.
+//! - [`implicit`]: `integrator implicit`: per-term stiffness blocks and
+//!   Jacobi-preconditioned conjugate gradients in one workgroup, matrix-free.
 //!
 //! File-level circles, on purpose: `pack.rs` ↔ `surface.rs`, `tetra.rs`
 //! and `special.rs`. `pack.rs` lays out the whole topology, their sections
@@ -31,7 +33,10 @@
 //! `kinetics.rs`: the backend owns the device kinetics' buffer and
 //! dispatches its kernels in each step, and `kinetics.rs` lays that buffer
 //! out and adds to `GpuBackend` the methods that read its events and bond
-//! state back, so the buffer's layout has one home.
+//! state back, so the buffer's layout has one home. And `shader.rs` ↔
+//! `implicit.rs`: the composer appends the implicit step's stiffness
+//! dispatch, and `implicit.rs` compiles the composed program and reads the
+//! evaluator files to tell which laws have a device stiffness block.
 //!
 //! What runs where: each step — neighbour-list check and (when due) rebuild,
 //! forces, overdamped integration — runs on the GPU without reading anything
@@ -41,7 +46,8 @@
 //!
 //! Not on the GPU (refused by [`GpuBackend::new`], and by `device gpu`
 //! before a run; `device auto` falls back to the CPU): custom surface terms
-//! of bodies, which have no kernel yet. Bond kinetics
+//! of bodies, which have no kernel yet; the implicit
+//! step of the models [`implicit::refusal`] names. Bond kinetics
 //! are decided on the device for the rules [`kinetics`] ports, else on the
 //! host after every step (see [`backend`]).
 //!
@@ -64,6 +70,7 @@ pub mod backend;
 pub mod contact;
 pub mod context;
 pub mod custom;
+pub mod implicit;
 pub mod kinetics;
 mod nlist;
 pub mod pack;

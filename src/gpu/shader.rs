@@ -47,8 +47,21 @@ mod embedded {
 pub use embedded::{COMMON_SHADERS, INTERACTION_SHADERS};
 
 /// The common files in the order they must appear (declarations first).
-const COMMON_ORDER: [&str; 12] =
-    ["layout", "philox", "neighbor", "forces", "surface", "integrate", "contact", "kinetics", "tetra", "special", "adhesion", "protocol"];
+const COMMON_ORDER: [&str; 13] = [
+    "layout",
+    "philox",
+    "neighbor",
+    "forces",
+    "surface",
+    "integrate",
+    "contact",
+    "kinetics",
+    "tetra",
+    "special",
+    "adhesion",
+    "protocol",
+    "implicit",
+];
 
 fn common(name: &str) -> &'static str {
     COMMON_SHADERS.iter().find(|(stem, _)| *stem == name).map(|(_, src)| *src).unwrap_or_else(|| panic!("shaders/common/{name}.wgsl"))
@@ -143,6 +156,8 @@ pub fn compose_with(custom: &CustomSource) -> String {
     }
     program.push_str(&custom.functions);
     program.push_str(&dispatch(custom));
+    // The stiffness laws of the implicit step (src/gpu/implicit.rs).
+    program.push_str(&super::implicit::stiffness_dispatch());
     for name in &COMMON_ORDER[2..] {
         program.push_str(common(name));
     }

@@ -61,8 +61,19 @@ impl GpuSteps {
         let (model, state, sim_box) = (&sim.model, &sim.state, &sim.sim_box);
         let protocol = sim.protocols.for_device(model);
         let warned = device_kinetics.then(|| sim.kinetics.warned(model));
-        let gpu =
+        let mut gpu =
             GpuBackend::with_protocol(context, model, state, sim_box, &settings, warned.as_deref(), &protocol).map_err(RunError::Setup)?;
+        if let Integrator::Implicit(_, implicit) = &sim.integrator {
+            // The implicit step on the device (src/gpu/implicit.rs): f32 CG has a tolerance floor.
+            if implicit.tolerance < crate::gpu::implicit::F32_TOLERANCE {
+                sim.say(&format!(
+                    "device gpu: integrator implicit solves to relative residual {:e} in f32 (the deck asks for {:e})",
+                    crate::gpu::implicit::F32_TOLERANCE,
+                    implicit.tolerance
+                ));
+            }
+            gpu.step_implicitly(context, model, &settings, implicit).map_err(RunError::Setup)?;
+        }
         let evolving = sim.model.bond_kinetics.iter().flat_map(|k| &k.rules).any(|r| r.rule.evolves_every_step());
         Ok(Self { context: context.clone(), settings, gpu, evolving, resets: 0, stopping: false, device_kinetics, protocol })
     }
@@ -88,6 +99,9 @@ impl Stepper for GpuSteps {
         };
         // Each step took s·dt: below 1 where the contact step clamp shortened it (src/gpu/contact.rs).
         let mut taken = Taken { steps: done, last: None };
+        if let Some(report) = self.gpu.implicit_report() {
+            sim.last_solve = report;
+        }
         let mut clocks = Vec::new();
         for k in 0..done {
             let fraction = self.gpu.step_fraction(k);
@@ -206,14 +220,25 @@ impl Simulation {
     /// Why the next `run` cannot use the GPU backend: the first feature in
     /// use that only the CPU backend has (None when the GPU can run it).
     pub fn cpu_only_feature(&self) -> Option<&'static str> {
-        if matches!(self.integrator, Integrator::Implicit(..)) {
-            Some("`integrator implicit` runs on the CPU backend only")
+        if let Some(why) = self.implicit_refusal() {
+            Some(why)
         } else if !self.constraints.list.is_empty() {
             Some("constrained bonds (`constrain`) run on the CPU backend only")
         } else if self.model.has_cpu_only_surface_terms() {
             Some("custom surface terms of bodies (`custom` body lines) run on the CPU backend only")
         } else {
             None
+        }
+    }
+
+    /// Why the implicit step cannot run on the device (src/gpu/implicit.rs).
+    fn implicit_refusal(&self) -> Option<&'static str> {
+        match &self.integrator {
+            Integrator::Implicit(..) if !self.protocols.is_empty() => {
+                Some("`freeze`, `move`, `indent` and ramps with `integrator implicit` run on the CPU backend only")
+            }
+            Integrator::Implicit(_, implicit) => crate::gpu::implicit::refusal(&self.model, implicit),
+            Integrator::Overdamped(_) => None,
         }
     }
 

@@ -1,0 +1,410 @@
+// The linearly implicit step on the device (src/gpu/implicit.rs has the
+// equation, the buffer layout and the precision argument):
+//   (γ/dt·I + K̃)·Δx = F + √(2kT·γ/dt)·ξ,   x ← x + Δx,
+// solved by Jacobi-preconditioned conjugate gradients, matrix-free. After
+// the force pass of a step:
+//   1. `implicit_angles` (one invocation per angle): the angle's exact 9×9
+//      Hessian from its law's `NAME_hessian`, projected onto its positive
+//      semi-definite part (cyclic Jacobi), as the CPU's blocks.
+//   2. `implicit_blocks` (one per particle): the projected radial block of
+//      each of its bond ends and the Hessian of each of its externals, and
+//      the Jacobi diagonal from them and its angles' diagonal blocks.
+//   3. `implicit_solve` (ONE workgroup): the whole CG, every product K̃·v
+//      gathered per particle from its own terms in a fixed order, every dot
+//      product a fixed tree over the workgroup; the convergence test is
+//      taken on the device each iteration and nothing is read back.
+//   4. `implicit_move` (one per particle): x ← x + Δx in fixed point, the
+//      blow-up check of the explicit step (`step_particle`).
+// No float atomics: the same run gives the same bits.
+
+@group(1) @binding(1) var<storage, read> imp_topo: array<u32>;
+@group(1) @binding(2) var<storage, read_write> imp: array<vec4<f32>>;
+
+// Header words of `imp_topo` (src/gpu/implicit.rs writes them).
+const IMP_ANGLES: u32 = 0u;         // number of angles
+const IMP_OFF_ANGLES: u32 = 1u;     // angle records (i, j, k, term)
+const IMP_OFF_SLOT_START: u32 = 2u; // per particle (n + 1): start of its angle slots
+const IMP_OFF_SLOTS: u32 = 3u;      // angle slots (angle, role)
+const IMP_MAX_ITER: u32 = 4u;       // CG iteration cap
+const IMP_TOLERANCE: u32 = 5u;      // relative residual |r|/|b| (f32 bits)
+const IMP_OFF_DRAG: u32 = 6u;       // per type γ/dt (f32 bits; 0 for a fixed type)
+const IMP_OFF_KICK: u32 = 7u;       // per type √(2kT·γ/dt) (f32 bits)
+const IMP_V_BONDS: u32 = 8u;        // `imp` entry of the bond-end blocks (2 per end)
+const IMP_V_EXTERNALS: u32 = 9u;    // … of the external blocks (2 per external entry)
+const IMP_V_ANGLES: u32 = 10u;      // … of the angle blocks (21 per angle)
+const IMP_V_REPORT: u32 = 11u;      // … of the last solve's report
+
+// Per-particle vectors of `imp`: section s of particle i is imp[s·n + i].
+const VEC_X: u32 = 0u;    // Δx
+const VEC_R: u32 = 1u;    // residual (first the right-hand side)
+const VEC_Z: u32 = 2u;    // preconditioned residual
+const VEC_P: u32 = 3u;    // search direction
+const VEC_Q: u32 = 4u;    // A·p
+const VEC_DINV: u32 = 5u; // inverse Jacobi diagonal
+const ANGLE_VEC4: u32 = 21u;
+
+// The solve did not converge (status word ST_HALTED).
+const HALT_SOLVE: u32 = 32u;
+
+fn identity3() -> mat3x3<f32> {
+    return mat3x3<f32>(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(0.0, 0.0, 1.0));
+}
+
+// u·vᵀ.
+fn outer3(u: vec3<f32>, v: vec3<f32>) -> mat3x3<f32> {
+    return mat3x3<f32>(u * v.x, u * v.y, u * v.z);
+}
+
+// Writes the 3×3 block (rb, cb) of a row-major 9×9 matrix.
+fn put_block(h: ptr<function, array<f32, 81>>, rb: u32, cb: u32, m: mat3x3<f32>) {
+    for (var row = 0u; row < 3u; row++) {
+        for (var col = 0u; col < 3u; col++) {
+            (*h)[(3u * rb + row) * 9u + 3u * cb + col] = m[col][row];
+        }
+    }
+}
+
+// The positive semi-definite part Σ max(λ, 0)·v vᵀ of the symmetric
+// leading dim×dim block of a row-major 9×9 matrix (cyclic Jacobi rotations,
+// Numerical Recipes §11.1, until the off-diagonal mass is below 1e-14 of the
+// whole); left as it is when no eigenvalue is negative, as on the CPU.
+fn project_psd(h: ptr<function, array<f32, 81>>, dim: u32) {
+    var a = *h;
+    var v: array<f32, 81>;
+    var whole = 0.0;
+    for (var k = 0u; k < dim; k++) {
+        v[k * 9u + k] = 1.0;
+        for (var l = 0u; l < dim; l++) {
+            whole += a[k * 9u + l] * a[k * 9u + l];
+        }
+    }
+    for (var sweep = 0u; sweep < 16u; sweep++) {
+        var off = 0.0;
+        for (var p = 0u; p < dim; p++) {
+            for (var q = p + 1u; q < dim; q++) {
+                off += a[p * 9u + q] * a[p * 9u + q];
+            }
+        }
+        if !(off > 1e-14 * whole) {
+            break;
+        }
+        for (var p = 0u; p < dim; p++) {
+            for (var q = p + 1u; q < dim; q++) {
+                let apq = a[p * 9u + q];
+                if apq == 0.0 {
+                    continue;
+                }
+                let theta = (a[q * 9u + q] - a[p * 9u + p]) / (2.0 * apq);
+                let direction = select(1.0, -1.0, theta < 0.0);
+                var t = direction / (abs(theta) + sqrt(theta * theta + 1.0));
+                if abs(theta) > 1e18 {
+                    t = 0.5 / theta;
+                }
+                let c = 1.0 / sqrt(t * t + 1.0);
+                let s = t * c;
+                for (var k = 0u; k < dim; k++) {
+                    let kp = a[k * 9u + p];
+                    let kq = a[k * 9u + q];
+                    a[k * 9u + p] = c * kp - s * kq;
+                    a[k * 9u + q] = s * kp + c * kq;
+                }
+                for (var k = 0u; k < dim; k++) {
+                    let pk = a[p * 9u + k];
+                    let qk = a[q * 9u + k];
+                    a[p * 9u + k] = c * pk - s * qk;
+                    a[q * 9u + k] = s * pk + c * qk;
+                }
+                for (var k = 0u; k < dim; k++) {
+                    let kp = v[k * 9u + p];
+                    let kq = v[k * 9u + q];
+                    v[k * 9u + p] = c * kp - s * kq;
+                    v[k * 9u + q] = s * kp + c * kq;
+                }
+            }
+        }
+    }
+    var negative = false;
+    for (var e = 0u; e < dim; e++) {
+        negative = negative || a[e * 9u + e] < 0.0;
+    }
+    if !negative {
+        return;
+    }
+    for (var r = 0u; r < dim; r++) {
+        for (var c = 0u; c < dim; c++) {
+            var sum = 0.0;
+            for (var e = 0u; e < dim; e++) {
+                sum += max(a[e * 9u + e], 0.0) * v[r * 9u + e] * v[c * 9u + e];
+            }
+            (*h)[r * 9u + c] = sum;
+        }
+    }
+}
+
+// γ/dt of particle i (0 for a fixed particle).
+fn imp_drag(i: u32) -> f32 {
+    return bitcast<f32>(imp_topo[imp_topo[IMP_OFF_DRAG] + topo[i]]);
+}
+
+// A symmetric 3×3 block stored as two entries (xx, xy, xz, yy), (yz, zz).
+fn put_sym(at: u32, m: mat3x3<f32>) {
+    imp[at] = vec4<f32>(m[0][0], m[1][0], m[2][0], m[1][1]);
+    imp[at + 1u] = vec4<f32>(m[2][1], m[2][2], 0.0, 0.0);
+}
+
+fn sym_times(at: u32, v: vec3<f32>) -> vec3<f32> {
+    let a = imp[at];
+    let b = imp[at + 1u];
+    return vec3<f32>(a.x * v.x + a.y * v.y + a.z * v.z, a.y * v.x + a.w * v.y + b.x * v.z, a.z * v.x + b.x * v.y + b.y * v.z);
+}
+
+fn sym_diagonal(at: u32) -> vec3<f32> {
+    return vec3<f32>(imp[at].x, imp[at].w, imp[at + 1u].y);
+}
+
+// Entry f of angle a's row-major 9×9 block.
+fn angle_entry(a: u32, f: u32) -> f32 {
+    return imp[imp_topo[IMP_V_ANGLES] + ANGLE_VEC4 * a + f / 4u][f % 4u];
+}
+
+@compute @workgroup_size(256)
+fn implicit_angles(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    let a = linear_index(wg, local);
+    if a >= imp_topo[IMP_ANGLES] || halted() {
+        return;
+    }
+    let rec = imp_topo[IMP_OFF_ANGLES] + 4u * a;
+    let pj = imp_topo[rec + 1u];
+    let term = imp_topo[rec + 3u];
+    // The vertex j at the origin, i and k at their minimum images (as the force pass).
+    let ri = separation(pj, imp_topo[rec]);
+    let rk = separation(pj, imp_topo[rec + 2u]);
+    var h = three_body_hessian(topo[P.off_term_kind + term], term_params(term), ri, vec3<f32>(0.0), rk);
+    project_psd(&h, 9u);
+    let base = imp_topo[IMP_V_ANGLES] + ANGLE_VEC4 * a;
+    for (var k = 0u; k < 20u; k++) {
+        imp[base + k] = vec4<f32>(h[4u * k], h[4u * k + 1u], h[4u * k + 2u], h[4u * k + 3u]);
+    }
+    imp[base + 20u] = vec4<f32>(h[80], 0.0, 0.0, 0.0);
+}
+
+// The projected block of a radial term along d (as src/backend/stiffness.rs):
+// max(E″, 0)·ûûᵀ + max(E′/r, 0)·(I − ûûᵀ).
+fn radial_block(kind: u32, p: array<f32, 8>, d: vec3<f32>) -> mat3x3<f32> {
+    let r = length(d);
+    if r == 0.0 {
+        return mat3x3<f32>();
+    }
+    let u = d / r;
+    let uu = outer3(u, u);
+    let along = max(radial_curvature(kind, p, r), 0.0);
+    let across = max(radial_law(kind, p, r).de_dr / r, 0.0);
+    return uu * along + (identity3() - uu) * across;
+}
+
+@compute @workgroup_size(256)
+fn implicit_blocks(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    let i = linear_index(wg, local);
+    if i >= P.n || halted() {
+        return;
+    }
+    let drag = imp_drag(i);
+    let dinv = P.n * VEC_DINV + i;
+    if drag == 0.0 {
+        imp[dinv] = vec4<f32>(1.0, 1.0, 1.0, 0.0); // a fixed particle: the identity row
+        return;
+    }
+    var diagonal = vec3<f32>(drag);
+    let bonds_end = topo[P.off_bond_offsets + i + 1u];
+    for (var b = topo[P.off_bond_offsets + i]; b < bonds_end; b++) {
+        let term = topo[P.off_bond_ends + 2u * b + 1u];
+        let scale = fparams[P.off_term_scale + term] * bond_on(term);
+        let h = radial_block(topo[P.off_term_kind + term], term_params(term), separation(i, topo[P.off_bond_ends + 2u * b])) * scale;
+        let at = imp_topo[IMP_V_BONDS] + 2u * b;
+        put_sym(at, h);
+        diagonal += sym_diagonal(at);
+    }
+    let externals_end = topo[P.off_ext_offsets + i + 1u];
+    if externals_end > topo[P.off_ext_offsets + i] {
+        let x = unwrapped(i);
+        for (var t = topo[P.off_ext_offsets + i]; t < externals_end; t++) {
+            let term = topo[P.off_ext_terms + t];
+            let at = imp_topo[IMP_V_EXTERNALS] + 2u * t;
+            put_sym(at, one_body_hessian(topo[P.off_term_kind + term], term_params(term), x));
+            diagonal += sym_diagonal(at);
+        }
+    }
+    let slots_end = imp_topo[imp_topo[IMP_OFF_SLOT_START] + i + 1u];
+    for (var s = imp_topo[imp_topo[IMP_OFF_SLOT_START] + i]; s < slots_end; s++) {
+        let a = imp_topo[imp_topo[IMP_OFF_SLOTS] + 2u * s];
+        let role = imp_topo[imp_topo[IMP_OFF_SLOTS] + 2u * s + 1u];
+        for (var m = 0u; m < 3u; m++) {
+            diagonal[m] += angle_entry(a, (3u * role + m) * 10u);
+        }
+    }
+    imp[dinv] = vec4<f32>(1.0 / diagonal, 0.0);
+}
+
+fn imp_vec(section: u32, i: u32) -> vec3<f32> {
+    return imp[P.n * section + i].xyz;
+}
+
+// (A·v)_i for the vector in `section`: γ/dt·v_i plus particle i's rows of its
+// bond ends, externals and angles, in that order (a fixed particle: v_i).
+// Fixed particles' entries of every vector the solve forms are 0, so their
+// couplings drop out as in the CPU's matrix.
+fn apply_row(i: u32, section: u32) -> vec3<f32> {
+    let vi = imp_vec(section, i);
+    let drag = imp_drag(i);
+    if drag == 0.0 {
+        return vi;
+    }
+    var out = drag * vi;
+    let bonds_end = topo[P.off_bond_offsets + i + 1u];
+    for (var b = topo[P.off_bond_offsets + i]; b < bonds_end; b++) {
+        let other = topo[P.off_bond_ends + 2u * b];
+        out += sym_times(imp_topo[IMP_V_BONDS] + 2u * b, vi - imp_vec(section, other));
+    }
+    let externals_end = topo[P.off_ext_offsets + i + 1u];
+    for (var t = topo[P.off_ext_offsets + i]; t < externals_end; t++) {
+        out += sym_times(imp_topo[IMP_V_EXTERNALS] + 2u * t, vi);
+    }
+    let slots_end = imp_topo[imp_topo[IMP_OFF_SLOT_START] + i + 1u];
+    for (var s = imp_topo[imp_topo[IMP_OFF_SLOT_START] + i]; s < slots_end; s++) {
+        let a = imp_topo[imp_topo[IMP_OFF_SLOTS] + 2u * s];
+        let role = imp_topo[imp_topo[IMP_OFF_SLOTS] + 2u * s + 1u];
+        let rec = imp_topo[IMP_OFF_ANGLES] + 4u * a;
+        for (var c = 0u; c < 3u; c++) {
+            let vc = imp_vec(section, imp_topo[rec + c]);
+            for (var m = 0u; m < 3u; m++) {
+                let row = (3u * role + m) * 9u + 3u * c;
+                out[m] += angle_entry(a, row) * vc.x + angle_entry(a, row + 1u) * vc.y + angle_entry(a, row + 2u) * vc.z;
+            }
+        }
+    }
+    return out;
+}
+
+var<workgroup> partial_sums: array<vec3<f32>, 256>;
+var<workgroup> workgroup_total: vec3<f32>;
+var<workgroup> workgroup_flag: u32;
+// The iteration cap and the tolerance's bits, loaded once as workgroup-uniform values.
+var<workgroup> workgroup_limits: vec2<u32>;
+
+// The sum of each invocation's `v` over the workgroup by a fixed pairwise
+// tree (the same bits on every run), the same value in every invocation.
+fn workgroup_sum(local: u32, v: vec3<f32>) -> vec3<f32> {
+    partial_sums[local] = v;
+    workgroupBarrier();
+    for (var width = WORKGROUP / 2u; width > 0u; width = width >> 1u) {
+        if local < width {
+            partial_sums[local] = partial_sums[local] + partial_sums[local + width];
+        }
+        workgroupBarrier();
+    }
+    if local == 0u {
+        workgroup_total = partial_sums[0];
+    }
+    return workgroupUniformLoad(&workgroup_total);
+}
+
+// Particle i's right-hand side F_i + √(2kT·γ/dt)·ξ_i (0 for a fixed particle).
+fn implicit_rhs(i: u32) -> vec3<f32> {
+    if imp_drag(i) == 0.0 {
+        return vec3<f32>(0.0);
+    }
+    let kick = bitcast<f32>(imp_topo[imp_topo[IMP_OFF_KICK] + topo[i]]);
+    if kick == 0.0 {
+        return force[i].xyz;
+    }
+    return force[i].xyz + kick * unit_noise(i);
+}
+
+@compute @workgroup_size(256)
+fn implicit_solve(@builtin(local_invocation_index) local: u32) {
+    if local == 0u {
+        workgroup_flag = atomicLoad(&status[ST_HALTED]);
+        workgroup_limits = vec2<u32>(imp_topo[IMP_MAX_ITER], imp_topo[IMP_TOLERANCE]);
+    }
+    if workgroupUniformLoad(&workgroup_flag) != 0u {
+        return;
+    }
+    let n = P.n;
+    // The explicit step as the first guess: Δx = b·dt/γ.
+    for (var i = local; i < n; i += WORKGROUP) {
+        let b = implicit_rhs(i);
+        let drag = imp_drag(i);
+        imp[n * VEC_R + i] = vec4<f32>(b, 0.0);
+        imp[n * VEC_X + i] = vec4<f32>(select(b / drag, vec3<f32>(0.0), drag == 0.0), 0.0);
+    }
+    storageBarrier();
+    var sums = vec3<f32>(0.0);
+    for (var i = local; i < n; i += WORKGROUP) {
+        let b = imp_vec(VEC_R, i);
+        let r = b - apply_row(i, VEC_X);
+        let z = imp[n * VEC_DINV + i].xyz * r;
+        imp[n * VEC_R + i] = vec4<f32>(r, 0.0);
+        imp[n * VEC_Z + i] = vec4<f32>(z, 0.0);
+        imp[n * VEC_P + i] = vec4<f32>(z, 0.0);
+        sums += vec3<f32>(dot(r, z), dot(r, r), dot(b, b));
+    }
+    let start = workgroup_sum(local, sums);
+    var rz = start.x;
+    var residual = sqrt(start.y);
+    let b_norm = sqrt(start.z);
+    let limits = workgroupUniformLoad(&workgroup_limits);
+    let threshold = bitcast<f32>(limits.y) * b_norm;
+    let cap = limits.x;
+    var iterations = 0u;
+    loop {
+        if b_norm == 0.0 || residual < threshold || iterations >= cap {
+            break;
+        }
+        storageBarrier();
+        var pq = 0.0;
+        for (var i = local; i < n; i += WORKGROUP) {
+            let q = apply_row(i, VEC_P);
+            imp[n * VEC_Q + i] = vec4<f32>(q, 0.0);
+            pq += dot(imp_vec(VEC_P, i), q);
+        }
+        let curvature = workgroup_sum(local, vec3<f32>(pq, 0.0, 0.0)).x;
+        if !(curvature > 0.0) {
+            break;
+        }
+        let alpha = rz / curvature;
+        var next = vec3<f32>(0.0);
+        for (var i = local; i < n; i += WORKGROUP) {
+            let x = imp_vec(VEC_X, i) + alpha * imp_vec(VEC_P, i);
+            let r = imp_vec(VEC_R, i) - alpha * imp_vec(VEC_Q, i);
+            let z = imp[n * VEC_DINV + i].xyz * r;
+            imp[n * VEC_X + i] = vec4<f32>(x, 0.0);
+            imp[n * VEC_R + i] = vec4<f32>(r, 0.0);
+            imp[n * VEC_Z + i] = vec4<f32>(z, 0.0);
+            next += vec3<f32>(dot(r, z), dot(r, r), 0.0);
+        }
+        let after = workgroup_sum(local, next);
+        let beta = after.x / rz;
+        rz = after.x;
+        residual = sqrt(after.y);
+        for (var i = local; i < n; i += WORKGROUP) {
+            imp[n * VEC_P + i] = vec4<f32>(imp_vec(VEC_Z, i) + beta * imp_vec(VEC_P, i), 0.0);
+        }
+        iterations += 1u;
+    }
+    if local == 0u {
+        let relative = select(residual / b_norm, 0.0, b_norm == 0.0);
+        imp[imp_topo[IMP_V_REPORT]] = vec4<f32>(bitcast<f32>(iterations), relative, 0.0, 0.0);
+        if !(b_norm == 0.0 || residual < threshold) {
+            atomicOr(&status[ST_HALTED], HALT_SOLVE);
+        }
+    }
+}
+
+@compute @workgroup_size(256)
+fn implicit_move(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    let i = linear_index(wg, local);
+    if i >= P.n || halted() {
+        return;
+    }
+    step_particle(i, imp_vec(VEC_X, i));
+}

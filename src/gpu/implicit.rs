@@ -1,0 +1,325 @@
+//! `integrator implicit` on the device (kernels: shaders/common/implicit.wgsl).
+//!
+//! # The step
+//!
+//! As on the CPU (src/integrate/implicit.rs; Nédélec & Foethke, *New J.
+//! Phys.* 9, 427 (2007)), each step solves
+//!
+//! (γ/dt·I + K̃)·Δx = F(x) + √(2·kT·γ/dt)·ξ,   x ← x + Δx,
+//!
+//! with K̃ the energy Hessian made positive semi-definite term by term, by
+//! conjugate gradients with a Jacobi preconditioner from the explicit step
+//! Δx₀ = b·dt/γ, to the relative residual |b − AΔx|/|b| ≤ tolerance, as
+//! faer's CG does on the CPU. The blocks are the CPU's
+//! (src/backend/stiffness.rs), computed on the device in f32 after the
+//! force pass of each step:
+//!
+//! - **Bonds**: max(E″, 0)·ûûᵀ + max(E′/r, 0)·(I − ûûᵀ), with E″ from the
+//!   law's `NAME_curvature` (shaders/interactions/NAME.wgsl), once per
+//!   bond end (both ends compute the same bits: the separation is an exact
+//!   fixed-point difference rounded once, and the block is even in it).
+//! - **Angles**: the law's exact 9×9 Hessian (`NAME_hessian`) projected onto
+//!   its positive semi-definite part by cyclic Jacobi rotations. The CPU
+//!   takes the same Hessian by central differences of the analytic forces
+//!   (relative error ~1e-10) and projects it with an eigensolver, so the two
+//!   differ by the f32 rounding only.
+//! - **Externals**: the law's 3×3 Hessian (`NAME_hessian`), positive
+//!   semi-definite as written (a wall's k·n̂n̂ᵀ inside it, 0 for a constant
+//!   force).
+//!
+//! Fixed particles have the identity row and no couplings, as on the CPU.
+//!
+//! # Which models ([`refusal`])
+//!
+//! Every bond, angle and external law must have its device block (a WGSL
+//! function `NAME_curvature` or `NAME_hessian`; `harmonic`, `wlc_bending`,
+//! `wall` and `constant_force` have one); models with pair, body, contact or
+//! volume-element terms, custom terms, bond kinetics or constraints stay on
+//! the CPU with the reason. `solver cholesky` does too: its decks take Newton
+//! steps (γ/dt = 1e-6 against stiffnesses of 10²–10⁵), which f32 conjugate
+//! gradients cannot solve to a direct solver's accuracy.
+//!
+//! # Determinism and the read-back
+//!
+//! The whole CG runs in ONE workgroup (`implicit_solve`): each product K̃·v
+//! is gathered per particle from its own bond ends, externals and angle
+//! slots in a fixed order, and each dot product is a fixed pairwise tree
+//! over the workgroup, so the same run gives the same bits (no atomics on
+//! floats). One workgroup has workgroup barriers, so the convergence test
+//! is taken on the device every iteration and nothing is read back per step
+//! or per iteration: the host reads the last step's iterations and residual
+//! (16 bytes) at its synchronisations, for the thermo's `solver_iterations`
+//! and `solver_residual`. A solve that does not converge within
+//! `max_iterations` halts the run before that step is taken
+//! (the host reports the step, the residual and the iterations). The cost:
+//! one workgroup runs the solve on one compute unit. That suits filaments
+//! and networks of up to ~10⁴ particles; the 10⁵–10⁶-particle systems would
+//! need a multi-workgroup CG (one dispatch per phase with a device-side
+//! convergence flag), which is not written.
+//!
+//! # Precision
+//!
+//! f32 residuals stop decreasing near ε_f32·κ(A)·|b|, so the CPU's default
+//! relative tolerance 1e-10 is out of reach: the device solves to
+//! max(tolerance, [`F32_TOLERANCE`]) and says so in the log when it raises
+//! the deck's tolerance. The step then differs from the CPU's by about
+//! κ(A)·[`F32_TOLERANCE`] relative at most, in practice the f32 rounding of
+//! forces and blocks (measured in tests/gpu_implicit.rs).
+
+use wgpu::util::DeviceExt;
+
+use super::context::GpuContext;
+use super::pack::push_csr;
+use super::shader;
+use crate::integrate::implicit::{ImplicitSettings, LinearSolver, SolveReport};
+use crate::interactions::{Law, REGISTRY};
+use crate::system::Model;
+
+/// The smallest relative residual the device's f32 conjugate gradients are
+/// asked for (ε_f32 ≈ 6e-8, times the condition numbers of the filament
+/// decks' systems, ~10³, leaves a margin of ten).
+pub const F32_TOLERANCE: f64 = 1e-6;
+
+const HEADER_WORDS: usize = 12;
+/// `imp` entries per particle (Δx, r, z, p, A·p, the Jacobi diagonal).
+const PARTICLE_VECTORS: usize = 6;
+/// `imp` entries of an angle's 9×9 block.
+const ANGLE_VEC4: usize = 21;
+
+/// Why the model's implicit step cannot run on the device (None: it can).
+pub fn refusal(model: &Model, implicit: &ImplicitSettings) -> Option<&'static str> {
+    if implicit.solver == LinearSolver::Cholesky {
+        return Some(
+            "`integrator implicit solver cholesky` runs on the CPU backend only (the GPU solves by f32 conjugate gradients, \
+             which cannot reach a direct solve's accuracy)",
+        );
+    }
+    if model.has_kinetics() {
+        return Some("bond kinetics with `integrator implicit` run on the CPU backend only");
+    }
+    if !model.pair_rules.is_empty() || !model.body_rules.is_empty() || !model.tetras.is_empty() || model.has_contact_terms() {
+        return Some(
+            "`integrator implicit` with pair, body, contact or volume-element terms runs on the CPU backend only \
+             (the GPU has stiffness blocks for bonds, angles and externals)",
+        );
+    }
+    let kinds = super::custom::gpu_kinds(model);
+    if !kinds.iter().all(|&k| REGISTRY.get(k as usize).is_some_and(|i| stiffness_function(*i).is_some())) {
+        return Some(
+            "`integrator implicit` with a bond, angle or external law that has no GPU stiffness block runs on the CPU backend only \
+             (harmonic, wlc_bending, wall and constant_force have one)",
+        );
+    }
+    None
+}
+
+/// The WGSL function giving an interaction's stiffness, if its evaluator
+/// file has one: `NAME_curvature` (E″ of a radial law) or `NAME_hessian`
+/// (a three- or one-body law's Hessian).
+fn stiffness_function(interaction: &dyn crate::interactions::Interaction) -> Option<String> {
+    let name = interaction.name();
+    let function = match interaction.law() {
+        Law::Radial { .. } => format!("{name}_curvature"),
+        Law::ThreeBody(_) | Law::OneBody(_) => format!("{name}_hessian"),
+        _ => return None,
+    };
+    shader::interaction_source(name).filter(|s| s.contains(&format!("fn {function}("))).map(|_| function)
+}
+
+/// The stiffness dispatch functions over the registry: `radial_curvature`,
+/// `three_body_hessian` and `one_body_hessian` (0 for laws without one,
+/// which [`refusal`] keeps off the device).
+pub fn stiffness_dispatch() -> String {
+    let mut radial = String::from("fn radial_curvature(kind: u32, p: array<f32, 8>, r: f32) -> f32 {\n    switch kind {\n");
+    let mut three = String::from(
+        "fn three_body_hessian(kind: u32, p: array<f32, 8>, ri: vec3<f32>, rj: vec3<f32>, rk: vec3<f32>) -> array<f32, 81> {\n    switch kind {\n",
+    );
+    let mut one = String::from("fn one_body_hessian(kind: u32, p: array<f32, 8>, x: vec3<f32>) -> mat3x3<f32> {\n    switch kind {\n");
+    for (index, interaction) in REGISTRY.iter().enumerate() {
+        let Some(function) = stiffness_function(*interaction) else { continue };
+        let (out, args) = match interaction.law() {
+            Law::Radial { .. } => (&mut radial, "p, r"),
+            Law::ThreeBody(_) => (&mut three, "p, ri, rj, rk"),
+            _ => (&mut one, "p, x"),
+        };
+        out.push_str(&format!("        case {index}u: {{ return {function}({args}); }}\n"));
+    }
+    radial.push_str("        default: { return 0.0; }\n    }\n}\n");
+    three.push_str("        default: { return array<f32, 81>(); }\n    }\n}\n");
+    one.push_str("        default: { return mat3x3<f32>(); }\n    }\n}\n");
+    radial + &three + &one
+}
+
+/// The device's implicit solver: its buffers, bind group (group 1) and kernels.
+pub(super) struct ImplicitSolver {
+    pub(super) group: wgpu::BindGroup,
+    pub(super) angles: wgpu::ComputePipeline,
+    pub(super) blocks: wgpu::ComputePipeline,
+    pub(super) solve: wgpu::ComputePipeline,
+    pub(super) moves: wgpu::ComputePipeline,
+    /// The `imp` buffer and the byte offset of its report entry.
+    pub(super) buffer: wgpu::Buffer,
+    pub(super) report_at: u64,
+    angle_count: u32,
+    /// The relative residual the device solves to.
+    tolerance: f64,
+    max_iterations: usize,
+}
+
+impl ImplicitSolver {
+    /// Packs the angle slots and per-type factors, and compiles the kernels
+    /// against the backend's main bind group layout.
+    pub(super) fn new(
+        ctx: &GpuContext,
+        main_layout: &wgpu::BindGroupLayout,
+        model: &Model,
+        (dt, kt): (f64, f64),
+        implicit: &ImplicitSettings,
+    ) -> Result<Self, String> {
+        if let Some(why) = refusal(model, implicit) {
+            return Err(why.into());
+        }
+        // The main group's storage buffers and these two.
+        let needed = super::context::STORAGE_BINDINGS + 2;
+        if ctx.limits.max_storage_buffers_per_shader_stage < needed {
+            return Err(format!(
+                "the implicit step needs {needed} storage buffers per shader stage; {} allows {}",
+                ctx.info.name, ctx.limits.max_storage_buffers_per_shader_stage
+            ));
+        }
+        let n = model.len();
+        let tolerance = implicit.tolerance.max(F32_TOLERANCE);
+        let angle_base = model.bond_types.len();
+        let mut header = vec![0u32; HEADER_WORDS];
+        let mut words = Vec::new();
+        header[0] = model.angles.len() as u32;
+        header[1] = HEADER_WORDS as u32;
+        let mut slot_rows = vec![Vec::new(); n];
+        for (a, &[i, j, k]) in model.angles.iter().enumerate() {
+            words.extend([i, j, k, (angle_base + model.angle_type[a] as usize) as u32]);
+            for (role, p) in [i, j, k].into_iter().enumerate() {
+                slot_rows[p as usize].push([a as u32, role as u32]);
+            }
+        }
+        let (mut starts, mut slots) = (Vec::new(), Vec::new());
+        push_csr(&slot_rows, &mut starts, &mut slots);
+        header[2] = (HEADER_WORDS + words.len()) as u32;
+        words.extend(&starts);
+        header[3] = (HEADER_WORDS + words.len()) as u32;
+        words.extend(slots.iter().flatten());
+        header[4] = implicit.max_iterations.min(u32::MAX as usize) as u32;
+        header[5] = (tolerance as f32).to_bits();
+        let drag = |g: f64| if g.is_finite() { (g / dt) as f32 } else { 0.0 };
+        let kick = |g: f64| if g.is_finite() && kt > 0.0 { (2.0 * kt * g / dt).sqrt() as f32 } else { 0.0 };
+        header[6] = (HEADER_WORDS + words.len()) as u32;
+        words.extend(model.type_drag.iter().map(|&g| drag(g).to_bits()));
+        header[7] = (HEADER_WORDS + words.len()) as u32;
+        words.extend(model.type_drag.iter().map(|&g| kick(g).to_bits()));
+        // `imp`: the particle vectors, then 2 entries per bond end and per
+        // external entry, 21 per angle, then the report.
+        let externals: usize = model.externals.iter().map(|e| e.members.len()).sum();
+        let bonds_at = PARTICLE_VECTORS * n;
+        let externals_at = bonds_at + 2 * 2 * model.bonds.len();
+        let angles_at = externals_at + 2 * externals;
+        let report = angles_at + ANGLE_VEC4 * model.angles.len();
+        header[8] = bonds_at as u32;
+        header[9] = externals_at as u32;
+        header[10] = angles_at as u32;
+        header[11] = report as u32;
+        let topo: Vec<u32> = header.into_iter().chain(words).collect();
+        let entries = (report + 1) as u64;
+        let limit = ctx.limits.max_storage_buffer_binding_size.min(ctx.limits.max_buffer_size);
+        if 16 * entries > limit || entries > u32::MAX as u64 {
+            return Err(format!(
+                "the implicit solver's vectors and blocks need {:.0} MiB, more than one storage binding",
+                16.0 * entries as f64 / 1048576.0
+            ));
+        }
+        let device = &ctx.device;
+        let imp_topo = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("imp_topo"),
+            contents: bytemuck::cast_slice(&topo),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("imp"),
+            size: 16 * entries,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let entry = |binding: u32, read_only: bool| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("cellmd implicit"),
+            entries: &[entry(1, true), entry(2, false)],
+        });
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("cellmd implicit"),
+            layout: &layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 1, resource: imp_topo.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: buffer.as_entire_binding() },
+            ],
+        });
+        let program = shader::compose_with(&super::custom::source(model)?);
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("cellmd implicit"),
+            source: wgpu::ShaderSource::Wgsl(program.into()),
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("cellmd implicit"),
+            bind_group_layouts: &[Some(main_layout), Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = |entry: &str| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: Some(&pipeline_layout),
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        Ok(Self {
+            group,
+            angles: pipeline("implicit_angles"),
+            blocks: pipeline("implicit_blocks"),
+            solve: pipeline("implicit_solve"),
+            moves: pipeline("implicit_move"),
+            buffer,
+            report_at: 16 * report as u64,
+            angle_count: model.angles.len() as u32,
+            tolerance,
+            max_iterations: implicit.max_iterations,
+        })
+    }
+
+    /// Workgroups of the per-angle kernel (0 without angles).
+    pub(super) fn angle_groups(&self, workgroup: u32) -> u32 {
+        self.angle_count.div_ceil(workgroup)
+    }
+
+    /// The last solve's report, from the 16 bytes of its entry.
+    pub(super) fn report(&self, bytes: &[u8]) -> SolveReport {
+        let entry: [f32; 4] = bytemuck::pod_read_unaligned(&bytes[..16]);
+        SolveReport { iterations: entry[0].to_bits() as usize, relative_residual: f64::from(entry[1]), step_fraction: 1.0 }
+    }
+
+    /// Why a solve halted the run.
+    pub(super) fn failure(&self, report: &SolveReport) -> String {
+        format!(
+            "integrator implicit: the device's conjugate gradients reached relative residual {:e} after {} iterations \
+             (tolerance {:e}, max_iterations {})",
+            report.relative_residual, report.iterations, self.tolerance, self.max_iterations
+        )
+    }
+}

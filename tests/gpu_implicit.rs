@@ -1,0 +1,134 @@
+//! `integrator implicit` on the device (src/gpu/implicit.rs) against the
+//! CPU's f64 step, on whatever Vulkan adapter exists (CI: Mesa's llvmpipe).
+
+mod common;
+
+use cellmd::backend::{CpuBackend, Forces};
+use cellmd::gpu::implicit::F32_TOLERANCE;
+use cellmd::gpu::DevicePreference;
+use cellmd::run::{RunOptions, Simulation};
+use cellmd::system::State;
+use glam::DVec3;
+
+/// A bent 12-bead filament (stiff harmonic bonds, wlc_bending angles),
+/// anchored at its left end, its right end pushed into a wall, at `kt`,
+/// `steps` implicit steps of 1e-3 s (γ/dt = 3.5 pN/µm against bonds of
+/// 2000 pN/µm: 40× the explicit limit).
+fn filament(steps: u64, kt: f64) -> common::Case {
+    let mut top = String::from("[ particles ]\n");
+    for k in 0..12 {
+        let x = 0.3 * k as f64;
+        let y = 0.05 * (std::f64::consts::PI * x / 3.3).sin() + 0.01 * (k % 3) as f64;
+        top += &format!("{} {} {x} {y} {}\n", k + 1, if k == 0 { "anchor" } else { "bead" }, 0.002 * k as f64);
+    }
+    top += "[ bonds ]\n";
+    for k in 1..12 {
+        top += &format!("rod {k} {}\n", k + 1);
+    }
+    top += "[ angles ]\n";
+    for k in 1..11 {
+        top += &format!("bend {k} {} {}\n", k + 1, k + 2);
+    }
+    let ff = "particle bead drag 0.0035\nparticle anchor fixed\n\
+              bond rod harmonic k 2000 r0 0.31\nangle bend wlc_bending kappa 2 l0 0.3\n";
+    let deck = format!(
+        "units cell\ntopology t.top\nforcefield f.ff\nbox x -5 10 f y -5 5 f z -5 5 f\ngroup tip id 12\n\
+         external push tip constant_force fx -2 fy 0.5\nexternal stop tip wall nx -1 d -3.28 k 1000\n\
+         integrator implicit\ntimestep 1e-3\ntemperature {kt}\nseed 3\nrun {steps}\n"
+    );
+    common::Case::new(&[("t.top", &top), ("f.ff", ff), ("deck.in", &deck)])
+}
+
+fn run(case: &common::Case, device: DevicePreference) -> Simulation {
+    let options = RunOptions { output_dir: case.output_dir().to_path_buf(), device: Some(device), ..Default::default() };
+    Simulation::execute(case.plan(), options).unwrap_or_else(|e| panic!("{device:?}: {e}"))
+}
+
+/// One implicit step: the GPU's Δx equals the CPU's within the bound of an
+/// inexact solve. With A = γ/dt·I + K̃ ⪰ γ/dt·I, an error δ in the solve
+/// (relative residual ≤ F32_TOLERANCE) and in A and b (f32 rounding of the
+/// forces and blocks, a few ε_f32 relative) moves Δx by at most
+/// κ(A)·(F32_TOLERANCE + 8·ε_f32)·|Δx|, with κ(A) ≤ (γ/dt + max row sum of
+/// |K̃|)/(γ/dt) (Gershgorin), computed here from the CPU's blocks.
+#[test]
+fn one_implicit_step_on_the_gpu_matches_the_cpu() {
+    let case = filament(1, 0.0);
+    let plan = case.plan();
+    let start = State::new(plan.positions.clone());
+    let cpu = run(&case, DevicePreference::Cpu);
+    let gpu = run(&case, DevicePreference::Gpu);
+    let dx = |s: &State| -> Vec<DVec3> { s.positions.iter().zip(&start.positions).map(|(a, b)| *a - *b).collect() };
+    let (dc, dg) = (dx(&cpu.state), dx(&gpu.state));
+    let norm = |v: &[DVec3]| v.iter().map(|d| d.length_squared()).sum::<f64>().sqrt();
+    let error = norm(&dc.iter().zip(&dg).map(|(c, g)| *c - *g).collect::<Vec<_>>());
+    // κ(A) by Gershgorin from the CPU's stiffness at the start.
+    let model = &plan.model;
+    let mut backend = CpuBackend::new(model, &start, &plan.sim_box, 0.0).unwrap();
+    backend.compute(model, &start, &plan.sim_box, &mut Forces::default());
+    let stiffness = backend.stiffness(model, &start, &plan.sim_box);
+    let mut rows = vec![0.0f64; 3 * model.len()];
+    for b in &stiffness.blocks {
+        for r in 0..3 {
+            rows[3 * b.i as usize + r] += (0..3).map(|c| b.block.col(c)[r].abs()).sum::<f64>();
+        }
+    }
+    let drag = 0.0035 / 1e-3;
+    let kappa = (drag + rows.iter().cloned().fold(0.0, f64::max)) / drag;
+    let bound = kappa * (F32_TOLERANCE + 8.0 * f32::EPSILON as f64) * norm(&dc);
+    println!(
+        "|Δx| {:.4e}, GPU − CPU {error:.3e} (bound {bound:.3e}, κ ≤ {kappa:.0}); iterations GPU {} CPU {}, residual GPU {:.2e}",
+        norm(&dc),
+        gpu.last_solve.iterations,
+        cpu.last_solve.iterations,
+        gpu.last_solve.relative_residual
+    );
+    assert!(norm(&dc) > 1e-3, "the step moved nothing: {:e}", norm(&dc));
+    assert!(gpu.last_solve.iterations > 1 && gpu.last_solve.relative_residual <= F32_TOLERANCE);
+    assert!(error <= bound, "GPU − CPU {error:e} > {bound:e}");
+}
+
+/// At kT > 0 the same implicit run twice gives the same bits (no float
+/// atomics; fixed-order gathers and reduction trees).
+#[test]
+fn the_same_implicit_gpu_run_twice_gives_the_same_bits() {
+    let case = filament(30, 4.1e-3);
+    let (a, b) = (run(&case, DevicePreference::Gpu), run(&case, DevicePreference::Gpu));
+    let bits = |s: &Simulation| s.state.positions.iter().flat_map(|x| x.to_array().map(f64::to_bits)).collect::<Vec<_>>();
+    assert_eq!(bits(&a), bits(&b));
+    let moved = a.state.positions.iter().zip(&filament(0, 0.0).plan().positions).map(|(x, y)| (*x - *y).length()).fold(0.0, f64::max);
+    assert!(moved > 1e-3, "nothing moved: {moved:e}");
+}
+
+/// A solver the device does not have, or a law without a device stiffness
+/// block, is refused with the reason.
+#[test]
+fn implicit_decks_the_device_cannot_solve_are_refused_with_the_reason() {
+    let case = filament(1, 0.0);
+    let deck = std::fs::read_to_string(case.path("deck.in")).unwrap();
+    std::fs::write(case.path("deck.in"), deck.replace("integrator implicit", "integrator implicit solver cholesky")).unwrap();
+    let options = RunOptions { output_dir: case.output_dir().to_path_buf(), device: Some(DevicePreference::Gpu), ..Default::default() };
+    let refused = Simulation::execute(case.plan(), options.clone()).err().map(|e| e.to_string()).unwrap_or_default();
+    assert!(refused.contains("solver cholesky` runs on the CPU backend only"), "{refused}");
+    let ff = std::fs::read_to_string(case.path("f.ff")).unwrap();
+    std::fs::write(case.path("f.ff"), ff.replace("harmonic k 2000 r0 0.31", "fene K 30 R0 1.5 epsilon 0 sigma 1")).unwrap();
+    std::fs::write(case.path("deck.in"), deck).unwrap();
+    let refused = Simulation::execute(case.plan(), options).err().map(|e| e.to_string()).unwrap_or_default();
+    assert!(refused.contains("has no GPU stiffness block"), "{refused}");
+}
+
+/// Wall-clock time of `inputs/buckling_filament.in` (1500 implicit steps) on
+/// the CPU and on the GPU: `cargo test --test gpu_implicit buckling -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn buckling_filament_timing() {
+    let deck = std::path::Path::new("inputs/buckling_filament.in");
+    for device in [DevicePreference::Cpu, DevicePreference::Gpu] {
+        let dir = tempfile::tempdir().unwrap();
+        let plan = cellmd::deck::validate_file(deck, &[]).unwrap();
+        let options = RunOptions { output_dir: dir.path().to_path_buf(), device: Some(device), ..Default::default() };
+        let started = std::time::Instant::now();
+        let sim = Simulation::execute(plan, options).unwrap();
+        let seconds = started.elapsed().as_secs_f64();
+        println!("{device:?}: {} steps in {seconds:.2} s, last solve {} iterations", sim.state.step, sim.last_solve.iterations);
+    }
+}
