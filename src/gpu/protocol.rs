@@ -143,9 +143,9 @@ pub(super) struct ProtocolPack {
     pub(super) fields: [u32; 8],
     /// The buffer's words at the start (held words, moving groups).
     pub(super) words: Vec<u32>,
-    /// The ramps' values per step from a first step ([`super::GpuBackend::set_ramps`]).
+    /// The ramps' values per step from a first step (`GpuBackend::set_ramps`).
     values: (u64, Vec<Vec<f64>>),
-    /// Per drive: its centres from the current call's start ([`super::GpuBackend::set_drives`]),
+    /// Per drive: its centres from the current call's start (`GpuBackend::set_drives`),
     /// how far it advanced since, and whether it holds.
     drives: Vec<(Vec<DVec3>, u64, bool)>,
 }
