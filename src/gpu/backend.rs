@@ -70,6 +70,9 @@ pub enum GpuHalt {
     /// body spans more than half the periodic box, or the implicit step's
     /// solve did not converge; the state is that of `step`.
     Capacity { step: u64, message: String },
+    /// A face of a contact body outgrew the contact search, whose reach is
+    /// set when the backend is built; the state is that of `step`.
+    Reach { step: u64 },
 }
 
 /// Seconds per call of each phase of a step, each timed alone
@@ -1135,6 +1138,9 @@ impl GpuBackend {
             }
             if status[ST_HALTED] & HALT_BLOWUP != 0 {
                 return Err(GpuHalt::Blowup { step: first_step + done, particle: status[ST_BLOWUP_PARTICLE] as usize });
+            }
+            if status[ST_HALTED] & HALT_REACH != 0 {
+                return Err(GpuHalt::Reach { step: first_step + done });
             }
             if let Some(message) = self.span_halt(&status) {
                 return Err(GpuHalt::Capacity { step: first_step + done, message });

@@ -95,7 +95,7 @@ impl Stepper for GpuSteps {
         sim.protocols.follow_device_drives(&mut sim.model, &centres, &self.gpu.drive_states());
         let done = match &outcome {
             Ok(done) => *done,
-            Err(GpuHalt::Blowup { step, .. } | GpuHalt::Capacity { step, .. }) => step - sim.state.step,
+            Err(GpuHalt::Blowup { step, .. } | GpuHalt::Capacity { step, .. } | GpuHalt::Reach { step }) => step - sim.state.step,
         };
         // Each step took s·dt: below 1 where the contact step clamp shortened it (src/gpu/contact.rs).
         let mut taken = Taken { steps: done, last: None };
@@ -129,6 +129,13 @@ impl Stepper for GpuSteps {
             if let Some(bonds) = sim.state.bonds.as_mut() {
                 self.gpu.download_bond_state(bonds);
             }
+        }
+        if let Err(GpuHalt::Reach { .. }) = outcome {
+            // A face outgrew the contact search (src/gpu/contact.rs): the
+            // backend is built anew from this state, with the reach of its
+            // faces now, and the run goes on.
+            *self = GpuSteps::new(sim, &self.context)?;
+            return Ok(taken);
         }
         if let Err(GpuHalt::Capacity { message, .. }) = outcome {
             return Err(RunError::Setup(format!("device gpu at step {}: {message}", sim.state.step)));
