@@ -1,13 +1,29 @@
 // wlc_bending: E = (κ/ℓ)(1 − t̂1·t̂2) with t̂1 = (rj − ri)/|·|, t̂2 = (rk − rj)/|·|; p = [κ, ℓ].
-fn wlc_bending_three(p: array<f32, 8>, ri: vec3<f32>, rj: vec3<f32>, rk: vec3<f32>) -> ThreeBody {
-    let strength = p[WLC_BENDING_KAPPA] / p[WLC_BENDING_L0];
+// The two arms a = rj − ri, b = rk − rj: lengths, unit vectors, t̂1·t̂2.
+struct WlcBendingArms {
+    la: f32,
+    lb: f32,
+    t1: vec3<f32>,
+    t2: vec3<f32>,
+    c: f32,
+}
+
+fn wlc_bending_arms(ri: vec3<f32>, rj: vec3<f32>, rk: vec3<f32>) -> WlcBendingArms {
     let a = rj - ri;
     let b = rk - rj;
     let la = length(a);
     let lb = length(b);
-    let t1 = a / la;
-    let t2 = b / lb;
-    let c = dot(t1, t2);
+    return WlcBendingArms(la, lb, a / la, b / lb, dot(a / la, b / lb));
+}
+
+fn wlc_bending_three(p: array<f32, 8>, ri: vec3<f32>, rj: vec3<f32>, rk: vec3<f32>) -> ThreeBody {
+    let strength = p[WLC_BENDING_KAPPA] / p[WLC_BENDING_L0];
+    let arms = wlc_bending_arms(ri, rj, rk);
+    let la = arms.la;
+    let lb = arms.lb;
+    let t1 = arms.t1;
+    let t2 = arms.t2;
+    let c = arms.c;
     let fi = -strength * (t2 - c * t1) / la;
     let fk = strength * (t1 - c * t2) / lb;
     return ThreeBody(strength * (1.0 - c), fi, -fi - fk, fk);
@@ -21,13 +37,12 @@ fn wlc_bending_three(p: array<f32, 8>, ri: vec3<f32>, rj: vec3<f32>, rk: vec3<f3
 // mapped to positions by a = −ri + rj, b = −rj + rk.
 fn wlc_bending_hessian(p: array<f32, 8>, ri: vec3<f32>, rj: vec3<f32>, rk: vec3<f32>) -> array<f32, 81> {
     let strength = p[WLC_BENDING_KAPPA] / p[WLC_BENDING_L0];
-    let a = rj - ri;
-    let b = rk - rj;
-    let la = length(a);
-    let lb = length(b);
-    let t1 = a / la;
-    let t2 = b / lb;
-    let c = dot(t1, t2);
+    let arms = wlc_bending_arms(ri, rj, rk);
+    let la = arms.la;
+    let lb = arms.lb;
+    let t1 = arms.t1;
+    let t2 = arms.t2;
+    let c = arms.c;
     let ga = (t2 - c * t1) / la;
     let gb = (t1 - c * t2) / lb;
     let p1 = identity3() - outer3(t1, t1);

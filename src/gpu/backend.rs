@@ -24,6 +24,7 @@ use wgpu::util::DeviceExt;
 
 use super::adhesion::AdhesionPack;
 use super::contact::{reach_message, ContactPack, CONTACT_ONLY, FRACTION_SLOTS};
+use super::context::storage_entry;
 use super::context::GpuContext;
 use super::implicit::ImplicitSolver;
 use super::kinetics::{KinKernels, KinLayout};
@@ -207,19 +208,6 @@ fn check_binding(ctx: &GpuContext, what: &str, bytes: u64) -> Result<(), String>
         ));
     }
     Ok(())
-}
-
-fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
 }
 
 fn words<T: bytemuck::Pod>(data: &[T]) -> &[u8] {

@@ -68,7 +68,7 @@
 
 use wgpu::util::DeviceExt;
 
-use super::context::GpuContext;
+use super::context::{storage_entry, GpuContext};
 use super::pack::push_csr;
 use super::shader;
 use crate::integrate::implicit::{ImplicitSettings, LinearSolver, SolveReport};
@@ -247,19 +247,9 @@ impl ImplicitSolver {
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        let entry = |binding: u32, read_only: bool| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Storage { read_only },
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("cellmd implicit"),
-            entries: &[entry(1, true), entry(2, false)],
+            entries: &[storage_entry(1, true), storage_entry(2, false)],
         });
         let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("cellmd implicit"),
