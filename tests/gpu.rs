@@ -801,7 +801,7 @@ fn every_input_deck_runs_on_the_gpu_like_on_the_cpu() {
             }
             // A CPU-only feature that starts after the first run (a `ramp`
             // between runs): the GPU must refuse that run with its reason.
-            Err(e) if e.starts_with("device gpu: ") && e.ends_with("run on the CPU backend only; use `device cpu` or `device auto`") => {
+            Err(e) if refused_by_the_gpu(&e) => {
                 println!("{:40} refused at a later run: {e}", deck.display());
                 refused += 1
             }
@@ -810,6 +810,12 @@ fn every_input_deck_runs_on_the_gpu_like_on_the_cpu() {
     }
     println!("{compared} decks compared, {refused} refused for CPU-only features");
     assert!(compared >= 5, "only {compared} decks compared");
+}
+
+/// Whether a run's error is the GPU refusing a CPU-only feature
+/// (`Simulation::cpu_only_feature`), e.g. one that starts after the first run.
+fn refused_by_the_gpu(error: &str) -> bool {
+    error.starts_with("device gpu: ") && error.ends_with("run on the CPU backend only; use `device cpu` or `device auto`")
 }
 
 /// Double-single positions: a particle pushed by a constant force takes 10⁴
@@ -1044,12 +1050,7 @@ fn kinetics_decks_give_the_same_events_on_the_gpu() {
                 Ok(sim) => sim,
                 // A CPU-only feature that starts after the first run (checked in
                 // `every_input_deck_runs_on_the_gpu_like_on_the_cpu`).
-                Err(e)
-                    if device == DevicePreference::Gpu
-                        && e.to_string().ends_with("run on the CPU backend only; use `device cpu` or `device auto`") =>
-                {
-                    return None
-                }
+                Err(e) if device == DevicePreference::Gpu && refused_by_the_gpu(&e.to_string()) => return None,
                 Err(e) => panic!("{} on {device:?}: {e}", deck.display()),
             };
             let events: Vec<String> = std::fs::read_dir(dir.path())
