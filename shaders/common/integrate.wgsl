@@ -5,6 +5,10 @@
 // stream keyed by (seed, step, particle). The new position goes to `next`;
 // `commit` copies it back only if no particle's step was refused (non-finite,
 // or longer than max_displacement), so a blow-up keeps the last good state.
+// A refused step only lowers ST_BLOWUP_PARTICLE; `commit`, the next
+// dispatch, raises HALT_BLOWUP. Raised here, it would stop the workgroups
+// that had not run yet (they return on `halted()`), and the particle named
+// would be the lowest refused among those that ran first, not the lowest.
 
 fn current_step() -> vec2<u32> {
     let done = atomicLoad(&status[ST_STEPS_DONE]);
@@ -97,13 +101,11 @@ fn step_particle(i: u32, dx: vec3<f32>) {
     let d2 = dot(dx, dx);
     if !(d2 <= P.max_disp2) {
         atomicMin(&status[ST_BLOWUP_PARTICLE], i);
-        atomicOr(&status[ST_HALTED], HALT_BLOWUP);
         return;
     }
     let placed = prescribe(i, wrap_into_box(fixed_add(fixed_of(i), fixed_of_length(dx)), image_of(i)));
     if !placed.ok {
         atomicMin(&status[ST_BLOWUP_PARTICLE], i);
-        atomicOr(&status[ST_HALTED], HALT_BLOWUP);
         return;
     }
     let x = placed.x;
@@ -117,6 +119,10 @@ fn step_particle(i: u32, dx: vec3<f32>) {
 fn commit(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) local: u32) {
     let i = linear_index(wg, local);
     if i >= P.n || halted() {
+        return;
+    }
+    if atomicLoad(&status[ST_BLOWUP_PARTICLE]) != NO_PARTICLE {
+        atomicOr(&status[ST_HALTED], HALT_BLOWUP);
         return;
     }
     state[i] = next[i];

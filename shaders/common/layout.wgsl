@@ -110,7 +110,7 @@ const ST_OVERFLOW_NEED: u32 = 1u; // largest neighbour count met (when it overfl
 const ST_MAX_DISP2: u32 = 2u;     // bits of the largest squared displacement since the last build
 const ST_BUILDS: u32 = 3u;        // neighbour-list builds so far
 const ST_STEPS_DONE: u32 = 4u;    // steps completed in this call
-const ST_BLOWUP_PARTICLE: u32 = 5u; // lowest particle index whose step was refused
+const ST_BLOWUP_PARTICLE: u32 = 5u; // lowest particle index whose step was refused (NO_PARTICLE: none)
 const ST_FORCE_REBUILD: u32 = 6u; // host request: rebuild before the next step
 const ST_SPAN_BODY: u32 = 7u;     // lowest packed body wider than half the periodic box
 const HALT_OVERFLOW: u32 = 1u;
@@ -119,6 +119,7 @@ const HALT_SPAN: u32 = 4u;
 const ST_FRACTION: u32 = 8u;      // bits of this step's fraction s of dt (contact step clamp; 1.0 without)
 const HALT_REACH: u32 = 8u;       // a face edge outgrew the contact search (src/gpu/contact.rs)
 const ST_ELAPSED: u32 = 9u;       // bits of the fractions of dt the steps of this call took, summed (f32; `sim_time`)
+const NO_PARTICLE: u32 = 0xffffffffu; // ST_BLOWUP_PARTICLE while no step was refused
 const CONTACT_ONLY: u32 = 0x80000000u; // neighbour-list entry kept for the contact search only
 
 const WORKGROUP: u32 = 256u;
@@ -131,6 +132,14 @@ fn linear_index(wg: vec3<u32>, local: u32) -> u32 {
 
 fn halted() -> bool {
     return atomicLoad(&status[ST_HALTED]) != 0u;
+}
+
+// Halted for a reason other than `own`: a kernel that raises `own` and names
+// the lowest index at fault reads this, so the workgroups that run after the
+// first one found still look (the host's report names the lowest, whatever
+// order the workgroups ran in).
+fn halted_other_than(own: u32) -> bool {
+    return (atomicLoad(&status[ST_HALTED]) & ~own) != 0u;
 }
 
 // 64-bit fixed point per axis: (h, f) = h·2³² + f with h signed.
