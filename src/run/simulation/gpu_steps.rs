@@ -229,11 +229,6 @@ impl Simulation {
     pub fn cpu_only_feature(&self) -> Option<&'static str> {
         if let Some(why) = self.implicit_refusal() {
             Some(why)
-        } else if self.protocols.has_ramps() && self.model.has_kinetics() && crate::gpu::kinetics::refusal(&self.model).is_some() {
-            // Measured on collagen_two_cells.in (llvmpipe): GPU − CPU 3.2e-2 after
-            // 39.5 with no bond event, against 1e-5 of the path elsewhere; not
-            // understood yet, so not run.
-            Some("ramps with bond kinetics decided on the host run on the CPU backend only")
         } else if !self.constraints.list.is_empty() {
             Some("constrained bonds (`constrain`) run on the CPU backend only")
         } else if self.model.has_cpu_only_surface_terms() {
