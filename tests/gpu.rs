@@ -680,8 +680,8 @@ fn implicit_condition_bound(sim: &Simulation) -> f64 {
 /// solve (src/gpu/implicit.rs), which it refuses with the message of
 /// `Simulation::cpu_only_feature`): at kT = 0, GPU positions stay within
 /// 1e-5 of the distance the particles travelled, after 10⁴ steps per `run`
-/// (10³ for decks of more than 1 000 particles; measured on llvmpipe: ≤ 3.7e-6, about the spread between two CPU runs
-/// whose starts differ by f32 rounding); over a tenth, a hundredth … of the steps where that
+/// (10³ for decks of more than 1 000 particles; measured on llvmpipe: ≤ 1.5e-6 of the path, within the spread
+/// between two CPU runs whose starts differ by f32 rounding, ≤ 6.3e-6); over a tenth, a hundredth … of the steps where that
 /// spread itself exceeds the bound (a chaotic deck: cell_contact.in, whose
 /// CPU runs part by 7.9e-2 µm in 10⁴ clamped steps; adhesive_doublet.in, 10
 /// steps) or the deck's prescribed
