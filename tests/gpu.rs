@@ -956,6 +956,72 @@ fn thermal_runs_have_the_same_statistics_and_the_same_first_steps() {
     assert!(worst < 3.0 * 4.0 * amplitude * 2f64.powi(-22), "GPU − CPU after 3 steps {worst:e}: the noise streams differ");
 }
 
+/// The volume of a thermal cell (kT = 0.5, lj units; a level-1 icosphere of
+/// radius 3 whose edges rest as built, under `turgor` K = 50 at its built
+/// volume V0 = 98.8): V fluctuates by about √(kT·V0/K) ≈ 1.0 (edges add a
+/// little stiffness; measured var V 1.01 ± 0.04 on the CPU, 0.94 ± 0.03 on the
+/// GPU, ⟨V⟩ 97.54 ± 0.07 and 97.53 ± 0.06). The GPU (seed 2) and the CPU (seed 1), 10⁴ steps
+/// each sampled every 10 (the volume relaxes in ≈ 7 steps), give the same
+/// ⟨V⟩ and var V within 4 standard errors of their difference, each error
+/// from 10 blocks of the run's samples. Independent seeds: with the same
+/// seed the two runs would be one trajectory.
+#[test]
+fn a_thermal_cell_has_the_same_volume_statistics_on_the_gpu() {
+    let args = cellmd::build::IcosphereArgs {
+        level: 1,
+        radius: 3.0,
+        centre: vec![0.0; 3],
+        shell: cellmd::build::ShellOptions::default(),
+        body_id: 1,
+        first_id: 1,
+        box_half_width: None,
+        rest_from_geometry: true,
+        output: "cell.top".into(),
+    };
+    let built = cellmd::build::icosphere(&args).unwrap();
+    let v0 = built.shells[0].volume;
+    let ff = format!("particle node drag 1\nbond edge harmonic k 20 r0 1\nbody cell turgor k 50 dp0 0 v0 {v0}\n");
+    let samples = |device: DevicePreference, seed: u32| {
+        let deck = format!(
+            "units lj\ntopology cell.top\nforcefield cell.ff\nbox x -20 20 f y -20 20 f z -20 20 f\n\
+             temperature 0.5\ntimestep 1e-3\nseed {seed}\nthermo 10 step volume/cell\nthermo_file v.csv\nrun 10200\n"
+        );
+        let case = common::Case::new(&[("cell.top", &built.text), ("cell.ff", &ff), ("deck.in", &deck)]);
+        let options = RunOptions { output_dir: case.output_dir().to_path_buf(), device: Some(device), ..Default::default() };
+        Simulation::execute(case.plan(), options).unwrap();
+        let text = std::fs::read_to_string(case.output_dir().join("v.csv")).unwrap();
+        // The first 200 steps relax the start; then 1000 rows.
+        text.lines().skip(1 + 20).take(1000).map(|l| l.split(',').nth(1).unwrap().parse::<f64>().unwrap()).collect::<Vec<f64>>()
+    };
+    // Mean and variance, each with its standard error from 10 blocks.
+    let statistics = |v: &[f64]| {
+        let blocks: Vec<(f64, f64)> = v
+            .chunks(v.len() / 10)
+            .map(|b| {
+                let mean = b.iter().sum::<f64>() / b.len() as f64;
+                (mean, b.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (b.len() - 1) as f64)
+            })
+            .collect();
+        let of = |f: fn(&(f64, f64)) -> f64| {
+            let values: Vec<f64> = blocks.iter().map(f).collect();
+            let mean = values.iter().sum::<f64>() / values.len() as f64;
+            let spread = values.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (values.len() - 1) as f64;
+            (mean, (spread / values.len() as f64).sqrt())
+        };
+        (of(|b| b.0), of(|b| b.1))
+    };
+    let (cpu, gpu) = (statistics(&samples(DevicePreference::Cpu, 1)), statistics(&samples(DevicePreference::Gpu, 2)));
+    println!(
+        "V0 {v0:.4}; CPU ⟨V⟩ {:.4} ± {:.4}, var {:.4} ± {:.4}; GPU ⟨V⟩ {:.4} ± {:.4}, var {:.4} ± {:.4}",
+        cpu.0 .0, cpu.0 .1, cpu.1 .0, cpu.1 .1, gpu.0 .0, gpu.0 .1, gpu.1 .0, gpu.1 .1
+    );
+    for ((c, c_se), (g, g_se), what) in [(cpu.0, gpu.0, "⟨V⟩"), (cpu.1, gpu.1, "var V")] {
+        assert!((c - g).abs() < 4.0 * (c_se * c_se + g_se * g_se).sqrt(), "{what}: CPU {c} ± {c_se}, GPU {g} ± {g_se}");
+    }
+    // The fluctuations are resolved (far above f32's resolution of V) and of the expected size.
+    assert!(cpu.1 .0 > 0.25 && cpu.1 .0 < 0.5 * v0 / 50.0 * 1.5, "var V {} (kT·V0/K = {})", cpu.1 .0, 0.5 * v0 / 50.0);
+}
+
 /// A neighbour list larger than one storage binding is bound in chunks of
 /// particles (nb_build and forces dispatched per chunk): with the binding
 /// capped so that the 400-particle random system takes several chunks, the
