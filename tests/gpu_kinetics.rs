@@ -93,8 +93,9 @@ fn device_kinetics_repeat_bit_for_bit() {
 /// bond b survives the run with probability exp(−k(F_b)·T), so a force's
 /// break count is a sum of Bernoulli variables, within 4.5 standard
 /// deviations of its mean (+1 for the discreteness), for each of the eight
-/// forces; the tension each break reports is the held force within f32
-/// rounding (1e-4 pN of up to 28 pN).
+/// forces; the steps of the breaks follow the exponential law conditioned on
+/// breaking within the run (Kolmogorov–Smirnov, α = 0.001); the tension each
+/// break reports is the held force within f32 rounding (1e-4 pN of up to 28 pN).
 #[test]
 fn device_breaks_follow_the_catch_slip_rate() {
     let (sim, settings) = sweep();
@@ -109,6 +110,7 @@ fn device_breaks_follow_the_catch_slip_rate() {
     };
     let types = sim.model.bond_types.len();
     let (mut mean, mut var, mut breaks) = (vec![0.0; types], vec![0.0; types], vec![0usize; types]);
+    let mut steps_of = vec![Vec::new(); types];
     for b in 0..sim.model.bonds.len() {
         let q = 1.0 - (-rate(held(b)) * steps as f64 * settings.context.dt).exp();
         let t = sim.model.bond_type[b] as usize;
@@ -117,11 +119,16 @@ fn device_breaks_follow_the_catch_slip_rate() {
     }
     for e in &decided.events {
         breaks[sim.model.bond_type[e.bond] as usize] += 1;
+        steps_of[sim.model.bond_type[e.bond] as usize].push(e.step);
         assert!((e.force - held(e.bond)).abs() < 1e-4, "bond {}: tension {} held at {}", e.bond, e.force, held(e.bond));
     }
     for t in 0..types {
         let label = &sim.model.bond_types[t].label.text;
-        println!("{label}: {} breaks, expected {:.1} ± {:.1}", breaks[t], mean[t], var[t].sqrt());
+        // Every bond of a type is held at the same force.
+        let first = (0..sim.model.bonds.len()).find(|&b| sim.model.bond_type[b] as usize == t).unwrap();
+        let ks = common::ks_exponential_steps(&steps_of[t], rate(held(first)) * settings.context.dt, Some(steps));
+        println!("{label}: {} breaks, expected {:.1} ± {:.1}; KS D√N {ks:.2}", breaks[t], mean[t], var[t].sqrt());
+        assert!(ks < 1.95, "{label}: break steps not exponential, KS D√N = {ks}");
         assert!(
             (breaks[t] as f64 - mean[t]).abs() <= 4.5 * var[t].sqrt() + 1.0,
             "{label}: {} breaks, expected {:.1} ± {:.1}",

@@ -56,22 +56,6 @@ fn events(case: &Case) -> Vec<(u64, String, usize, f64)> {
         .collect()
 }
 
-/// Kolmogorov–Smirnov statistic D·√N of break steps against the exact law
-/// P(s ≤ m) = 1 − exp(−k·dt·(m + 1)), compared at each distinct step (the
-/// data are discrete); the critical value at α = 0.001 is 1.95.
-fn ks_exponential_steps(steps: &[u64], rate_dt: f64) -> f64 {
-    let mut s = steps.to_vec();
-    s.sort_unstable();
-    let nn = s.len() as f64;
-    let mut d: f64 = 0.0;
-    for (i, &m) in s.iter().enumerate() {
-        if s.get(i + 1) != Some(&m) {
-            d = d.max(((i + 1) as f64 / nn - (1.0 - (-rate_dt * (m as f64 + 1.0)).exp())).abs());
-        }
-    }
-    d * nn.sqrt()
-}
-
 /// Lifetimes at fixed force across a sweep: for each force F, 4·10⁴ parallel
 /// bonds of their own type (harmonic, k = 10, held F/k beyond rest between
 /// fixed particles) carrying the kinetic rule `rule`, run until the
@@ -119,7 +103,7 @@ fn lifetime_sweep(rule: &str, kt: f64, forces: &[f64], rate: impl Fn(f64) -> f64
         steps_of[bond / per_force].push(step);
     }
     for (g, &f) in forces.iter().enumerate() {
-        let ks = ks_exponential_steps(&steps_of[g], rate(f) * dt);
+        let ks = common::ks_exponential_steps(&steps_of[g], rate(f) * dt, None);
         assert!(ks < 1.95, "F = {f}: lifetimes not exponential, KS D√N = {ks}");
     }
     measured
