@@ -1120,7 +1120,8 @@ fn kinetics_decks_give_the_same_events_on_the_gpu() {
         // spheroid_spreading over 30 steps: between its steps 30 and 40 the GPU
         // run departs from the CPU's (3.2e-5 µm at 40, 3.2e-4 at 50, its clock
         // 4.6e-7 s behind; two CPU runs from starts 1.9e-6 apart stay 1.8e-6
-        // apart): an open discrepancy (README, *GPU*), not f32 rounding.
+        // apart); from the CPU's state at step 39 the GPU's clamped step is
+        // 1.2e-5 shorter: an open discrepancy (README, *GPU*).
         let steps = |n: u32| {
             let mut overrides = vec![("steps".into(), n.to_string()), ("fire_iterations".into(), "10".into())];
             if deck.ends_with("collagen_two_cells.in") {
