@@ -15,7 +15,8 @@
 struct Params {
     box_len_h: vec4<u32>,       // box edge lengths in fixed point: integer part (units of q)
     box_len_f: vec4<u32>,       // … fraction (units of q·2⁻³²)
-    box_lo: vec4<f32>,          // lower corner (f32; unwrapped positions for externals)
+    box_lo_h: vec4<u32>,        // lower corner in the same fixed point (unwrapped positions for externals)
+    box_lo_f: vec4<u32>,
     periodic: vec4<u32>,        // 1 on periodic axes
     grid: vec4<u32>,            // cells along x, y, z; w = total cells
     cell_inv_width: vec4<f32>,  // cells per unit length
@@ -197,9 +198,13 @@ fn relative_position(i: u32) -> vec3<f32> {
     return fixed_to_length(fixed_of(i));
 }
 
-// Unwrapped position in f32 (for external fields).
+// Unwrapped position in f32 (for external fields): box_lo + x in fixed
+// point, rounded once, so a coordinate near 0 in a box from −70 keeps f32's
+// precision at its own size, not at 70's (a stiff wall multiplies the
+// difference: 3.8e-6 µm × 1000 pN/µm), then the images' shift.
 fn unwrapped(i: u32) -> vec3<f32> {
-    return P.box_lo.xyz + relative_position(i) + vec3<f32>(image_of(i)) * P.box_len.xyz;
+    let lo = Fixed3(bitcast<vec3<i32>>(P.box_lo_h.xyz), P.box_lo_f.xyz);
+    return fixed_to_length(fixed_add(fixed_of(i), lo)) + vec3<f32>(image_of(i)) * P.box_len.xyz;
 }
 
 // Parameters of a force-field term (eight slots, in schema order).

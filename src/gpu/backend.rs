@@ -315,12 +315,14 @@ impl GpuBackend {
         let lengths = sim_box.lengths();
         let fixed = FixedPoint::for_box(sim_box);
         let box_fixed = [0, 1, 2].map(|a| fixed.encode(lengths[a]));
+        let lo_fixed = [0, 1, 2].map(|a| fixed.encode(sim_box.lo[a]));
         let groups_x = ctx.limits.max_compute_workgroups_per_dimension.min(65_535);
         let params = Params {
             box_len_h: [box_fixed[0].0, box_fixed[1].0, box_fixed[2].0, 0],
             box_len_f: [box_fixed[0].1, box_fixed[1].1, box_fixed[2].1, 0],
             box_len: [lengths.x as f32, lengths.y as f32, lengths.z as f32, fixed.q as f32],
-            box_lo: [sim_box.lo.x as f32, sim_box.lo.y as f32, sim_box.lo.z as f32, 0.0],
+            box_lo_h: [lo_fixed[0].0, lo_fixed[1].0, lo_fixed[2].0, 0],
+            box_lo_f: [lo_fixed[0].1, lo_fixed[1].1, lo_fixed[2].1, 0],
             periodic: [sim_box.periodic[0] as u32, sim_box.periodic[1] as u32, sim_box.periodic[2] as u32, 0],
             grid: [grid[0], grid[1], grid[2], cells],
             cell_inv_width: [inv_width[0], inv_width[1], inv_width[2], 0.0],

@@ -44,7 +44,8 @@ pub const PARAM_SLOTS: usize = 8;
 pub struct Params {
     pub box_len_h: [u32; 4],
     pub box_len_f: [u32; 4],
-    pub box_lo: [f32; 4],
+    pub box_lo_h: [u32; 4],
+    pub box_lo_f: [u32; 4],
     pub periodic: [u32; 4],
     pub grid: [u32; 4],
     pub cell_inv_width: [f32; 4],
