@@ -1165,13 +1165,12 @@ fn kinetics_decks_give_the_same_events_on_the_gpu() {
             // No kinetics, or refused by the GPU (checked in `every_input_deck_runs_on_the_gpu_like_on_the_cpu`).
             continue;
         }
-        let Some((_, gpu)) = run_kinetics_deck(&plan, DevicePreference::Gpu) else {
+        let Some((gpu, gpu_events)) = run_kinetics_deck(&plan, DevicePreference::Gpu) else {
             println!("{:40} refused at a later run", deck.display());
             continue;
         };
-        let (gpu, gpu_events) = gpu;
-        let (start, cpu) = run_kinetics_deck(&plan, DevicePreference::Cpu).expect("the CPU runs every deck");
-        let (cpu, cpu_events) = cpu;
+        let (cpu, cpu_events) = run_kinetics_deck(&plan, DevicePreference::Cpu).expect("the CPU runs every deck");
+        let start = Simulation::new(&plan, RunOptions::default()).state;
         let unwrap = |s: &State, i: usize| plan.sim_box.unwrap(s.positions[i], s.images[i]);
         let travelled = (0..start.len()).map(|i| (unwrap(&cpu, i) - unwrap(&start, i)).length()).fold(0.0, f64::max);
         let deviation = (0..start.len()).map(|i| (unwrap(&cpu, i) - unwrap(&gpu, i)).length()).fold(0.0, f64::max);
@@ -1226,14 +1225,12 @@ fn kinetics_decks_give_the_same_events_on_the_gpu() {
     assert!(all_events >= 100, "only {all_events} events to compare");
 }
 
-/// Runs a kinetics deck on `device`; returns its start, and its final state
-/// with the event logs' texts, or None where the GPU refuses a CPU-only
-/// feature that starts after the first run (checked in
-/// `every_input_deck_runs_on_the_gpu_like_on_the_cpu`).
-fn run_kinetics_deck(plan: &Plan, device: DevicePreference) -> Option<(State, (State, Vec<String>))> {
+/// Runs a kinetics deck on `device`; returns its final state with the event
+/// logs' texts, or None where the GPU refuses a CPU-only feature that starts
+/// after the first run (checked in `every_input_deck_runs_on_the_gpu_like_on_the_cpu`).
+fn run_kinetics_deck(plan: &Plan, device: DevicePreference) -> Option<(State, Vec<String>)> {
     let dir = tempfile::tempdir().unwrap();
     let options = RunOptions { output_dir: dir.path().to_path_buf(), device: Some(device), ..Default::default() };
-    let start = Simulation::new(plan, RunOptions::default()).state;
     let sim = match Simulation::execute(plan.clone(), options) {
         Ok(sim) => sim,
         Err(e) if device == DevicePreference::Gpu && refused_by_the_gpu(&e.to_string()) => return None,
@@ -1245,7 +1242,7 @@ fn run_kinetics_deck(plan: &Plan, device: DevicePreference) -> Option<(State, (S
         .filter(|p| p.to_string_lossy().ends_with(".events.csv"))
         .map(|p| std::fs::read_to_string(p).unwrap())
         .collect();
-    Some((start, (sim.state, events)))
+    Some((sim.state, events))
 }
 
 /// Bonds whose law changes every step — motors shortening their rest length at
@@ -1473,18 +1470,20 @@ fn the_contact_step_clamp_runs_on_the_gpu_like_on_the_cpu() {
 fn a_contact_blowup_on_the_gpu_names_the_step_particle_and_term() {
     let settings = "integrator overdamped max_displacement 1e-3\ntemperature 0\ntimestep 1e-3\nrun 50\n";
     for (ff, gap, push, term) in [(CONTACT_BARRIER, 0.01, 1.0, "contact_barrier"), (CONTACT_ADHESION, 0.1, 0.0, "contact_adhesion")] {
+        let blowup = |device: DevicePreference| {
+            let case = contact_case(ff, gap, push, settings);
+            let options = RunOptions { output_dir: case.output_dir().to_path_buf(), device: Some(device), ..Default::default() };
+            match Simulation::execute(case.plan(), options) {
+                Ok(_) => panic!("{device:?}: the run should blow up"),
+                Err(e) => e,
+            }
+        };
+        let cpu = blowup(DevicePreference::Cpu);
+        let cellmd::run::RunError::Blowup { step: cpu_step, particle_id: cpu_particle, .. } = &cpu else { panic!("{cpu}") };
         for _ in 0..3 {
-            let [cpu, gpu] = [DevicePreference::Cpu, DevicePreference::Gpu].map(|device| {
-                let case = contact_case(ff, gap, push, settings);
-                let options = RunOptions { output_dir: case.output_dir().to_path_buf(), device: Some(device), ..Default::default() };
-                match Simulation::execute(case.plan(), options) {
-                    Ok(_) => panic!("{device:?}: the run should blow up"),
-                    Err(e) => e,
-                }
-            });
+            let gpu = blowup(DevicePreference::Gpu);
             println!("CPU: {cpu}\nGPU: {gpu}");
             let cellmd::run::RunError::Blowup { step, particle_id, culprit, .. } = &gpu else { panic!("{gpu}") };
-            let cellmd::run::RunError::Blowup { step: cpu_step, particle_id: cpu_particle, .. } = &cpu else { panic!("{cpu}") };
             assert_eq!((step, particle_id), (cpu_step, cpu_particle), "GPU: {gpu}\nCPU: {cpu}");
             let culprit = culprit.as_ref().unwrap();
             assert_eq!((culprit.kind, culprit.interaction), ("contact", term), "{gpu}");

@@ -214,7 +214,7 @@ fn surface_edge_forces(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invo
 @compute @workgroup_size(256)
 fn surface_forces(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) local: u32) {
     let f = linear_index(wg, local);
-    if f >= P.n_faces || halted_other_than(HALT_SPAN) {
+    if f >= P.n_faces || halted() {
         return;
     }
     let b = face_word(f, 3u);

@@ -1,11 +1,14 @@
 // wlc_bending: E = (κ/ℓ)(1 − t̂1·t̂2) with t̂1 = (rj − ri)/|·|, t̂2 = (rk − rj)/|·|; p = [κ, ℓ].
-// The two arms a = rj − ri, b = rk − rj: lengths, unit vectors, t̂1·t̂2.
+// The two arms a = rj − ri, b = rk − rj: lengths, unit vectors, f = t̂1·t̂2
+// and its gradients g_a = ∂f/∂a = (t̂2 − f t̂1)/|a|, g_b = ∂f/∂b = (t̂1 − f t̂2)/|b|.
 struct WlcBendingArms {
     la: f32,
     lb: f32,
     t1: vec3<f32>,
     t2: vec3<f32>,
     c: f32,
+    ga: vec3<f32>,
+    gb: vec3<f32>,
 }
 
 fn wlc_bending_arms(ri: vec3<f32>, rj: vec3<f32>, rk: vec3<f32>) -> WlcBendingArms {
@@ -13,20 +16,18 @@ fn wlc_bending_arms(ri: vec3<f32>, rj: vec3<f32>, rk: vec3<f32>) -> WlcBendingAr
     let b = rk - rj;
     let la = length(a);
     let lb = length(b);
-    return WlcBendingArms(la, lb, a / la, b / lb, dot(a / la, b / lb));
+    let t1 = a / la;
+    let t2 = b / lb;
+    let c = dot(t1, t2);
+    return WlcBendingArms(la, lb, t1, t2, c, (t2 - c * t1) / la, (t1 - c * t2) / lb);
 }
 
 fn wlc_bending_three(p: array<f32, 8>, ri: vec3<f32>, rj: vec3<f32>, rk: vec3<f32>) -> ThreeBody {
     let strength = p[WLC_BENDING_KAPPA] / p[WLC_BENDING_L0];
     let arms = wlc_bending_arms(ri, rj, rk);
-    let la = arms.la;
-    let lb = arms.lb;
-    let t1 = arms.t1;
-    let t2 = arms.t2;
-    let c = arms.c;
-    let fi = -strength * (t2 - c * t1) / la;
-    let fk = strength * (t1 - c * t2) / lb;
-    return ThreeBody(strength * (1.0 - c), fi, -fi - fk, fk);
+    let fi = -strength * arms.ga;
+    let fk = strength * arms.gb;
+    return ThreeBody(strength * (1.0 - arms.c), fi, -fi - fk, fk);
 }
 
 // The exact 9×9 Hessian of E (rows and columns i, j, k; row-major), not yet
@@ -38,18 +39,11 @@ fn wlc_bending_three(p: array<f32, 8>, ri: vec3<f32>, rj: vec3<f32>, rk: vec3<f3
 fn wlc_bending_hessian(p: array<f32, 8>, ri: vec3<f32>, rj: vec3<f32>, rk: vec3<f32>) -> array<f32, 81> {
     let strength = p[WLC_BENDING_KAPPA] / p[WLC_BENDING_L0];
     let arms = wlc_bending_arms(ri, rj, rk);
-    let la = arms.la;
-    let lb = arms.lb;
-    let t1 = arms.t1;
-    let t2 = arms.t2;
-    let c = arms.c;
-    let ga = (t2 - c * t1) / la;
-    let gb = (t1 - c * t2) / lb;
-    let p1 = identity3() - outer3(t1, t1);
-    let p2 = identity3() - outer3(t2, t2);
-    let faa = (outer3(t1, ga) + outer3(ga, t1)) * (-1.0 / la) - p1 * (c / (la * la));
-    let fbb = (outer3(t2, gb) + outer3(gb, t2)) * (-1.0 / lb) - p2 * (c / (lb * lb));
-    let fab = (p1 * p2) * (1.0 / (la * lb));
+    let p1 = identity3() - outer3(arms.t1, arms.t1);
+    let p2 = identity3() - outer3(arms.t2, arms.t2);
+    let faa = (outer3(arms.t1, arms.ga) + outer3(arms.ga, arms.t1)) * (-1.0 / arms.la) - p1 * (arms.c / (arms.la * arms.la));
+    let fbb = (outer3(arms.t2, arms.gb) + outer3(arms.gb, arms.t2)) * (-1.0 / arms.lb) - p2 * (arms.c / (arms.lb * arms.lb));
+    let fab = (p1 * p2) * (1.0 / (arms.la * arms.lb));
     let s = -strength;
     var h: array<f32, 81>;
     put_block(&h, 0u, 0u, faa * s);

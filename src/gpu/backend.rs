@@ -24,8 +24,7 @@ use wgpu::util::DeviceExt;
 
 use super::adhesion::AdhesionPack;
 use super::contact::{reach_message, ContactPack, CONTACT_ONLY, FRACTION_SLOTS};
-use super::context::storage_entry;
-use super::context::GpuContext;
+use super::context::{storage_entry, GpuContext};
 use super::implicit::ImplicitSolver;
 use super::kinetics::{KinKernels, KinLayout};
 use super::nlist::NeighbourStorage;
