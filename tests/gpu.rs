@@ -720,7 +720,7 @@ fn implicit_condition_bound(sim: &Simulation) -> f64 {
 /// motion wrecks it within the horizon (tensegrity_substrate.in). An implicit deck
 /// (buckling_filament.in) is compared over 10² steps, within κ(A)·(the device's
 /// CG tolerance + 8ε_f32) of the distance travelled ([`implicit_condition_bound`]):
-/// its f32 solve is only that exact (measured: 1.5e-3 of the path).
+/// its f32 solve is only that exact (measured: 2.5e-6 of the path).
 #[test]
 fn every_input_deck_runs_on_the_gpu_like_on_the_cpu() {
     let mut decks: Vec<_> =
