@@ -452,30 +452,38 @@ fn profile_gpu(plan: &crate::deck::Plan, repetitions: u32, rebuild_rate: Option<
         neighbor_every: sim.neighbor.every,
         neighbor_check: sim.neighbor.check,
     };
-    let mut gpu = GpuBackend::new(&context, &sim.model, &sim.state, &sim.sim_box, &settings)?;
+    // Bond kinetics on the device where the run would decide them there.
+    let kinetics = sim.model.has_kinetics() && crate::gpu::kinetics::refusal(&sim.model).is_none();
+    let backend = || match kinetics {
+        true => GpuBackend::with_device_kinetics(&context, &sim.model, &sim.state, &sim.sim_box, &settings, &[]),
+        false => GpuBackend::new(&context, &sim.model, &sim.state, &sim.sim_box, &settings),
+    };
+    let mut gpu = backend()?;
     let rate = match rebuild_rate {
         Some(rate) => rate,
         None => {
-            let mut probe = GpuBackend::new(&context, &sim.model, &sim.state, &sim.sim_box, &settings)?;
+            let mut probe = backend()?;
             let before = probe.neighbor_builds();
             let done = probe.run(0, 200).map_err(|e| format!("{e:?}"))?;
             (probe.neighbor_builds() - before).saturating_sub(1) as f64 / done.max(1) as f64
         }
     };
     let t = gpu.profile(repetitions)?;
-    let step = t.check + rate * t.neighbor_build + t.forces + t.integrate + t.contact + t.adhesion;
+    let checks = t.check * t.checks as f64;
+    let step = checks + rate * t.neighbor_build + t.forces + t.integrate + t.contact + t.adhesion + t.kinetics;
     let n = sim.model.len() as f64;
     let mut table = String::new();
     table += &format!("device: {}\n", context.describe());
     table += &format!("{} particles; {rate:.4} neighbour rebuilds per step\n", sim.model.len());
     table += &format!("{:<26} {:>14} {:>12}\n", "phase", "µs per call", "share/step");
     let rows = [
-        ("neighbour check", t.check, t.check),
+        ("neighbour check", t.check, checks),
         ("neighbour rebuild", t.neighbor_build, rate * t.neighbor_build),
         ("forces", t.forces, t.forces),
         ("integration", t.integrate, t.integrate),
         ("contact and step clamp", t.contact, t.contact),
         ("adhesion node/weight", t.adhesion, t.adhesion),
+        ("bond kinetics and bind", t.kinetics, t.kinetics),
     ];
     for (name, per_call, per_step) in rows {
         table += &format!("{name:<26} {:>14.1} {:>11.1}%\n", per_call * 1e6, 100.0 * per_step / step);

@@ -149,8 +149,8 @@ fn unported_rules_keep_kinetics_on_the_host() {
     assert_eq!(reason("inputs/catch_slip_sweep.in"), None);
     let motor = reason("inputs/contractile_network.in").unwrap();
     assert!(motor.contains("motor"), "{motor}");
-    let bind = reason("inputs/aggregate.in").unwrap();
-    assert!(bind.contains("`bind`"), "{bind}");
+    // `bind` formation runs on the device (tests/gpu_bind.rs), but not `partner nearest`.
+    assert_eq!(reason("inputs/aggregate.in"), None);
 }
 
 /// A broken bond stops excluding its pair, also across GPU segments: 30

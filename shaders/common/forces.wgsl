@@ -74,6 +74,10 @@ fn forces(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index)
         f += scale * force_along(radial, d, r);
         e += 0.5 * scale * radial.energy;
     }
+    // Bonds formed on the device since the backend was built (bind.wgsl).
+    let formed = formed_bond_forces(i);
+    f += formed.xyz;
+    e += formed.w;
 
     // Angles: evaluated around the vertex j with i and k at their minimum images.
     let angles_end = topo[P.off_angle_offsets + i + 1u];

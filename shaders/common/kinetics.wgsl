@@ -79,7 +79,8 @@ fn exclusion_on(e: u32) -> bool {
 
 @compute @workgroup_size(1)
 fn kin_room() {
-    if kin_word(KIN_CURSOR) + P.kin_bonds > P.kin_capacity {
+    // A step's events: at most one per kinetic bond, and its bindings (bind.wgsl).
+    if kin_word(KIN_CURSOR) + P.kin_bonds + kin_word(KIN_CAND_CAP) > P.kin_capacity {
         atomicOr(&status[ST_HALTED], HALT_EVENTS);
     }
 }
@@ -91,6 +92,9 @@ fn kin_measure(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_i
         return;
     }
     let rec = kin_word(KIN_BONDS) + KIN_BOND_WORDS * k;
+    if kin_word(rec) == KIN_NONE {
+        return; // a pool record not yet taken (bind.wgsl)
+    }
     let d = separation(kin_word(rec), kin_word(rec + 1u));
     let r = length(d);
     let term = kin_word(rec + 4u);
@@ -284,6 +288,9 @@ fn kin_decide(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_in
 // its bound flag and age, returns its event kind (0: none).
 fn kin_decide_bond(k: u32) -> u32 {
     let rec = kin_word(KIN_BONDS) + KIN_BOND_WORDS * k;
+    if kin_word(rec) == KIN_NONE {
+        return 0u; // a pool record not yet taken (bind.wgsl)
+    }
     let bond = kin_word(rec + 3u);
     let trec = kin_word(KIN_TYPE) + KIN_TYPE_WORDS * kin_word(rec + 2u);
     let rules = kin_word(trec);

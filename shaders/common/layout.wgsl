@@ -120,6 +120,7 @@ const HALT_SPAN: u32 = 4u;
 const ST_FRACTION: u32 = 8u;      // bits of this step's fraction s of dt (contact step clamp; 1.0 without)
 const HALT_REACH: u32 = 8u;       // a face edge outgrew the contact search (src/gpu/contact.rs)
 const ST_ELAPSED: u32 = 9u;       // bits of the fractions of dt the steps of this call took, summed (f32; `sim_time`)
+const ST_LIST_AFTER_STEP: u32 = 10u; // 1 while the list is checked after `commit` (bind.wgsl): an overflow there defers, not halts
 const NO_PARTICLE: u32 = 0xffffffffu; // ST_BLOWUP_PARTICLE while no step was refused
 const CONTACT_ONLY: u32 = 0x80000000u; // neighbour-list entry kept for the contact search only
 

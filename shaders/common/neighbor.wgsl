@@ -63,6 +63,11 @@ fn nb_decide() {
     let moved = atomicLoad(&status[ST_MAX_DISP2]) != 0u;
     let due = (step % P.neighbor_every) == 0u && (moved || P.neighbor_check == 0u);
     let go = !halted() && (due || atomicLoad(&status[ST_FORCE_REBUILD]) != 0u);
+    // A list that overflowed when checked after the last `commit` (bind.wgsl)
+    // halts before any force reads it.
+    if atomicLoad(&status[ST_LIST_AFTER_STEP]) == 0u && atomicLoad(&status[ST_OVERFLOW_NEED]) > P.nlist_cap {
+        atomicOr(&status[ST_HALTED], HALT_OVERFLOW);
+    }
     let particle_groups = (P.n + WORKGROUP - 1u) / WORKGROUP;
     let cell_groups = (P.grid.w + WORKGROUP - 1u) / WORKGROUP;
     write_args(0u, particle_groups, go);
@@ -74,6 +79,13 @@ fn nb_decide() {
         atomicStore(&status[ST_FORCE_REBUILD], 0u);
         atomicAdd(&status[ST_BUILDS], 1u);
     }
+}
+
+// Dispatched before and after the list check that follows `commit` (with
+// `bind` on the device): toggles ST_LIST_AFTER_STEP.
+@compute @workgroup_size(1)
+fn nb_after_step() {
+    atomicXor(&status[ST_LIST_AFTER_STEP], 1u);
 }
 
 @compute @workgroup_size(256)
@@ -265,8 +277,10 @@ fn nb_build(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_inde
                     let d = separation(i, j);
                     if dot(d, d) < P.range2 {
                         // An excluded pair of different contact bodies stays, marked (src/gpu/contact.rs).
+                        // With `bind` on the device (no pair terms there) bonded pairs stay:
+                        // a bond that breaks may bind again within the step (bind.wgsl).
                         var entry = j;
-                        if is_excluded(i, j) {
+                        if !bind_on() && is_excluded(i, j) {
                             entry = select(NO_ENTRY, j | CONTACT_ONLY, contact_pair_kept(i, j));
                         }
                         if entry != NO_ENTRY {
@@ -283,7 +297,10 @@ fn nb_build(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_inde
     nlist[row] = count;
     if count > P.nlist_cap {
         atomicMax(&status[ST_OVERFLOW_NEED], count);
-        atomicOr(&status[ST_HALTED], HALT_OVERFLOW);
+        // After `commit` the step is finished first (its formation deferred, bind.wgsl).
+        if atomicLoad(&status[ST_LIST_AFTER_STEP]) == 0u {
+            atomicOr(&status[ST_HALTED], HALT_OVERFLOW);
+        }
     }
     reference[i] = state[i];
     reference[P.n + i] = state[P.n + i];

@@ -37,7 +37,7 @@ use crate::neighbor::Exclusions;
 use crate::system::{BondState, Model, SimBox, State};
 
 const WORKGROUP: u32 = 256;
-const STATUS_WORDS: usize = 10;
+const STATUS_WORDS: usize = 11;
 const ST_HALTED: usize = 0;
 const ST_OVERFLOW_NEED: usize = 1;
 const ST_BUILDS: usize = 3;
@@ -57,6 +57,8 @@ const ST_ELAPSED: usize = 9;
 const HALT_REACH: u32 = 8;
 /// The implicit step's solve did not converge (src/gpu/implicit.rs).
 const HALT_SOLVE: u32 = 32;
+/// A step's `bind` formation was left to the host (src/gpu/bind.rs).
+const HALT_FORMATION: u32 = 64;
 /// Steps per command buffer.
 const STEPS_PER_SUBMIT: u64 = 64;
 
@@ -73,6 +75,11 @@ pub enum GpuHalt {
     /// A face of a contact body outgrew the contact search, whose reach is
     /// set when the backend is built; the state is that of `step`.
     Reach { step: u64 },
+    /// The formation of the step before `step` might have overflowed the
+    /// device's bond pool, slots or candidate list, so the device bound
+    /// nothing in it (src/gpu/bind.rs); the state, breaks and rebinds are
+    /// those of `step`.
+    Formation { step: u64 },
 }
 
 /// Seconds per call of each phase of a step, each timed alone
@@ -93,6 +100,12 @@ pub struct PhaseTimes {
     pub contact: f64,
     /// The area-weighted contact terms' node and weight passes (0 without them), apart from `contact`.
     pub adhesion: f64,
+    /// Bond kinetics decided on the device and `bind` formation (0 without
+    /// them; src/gpu/kinetics.rs, src/gpu/bind.rs), at the deck's start.
+    pub kinetics: f64,
+    /// Neighbour checks per step: 2 with `bind` on the device (the list is
+    /// checked again after `commit`).
+    pub checks: u32,
 }
 
 /// Settings the kernels need besides the model.
@@ -117,6 +130,7 @@ struct Kernels {
     scatter: wgpu::ComputePipeline,
     sort: wgpu::ComputePipeline,
     build: wgpu::ComputePipeline,
+    after_step: wgpu::ComputePipeline,
     surface_faces: wgpu::ComputePipeline,
     surface_bodies: wgpu::ComputePipeline,
     surface_edges: wgpu::ComputePipeline,
@@ -307,7 +321,10 @@ impl GpuBackend {
         // The list also serves the contact search (src/gpu/contact.rs).
         let has_pairs = (!model.pair_rules.is_empty() && cutoff > 0.0) || contact.faces() > 0;
         let skin = settings.skin.max(contact.skin());
-        let range = cutoff.max(contact.reach()) + skin;
+        // With `bind` on the device, the list also serves the capture search (src/gpu/bind.rs).
+        let capture = if kin_words.as_ref().is_some_and(|(_, l)| l.binds()) { super::bind::capture(model) } else { 0.0 };
+        let has_pairs = has_pairs || capture > 0.0;
+        let range = cutoff.max(contact.reach()).max(capture) + skin;
         let (grid, inv_width) = if has_pairs { cell_grid(sim_box, range, n) } else { ([1, 1, 1], [0.0; 3]) };
         let cells = grid.iter().product::<u32>();
         let scan_blocks = cells.div_ceil(WORKGROUP);
@@ -475,6 +492,7 @@ impl GpuBackend {
             scatter: pipeline("nb_scatter", &main_layout),
             sort: pipeline("nb_sort", &main_layout),
             build: pipeline("nb_build", &main_layout),
+            after_step: pipeline("nb_after_step", &main_layout),
             surface_faces: pipeline("surface_faces", &main_layout),
             surface_bodies: pipeline("surface_bodies", &main_layout),
             surface_edges: pipeline("surface_edges", &main_layout),
@@ -861,6 +879,22 @@ impl GpuBackend {
             0.0
         };
         let integrate = time(self, &[(&k.integrate, particles), (&k.commit, particles), (&k.advance, Over::Groups(1))], false);
+        let (kinetics, checks) = match &self.kinetics {
+            Some((layout, kin)) => {
+                let bonds = Over::Groups(layout.bonds().div_ceil(WORKGROUP));
+                let mut passes = vec![(&kin.measure, bonds), (&kin.decide, bonds), (&kin.scan, Over::Groups(1)), (&kin.emit, bonds)];
+                if layout.binds() {
+                    passes.extend([
+                        (&kin.bind_count, Over::Chunks),
+                        (&kin.bind_scan, Over::Groups(1)),
+                        (&kin.bind_write, Over::Chunks),
+                        (&kin.bind_accept, Over::Groups(1)),
+                    ]);
+                }
+                (time(self, &passes, false), 1 + layout.binds() as u32)
+            }
+            None => (0.0, 1),
+        };
         let started = std::time::Instant::now();
         for _ in 0..repetitions {
             self.read(&self.state, 48 * self.params.n as u64);
@@ -868,7 +902,7 @@ impl GpuBackend {
         let readback = started.elapsed().as_secs_f64() / repetitions as f64;
         self.ctx.queue.write_buffer(&self.state, 0, &saved);
         self.pending_rebuild = true;
-        Ok(PhaseTimes { check, neighbor_build, forces, integrate, readback, contact, adhesion })
+        Ok(PhaseTimes { check, neighbor_build, forces, integrate, readback, contact, adhesion, kinetics, checks })
     }
 
     /// Dispatches `pipeline` over `over`: wider than the dispatch width,
@@ -911,22 +945,7 @@ impl GpuBackend {
             self.dispatch(pass, &kin.room, Over::Groups(1));
         }
         if self.has_pairs {
-            self.dispatch(pass, &k.displacement, Over::Particles);
-            pass.set_pipeline(&k.decide);
-            pass.set_bind_group(1, &self.args_group, &[]);
-            pass.dispatch_workgroups(1, 1, 1);
-            let indirect = |pass: &mut wgpu::ComputePass, pipeline: &wgpu::ComputePipeline, slot: u64| {
-                pass.set_pipeline(pipeline);
-                pass.dispatch_workgroups_indirect(&self.args, 12 * slot);
-            };
-            indirect(pass, &k.clear, 1);
-            indirect(pass, &k.count, 0);
-            indirect(pass, &k.scan_blocks, 1);
-            indirect(pass, &k.scan_totals, 2);
-            indirect(pass, &k.scan_add, 1);
-            indirect(pass, &k.scatter, 0);
-            indirect(pass, &k.sort, 1);
-            self.per_chunk(pass, |pass| indirect(pass, &k.build, 3));
+            self.encode_neighbors(pass);
         }
         for (pipeline, over) in self.surface_passes() {
             self.dispatch(pass, pipeline, over);
@@ -961,6 +980,16 @@ impl GpuBackend {
                 self.dispatch(pass, &k.integrate, Over::Particles);
             }
             self.dispatch(pass, &k.commit, Over::Particles);
+            let binds = self.kinetics.as_ref().filter(|(layout, _)| layout.binds()).map(|(_, kernels)| kernels);
+            if binds.is_some() {
+                // `bind` captures at the new positions (src/gpu/bind.rs): the
+                // list is checked (and rebuilt if due) now, for the capture
+                // search and the next step's forces, so no pair within the
+                // capture radius can be missing from it.
+                self.dispatch(pass, &k.after_step, Over::Groups(1));
+                self.encode_neighbors(pass);
+                self.dispatch(pass, &k.after_step, Over::Groups(1));
+            }
             if drives {
                 self.dispatch(pass, &k.protocol_drive_advance, Over::Groups(1));
             }
@@ -969,8 +998,38 @@ impl GpuBackend {
                 self.dispatch(pass, &kin.scan, Over::Groups(1));
                 self.dispatch(pass, &kin.emit, bonds);
             }
+            if let Some(kin) = binds {
+                self.dispatch(pass, &kin.bind_count, Over::Chunks);
+                self.dispatch(pass, &kin.bind_scan, Over::Groups(1));
+                self.dispatch(pass, &kin.bind_write, Over::Chunks);
+                self.dispatch(pass, &kin.bind_accept, Over::Groups(1));
+            }
             self.dispatch(pass, &k.advance, Over::Groups(1));
+            if let Some(kin) = binds {
+                self.dispatch(pass, &kin.bind_halt, Over::Groups(1));
+            }
         }
+    }
+
+    /// The neighbour-list check and, when due, its rebuild (indirect dispatches).
+    fn encode_neighbors(&self, pass: &mut wgpu::ComputePass) {
+        let k = &self.kernels;
+        self.dispatch(pass, &k.displacement, Over::Particles);
+        pass.set_pipeline(&k.decide);
+        pass.set_bind_group(1, &self.args_group, &[]);
+        pass.dispatch_workgroups(1, 1, 1);
+        let indirect = |pass: &mut wgpu::ComputePass, pipeline: &wgpu::ComputePipeline, slot: u64| {
+            pass.set_pipeline(pipeline);
+            pass.dispatch_workgroups_indirect(&self.args, 12 * slot);
+        };
+        indirect(pass, &k.clear, 1);
+        indirect(pass, &k.count, 0);
+        indirect(pass, &k.scan_blocks, 1);
+        indirect(pass, &k.scan_totals, 2);
+        indirect(pass, &k.scan_add, 1);
+        indirect(pass, &k.scatter, 0);
+        indirect(pass, &k.sort, 1);
+        self.per_chunk(pass, |pass| indirect(pass, &k.build, 3));
     }
 
     fn status(&self) -> [u32; STATUS_WORDS] {
@@ -1130,6 +1189,9 @@ impl GpuBackend {
             }
             if status[ST_HALTED] & HALT_REACH != 0 {
                 return Err(GpuHalt::Reach { step: first_step + done });
+            }
+            if status[ST_HALTED] & HALT_FORMATION != 0 {
+                return Err(GpuHalt::Formation { step: first_step + done });
             }
             if let Some(message) = self.span_halt(&status) {
                 return Err(GpuHalt::Capacity { step: first_step + done, message });

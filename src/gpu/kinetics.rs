@@ -25,7 +25,9 @@
 //! positions.
 //!
 //! Which models: [`refusal`] says why a model's kinetics stay on the host
-//! (one GPU step per segment, as before): `bind` formation, the rules that
+//! (one GPU step per segment, as before): the `bind` rules that
+//! [`super::bind::refusal`] names (other `bind` formation runs on the
+//! device, src/gpu/bind.rs, in pool records after the kinetic bonds), the rules that
 //! change a bond's law every step or at a strain (`motor`, `ratchet`,
 //! `maturation`, `plastic`), more than [`RULES_PER_TYPE`] rules on a bond
 //! type, `special_bonds` 1-3 or 1-4 weights other than 1 with pair terms (the
@@ -34,8 +36,9 @@
 //!
 //! # The `kin` buffer (u32 words)
 //!
-//! A header (word indices as the `KIN_*` constants of kinetics.wgsl), then:
-//! per kinetic bond (the bonds with a term of their own, in bond order) its
+//! A header of 32 words (word indices as the `KIN_*` constants of
+//! kinetics.wgsl, 16–31 those of bind.wgsl), then: per kinetic record (the
+//! bonds with a term of their own, in bond order, then `bind`'s pool) its
 //! record (i, j, bond type, bond index, term, rest length), bound flag, age
 //! (high, low words of the f64), tension, length and k·dt (f32 bits) and this
 //! step's event kind; per block of 256 bonds its event count, then its base;
@@ -43,7 +46,7 @@
 //! k·dt = 0.1, that step, that k·dt, two spare words, then up to four rules as
 //! a code and eight f32 parameters); per exclusion entry of the topology its
 //! kinetic bond (or none); the events (step low, high, bond, kind, tension,
-//! length, age high, low).
+//! length, age high, low); then `bind`'s sections (src/gpu/bind.rs).
 
 use super::backend::GpuBackend;
 use super::pack::{Packed, PARAM_SLOTS};
@@ -53,7 +56,7 @@ use crate::system::{BondState, Model};
 
 /// Rules a bond type may combine with kinetics on the device.
 pub const RULES_PER_TYPE: usize = 4;
-const HEADER_WORDS: usize = 16;
+const HEADER_WORDS: usize = 32;
 const BOND_WORDS: usize = 6;
 const TYPE_WORDS: usize = 44;
 const EVENT_WORDS: usize = 8;
@@ -68,8 +71,8 @@ fn rule_code(name: &str) -> Option<u32> {
 
 /// Why the model's bond kinetics cannot be decided on the device (None: they can).
 pub fn refusal(model: &Model) -> Option<String> {
-    if !model.bind_rules.is_empty() {
-        return Some("`bind` formation".into());
+    if let Some(why) = super::bind::refusal(model) {
+        return Some(why);
     }
     for (t, kinetics) in model.bond_kinetics.iter().enumerate() {
         let label = &model.bond_types[t].label.text;
@@ -106,6 +109,12 @@ pub(super) struct KinLayout {
     pub(super) capacity: u32,
     /// The term of the first kinetic bond.
     pub(super) first_term: u32,
+    /// `bind` formation's pool (src/gpu/bind.rs): its first record, and the
+    /// model bond index its first new bond takes.
+    pool_first: u32,
+    bond_base: u32,
+    /// Kinetic records: the kinetic bonds, then the pool.
+    records: u32,
 }
 
 /// The kernels of kinetics.wgsl.
@@ -115,6 +124,11 @@ pub(super) struct KinKernels {
     pub(super) decide: wgpu::ComputePipeline,
     pub(super) scan: wgpu::ComputePipeline,
     pub(super) emit: wgpu::ComputePipeline,
+    pub(super) bind_count: wgpu::ComputePipeline,
+    pub(super) bind_scan: wgpu::ComputePipeline,
+    pub(super) bind_write: wgpu::ComputePipeline,
+    pub(super) bind_accept: wgpu::ComputePipeline,
+    pub(super) bind_halt: wgpu::ComputePipeline,
 }
 
 impl KinKernels {
@@ -125,6 +139,11 @@ impl KinKernels {
             decide: pipeline("kin_decide"),
             scan: pipeline("kin_scan"),
             emit: pipeline("kin_emit"),
+            bind_count: pipeline("bind_count"),
+            bind_scan: pipeline("bind_scan"),
+            bind_write: pipeline("bind_write"),
+            bind_accept: pipeline("bind_accept"),
+            bind_halt: pipeline("bind_halt"),
         }
     }
 }
@@ -143,6 +162,8 @@ pub struct DeviceEvent {
     pub step: u64,
     pub bond: usize,
     pub kind: EventKind,
+    /// A formed bond's type and particles.
+    pub formed: Option<(u32, [u32; 2])>,
     pub force: f64,
     pub length: f64,
     pub age: f64,
@@ -167,9 +188,10 @@ impl KinLayout {
         warned: &[bool],
     ) -> (Vec<u32>, Self) {
         let own = &packed.own_bonds;
-        let count = own.len();
+        let bind = super::bind::BindSizes::of(model);
+        let count = own.len() + bind.pool;
         let blocks = count.div_ceil(WORKGROUP);
-        let capacity = 2 * count + 1024;
+        let capacity = 2 * count + 1024 + bind.candidates;
         let mut header = [0u32; HEADER_WORDS];
         let sizes = [BOND_WORDS * count, count, 2 * count, 3 * count, count, 2 * blocks, TYPE_WORDS * model.bond_types.len()];
         let mut at = HEADER_WORDS;
@@ -184,6 +206,11 @@ impl KinLayout {
             own.iter().enumerate().for_each(|(k, &b)| of[b as usize] = k as u32);
             of
         };
+        // Pool records not yet taken: i = none (src/gpu/bind.rs).
+        for k in own.len()..count {
+            let at = header[0] as usize + BOND_WORDS * k;
+            words[at..at + BOND_WORDS].fill(NONE);
+        }
         for (k, &b) in own.iter().enumerate() {
             let b = b as usize;
             let [i, j] = model.bonds[b];
@@ -228,6 +255,7 @@ impl KinLayout {
         header[11] = dt_lo;
         header[12] = (dt as f32).to_bits();
         header[13] = (kt as f32).to_bits();
+        super::bind::append(model, &bind, count, &mut words, &mut header);
         words[..HEADER_WORDS].copy_from_slice(&header);
         let layout = Self {
             own_bonds: own.clone(),
@@ -235,12 +263,25 @@ impl KinLayout {
             types: model.bond_types.len(),
             capacity: capacity as u32,
             first_term: packed.first_own_term,
+            pool_first: own.len() as u32,
+            bond_base: model.bonds.len() as u32,
+            records: count as u32,
         };
         (words, layout)
     }
 
     pub(super) fn bonds(&self) -> u32 {
-        self.own_bonds.len() as u32
+        self.records
+    }
+
+    /// Whether `bind` formation runs on the device (src/gpu/bind.rs).
+    pub(super) fn binds(&self) -> bool {
+        self.records > self.pool_first
+    }
+
+    /// The pool record of a bond formed on the device.
+    fn pool_record(&self, bond: usize) -> u64 {
+        (self.pool_first as usize + bond - self.bond_base as usize) as u64
     }
 }
 
@@ -256,12 +297,15 @@ impl GpuBackend {
         let count = self.read_kin(CURSOR as u64, 1)[0] as usize;
         if count > 0 {
             let words = self.read_kin(header[8] as u64, (EVENT_WORDS * count) as u64);
+            let formed = self.formed_records(&words);
             for e in words.chunks_exact(EVENT_WORDS) {
-                let kind = if e[3] == 1 { EventKind::Break } else { EventKind::Rebind };
+                let kind = [EventKind::Break, EventKind::Rebind, EventKind::Form][e[3] as usize - 1];
+                let bond = e[2] as usize;
                 out.events.push(DeviceEvent {
                     step: (e[1] as u64) << 32 | e[0] as u64,
-                    bond: e[2] as usize,
+                    bond,
                     kind,
+                    formed: (kind == EventKind::Form).then(|| formed(bond)),
                     force: f32::from_bits(e[4]) as f64,
                     length: f32::from_bits(e[5]) as f64,
                     age: f64::from_bits((e[6] as u64) << 32 | e[7] as u64),
@@ -280,15 +324,38 @@ impl GpuBackend {
     }
 
     /// The device's bound flags and ages written into `bonds` (the kinetic
-    /// bonds'; nothing without device kinetics).
+    /// bonds', and those of the bonds formed on the device that the host has
+    /// drained; nothing without device kinetics).
     pub fn download_bond_state(&self, bonds: &mut BondState) {
         let Some(kinetics) = self.device_kinetics() else { return };
-        let n = kinetics.own_bonds.len() as u64;
+        let formed = bonds.len().saturating_sub(kinetics.bond_base as usize).min((kinetics.records - kinetics.pool_first) as usize);
+        let n = kinetics.own_bonds.len() as u64 + formed as u64;
         let bound = self.read_kin(kinetics.header[1] as u64, n);
         let ages = self.read_kin(kinetics.header[2] as u64, 2 * n);
-        for (k, &b) in kinetics.own_bonds.iter().enumerate() {
+        let pool = (0..formed).map(|f| kinetics.bond_base + f as u32);
+        for (k, b) in kinetics.own_bonds.iter().copied().chain(pool).enumerate() {
             bonds.bound[b as usize] = bound[k] == 1;
             bonds.age[b as usize] = f64::from_bits((ages[2 * k] as u64) << 32 | ages[2 * k + 1] as u64);
+        }
+    }
+
+    /// The type and particles of each bond formed on the device among the
+    /// event words `events`, read from their pool records in one read.
+    fn formed_records(&self, events: &[u32]) -> impl Fn(usize) -> (u32, [u32; 2]) {
+        let kinetics = self.device_kinetics().expect("events come from device kinetics");
+        // Formed bonds take consecutive indices, in event order.
+        let formed: Vec<usize> = events.chunks_exact(EVENT_WORDS).filter(|e| e[3] == 3).map(|e| e[2] as usize).collect();
+        let first = formed.first().copied().unwrap_or(0);
+        let records = match formed.last() {
+            Some(&last) => self.read_kin(
+                kinetics.header[0] as u64 + BOND_WORDS as u64 * kinetics.pool_record(first),
+                (BOND_WORDS * (last - first + 1)) as u64,
+            ),
+            None => Vec::new(),
+        };
+        move |bond: usize| {
+            let r = &records[BOND_WORDS * (bond - first)..];
+            (r[2], [r[0], r[1]])
         }
     }
 }

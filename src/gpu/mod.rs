@@ -16,6 +16,8 @@
 //!   (`Law::ContactArea`: adhesion), in passes around the contact pass.
 //! - [`kinetics`]: bond breaking and rebinding decided on the device, events
 //!   compacted in bond order and drained by the host at synchronisations.
+//! - [`bind`]: `bind` formation on the device: candidates from the GPU
+//!   neighbour list, accepted in the CPU's order into a preallocated pool.
 //! - [`special`]: pairs of bonded neighbours with a fractional
 //!   `special_bonds` weight, each particle's own list.
 //! - [`tetra`]: volume elements (`[ tetrahedra ]`): one pass per element
@@ -67,6 +69,7 @@
 
 pub mod adhesion;
 pub mod backend;
+pub mod bind;
 pub mod contact;
 pub mod context;
 pub mod custom;

@@ -47,7 +47,7 @@ mod embedded {
 pub use embedded::{COMMON_SHADERS, INTERACTION_SHADERS};
 
 /// The common files in the order they must appear (declarations first).
-const COMMON_ORDER: [&str; 13] = [
+const COMMON_ORDER: [&str; 14] = [
     "layout",
     "philox",
     "neighbor",
@@ -56,6 +56,7 @@ const COMMON_ORDER: [&str; 13] = [
     "integrate",
     "contact",
     "kinetics",
+    "bind",
     "tetra",
     "special",
     "adhesion",

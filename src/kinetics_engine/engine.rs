@@ -218,14 +218,7 @@ impl Kinetics {
         let mut events = Vec::with_capacity(bindings.len());
         for binding in bindings {
             let (b, kind) = match binding {
-                Binding::New(t, [i, j]) => {
-                    model.bonds.push([i, j]);
-                    model.bond_type.push(t);
-                    bonds.push(model.evolving_rest_length(t as usize), maturation_scale(model, t as usize, 0.0));
-                    bonds.formed.push(FormedBond { bond_type: t, particles: [i, j] });
-                    self.forms += 1;
-                    (model.bonds.len() - 1, EventKind::Form)
-                }
+                Binding::New(t, particles) => (self.push_formed(model, bonds, t, particles), EventKind::Form),
                 Binding::Again(b) => {
                     bonds.bound[b] = true;
                     bonds.age[b] = 0.0;
@@ -239,6 +232,41 @@ impl Kinetics {
             events.push(Event::of(model, b, kind, clock, 0.0, length, 0.0));
         }
         events
+    }
+}
+
+impl Kinetics {
+    /// A new bond of type `t` between `particles`, appended to the model and
+    /// the bond state (bound, age 0) and counted; returns its index.
+    fn push_formed(&mut self, model: &mut Model, bonds: &mut BondState, t: u32, particles: [u32; 2]) -> usize {
+        model.bonds.push(particles);
+        model.bond_type.push(t);
+        bonds.push(model.evolving_rest_length(t as usize), maturation_scale(model, t as usize, 0.0));
+        bonds.formed.push(FormedBond { bond_type: t, particles });
+        self.forms += 1;
+        model.bonds.len() - 1
+    }
+
+    /// A bond formed elsewhere (`bind` on the GPU, src/gpu/bind.rs) at the
+    /// step `clock` describes, with the index `bond` it took there: appended
+    /// as [`Self::apply_bindings`] appends; returns its event.
+    #[allow(clippy::too_many_arguments)]
+    pub fn apply_formed(
+        &mut self,
+        model: &mut Model,
+        state: &mut State,
+        bond: usize,
+        t: u32,
+        particles: [u32; 2],
+        clock: StepClock,
+        length: f64,
+    ) -> Result<Event, String> {
+        if bond != model.bonds.len() {
+            return Err(format!("the GPU formed bond {bond} where the host has {} bonds", model.bonds.len()));
+        }
+        let bonds = state.bonds.as_mut().expect("bond state exists with bind rules");
+        let b = self.push_formed(model, bonds, t, particles);
+        Ok(Event::of(model, b, EventKind::Form, clock, 0.0, length, 0.0))
     }
 }
 

@@ -101,6 +101,9 @@ pub struct Simulation {
     step_limits: Vec<f64>,
     /// Explicit steps shortened by the contact step clamp.
     pub contact_clamps: u64,
+    /// GPU steps whose `bind` formation the device left to the host (its
+    /// bond pool or slots were full, src/gpu/bind.rs), this run.
+    pub host_formations: u64,
     /// The last minimisation's outcome.
     pub last_minimize: Option<FireReport>,
     /// The deck's `device` setting.
@@ -174,6 +177,7 @@ impl Simulation {
             scratch: Vec::new(),
             step_limits: Vec::new(),
             contact_clamps: 0,
+            host_formations: 0,
             last_minimize: None,
             device: DevicePreference::Cpu,
             last_solve: SolveReport::default(),

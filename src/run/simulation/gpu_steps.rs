@@ -95,7 +95,9 @@ impl Stepper for GpuSteps {
         sim.protocols.follow_device_drives(&mut sim.model, &centres, &self.gpu.drive_states());
         let done = match &outcome {
             Ok(done) => *done,
-            Err(GpuHalt::Blowup { step, .. } | GpuHalt::Capacity { step, .. } | GpuHalt::Reach { step }) => step - sim.state.step,
+            Err(GpuHalt::Blowup { step, .. } | GpuHalt::Capacity { step, .. } | GpuHalt::Reach { step } | GpuHalt::Formation { step }) => {
+                step - sim.state.step
+            }
         };
         // Each step took s·dt: below 1 where the contact step clamp shortened it (src/gpu/contact.rs).
         let mut taken = Taken { steps: done, last: None };
@@ -134,6 +136,17 @@ impl Stepper for GpuSteps {
             // A face outgrew the contact search (src/gpu/contact.rs): the
             // backend is built anew from this state, with the reach of its
             // faces now, and the run goes on.
+            *self = GpuSteps::new(sim, &self.context)?;
+            return Ok(taken);
+        }
+        if let (Err(GpuHalt::Formation { .. }), Some(clock)) = (&outcome, taken.last) {
+            // The device left the last step's `bind` formation to the host
+            // (src/gpu/bind.rs): decided here from the state read back, then
+            // a backend with the formed bonds in its rows and an empty pool.
+            sim.host_formations += 1;
+            let (events, _) = sim.bind_on_host(clock)?;
+            sim.record_events(&events, clock.length)?;
+            sim.cpu.invalidate();
             *self = GpuSteps::new(sim, &self.context)?;
             return Ok(taken);
         }
@@ -207,15 +220,26 @@ impl GpuSteps {
             }
         }
         let Some(first) = clocks.first().map(|c| c.step) else { return Ok(()) };
+        let mut formed = false;
         for group in decided.events.chunk_by(|a, b| a.step == b.step) {
             let clock = clocks[(group[0].step - first) as usize];
-            let events: Vec<_> = group
-                .iter()
-                .map(|e| sim.kinetics.apply_decided(&sim.model, &mut sim.state, e.bond, e.kind, clock, e.force, e.length, e.age))
-                .collect();
+            let mut events = Vec::with_capacity(group.len());
+            for e in group {
+                events.push(match e.formed {
+                    Some((t, particles)) => {
+                        formed = true;
+                        let (model, state) = (&mut sim.model, &mut sim.state);
+                        sim.kinetics.apply_formed(model, state, e.bond, t, particles, clock, e.length).map_err(RunError::Setup)?
+                    }
+                    None => sim.kinetics.apply_decided(&sim.model, &mut sim.state, e.bond, e.kind, clock, e.force, e.length, e.age),
+                });
+            }
             sim.record_events(&events, clock.length)?;
         }
-        if !decided.events.is_empty() {
+        if formed {
+            // New bonds: the CPU backend is built anew where it is next needed.
+            sim.cpu.invalidate();
+        } else if !decided.events.is_empty() {
             let backend = sim.cpu.get(&sim.model, &sim.state, &sim.sim_box, sim.neighbor.skin)?;
             backend.bonds_changed(&sim.model, &sim.state, &sim.sim_box).map_err(RunError::Setup)?;
         }

@@ -71,6 +71,7 @@ impl Simulation {
     /// header and the outputs of the first step.
     pub fn begin_run(&mut self, steps: u64) -> Result<ActiveRun, RunError> {
         self.check_kinetics_temperature()?;
+        self.host_formations = 0;
         self.protocols.begin_run(self.state.step, self.state.step + steps);
         if self.protocols.set_ramps(&mut self.model, self.state.step) {
             self.forces_current = false;
@@ -145,6 +146,13 @@ impl Simulation {
         self.protocols.end_run();
         self.write_lifetimes()?;
         let seconds = run.started.elapsed().as_secs_f64();
+        if self.host_formations > 0 {
+            self.say(&format!(
+                "device gpu: the `bind` formation of {} steps was decided on the host (the device's bond pool or slots were full; \
+                 each rebuilt the GPU backend)",
+                self.host_formations
+            ));
+        }
         self.say(&format!(
             "loop time {seconds:.6} s for {} steps with {} particles: {:.6e} particle-steps/s",
             run.steps,
@@ -193,13 +201,9 @@ impl Simulation {
         for warning in &report.warnings {
             eprintln!("{warning}");
         }
-        let mut formed_any = false;
-        if let Some(formation) = &mut self.formation {
-            let bindings = formation.decide(&self.model, &self.state, &self.sim_box, clock).map_err(RunError::Setup)?;
-            formed_any = bindings.iter().any(|b| matches!(b, Binding::New(..)));
-            report.bonds_changed |= !bindings.is_empty();
-            report.events.extend(self.kinetics.apply_bindings(&mut self.model, &mut self.state, &self.sim_box, bindings, clock));
-        }
+        let (bindings, formed_any) = self.bind_on_host(clock)?;
+        report.bonds_changed |= !bindings.is_empty();
+        report.events.extend(bindings);
         self.record_events(&report.events, clock.length)?;
         if formed_any {
             // New bonds change every per-bond buffer: rebuild the backend.
@@ -209,6 +213,16 @@ impl Simulation {
             backend.bonds_changed(&self.model, &self.state, &self.sim_box).map_err(RunError::Setup)?;
         }
         Ok(report.bonds_changed)
+    }
+
+    /// The bindings of the step `clock` describes (after its breaks and
+    /// rebinds), decided and applied on the host (src/kinetics_engine/formation.rs):
+    /// their events, and whether new bonds formed.
+    pub(super) fn bind_on_host(&mut self, clock: StepClock) -> Result<(Vec<Event>, bool), RunError> {
+        let Some(formation) = &mut self.formation else { return Ok((Vec::new(), false)) };
+        let bindings = formation.decide(&self.model, &self.state, &self.sim_box, clock).map_err(RunError::Setup)?;
+        let formed_any = bindings.iter().any(|b| matches!(b, Binding::New(..)));
+        Ok((self.kinetics.apply_bindings(&mut self.model, &mut self.state, &self.sim_box, bindings, clock), formed_any))
     }
 
     /// The events of one step (`dt` long; none: nothing) into the lifetime
