@@ -120,6 +120,9 @@ fn face_outgrew_search(f: u32) -> bool {
     return max(max(dot(b, b), dot(c, c)), dot(bc, bc)) > P.contact_edge2;
 }
 
+// Faces of one corner tested per walk of its neighbour list.
+const CORNER_BATCH: u32 = 8u;
+
 // The largest s ∈ (0, 1] with s·a + √s·b ≤ limit (src/integrate/overdamped.rs, `step_fraction`).
 fn contact_step_fraction(a: f32, b: f32, limit: f32) -> f32 {
     if a + b <= limit {
@@ -196,25 +199,35 @@ fn contact_forces(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocatio
     var closest = part.closest;
     let row = nlist_row(i);
     let count = min(nlist[row], P.nlist_cap);
-    // As a corner: each of its faces against the neighbours of other bodies.
+    // As a corner: its faces against the neighbours of other bodies, up to
+    // CORNER_BATCH faces per walk of the neighbour list (one walk for a mesh
+    // node's 5–6 faces).
     let corner_end = topo[P.off_corner_start + i + 1u];
-    for (var q = topo[P.off_corner_start + i]; q < corner_end; q++) {
-        let slot = topo[P.off_corner_faces + q];
-        let face = slot / 4u;
-        let role = slot % 4u;
-        if role == 0u && face_outgrew_search(face) {
-            atomicOr(&status[ST_HALTED], HALT_REACH);
-        }
-        // The face's bounding sphere (centre c, radius r, relative to this
+    for (var first = topo[P.off_corner_start + i]; first < corner_end; first += CORNER_BATCH) {
+        let batch = min(corner_end - first, CORNER_BATCH);
+        // Each face's bounding sphere (centre c, radius r, relative to this
         // corner): a node within d̂ of the face is within d̂ + r of c. The
         // test only skips pairs farther than d̂ (zero force, above the clamp's
         // cap), with a margin of 1e-3 for f32 rounding.
-        let xa = separation(i, contact_face(face, 0u));
-        let xb = separation(i, contact_face(face, 1u));
-        let xc = separation(i, contact_face(face, 2u));
-        let centre = (xa + xb + xc) / 3.0;
-        let radius2 = max(max(dot(xa - centre, xa - centre), dot(xb - centre, xb - centre)), dot(xc - centre, xc - centre));
-        let reach = 1.001 * (P.contact_dhat + sqrt(radius2));
+        var centres: array<vec3<f32>, CORNER_BATCH>;
+        var reach2: array<f32, CORNER_BATCH>;
+        var slots: array<u32, CORNER_BATCH>;
+        for (var q = 0u; q < batch; q++) {
+            let slot = topo[P.off_corner_faces + first + q];
+            let face = slot / 4u;
+            if slot % 4u == 0u && face_outgrew_search(face) {
+                atomicOr(&status[ST_HALTED], HALT_REACH);
+            }
+            let xa = separation(i, contact_face(face, 0u));
+            let xb = separation(i, contact_face(face, 1u));
+            let xc = separation(i, contact_face(face, 2u));
+            let centre = (xa + xb + xc) / 3.0;
+            let radius2 = max(max(dot(xa - centre, xa - centre), dot(xb - centre, xb - centre)), dot(xc - centre, xc - centre));
+            let reach = 1.001 * (P.contact_dhat + sqrt(radius2));
+            centres[q] = centre;
+            reach2[q] = reach * reach;
+            slots[q] = slot;
+        }
         for (var k = 0u; k < count; k++) {
             let node = nlist[row + 1u + k] & ~CONTACT_ONLY;
             let other = contact_body(node);
@@ -225,18 +238,23 @@ fn contact_forces(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocatio
             if topo[P.off_cany + types] == 0u {
                 continue;
             }
-            let off_centre = separation(i, node) - centre;
-            if dot(off_centre, off_centre) >= reach * reach {
-                continue;
-            }
-            let pair = contact_pair(node, face);
-            closest = min(closest, pair.d);
-            let b = contact_radial(types, pair.d);
-            if b.de_dr != 0.0 {
-                f += b.de_dr * pair.w[role] * pair.n;
-            }
-            if P.n_arules > 0u {
-                f += adhesion_corner(node, face, role, types, pair);
+            let x = separation(i, node);
+            for (var q = 0u; q < batch; q++) {
+                let off_centre = x - centres[q];
+                if dot(off_centre, off_centre) >= reach2[q] {
+                    continue;
+                }
+                let face = slots[q] / 4u;
+                let role = slots[q] % 4u;
+                let pair = contact_pair(node, face);
+                closest = min(closest, pair.d);
+                let b = contact_radial(types, pair.d);
+                if b.de_dr != 0.0 {
+                    f += b.de_dr * pair.w[role] * pair.n;
+                }
+                if P.n_arules > 0u {
+                    f += adhesion_corner(node, face, role, types, pair);
+                }
             }
         }
     }
