@@ -55,6 +55,15 @@ fn bind_on() -> bool {
     return P.kin_bonds > 0u && kin_word(KIN_SLOT_WIDTH) > 0u;
 }
 
+// Particle i's slots: the word of the first, and how many (0: it takes no part).
+fn slot_range(i: u32) -> vec2<u32> {
+    let base = kin_word(kin_word(KIN_SLOT_OF) + i);
+    if base == KIN_NONE {
+        return vec2<u32>(0u);
+    }
+    return vec2<u32>(kin_word(KIN_SLOTS) + base, kin_word(KIN_SLOT_WIDTH));
+}
+
 // The other end of kinetic record k seen from particle i.
 fn record_partner(k: u32, i: u32) -> u32 {
     let rec = kin_word(KIN_BONDS) + KIN_BOND_WORDS * k;
@@ -76,11 +85,10 @@ struct BondsOfType {
     bound: u32,         // bound records of the type
     pair_bound: bool,   // one of them joins i and `partner`
     pair_unbound: u32,  // the first unbound record joining them (KIN_NONE: none)
-    used_slots: u32,
 }
 
 fn bonds_of_type(i: u32, bond_type: u32, partner: u32) -> BondsOfType {
-    var out = BondsOfType(0u, false, KIN_NONE, 0u);
+    var out = BondsOfType(0u, false, KIN_NONE);
     let end = topo[P.off_bond_offsets + i + 1u];
     for (var b = topo[P.off_bond_offsets + i]; b < end; b++) {
         let term = topo[P.off_bond_ends + 2u * b + 1u];
@@ -89,18 +97,12 @@ fn bonds_of_type(i: u32, bond_type: u32, partner: u32) -> BondsOfType {
         }
         bond_of_type_seen(&out, term - P.kin_first_term, topo[P.off_bond_ends + 2u * b], bond_type, partner);
     }
-    let base = kin_word(kin_word(KIN_SLOT_OF) + i);
-    if base == KIN_NONE {
-        return out;
-    }
-    let slots = kin_word(KIN_SLOTS) + base;
-    let width = kin_word(KIN_SLOT_WIDTH);
-    for (var s = 0u; s < width; s++) {
-        let k = kin_word(slots + s);
+    let slots = slot_range(i);
+    for (var s = 0u; s < slots.y; s++) {
+        let k = kin_word(slots.x + s);
         if k == KIN_NONE {
             break;
         }
-        out.used_slots += 1u;
         bond_of_type_seen(&out, k, record_partner(k, i), bond_type, partner);
     }
     return out;
@@ -125,14 +127,9 @@ fn formed_bond_forces(i: u32) -> vec4<f32> {
     if !bind_on() {
         return vec4<f32>(f, e);
     }
-    let base = kin_word(kin_word(KIN_SLOT_OF) + i);
-    if base == KIN_NONE {
-        return vec4<f32>(f, e);
-    }
-    let slots = kin_word(KIN_SLOTS) + base;
-    let width = kin_word(KIN_SLOT_WIDTH);
-    for (var s = 0u; s < width; s++) {
-        let k = kin_word(slots + s);
+    let slots = slot_range(i);
+    for (var s = 0u; s < slots.y; s++) {
+        let k = kin_word(slots.x + s);
         if k == KIN_NONE {
             break;
         }
@@ -254,42 +251,15 @@ fn bind_count(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_in
     }
 }
 
-var<workgroup> bind_partial: array<u32, 256>;
-
 // One workgroup: block bases (exclusive scan of the block counts, which are
 // zeroed for the next step) and the step's total.
 @compute @workgroup_size(256)
 fn bind_scan(@builtin(local_invocation_index) local: u32) {
     let blocks = (P.n + WORKGROUP - 1u) / WORKGROUP;
-    let per = (blocks + WORKGROUP - 1u) / WORKGROUP;
     let counts = kin_word(KIN_CAND_BLOCK);
-    let bases = counts + blocks;
-    let first = min(local * per, blocks);
-    let end = min(first + per, blocks);
-    var sum = 0u;
-    for (var b = first; b < end; b++) {
-        sum += kin_word(counts + b);
-    }
-    bind_partial[local] = sum;
-    workgroupBarrier();
-    for (var step = 1u; step < WORKGROUP; step *= 2u) {
-        var v = bind_partial[local];
-        if local >= step {
-            v += bind_partial[local - step];
-        }
-        workgroupBarrier();
-        bind_partial[local] = v;
-        workgroupBarrier();
-    }
-    var base = bind_partial[local] - sum;
-    for (var b = first; b < end; b++) {
-        let count = kin_word(counts + b);
-        atomicStore(&kin[bases + b], base);
-        atomicStore(&kin[counts + b], 0u);
-        base += count;
-    }
+    let total = scan_block_counts(local, blocks, counts, counts + blocks, 0u, true, true);
     if local == 0u {
-        atomicStore(&kin[KIN_CAND_TOTAL], select(0u, bind_partial[WORKGROUP - 1u], !halted()));
+        atomicStore(&kin[KIN_CAND_TOTAL], select(0u, total, !halted()));
     }
 }
 
@@ -338,17 +308,12 @@ fn bind_write(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_in
 }
 
 fn free_slots(i: u32) -> u32 {
-    let base = kin_word(kin_word(KIN_SLOT_OF) + i);
-    if base == KIN_NONE {
-        return 0u;
-    }
-    let slots = kin_word(KIN_SLOTS) + base;
-    let width = kin_word(KIN_SLOT_WIDTH);
+    let slots = slot_range(i);
     var used = 0u;
-    while used < width && kin_word(slots + used) != KIN_NONE {
+    while used < slots.y && kin_word(slots.x + used) != KIN_NONE {
         used += 1u;
     }
-    return width - used;
+    return slots.y - used;
 }
 
 // Whether every candidate can be taken without running out of pool records
@@ -369,12 +334,12 @@ fn bind_room(total: u32) -> bool {
 }
 
 fn take_slot(i: u32, k: u32) {
-    let slots = kin_word(KIN_SLOTS) + kin_word(kin_word(KIN_SLOT_OF) + i);
+    let slots = slot_range(i);
     var s = 0u;
-    while kin_word(slots + s) != KIN_NONE {
+    while kin_word(slots.x + s) != KIN_NONE {
         s += 1u;
     }
-    atomicStore(&kin[slots + s], k);
+    atomicStore(&kin[slots.x + s], k);
 }
 
 fn bind_event(k: u32, kind: u32, length_: f32) {

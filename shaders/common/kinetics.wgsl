@@ -360,47 +360,59 @@ fn kin_decide_bond(k: u32) -> u32 {
     return 0u;
 }
 
-var<workgroup> kin_partial: array<u32, 256>;
+var<workgroup> block_partial: array<u32, 256>;
 
-// One workgroup: block bases = cursor + exclusive scan of the block counts.
-@compute @workgroup_size(256)
-fn kin_scan(@builtin(local_invocation_index) local: u32) {
-    let blocks = (P.kin_bonds + WORKGROUP - 1u) / WORKGROUP;
+// One workgroup (all of it calls this): the bases of `blocks` block counts
+// (words `counts`…) as `start` + their exclusive scan, written to words
+// `bases`… when `go`; with `clear`, each count is zeroed once read. Returns
+// the counts' total. Used by kin_scan and bind_scan (bind.wgsl).
+fn scan_block_counts(local: u32, blocks: u32, counts: u32, bases: u32, start: u32, go: bool, clear: bool) -> u32 {
     let per = (blocks + WORKGROUP - 1u) / WORKGROUP;
-    let counts = kin_word(KIN_BLOCK);
-    let bases = counts + blocks;
     let first = min(local * per, blocks);
     let end = min(first + per, blocks);
     var sum = 0u;
     for (var b = first; b < end; b++) {
         sum += kin_word(counts + b);
     }
-    kin_partial[local] = sum;
+    block_partial[local] = sum;
     workgroupBarrier();
     // Inclusive Hillis–Steele scan of the 256 partial sums.
     for (var step = 1u; step < WORKGROUP; step *= 2u) {
-        var v = kin_partial[local];
+        var v = block_partial[local];
         if local >= step {
-            v += kin_partial[local - step];
+            v += block_partial[local - step];
         }
         workgroupBarrier();
-        kin_partial[local] = v;
+        block_partial[local] = v;
         workgroupBarrier();
     }
+    var base = start + block_partial[local] - sum;
+    for (var b = first; b < end && go; b++) {
+        let count = kin_word(counts + b);
+        atomicStore(&kin[bases + b], base);
+        if clear {
+            atomicStore(&kin[counts + b], 0u);
+        }
+        base += count;
+    }
+    let total = block_partial[WORKGROUP - 1u];
+    workgroupBarrier();
+    return total;
+}
+
+// One workgroup: block bases = cursor + exclusive scan of the block counts.
+@compute @workgroup_size(256)
+fn kin_scan(@builtin(local_invocation_index) local: u32) {
+    let blocks = (P.kin_bonds + WORKGROUP - 1u) / WORKGROUP;
+    let counts = kin_word(KIN_BLOCK);
     // A halted step decided nothing (the halt was set before this step).
     let go = !halted();
     let cursor = kin_word(KIN_CURSOR);
-    var base = cursor + kin_partial[local] - sum;
-    for (var b = first; b < end && go; b++) {
-        atomicStore(&kin[bases + b], base);
-        base += kin_word(counts + b);
-    }
-    workgroupBarrier();
+    let total = scan_block_counts(local, blocks, counts, counts + blocks, cursor, go, false);
     if !go {
         return;
     }
     if local == 0u {
-        let total = kin_partial[WORKGROUP - 1u];
         atomicStore(&kin[KIN_CURSOR], cursor + total);
         if total > 0u {
             // Breaks and rebinds change the pair exclusions.
