@@ -146,12 +146,13 @@ fn contact_node_part(i: u32, body: u32, track: bool) -> ContactNode {
     var out = ContactNode(vec3<f32>(0.0), 0.0, P.contact_dhat);
     let row = nlist_row(i);
     let count = min(nlist[row], P.nlist_cap);
-    // The faces whose first corner is a neighbour of another body.
+    // The faces whose first corner is a neighbour of another body (the
+    // list holds those first, shaders/common/neighbor.wgsl).
     for (var k = 0u; k < count; k++) {
         let j = nlist[row + 1u + k] & ~CONTACT_ONLY;
         let other = contact_body(j);
         if other == NO_BODY || other == body {
-            continue;
+            break;
         }
         let types = contact_types(body, other);
         if topo[P.off_cany + types] == 0u {
@@ -232,7 +233,7 @@ fn contact_forces(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocatio
             let node = nlist[row + 1u + k] & ~CONTACT_ONLY;
             let other = contact_body(node);
             if other == NO_BODY || other == body {
-                continue;
+                break; // the other bodies' nodes come first in the list
             }
             let types = contact_types(other, body);
             if topo[P.off_cany + types] == 0u {

@@ -251,15 +251,12 @@ fn stencil_cell(v: i32, axis: u32) -> i32 {
     return -1;
 }
 
-@compute @workgroup_size(256)
-fn nb_build(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) local: u32) {
-    let i = chunk_particle(wg, local);
-    if !in_chunk(i) {
-        return;
-    }
-    let ci = cell_coords(i);
-    var count = 0u;
-    let row = nlist_row(i);
+// Appends to row `row` (holding `count` entries) the neighbours of i (in
+// cell `ci`) within the list range that are (`cross`) or are not pairs of
+// nodes of two contact bodies; returns the new count (entries beyond the
+// capacity are counted, not written).
+fn nb_gather(i: u32, ci: vec3<u32>, row: u32, count_in: u32, cross: bool) -> u32 {
+    var count = count_in;
     for (var dz = 0; dz < stencil_len(2u); dz++) {
         let z = stencil_cell(stencil_start(ci.z, 2u) + dz, 2u);
         if z < 0 { continue; }
@@ -273,7 +270,7 @@ fn nb_build(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_inde
                 let end = cell_data[c + 1u];
                 for (var m = cell_data[c]; m < end; m++) {
                     let j = cell_data[off_members() + m];
-                    if j == i { continue; }
+                    if j == i || contact_pair_kept(i, j) != cross { continue; }
                     let d = separation(i, j);
                     if dot(d, d) < P.range2 {
                         // An excluded pair of different contact bodies stays, marked (src/gpu/contact.rs).
@@ -281,7 +278,7 @@ fn nb_build(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_inde
                         // a bond that breaks may bind again within the step (bind.wgsl).
                         var entry = j;
                         if !bind_on() && is_excluded(i, j) {
-                            entry = select(NO_ENTRY, j | CONTACT_ONLY, contact_pair_kept(i, j));
+                            entry = select(NO_ENTRY, j | CONTACT_ONLY, cross);
                         }
                         if entry != NO_ENTRY {
                             if count < P.nlist_cap {
@@ -294,6 +291,25 @@ fn nb_build(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_inde
             }
         }
     }
+    return count;
+}
+
+// Each particle's row: with contact bodies, the nodes of other contact
+// bodies first (the contact pass stops at the first entry that is not one,
+// src/gpu/contact.rs), then the rest, each part in cell-stencil order.
+@compute @workgroup_size(256)
+fn nb_build(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    let i = chunk_particle(wg, local);
+    if !in_chunk(i) {
+        return;
+    }
+    let ci = cell_coords(i);
+    let row = nlist_row(i);
+    var count = 0u;
+    if P.n_cfaces > 0u {
+        count = nb_gather(i, ci, row, count, true);
+    }
+    count = nb_gather(i, ci, row, count, false);
     nlist[row] = count;
     if count > P.nlist_cap {
         atomicMax(&status[ST_OVERFLOW_NEED], count);
