@@ -22,7 +22,7 @@
 //! the force pass gathers each particle's slots. A step whose candidates
 //! might overflow the candidate list, the pool or an end's slots binds
 //! nothing on the device: it halts the run after the step
-//! ([`super::GpuHalt::Formation`]); the host decides that step's formation
+//! (`GpuHalt::Formation`); the host decides that step's formation
 //! on the CPU and builds the backend anew, with the formed bonds in the bond
 //! rows and an empty pool.
 //!
