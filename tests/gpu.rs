@@ -1141,11 +1141,11 @@ fn kinetics_decks_give_the_same_events_on_the_gpu() {
     decks.sort();
     let (mut compared, mut all_events) = (0, 0);
     for deck in decks {
-        // aggregate (8 100 particles), spheroid_spreading (3 805; measured 2.4 s
-        // a GPU step on loaded llvmpipe) and collagen_two_cells step one GPU step
-        // per segment on llvmpipe (host kinetics: `bind`, `plastic`): 50 steps
-        // a run keep CI time in bounds and still cross the contact, step and sync
-        // paths. collagen_two_cells is compared over 7 of its 10 stages: in the
+        // aggregate (8 100 particles) and spheroid_spreading (3 805) form their
+        // bonds on the device (src/gpu/bind.rs); collagen_two_cells steps one GPU
+        // step per segment (host kinetics: `plastic`). Decks over 3 000 particles
+        // run 50 steps a run, which keeps CI time in bounds and still crosses the
+        // contact, step and sync paths. collagen_two_cells is compared over 7 of its 10 stages: in the
         // 8th, plastic resets crush a fibre segment below the 1.1 µm its
         // explicit step needs with `bend` 400 at dt 1e-3 (l > √(3K·dt/γ)), and
         // from its step 389 a difference grows sevenfold a step on the CPU too.
