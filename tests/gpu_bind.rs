@@ -86,6 +86,45 @@ fn bind_forms_the_cpus_bonds_on_the_device() {
     assert!(deviation <= 1e-5 * travelled, "GPU − CPU {deviation:e} > 1e-5 × {travelled:e}");
 }
 
+/// Bonds of a `bind` type without kinetic rules count on the device too:
+/// 20 a–b pairs start bound by permanent `link` bonds (max_bonds 1), so those
+/// 40 particles never bind again; on both backends the other particles form
+/// the same bonds in the same steps, and no particle holds two.
+#[test]
+fn permanent_bonds_of_a_bind_type_count_on_the_device() {
+    let mut top = scattered_particles();
+    top += "[ bonds ]\n";
+    for m in 0..20 {
+        top += &format!("link {} {}\n", 2 * m + 1, 2 * m + 2);
+    }
+    let ff = "particle a drag 0.005\nparticle b drag 0.005\nbond link harmonic k 0.05 r0 0.3\n\
+              bind a b link k_on 50 capture 0.5 max_bonds 1\n";
+    let deck = "units cell\ntopology t.top\nforcefield f.ff\nbox x 0 7 p y 0 7 p z 0 7 p\n\
+                temperature 298\ntimestep 1e-3\nseed 5\nevents e.events.csv\nrun 300\n";
+    let case = common::Case::new(&[("t.top", &top), ("f.ff", ff), ("deck.in", deck)]);
+    let plan = case.plan();
+    assert_eq!(refusal(&plan.model), None);
+    let run = |device: DevicePreference| {
+        let dir = tempfile::tempdir().unwrap();
+        let options = RunOptions { output_dir: dir.path().to_path_buf(), device: Some(device), ..Default::default() };
+        let sim = Simulation::execute(plan.clone(), options).unwrap();
+        (sim, std::fs::read_to_string(dir.path().join("e.events.csv")).unwrap())
+    };
+    let ((gpu, gpu_log), (cpu, cpu_log)) = (run(DevicePreference::Gpu), run(DevicePreference::Cpu));
+    let key = |log: &str| log.lines().skip(1).map(|l| l.split(',').take(7).collect::<Vec<_>>().join(",")).collect::<Vec<_>>();
+    let forms = key(&cpu_log).len();
+    println!("{forms} bonds formed on the CPU, {} on the GPU", key(&gpu_log).len());
+    assert!(forms > 50, "only {forms} bonds formed");
+    assert_eq!(key(&cpu_log), key(&gpu_log), "event logs");
+    assert_eq!(cpu.model.bonds, gpu.model.bonds);
+    let mut held = vec![0; gpu.model.len()];
+    for &[i, j] in &gpu.model.bonds {
+        held[i as usize] += 1;
+        held[j as usize] += 1;
+    }
+    assert!(held.iter().all(|&h| h <= 1), "a particle holds two links on the GPU");
+}
+
 /// The `bind` rules the device does not take say why; the others pass.
 #[test]
 fn bind_rules_the_device_refuses_say_why() {

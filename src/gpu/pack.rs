@@ -171,11 +171,14 @@ pub fn pack(model: &Model, exclusions: &Exclusions, dt: f64, kt: f64, bonds: Opt
     let body_base = external_base + model.externals.len();
     let tetra_base = body_base + model.body_rules.len();
     // Bonds with their own parameters (bound, and of a type with kinetic
-    // rules or with a rest length of their own): (bond, own term).
+    // rules, or that `bind` forms — the device's formation counts them,
+    // src/gpu/bind.rs — or with a rest length of their own): (bond, own term).
+    let has_state = |b: usize| {
+        let t = model.bond_type[b];
+        !model.bond_kinetics[t as usize].rules.is_empty() || model.bind_rules.iter().any(|r| r.bond_type == t)
+    };
     let kinetic: Vec<usize> = match bonds {
-        Some(state) => (0..model.bonds.len())
-            .filter(|&b| state.bound[b] && (state.rest[b].is_some() || !model.bond_kinetics[model.bond_type[b] as usize].rules.is_empty()))
-            .collect(),
+        Some(state) => (0..model.bonds.len()).filter(|&b| state.bound[b] && (state.rest[b].is_some() || has_state(b))).collect(),
         None => Vec::new(),
     };
     let mut own_term = vec![u32::MAX; model.bonds.len()];
