@@ -185,6 +185,8 @@ pub struct GpuBackend {
     kernels: Kernels,
     builds: u64,
     grown: u32,
+    /// The largest neighbour count of an overflow that did not halt the step (bind.wgsl).
+    overflow_met: u32,
     settings: StepSettings,
     /// The next `run` or `evaluate` rebuilds the neighbour list first.
     pending_rebuild: bool,
@@ -544,6 +546,7 @@ impl GpuBackend {
             kernels,
             builds: 0,
             grown: 0,
+            overflow_met: 0,
             settings: *settings,
             pending_rebuild: true,
             ctx: ctx.clone(),
@@ -1090,13 +1093,32 @@ impl GpuBackend {
         if status[ST_HALTED] & HALT_OVERFLOW == 0 {
             return Ok(false);
         }
-        let need = status[ST_OVERFLOW_NEED] as u64;
+        self.reserve_neighbors(status[ST_OVERFLOW_NEED])?;
+        Ok(true)
+    }
+
+    /// Grows the neighbour list to hold `need` neighbours per particle (with
+    /// a quarter's margin); nothing if it does. The list is rebuilt before the next step.
+    pub fn reserve_neighbors(&mut self, need: u32) -> Result<(), String> {
+        if need <= self.params.nlist_cap {
+            return Ok(());
+        }
+        let need = need as u64;
         let cap = (need + need / 4 + 8).next_multiple_of(8) as u32;
         self.nlist = NeighbourStorage::new(&self.ctx, self.params.n, cap, self.nlist_binding_limit)?;
         self.params.nlist_cap = cap;
         self.main_group = self.bind_main();
+        self.pending_rebuild = true;
         self.grown += 1;
-        Ok(true)
+        Ok(())
+    }
+
+    /// The neighbours per particle the list met, at least its capacity: with
+    /// the largest count of a check after `commit` that overflowed (which
+    /// halts with [`GpuHalt::Formation`], src/gpu/bind.rs), so a backend
+    /// built anew can [`Self::reserve_neighbors`] them.
+    pub fn neighbors_met(&self) -> u32 {
+        self.params.nlist_cap.max(self.overflow_met)
     }
 
     /// Forces at the current state (neighbour list rebuilt first); an error
@@ -1191,6 +1213,7 @@ impl GpuBackend {
                 return Err(GpuHalt::Reach { step: first_step + done });
             }
             if status[ST_HALTED] & HALT_FORMATION != 0 {
+                self.overflow_met = self.overflow_met.max(status[ST_OVERFLOW_NEED]);
                 return Err(GpuHalt::Formation { step: first_step + done });
             }
             if let Some(message) = self.span_halt(&status) {

@@ -147,7 +147,10 @@ impl Stepper for GpuSteps {
             let (events, _) = sim.bind_on_host(clock)?;
             sim.record_events(&events, clock.length)?;
             sim.cpu.invalidate();
+            // The new backend keeps the neighbour capacity this one needed.
+            let met = self.gpu.neighbors_met();
             *self = GpuSteps::new(sim, &self.context)?;
+            self.gpu.reserve_neighbors(met).map_err(RunError::Setup)?;
             return Ok(taken);
         }
         if let Err(GpuHalt::Capacity { message, .. }) = outcome {

@@ -148,8 +148,8 @@ impl Simulation {
         let seconds = run.started.elapsed().as_secs_f64();
         if self.host_formations > 0 {
             self.say(&format!(
-                "device gpu: the `bind` formation of {} steps was decided on the host (the device's bond pool or slots were full; \
-                 each rebuilt the GPU backend)",
+                "device gpu: the `bind` formation of {} steps was decided on the host (the device's bond pool, slots, candidate list \
+                 or neighbour list ran out of room; each rebuilt the GPU backend)",
                 self.host_formations
             ));
         }
