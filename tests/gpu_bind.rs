@@ -27,6 +27,15 @@ fn scattered_particles() -> String {
     top
 }
 
+/// Runs `plan` on `device` in a fresh directory: the simulation at its end
+/// and the text of its event log `log`.
+fn run_logged(plan: &cellmd::deck::Plan, device: DevicePreference, log: &str) -> (Simulation, String) {
+    let dir = tempfile::tempdir().unwrap();
+    let options = RunOptions { output_dir: dir.path().to_path_buf(), device: Some(device), ..Default::default() };
+    let sim = Simulation::execute(plan.clone(), options).unwrap();
+    (sim, std::fs::read_to_string(dir.path().join(log)).unwrap())
+}
+
 /// A churning a–b network at 298 K: pairs closer than 0.5 µm bind at
 /// k_on = 50/s (p ≈ 0.05 a step), up to two bonds per particle, and the soft
 /// bonds slip off at 10/s, so within 1 000 steps bonds form, break and
@@ -47,15 +56,8 @@ fn bind_forms_the_cpus_bonds_on_the_device() {
     let case = common::Case::new(&[("t.top", &scattered_particles()), ("f.ff", ff), ("deck.in", deck)]);
     let plan = case.plan();
     assert_eq!(refusal(&plan.model), None);
-    let run = |device: DevicePreference| {
-        let dir = tempfile::tempdir().unwrap();
-        let options = RunOptions { output_dir: dir.path().to_path_buf(), device: Some(device), ..Default::default() };
-        let sim = Simulation::execute(plan.clone(), options).unwrap();
-        let log = std::fs::read_to_string(dir.path().join("churn.events.csv")).unwrap();
-        (sim, log)
-    };
-    let (gpu, gpu_log) = run(DevicePreference::Gpu);
-    let (cpu, cpu_log) = run(DevicePreference::Cpu);
+    let (gpu, gpu_log) = run_logged(&plan, DevicePreference::Gpu, "churn.events.csv");
+    let (cpu, cpu_log) = run_logged(&plan, DevicePreference::Cpu, "churn.events.csv");
     let rows = |log: &str| log.lines().skip(1).map(|l| l.split(',').map(String::from).collect::<Vec<_>>()).collect::<Vec<_>>();
     let (cpu_rows, gpu_rows) = (rows(&cpu_log), rows(&gpu_log));
     let count = |kind: &str| cpu_rows.iter().filter(|r| r[2] == kind).count();
@@ -104,13 +106,8 @@ fn permanent_bonds_of_a_bind_type_count_on_the_device() {
     let case = common::Case::new(&[("t.top", &top), ("f.ff", ff), ("deck.in", deck)]);
     let plan = case.plan();
     assert_eq!(refusal(&plan.model), None);
-    let run = |device: DevicePreference| {
-        let dir = tempfile::tempdir().unwrap();
-        let options = RunOptions { output_dir: dir.path().to_path_buf(), device: Some(device), ..Default::default() };
-        let sim = Simulation::execute(plan.clone(), options).unwrap();
-        (sim, std::fs::read_to_string(dir.path().join("e.events.csv")).unwrap())
-    };
-    let ((gpu, gpu_log), (cpu, cpu_log)) = (run(DevicePreference::Gpu), run(DevicePreference::Cpu));
+    let (gpu, gpu_log) = run_logged(&plan, DevicePreference::Gpu, "e.events.csv");
+    let (cpu, cpu_log) = run_logged(&plan, DevicePreference::Cpu, "e.events.csv");
     let key = |log: &str| log.lines().skip(1).map(|l| l.split(',').take(7).collect::<Vec<_>>().join(",")).collect::<Vec<_>>();
     let forms = key(&cpu_log).len();
     println!("{forms} bonds formed on the CPU, {} on the GPU", key(&gpu_log).len());
