@@ -33,6 +33,22 @@ pub struct BindRule {
     pub between_bodies: bool,
 }
 
+/// The body of a particle outside every body (as `Model::body_of_particles` gives it).
+pub const NO_BODY: u32 = u32::MAX;
+
+impl BindRule {
+    /// Whether the rule pairs a particle of type `ti` with one of type `tj` (either order).
+    pub fn joins_types(&self, ti: u32, tj: u32) -> bool {
+        (self.type_a, self.type_b) == (ti, tj) || (self.type_a, self.type_b) == (tj, ti)
+    }
+
+    /// Whether particles of bodies `bi` and `bj` ([`NO_BODY`]: none) may bind
+    /// under the rule: any two, or with `between bodies` two of different bodies.
+    pub fn joins_bodies(&self, bi: u32, bj: u32) -> bool {
+        !self.between_bodies || (bi != NO_BODY && bj != NO_BODY && bi != bj)
+    }
+}
+
 /// A `bind` line as parsed (names resolved later against the model).
 #[derive(Clone, Debug)]
 pub struct BindLine {

@@ -39,7 +39,7 @@ mod custom;
 mod params;
 mod parse;
 
-pub use self::bind::{parse_bind, BindLine, BindRule};
+pub use self::bind::{parse_bind, BindLine, BindRule, NO_BODY};
 pub use self::custom::{parse_custom, parse_custom_external};
 pub use self::params::{
     check_param, param_position, param_value, parse_kinetics, parse_params, parse_values, BondTypeKinetics, TermType, Typed,

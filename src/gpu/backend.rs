@@ -76,9 +76,9 @@ pub enum GpuHalt {
     /// set when the backend is built; the state is that of `step`.
     Reach { step: u64 },
     /// The formation of the step before `step` might have overflowed the
-    /// device's bond pool, slots or candidate list, so the device bound
-    /// nothing in it (src/gpu/bind.rs); the state, breaks and rebinds are
-    /// those of `step`.
+    /// device's bond pool, slots or candidate list, or its neighbour list
+    /// overflowed, so the device bound nothing in it (src/gpu/bind.rs); the
+    /// state, breaks and rebinds are those of `step`.
     Formation { step: u64 },
 }
 

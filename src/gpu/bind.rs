@@ -61,31 +61,20 @@ pub fn refusal(model: &Model) -> Option<String> {
     if !model.pair_rules.is_empty() {
         return Some("`bind` with pair terms (formed bonds would change the pair exclusions)".into());
     }
-    let body = body_of_particle(model);
+    let body = model.body_of_particles();
     for (b, &[i, j]) in model.bonds.iter().enumerate() {
         let t = model.bond_type[b];
         let (ti, tj) = (model.types[i as usize], model.types[j as usize]);
-        let pairs = model.bind_rules.iter().any(|r| {
-            r.bond_type != t
-                && ((r.type_a, r.type_b) == (ti, tj) || (r.type_a, r.type_b) == (tj, ti))
-                && (!r.between_bodies || (body[i as usize] != NONE && body[j as usize] != NONE && body[i as usize] != body[j as usize]))
-        });
+        let pairs = model
+            .bind_rules
+            .iter()
+            .any(|r| r.bond_type != t && r.joins_types(ti, tj) && r.joins_bodies(body[i as usize], body[j as usize]));
         if pairs {
             let label = &model.bond_types[t as usize].label.text;
             return Some(format!("`bind` between particles that a bond of type `{label}` already joins"));
         }
     }
     None
-}
-
-fn body_of_particle(model: &Model) -> Vec<u32> {
-    let mut body = vec![NONE; model.len()];
-    for (b, nodes) in model.bodies.iter().enumerate() {
-        for &i in &nodes.nodes {
-            body[i as usize] = b as u32;
-        }
-    }
-    body
 }
 
 /// The sizes of the device's formation sections for `model`.
@@ -159,7 +148,7 @@ pub(super) fn append(model: &Model, sizes: &BindSizes, pool_end: usize, words: &
         words.extend(record);
     }
     header[21] = words.len() as u32;
-    words.extend(body_of_particle(model));
+    words.extend(model.body_of_particles());
     header[22] = (pool_end - sizes.pool) as u32;
     header[23] = pool_end as u32;
     header[24] = model.bonds.len() as u32;

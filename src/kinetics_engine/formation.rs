@@ -61,11 +61,9 @@ pub enum Binding {
 pub struct Formation {
     neighbors: NeighborList,
     none: Exclusions,
-    /// The body of each particle (`NO_BODY` outside bodies).
+    /// The body of each particle (`forcefield::NO_BODY` outside bodies).
     body: Vec<u32>,
 }
-
-const NO_BODY: u32 = u32::MAX;
 
 impl Formation {
     /// The candidate list has a skin of 0.3 × capture (capped so the box
@@ -77,12 +75,7 @@ impl Formation {
         let lengths = sim_box.lengths();
         let room = (0..3).filter(|&a| sim_box.periodic[a]).map(|a| 0.5 * lengths[a] - capture).fold(f64::INFINITY, f64::min);
         let skin = (0.3 * capture).min(room.max(0.0));
-        let mut body = vec![NO_BODY; model.len()];
-        for (b, nodes) in model.bodies.iter().enumerate() {
-            for &i in &nodes.nodes {
-                body[i as usize] = b as u32;
-            }
-        }
+        let body = model.body_of_particles();
         Self { neighbors: NeighborList::new(capture, skin), none: Exclusions::none(), body }
     }
 
@@ -122,11 +115,11 @@ impl Formation {
         let eligible = move |i: usize| {
             neighbors.neighbors(i).iter().filter_map(move |&j| {
                 let (ti, tj) = (model.types[i], model.types[j as usize]);
-                let k = model.bind_rules.iter().position(|r| (r.type_a, r.type_b) == (ti, tj) || (r.type_a, r.type_b) == (tj, ti))?;
+                let k = model.bind_rules.iter().position(|r| r.joins_types(ti, tj))?;
                 let r = &model.bind_rules[k];
                 let key = ((i as u32).min(j), (i as u32).max(j), r.bond_type);
                 let free = count_now[i * rules + k] < r.max_bonds && count_now[j as usize * rules + k] < r.max_bonds;
-                let across = !r.between_bodies || (body[i] != NO_BODY && body[j as usize] != NO_BODY && body[i] != body[j as usize]);
+                let across = r.joins_bodies(body[i], body[j as usize]);
                 let d = sim_box.minimum_image(x[j as usize] - x[i]).length();
                 (d < r.capture && free && across && !bound_now.contains(&key)).then_some((j, k, d))
             })

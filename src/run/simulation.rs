@@ -102,7 +102,8 @@ pub struct Simulation {
     /// Explicit steps shortened by the contact step clamp.
     pub contact_clamps: u64,
     /// GPU steps whose `bind` formation the device left to the host (its
-    /// bond pool or slots were full, src/gpu/bind.rs), this run.
+    /// bond pool, slots, candidate list or neighbour list ran out of room,
+    /// src/gpu/bind.rs), this run.
     pub host_formations: u64,
     /// The last minimisation's outcome.
     pub last_minimize: Option<FireReport>,

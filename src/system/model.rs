@@ -331,6 +331,17 @@ impl Model {
         self.has_kinetics() || self.bond_rest.iter().any(Option::is_some)
     }
 
+    /// The body of each particle ([`crate::forcefield::NO_BODY`] outside bodies).
+    pub fn body_of_particles(&self) -> Vec<u32> {
+        let mut body = vec![crate::forcefield::NO_BODY; self.len()];
+        for (b, nodes) in self.bodies.iter().enumerate() {
+            for &i in &nodes.nodes {
+                body[i as usize] = b as u32;
+            }
+        }
+        body
+    }
+
     /// Makes the bond list the topology's plus the bonds `formed` in a run.
     pub fn set_formed_bonds(&mut self, formed: &[crate::system::FormedBond]) {
         self.bonds.truncate(self.topology_bonds);
