@@ -10,19 +10,7 @@ use common::Case;
 /// (1: pinned, 2: clamped), its tip pulled by `load` (pN) along (lx, ly, 0);
 /// segments constrained.
 fn chain(n: usize, anchors: usize, integrator: &str, dt: f64, steps: u64, load: (f64, f64)) -> Case {
-    let mut top = String::from("[ particles ]\n");
-    for k in 0..=n {
-        top += &format!("{} {} {} 0 0\n", k + 1, if k < anchors { "anchor" } else { "bead" }, k as f64 * 0.1);
-    }
-    top += "[ bonds ]\n";
-    for k in 1..=n {
-        top += &format!("rod {k} {}\n", k + 1);
-    }
-    top += "[ angles ]\n";
-    for k in 1..n {
-        top += &format!("bend {k} {} {}\n", k + 1, k + 2);
-    }
-    let ff = "particle anchor fixed\nparticle bead drag 0.01\nbond rod harmonic k 10 r0 0.1\nangle bend wlc_bending kappa 0.01 l0 0.1\n";
+    let (top, ff) = common::chain_of_rods(n, anchors);
     let deck = format!(
         "topology t.top\nforcefield f.ff\nbox x -2 2 f y -2 2 f z -2 2 f\ngroup tip id {}\n\
          external load tip constant_force fx {} fy {}\nconstrain rod tolerance 1e-10\n{integrator}\ntimestep {dt}\n\

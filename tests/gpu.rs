@@ -708,7 +708,8 @@ fn implicit_condition_bound(sim: &Simulation) -> f64 {
 }
 
 /// Every `inputs/` deck without bond kinetics that the GPU runs (all but those
-/// with constraints, custom body terms, or an implicit step the device cannot
+/// with custom body terms, constraints the device cannot project
+/// (src/gpu/shake.rs), or an implicit step the device cannot
 /// solve (src/gpu/implicit.rs), which it refuses with the message of
 /// `Simulation::cpu_only_feature`): at kT = 0, GPU positions stay within
 /// 1e-5 of the distance the particles travelled, after 10⁴ steps per `run`

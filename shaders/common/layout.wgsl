@@ -182,7 +182,13 @@ fn image_of(i: u32) -> vec3<i32> {
 // axes: the box length is subtracted or added in fixed point too), then
 // rounded once to f32.
 fn separation(i: u32, j: u32) -> vec3<f32> {
-    var d = fixed_sub(fixed_of(j), fixed_of(i));
+    return minimum_image_length(fixed_sub(fixed_of(j), fixed_of(i)));
+}
+
+// A fixed-point difference of two positions as its minimum image (exact),
+// rounded once to a length.
+fn minimum_image_length(difference: Fixed3) -> vec3<f32> {
+    var d = difference;
     let l = box_fixed();
     let half = vec3<i32>(l.h / 2);
     let per = P.periodic.xyz == vec3<u32>(1u);

@@ -31,6 +31,8 @@ use super::nlist::NeighbourStorage;
 use super::pack::{cell_grid, pack, FixedPoint, Packed, Params};
 use super::protocol::{DeviceProtocol, PackedTerms, ProtocolPack, RAMP_ROWS};
 use super::shader;
+use super::shake::{DeviceShake, ShakeReport};
+use crate::integrate::constraints::Constraints;
 use crate::integrate::context::StepContext;
 use crate::integrate::implicit::{ImplicitSettings, SolveReport};
 use crate::neighbor::Exclusions;
@@ -59,6 +61,8 @@ const HALT_REACH: u32 = 8;
 const HALT_SOLVE: u32 = 32;
 /// A step's `bind` formation was left to the host (src/gpu/bind.rs).
 const HALT_FORMATION: u32 = 64;
+/// A constraint projection did not converge (src/gpu/shake.rs).
+const HALT_CONSTRAINT: u32 = 128;
 /// Steps per command buffer.
 const STEPS_PER_SUBMIT: u64 = 64;
 
@@ -208,6 +212,8 @@ pub struct GpuBackend {
     protocol: Option<ProtocolPack>,
     /// The implicit step on the device (src/gpu/implicit.rs), in place of `integrate`.
     implicit: Option<ImplicitSolver>,
+    /// The constraints' projection after each step (src/gpu/shake.rs).
+    shake: Option<DeviceShake>,
 }
 
 /// Refuses a storage buffer the adapter cannot bind (wgpu would abort).
@@ -281,6 +287,24 @@ impl GpuBackend {
     ) -> Result<(), String> {
         self.implicit = Some(ImplicitSolver::new(ctx, &self.layout, model, (settings.context.dt, settings.context.kt), implicit)?);
         Ok(())
+    }
+
+    /// Projects the constrained bonds after every step from now on
+    /// (src/gpu/shake.rs; the run must pass its `refusal`). Returns the
+    /// tolerance the device projects to.
+    pub fn constrain_bonds(&mut self, ctx: &GpuContext, model: &Model, constraints: &Constraints) -> Result<f64, String> {
+        let shake = DeviceShake::new(ctx, &self.layout, model, constraints)?;
+        let tolerance = shake.tolerance;
+        self.shake = Some(shake);
+        Ok(tolerance)
+    }
+
+    /// The constraint tensions of the last step (the deck's list order) and
+    /// the last projection's report (one small read-back; None without
+    /// constraints).
+    pub fn constraint_state(&self) -> Option<(Vec<f64>, ShakeReport)> {
+        let shake = self.shake.as_ref()?;
+        Some(shake.read(&self.read(&shake.buffer, 4 * (shake.count as u64 + 4))))
     }
 
     /// The last implicit step's iterations and relative residual (one small
@@ -560,6 +584,7 @@ impl GpuBackend {
             protocol_buffer: protocol,
             protocol: protocol_pack,
             implicit: None,
+            shake: None,
         };
         backend.set_clock(settings.context.time);
         backend.upload(state);
@@ -982,6 +1007,12 @@ impl GpuBackend {
             } else {
                 self.dispatch(pass, &k.integrate, Over::Particles);
             }
+            if let Some(shake) = &self.shake {
+                // The constraints' projection (src/gpu/shake.rs) on the new positions.
+                pass.set_bind_group(1, &shake.group, &[]);
+                self.dispatch(pass, &shake.solve, Over::Groups(1));
+                self.dispatch(pass, &shake.place, Over::Groups(shake.particles.div_ceil(WORKGROUP)));
+            }
             self.dispatch(pass, &k.commit, Over::Particles);
             let binds = self.kinetics.as_ref().filter(|(layout, _)| layout.binds()).map(|(_, kernels)| kernels);
             if binds.is_some() {
@@ -1222,6 +1253,11 @@ impl GpuBackend {
             if let Some(solver) = self.implicit.as_ref().filter(|_| status[ST_HALTED] & HALT_SOLVE != 0) {
                 let message = solver.failure(&self.implicit_report().unwrap_or_default());
                 return Err(GpuHalt::Capacity { step: first_step + done, message });
+            }
+            if let Some(shake) = self.shake.as_ref().filter(|_| status[ST_HALTED] & HALT_CONSTRAINT != 0) {
+                let report = self.constraint_state().map(|(_, report)| report).unwrap_or_default();
+                // The step the projection failed in is the one after the last done.
+                return Err(GpuHalt::Capacity { step: first_step + done, message: shake.failure(&report, first_step + done + 1) });
             }
             if status[ST_HALTED] & HALT_EVENTS != 0 {
                 // The event buffer is full: the host drains it and goes on.

@@ -68,9 +68,10 @@
 
 use wgpu::util::DeviceExt;
 
-use super::context::{storage_entry, GpuContext};
+use super::context::GpuContext;
 use super::pack::push_csr;
 use super::shader;
+use super::side_group::SideGroup;
 use crate::integrate::implicit::{ImplicitSettings, LinearSolver, SolveReport};
 use crate::interactions::{Law, REGISTRY};
 use crate::system::Model;
@@ -179,14 +180,6 @@ impl ImplicitSolver {
         if let Some(why) = refusal(model, implicit) {
             return Err(why.into());
         }
-        // The main group's storage buffers and these two.
-        let needed = super::context::STORAGE_BINDINGS + 2;
-        if ctx.limits.max_storage_buffers_per_shader_stage < needed {
-            return Err(format!(
-                "the implicit step needs {needed} storage buffers per shader stage; {} allows {}",
-                ctx.info.name, ctx.limits.max_storage_buffers_per_shader_stage
-            ));
-        }
         let n = model.len();
         let tolerance = implicit.tolerance.max(F32_TOLERANCE);
         let angle_base = model.bond_types.len();
@@ -247,44 +240,13 @@ impl ImplicitSolver {
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("cellmd implicit"),
-            entries: &[storage_entry(1, true), storage_entry(2, false)],
-        });
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("cellmd implicit"),
-            layout: &layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 1, resource: imp_topo.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: buffer.as_entire_binding() },
-            ],
-        });
-        let program = shader::compose_with(&super::custom::source(model)?);
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("cellmd implicit"),
-            source: wgpu::ShaderSource::Wgsl(program.into()),
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("cellmd implicit"),
-            bind_group_layouts: &[Some(main_layout), Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = |entry: &str| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: Some(&pipeline_layout),
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
+        let side = SideGroup::new(ctx, main_layout, model, "the implicit step", &[(1, true, &imp_topo), (2, false, &buffer)])?;
         Ok(Self {
-            group,
-            angles: pipeline("implicit_angles"),
-            blocks: pipeline("implicit_blocks"),
-            solve: pipeline("implicit_solve"),
-            moves: pipeline("implicit_move"),
+            angles: side.pipeline(ctx, "implicit_angles"),
+            blocks: side.pipeline(ctx, "implicit_blocks"),
+            solve: side.pipeline(ctx, "implicit_solve"),
+            moves: side.pipeline(ctx, "implicit_move"),
+            group: side.group,
             buffer,
             report_at: 16 * report as u64,
             angle_count: model.angles.len() as u32,

@@ -27,6 +27,11 @@
 //!   written per step from a table.
 //! - [`implicit`]: `integrator implicit`: per-term stiffness blocks and
 //!   Jacobi-preconditioned conjugate gradients in one workgroup, matrix-free.
+//! - [`shake`]: `constrain`: overdamped SHAKE after the explicit step, the
+//!   constraints coloured so that a colour's corrections run in parallel,
+//!   swept in one workgroup until converged.
+//! - `side_group`: the bind group 1 and pipelines of the kernels with
+//!   buffers of their own (the implicit step, the projection).
 //!
 //! File-level circles, on purpose: `pack.rs` ↔ `surface.rs`, `tetra.rs`
 //! and `special.rs`. `pack.rs` lays out the whole topology, their sections
@@ -36,9 +41,11 @@
 //! dispatches its kernels in each step, and `kinetics.rs` lays that buffer
 //! out and adds to `GpuBackend` the methods that read its events and bond
 //! state back, so the buffer's layout has one home. And `shader.rs` ↔
-//! `implicit.rs`: the composer appends the implicit step's stiffness
-//! dispatch, and `implicit.rs` compiles the composed program and reads the
-//! evaluator files to tell which laws have a device stiffness block.
+//! `implicit.rs` (and through `side_group.rs`): the composer appends the
+//! implicit step's stiffness dispatch, `implicit.rs` reads the evaluator
+//! files to tell which laws have a device stiffness block, and
+//! `side_group.rs`, which compiles the composed program for the implicit
+//! step's kernels, is one of `implicit.rs`'s imports.
 //!
 //! What runs where: each step — neighbour-list check and (when due) rebuild,
 //! forces, overdamped integration — runs on the GPU without reading anything
@@ -49,7 +56,8 @@
 //! Not on the GPU (refused by [`GpuBackend::new`], and by `device gpu`
 //! before a run; `device auto` falls back to the CPU): custom surface terms
 //! of bodies, which have no kernel yet; the implicit
-//! step of the models [`implicit::refusal`] names. Bond kinetics
+//! step of the models [`implicit::refusal`] names; constraints where
+//! [`shake::refusal`] names why. Bond kinetics
 //! are decided on the device for the rules [`kinetics`] ports, else on the
 //! host after every step (see [`backend`]).
 //!
@@ -79,6 +87,8 @@ mod nlist;
 pub mod pack;
 pub mod protocol;
 pub mod shader;
+pub mod shake;
+mod side_group;
 mod special;
 pub mod surface;
 pub mod tetra;

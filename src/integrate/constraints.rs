@@ -14,6 +14,9 @@
 //! axial tension along an inextensible filament is read (thermo
 //! `ctension/TYPE`). The force of the bond's own law still acts (it vanishes
 //! at r0 for harmonic-like laws).
+//!
+//! The GPU backend projects on the device with the same equation, the
+//! constraints swept colour by colour (src/gpu/shake.rs).
 
 use glam::DVec3;
 
@@ -38,6 +41,16 @@ pub struct Constraints {
     pub tension: Vec<f64>,
     /// Sweeps the last projection took.
     pub iterations: usize,
+}
+
+/// The message of a projection that failed at `step`: the constraint's
+/// ends (particle ids), the sweep cap, its relative error and the tolerance
+/// (the CPU's and the device's, src/gpu/shake.rs).
+pub fn failure_message(ends: [u64; 2], max_iterations: usize, step: u64, relative_error: f64, tolerance: f64) -> String {
+    format!(
+        "constraint of bond {}-{} not met after {max_iterations} sweeps at step {step}: |r − r0|/r0 = {relative_error:e} > tolerance {tolerance:e}",
+        ends[0], ends[1]
+    )
 }
 
 /// Why a projection failed.

@@ -141,6 +141,28 @@ pub fn merge_topologies(texts: &[&str]) -> String {
     sections.iter().map(|(name, body)| if name.is_empty() { body.clone() } else { format!("{name}\n{body}") }).collect()
 }
 
+/// A straight chain of `n` segments of 0.1 µm along x, its first `anchors`
+/// beads `anchor` (fixed), the rest `bead`, with `rod` bonds and `bend`
+/// angles, and its force field (soft harmonic rods, k = 10, that alone
+/// would stretch under a load; `wlc_bending`): the filament of the
+/// `constrain` tests (tests/constraints.rs, tests/gpu_constraints.rs).
+pub fn chain_of_rods(n: usize, anchors: usize) -> (String, &'static str) {
+    let mut top = String::from("[ particles ]\n");
+    for k in 0..=n {
+        top += &format!("{} {} {} 0 0\n", k + 1, if k < anchors { "anchor" } else { "bead" }, k as f64 * 0.1);
+    }
+    top += "[ bonds ]\n";
+    for k in 1..=n {
+        top += &format!("rod {k} {}\n", k + 1);
+    }
+    top += "[ angles ]\n";
+    for k in 1..n {
+        top += &format!("bend {k} {} {}\n", k + 1, k + 2);
+    }
+    let ff = "particle anchor fixed\nparticle bead drag 0.01\nbond rod harmonic k 10 r0 0.1\nangle bend wlc_bending kappa 0.01 l0 0.1\n";
+    (top, ff)
+}
+
 /// The bits of every position (for bit-identity checks).
 pub fn position_bits(sim: &Simulation) -> Vec<[u64; 3]> {
     sim.state.positions.iter().map(|x| x.to_array().map(f64::to_bits)).collect()

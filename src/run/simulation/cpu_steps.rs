@@ -7,6 +7,7 @@ use glam::DVec3;
 use super::reference::finite_force;
 use super::step_loop::{Stepper, Taken};
 use super::Simulation;
+use crate::integrate::constraints::failure_message;
 use crate::integrate::context::StepContext;
 use crate::integrate::fire::{fire_minimize, FireSettings};
 use crate::integrate::implicit::{implicit_step, ConstrainedBonds, ImplicitError, ImplicitSettings};
@@ -70,16 +71,10 @@ impl Stepper for CpuSteps {
                 sim.constraints.tension.iter_mut().zip(&sim.implicit_tension).for_each(|(t, extra)| *t += extra);
             }
             if let Err(failure) = projected {
-                let [i, j] = sim.model.bonds[failure.bond];
-                return Err(RunError::Setup(format!(
-                    "constraint of bond {}-{} not met after {} sweeps at step {}: |r − r0|/r0 = {:e} > tolerance {:e}",
-                    sim.model.ids[i as usize],
-                    sim.model.ids[j as usize],
-                    sim.constraints.max_iterations,
-                    sim.state.step,
-                    failure.relative_error,
-                    sim.constraints.tolerance
-                )));
+                let c = &sim.constraints;
+                let ends = sim.model.bonds[failure.bond].map(|p| sim.model.ids[p as usize]);
+                let message = failure_message(ends, c.max_iterations, sim.state.step, failure.relative_error, c.tolerance);
+                return Err(RunError::Setup(message));
             }
         }
         if let Err((particle, why)) = sim.protocols.after_step(&mut sim.state, &sim.sim_box, &ctx) {

@@ -74,6 +74,16 @@ impl GpuSteps {
             }
             gpu.step_implicitly(context, model, &settings, implicit).map_err(RunError::Setup)?;
         }
+        if !sim.constraints.list.is_empty() {
+            // The constraints' projection on the device (src/gpu/shake.rs): f32 lengths have a tolerance floor.
+            let tolerance = gpu.constrain_bonds(context, model, &sim.constraints).map_err(RunError::Setup)?;
+            if tolerance > sim.constraints.tolerance {
+                sim.say(&format!(
+                    "device gpu: constraints are projected to |r − r0|/r0 ≤ {tolerance:e} in f32 (the deck asks for {:e})",
+                    sim.constraints.tolerance
+                ));
+            }
+        }
         let evolving = sim.model.bond_kinetics.iter().flat_map(|k| &k.rules).any(|r| r.rule.evolves_every_step());
         Ok(Self { context: context.clone(), settings, gpu, evolving, resets: 0, stopping: false, device_kinetics, protocol })
     }
@@ -130,6 +140,10 @@ impl Stepper for GpuSteps {
             self.gpu.download(&mut sim.state);
             if let Some(bonds) = sim.state.bonds.as_mut() {
                 self.gpu.download_bond_state(bonds);
+            }
+            if let Some((tension, report)) = self.gpu.constraint_state() {
+                sim.constraints.tension = tension;
+                sim.constraints.iterations = report.sweeps;
             }
         }
         if let Err(GpuHalt::Reach { .. }) = outcome {
@@ -256,13 +270,19 @@ impl Simulation {
     pub fn cpu_only_feature(&self) -> Option<&'static str> {
         if let Some(why) = self.implicit_refusal() {
             Some(why)
-        } else if !self.constraints.list.is_empty() {
-            Some("constrained bonds (`constrain`) run on the CPU backend only")
+        } else if let Some(why) = self.constraint_refusal() {
+            Some(why)
         } else if self.model.has_cpu_only_surface_terms() {
             Some("custom surface terms of bodies (`custom` body lines) run on the CPU backend only")
         } else {
             None
         }
+    }
+
+    /// Why the constraints cannot be projected on the device (src/gpu/shake.rs).
+    fn constraint_refusal(&self) -> Option<&'static str> {
+        let implicit = matches!(self.integrator, Integrator::Implicit(..));
+        (!self.constraints.list.is_empty()).then(|| crate::gpu::shake::refusal(&self.model, implicit)).flatten()
     }
 
     /// Why the implicit step cannot run on the device (src/gpu/implicit.rs).
