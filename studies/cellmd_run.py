@@ -24,11 +24,14 @@ def run_command(command):
     return proc.stdout
 
 
-def run_deck(cellmd, deck, out, variables):
+def run_deck(cellmd, deck, out, variables, device=None):
     """`cellmd run DECK -o OUT --quiet --threads 1 --var KEY=VALUE …` (one
-    thread: a study runs its points in parallel); exits with the command and
-    its stderr if cellmd fails, else returns the wall time in seconds."""
+    thread: a study runs its points in parallel), with `--device DEVICE`
+    when one is given; exits with the command and its stderr if cellmd
+    fails, else returns the wall time in seconds."""
     command = [str(cellmd), "run", str(deck), "-o", str(out), "--quiet", "--threads", "1"]
+    if device:
+        command += ["--device", device]
     for key, value in variables.items():
         command += ["--var", f"{key}={value}"]
     start = time.monotonic()

@@ -651,9 +651,9 @@ fn a_body_spanning_half_the_periodic_box_halts_the_gpu_with_its_id() {
 
 /// Runs a deck's actions up to its last `run`, or to the first `minimize`
 /// after a `run`, with every `temperature` set to 0 and every `run` made
-/// `steps` long, on the given device; returns the final state. `minimize`
-/// runs on the CPU whatever the device, so it has nothing of the GPU's to
-/// check, and FIRE amplifies differences: `inputs/tensegrity_cell.in`'s
+/// `steps` long, on the given device; returns the final state. A `minimize`
+/// after a run ends the comparison (the device's FIRE is checked in
+/// tests/gpu_minimize.rs): FIRE amplifies differences: `inputs/tensegrity_cell.in`'s
 /// closing `minimize` (100 iterations here) turns a GPU − CPU difference of
 /// 2.3e-7 after its run into 1.2e-3, and the f32-rounded start's 2.2e-7 into
 /// 7.3e-5; `inputs/cell_compression.in`, whose stages are minimisations

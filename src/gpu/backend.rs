@@ -25,6 +25,7 @@ use wgpu::util::DeviceExt;
 use super::adhesion::AdhesionPack;
 use super::contact::{reach_message, ContactPack, CONTACT_ONLY, FRACTION_SLOTS};
 use super::context::{storage_entry, GpuContext};
+use super::fire::DeviceFire;
 use super::implicit::ImplicitSolver;
 use super::kinetics::{KinKernels, KinLayout};
 use super::nlist::NeighbourStorage;
@@ -34,6 +35,7 @@ use super::shader;
 use super::shake::{DeviceShake, ShakeReport};
 use crate::integrate::constraints::Constraints;
 use crate::integrate::context::StepContext;
+use crate::integrate::fire::FireSettings;
 use crate::integrate::implicit::{ImplicitSettings, SolveReport};
 use crate::neighbor::Exclusions;
 use crate::system::{BondState, Model, SimBox, State};
@@ -63,6 +65,8 @@ const HALT_SOLVE: u32 = 32;
 const HALT_FORMATION: u32 = 64;
 /// A constraint projection did not converge (src/gpu/shake.rs).
 const HALT_CONSTRAINT: u32 = 128;
+/// FIRE converged: max |F| < ftol (src/gpu/fire.rs).
+const HALT_CONVERGED: u32 = 256;
 /// Steps per command buffer.
 const STEPS_PER_SUBMIT: u64 = 64;
 
@@ -214,6 +218,8 @@ pub struct GpuBackend {
     implicit: Option<ImplicitSolver>,
     /// The constraints' projection after each step (src/gpu/shake.rs).
     shake: Option<DeviceShake>,
+    /// FIRE iterations in place of steps (src/gpu/fire.rs).
+    fire: Option<DeviceFire>,
 }
 
 /// Refuses a storage buffer the adapter cannot bind (wgpu would abort).
@@ -305,6 +311,21 @@ impl GpuBackend {
     pub fn constraint_state(&self) -> Option<(Vec<f64>, ShakeReport)> {
         let shake = self.shake.as_ref()?;
         Some(shake.read(&self.read(&shake.buffer, 4 * (shake.count as u64 + 4))))
+    }
+
+    /// Takes FIRE iterations in place of steps from now on (`minimize`,
+    /// src/gpu/fire.rs; the model must pass its `refusal`): each
+    /// [`Self::run`] step is one iteration, and a run ends early when max |F|
+    /// falls below `settings.ftol`. `dt`: the deck's timestep (Δt₀, masses γ·Δt₀).
+    pub fn minimize_with_fire(&mut self, ctx: &GpuContext, model: &Model, settings: &FireSettings, dt: f64) -> Result<(), String> {
+        self.fire = Some(DeviceFire::new(ctx, &self.layout, model, settings, dt, WORKGROUP)?);
+        Ok(())
+    }
+
+    /// FIRE iterations taken so far (one small read-back; None without FIRE).
+    pub fn fire_iterations(&self) -> Option<u64> {
+        let fire = self.fire.as_ref()?;
+        Some(DeviceFire::iterations(&self.read(&fire.buffer, 16)))
     }
 
     /// The last implicit step's iterations and relative residual (one small
@@ -585,6 +606,7 @@ impl GpuBackend {
             protocol: protocol_pack,
             implicit: None,
             shake: None,
+            fire: None,
         };
         backend.set_clock(settings.context.time);
         backend.upload(state);
@@ -995,7 +1017,14 @@ impl GpuBackend {
             if let Some((bonds, kin)) = kinetics {
                 self.dispatch(pass, &kin.measure, bonds);
             }
-            if let Some(solver) = &self.implicit {
+            if let Some(fire) = &self.fire {
+                // A FIRE iteration (src/gpu/fire.rs) in place of the step: it
+                // moves `state` itself, so there is nothing to commit.
+                pass.set_bind_group(1, &fire.group, &[]);
+                self.dispatch(pass, &fire.partials, Over::Particles);
+                self.dispatch(pass, &fire.control, Over::Groups(1));
+                self.dispatch(pass, &fire.moves, Over::Particles);
+            } else if let Some(solver) = &self.implicit {
                 // The implicit step (src/gpu/implicit.rs) in place of `integrate`.
                 pass.set_bind_group(1, &solver.group, &[]);
                 if solver.angle_groups(WORKGROUP) > 0 {
@@ -1013,7 +1042,9 @@ impl GpuBackend {
                 self.dispatch(pass, &shake.solve, Over::Groups(1));
                 self.dispatch(pass, &shake.place, Over::Groups(shake.particles.div_ceil(WORKGROUP)));
             }
-            self.dispatch(pass, &k.commit, Over::Particles);
+            if self.fire.is_none() {
+                self.dispatch(pass, &k.commit, Over::Particles);
+            }
             let binds = self.kinetics.as_ref().filter(|(layout, _)| layout.binds()).map(|(_, kernels)| kernels);
             if binds.is_some() {
                 // `bind` captures at the new positions (src/gpu/bind.rs): the
@@ -1236,6 +1267,10 @@ impl GpuBackend {
                 let entries: Vec<[f32; 4]> =
                     bytemuck::cast_slice(&self.read_at(&self.surf, ring, 16 * status[ST_STEPS_DONE] as u64)).to_vec();
                 self.fractions.extend(entries.iter().map(|e| e[0]));
+            }
+            if status[ST_HALTED] & HALT_CONVERGED != 0 {
+                // FIRE converged (src/gpu/fire.rs): no further iteration.
+                break;
             }
             if status[ST_HALTED] & HALT_BLOWUP != 0 {
                 return Err(GpuHalt::Blowup { step: first_step + done, particle: status[ST_BLOWUP_PARTICLE] as usize });

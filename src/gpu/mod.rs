@@ -30,8 +30,10 @@
 //! - [`shake`]: `constrain`: overdamped SHAKE after the explicit step, the
 //!   constraints coloured so that a colour's corrections run in parallel,
 //!   swept in one workgroup until converged.
+//! - [`fire`]: `minimize`: FIRE iterations as device steps, the power and
+//!   norms summed by fixed trees, stopping at convergence.
 //! - `side_group`: the bind group 1 and pipelines of the kernels with
-//!   buffers of their own (the implicit step, the projection).
+//!   buffers of their own (the implicit step, the projection, FIRE).
 //!
 //! File-level circles, on purpose: `pack.rs` ↔ `surface.rs`, `tetra.rs`
 //! and `special.rs`. `pack.rs` lays out the whole topology, their sections
@@ -81,6 +83,7 @@ pub mod bind;
 pub mod contact;
 pub mod context;
 pub mod custom;
+pub mod fire;
 pub mod implicit;
 pub mod kinetics;
 mod nlist;

@@ -47,7 +47,7 @@ mod embedded {
 pub use embedded::{COMMON_SHADERS, INTERACTION_SHADERS};
 
 /// The common files in the order they must appear (declarations first).
-const COMMON_ORDER: [&str; 15] = [
+const COMMON_ORDER: [&str; 16] = [
     "layout",
     "philox",
     "neighbor",
@@ -63,6 +63,7 @@ const COMMON_ORDER: [&str; 15] = [
     "protocol",
     "implicit",
     "shake",
+    "fire",
 ];
 
 fn common(name: &str) -> &'static str {

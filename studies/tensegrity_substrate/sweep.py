@@ -21,7 +21,7 @@ Writes OUT/calibration.csv, OUT/indentation.csv, OUT/curvature.csv and, with
 plot.py, the PNGs. Not part of CI (tests/tensegrity_substrate.rs runs a
 reduced case).
 
-    python3 studies/tensegrity_substrate/sweep.py --cellmd target/release/cellmd --out out/tensegrity_substrate [--level 2]
+    python3 studies/tensegrity_substrate/sweep.py --cellmd target/release/cellmd --out out/tensegrity_substrate [--level 2] [--device gpu]
 """
 
 import argparse
@@ -56,15 +56,16 @@ def build(cellmd, level, curvature, path):
     return volumes[0], volumes[1], bottom
 
 
-def run(cellmd, top, out, curvature, volumes, **variables):
-    """Runs the deck on one topology; returns the rows of its thermo files, by phase."""
+def run(cellmd, top, out, curvature, volumes, device=None, **variables):
+    """Runs the deck on one topology (on `device`: cpu, gpu or auto; the
+    deck's own setting if None); returns the rows of its thermo files, by phase."""
     v_cell, v_nucleus, bottom = volumes
     flat = curvature == "flat"
     values = {"topology": top, "v0_cell": v_cell, "v0_nucleus": v_nucleus, "c": 0 if flat else 1,
               "curvature": 0 if flat else float(curvature), "zc": -1000 if flat else bottom + float(curvature)}
     values.update(variables)
     out.mkdir(parents=True, exist_ok=True)
-    run_deck(cellmd, DECK, out, values)
+    run_deck(cellmd, DECK, out, values, device)
     phases = {}
     for phase in ["spread", "contract", "indentation"]:
         path = out / f"tensegrity_{phase}.thermo.csv"
@@ -103,6 +104,7 @@ def main():
     p.add_argument("--out", default="out/tensegrity_substrate")
     p.add_argument("--level", type=int, default=2)
     p.add_argument("--indent-stages", type=int, default=10)
+    p.add_argument("--device", choices=["cpu", "gpu", "auto"], help="cellmd's --device for every run (runs and FIRE relaxations on the GPU)")
     args = p.parse_args()
     out = Path(args.out).resolve()
     out.mkdir(parents=True, exist_ok=True)
@@ -113,12 +115,12 @@ def main():
         tops[curvature] = (top, build(args.cellmd, args.level, curvature, top))
 
     top, volumes = tops["flat"]
-    raw = run(args.cellmd, top, out / "calibrate", "flat", volumes, scale=1, spread_area=AREA, steps=0)
+    raw = run(args.cellmd, top, out / "calibrate", "flat", volumes, args.device, scale=1, spread_area=AREA, steps=0)
     force = crossing(raw["spread"], "hullarea/cortex", AREA, "fabs/fa")
     scale = F_SPRD / force
     print(f"calibration: Σ|f| = {force:.1f} pN at {AREA} µm² with unit stiffnesses; scale {scale:.4f}", file=sys.stderr)
 
-    checked = run(args.cellmd, top, out / "indent", "flat", volumes, scale=scale, f_sprd=F_SPRD,
+    checked = run(args.cellmd, top, out / "indent", "flat", volumes, args.device, scale=scale, f_sprd=F_SPRD,
                   indent_stages=args.indent_stages)
     area = crossing(checked["spread"], "fabs/fa", F_SPRD, "hullarea/cortex")
     with open(out / "calibration.csv", "w", newline="") as f:
@@ -142,7 +144,7 @@ def main():
         w = None
         for curvature in CURVATURES:
             top, volumes = tops[curvature]
-            phases = run(args.cellmd, top, out / f"R_{curvature}", curvature, volumes, scale=scale, f_sprd=F_SPRD)
+            phases = run(args.cellmd, top, out / f"R_{curvature}", curvature, volumes, args.device, scale=scale, f_sprd=F_SPRD)
             result = {"curvature_um": curvature, "inverse_radius_per_um": 0.0 if curvature == "flat" else 1 / float(curvature)}
             result.update({k: f"{v:.6g}" for k, v in readouts(phases).items()})
             if w is None:

@@ -9,7 +9,7 @@ use super::step_loop::{Stepper, Taken};
 use super::Simulation;
 use crate::integrate::constraints::failure_message;
 use crate::integrate::context::StepContext;
-use crate::integrate::fire::{fire_minimize, FireSettings};
+use crate::integrate::fire::{fire_minimize, FireReport, FireSettings};
 use crate::integrate::implicit::{implicit_step, ConstrainedBonds, ImplicitError, ImplicitSettings};
 use crate::integrate::overdamped::{overdamped_step, Blowup};
 use crate::integrate::Integrator;
@@ -157,9 +157,35 @@ impl Simulation {
         format!("displacement {displacement:e} in one step exceeds max_displacement {:e}", self.integrator.common().max_displacement)
     }
 
-    /// `minimize`: FIRE to max |F| < ftol. The step counter does not advance.
+    /// `minimize`: FIRE to max |F| < ftol, on the device where the run
+    /// would use the GPU and FIRE can run there (src/gpu/fire.rs), else on
+    /// the CPU. The step counter does not advance.
     pub fn minimize(&mut self, settings: &FireSettings) -> Result<(), RunError> {
         self.ensure_forces()?;
+        let report = match self.minimize_on_gpu(settings)? {
+            Some(report) => report,
+            None => self.minimize_on_cpu(settings)?,
+        };
+        if let Some(i) = self.forces.forces.iter().position(|f| !finite_force(*f)) {
+            return Err(self.blowup(i, "non-finite force during minimisation".into()));
+        }
+        self.check_in_box()?;
+        let verdict = if report.converged { "converged" } else { "stopped at maxiter without converging" };
+        self.say(&format!(
+            "minimize (FIRE): {verdict} after {} iterations: max |F| = {:e} (ftol {:e}), pe = {:e}{}",
+            report.iterations,
+            report.max_force,
+            settings.ftol,
+            report.energy,
+            if report.clamped > 0 { format!(", {} moves shortened by the contact step clamp", report.clamped) } else { String::new() }
+        ));
+        self.contact_clamps += report.clamped;
+        self.last_minimize = Some(report);
+        Ok(())
+    }
+
+    /// FIRE on the CPU backend, from current forces.
+    fn minimize_on_cpu(&mut self, settings: &FireSettings) -> Result<FireReport, RunError> {
         let ctx = self.step_context();
         let mass: Vec<f64> = self.model.types.iter().map(|&t| self.model.type_drag[t as usize] * ctx.dt).collect();
         let mut state = self.state.clone();
@@ -177,21 +203,6 @@ impl Simulation {
         self.state = state;
         self.forces_current = true;
         self.energies_current = true;
-        if let Some(i) = self.forces.forces.iter().position(|f| !finite_force(*f)) {
-            return Err(self.blowup(i, "non-finite force during minimisation".into()));
-        }
-        self.check_in_box()?;
-        let verdict = if report.converged { "converged" } else { "stopped at maxiter without converging" };
-        self.say(&format!(
-            "minimize (FIRE): {verdict} after {} iterations: max |F| = {:e} (ftol {:e}), pe = {:e}{}",
-            report.iterations,
-            report.max_force,
-            settings.ftol,
-            report.energy,
-            if report.clamped > 0 { format!(", {} moves shortened by the contact step clamp", report.clamped) } else { String::new() }
-        ));
-        self.contact_clamps += report.clamped;
-        self.last_minimize = Some(report);
-        Ok(())
+        Ok(report)
     }
 }

@@ -4,8 +4,9 @@
 use super::step_loop::{Stepper, Taken};
 use super::Simulation;
 use crate::gpu::backend::StepSettings;
-use crate::gpu::protocol::DeviceProtocol;
+use crate::gpu::protocol::{DeviceProtocol, HeldCoordinates};
 use crate::gpu::{DevicePreference, GpuBackend, GpuContext, GpuHalt};
+use crate::integrate::fire::{FireReport, FireSettings};
 use crate::integrate::Integrator;
 use crate::run::RunError;
 use crate::system::StepClock;
@@ -51,12 +52,7 @@ pub(super) struct GpuSteps {
 impl GpuSteps {
     /// The GPU backend for the steps of a run from the current state.
     pub(super) fn new(sim: &Simulation, context: &GpuContext) -> Result<Self, RunError> {
-        let settings = StepSettings {
-            context: sim.step_context(),
-            skin: sim.neighbor.skin,
-            neighbor_every: sim.neighbor.every,
-            neighbor_check: sim.neighbor.check,
-        };
+        let settings = sim.step_settings();
         let device_kinetics = sim.model.has_kinetics() && crate::gpu::kinetics::refusal(&sim.model).is_none();
         let (model, state, sim_box) = (&sim.model, &sim.state, &sim.sim_box);
         let protocol = sim.protocols.for_device(model);
@@ -277,6 +273,66 @@ impl Simulation {
         } else {
             None
         }
+    }
+
+    /// The GPU backend's step settings: the step context and the neighbour list's.
+    fn step_settings(&self) -> StepSettings {
+        StepSettings {
+            context: self.step_context(),
+            skin: self.neighbor.skin,
+            neighbor_every: self.neighbor.every,
+            neighbor_check: self.neighbor.check,
+        }
+    }
+
+    /// `minimize` on the device (src/gpu/fire.rs) where the run would use
+    /// the GPU and FIRE can run there: the iterations in segments of
+    /// [`GPU_SYNC_STEPS`], then the positions read back and the verdict, max
+    /// |F| and energy from the CPU's f64 forces there (masked as the CPU's
+    /// FIRE masks them). None: the CPU minimises.
+    pub(super) fn minimize_on_gpu(&mut self, settings: &FireSettings) -> Result<Option<FireReport>, RunError> {
+        if let Some(why) = crate::gpu::fire::refusal(&self.model) {
+            if self.options.device.unwrap_or(self.device) != DevicePreference::Cpu {
+                self.say(why);
+            }
+            return Ok(None);
+        }
+        let Some(context) = self.gpu_for_run()? else { return Ok(None) };
+        let settings_for_steps = self.step_settings();
+        // Held axes only: a minimisation takes no step, so nothing moves or ramps.
+        let full = self.protocols.for_device(&self.model);
+        let held = full.held.into_iter().map(|h| HeldCoordinates { mover: None, ..h }).collect();
+        let protocol = DeviceProtocol { held, ..Default::default() };
+        let (model, state, sim_box) = (&self.model, &self.state, &self.sim_box);
+        let mut gpu =
+            GpuBackend::with_protocol(&context, model, state, sim_box, &settings_for_steps, None, &protocol).map_err(RunError::Setup)?;
+        gpu.minimize_with_fire(&context, model, settings, self.dt).map_err(RunError::Setup)?;
+        let mut iterations = 0;
+        while iterations < settings.max_iterations {
+            let segment = (settings.max_iterations - iterations).min(GPU_SYNC_STEPS);
+            let outcome = gpu.run(self.state.step, segment);
+            iterations = gpu.fire_iterations().unwrap_or_default();
+            match outcome {
+                Ok(done) if done == segment => {}
+                Ok(_) => break,
+                Err(GpuHalt::Blowup { particle, .. }) => {
+                    gpu.download(&mut self.state);
+                    self.forces_current = false;
+                    return Err(self.blowup(particle, "non-finite FIRE move on the GPU during minimisation".into()));
+                }
+                Err(GpuHalt::Capacity { message, .. }) => return Err(RunError::Setup(format!("device gpu: minimize: {message}"))),
+                Err(halt) => unreachable!("no contact search or `bind` in a device minimisation: {halt:?}"),
+            }
+        }
+        gpu.download(&mut self.state);
+        self.forces_current = false;
+        self.ensure_forces()?;
+        let mut forces = self.forces.forces.clone();
+        self.protocols.mask(&mut forces);
+        let mobile = |i: &usize| self.model.type_drag[self.model.types[*i] as usize].is_finite();
+        let max_force = (0..forces.len()).filter(mobile).map(|i| forces[i].length()).fold(0.0, f64::max);
+        let energy = self.forces.total_energy();
+        Ok(Some(FireReport { converged: max_force < settings.ftol, iterations, energy, max_force, clamped: 0 }))
     }
 
     /// Why the constraints cannot be projected on the device (src/gpu/shake.rs).

@@ -1,0 +1,104 @@
+//! `minimize` (FIRE) on the device (kernels: shaders/common/fire.wgsl).
+//!
+//! # The iteration
+//!
+//! As on the CPU (src/integrate/fire.rs; Bitzek et al., *Phys. Rev. Lett.*
+//! 97, 170201 (2006)): fictitious inertial dynamics with mass mᵢ = γᵢ·Δt₀,
+//! the velocities mixed towards the force while the power P = Σ F·v stays
+//! positive (Δt grows ×1.1 up to 10Δt₀ and α shrinks ×0.99 after 5 such
+//! iterations) and zeroed when it turns negative (Δt halves, α back to 0.1),
+//! each move capped at dmax, until max |F| < ftol. `fixed` particles and
+//! held axes carry no force, as the CPU masks them. Each iteration is the
+//! neighbour check and force pass of a step followed by three kernels; the
+//! host runs the iterations as the steps of the backend's `run`
+//! (src/gpu/backend.rs), which stops at convergence (a halt bit the control
+//! kernel sets) and reads nothing back in between.
+//!
+//! # Determinism and precision
+//!
+//! The sums P, Σ|v|², Σ|F|² and max |F| are fixed trees (per workgroup,
+//! then over the workgroups in order), so the same minimisation gives the
+//! same bits. Forces and velocities are f32 and positions fixed point, so
+//! the path differs from the CPU's by rounding, and FIRE's branch on the
+//! sign of P can take the other turn where P is near 0: the two runs can
+//! take different numbers of iterations to the same minimum (measured in
+//! tests/gpu_minimize.rs). The verdict and the reported max |F| and energy
+//! are the CPU's f64 evaluation at the positions the device reached.
+//!
+//! # Which models ([`refusal`])
+//!
+//! Not with node–face contact between bodies: the CPU scales every move by
+//! the contact step clamp, computed on the device for the overdamped step
+//! only; nor with ramps or driven indenters (a minimisation takes no step).
+
+use wgpu::util::DeviceExt;
+
+use super::context::GpuContext;
+use super::side_group::SideGroup;
+use crate::integrate::fire::FireSettings;
+use crate::system::Model;
+
+/// `fire` entries before the per-workgroup partial sums.
+const CONTROL_ENTRIES: usize = 3;
+
+/// Why FIRE cannot run on the device for this model (None: it can).
+pub fn refusal(model: &Model) -> Option<&'static str> {
+    model.has_contact_terms().then_some("`minimize` with contact between bodies runs on the CPU (its moves take the contact step clamp)")
+}
+
+/// The device's FIRE: velocities, control words and partial sums, and the kernels.
+pub(super) struct DeviceFire {
+    pub(super) group: wgpu::BindGroup,
+    pub(super) partials: wgpu::ComputePipeline,
+    pub(super) control: wgpu::ComputePipeline,
+    pub(super) moves: wgpu::ComputePipeline,
+    /// `fire`: the control words, then the partials.
+    pub(super) buffer: wgpu::Buffer,
+}
+
+impl DeviceFire {
+    /// Zero velocities, Δt = Δt₀ (`dt`), α = 0.1, and the kernels compiled
+    /// against the backend's main bind group layout.
+    pub(super) fn new(
+        ctx: &GpuContext,
+        main_layout: &wgpu::BindGroupLayout,
+        model: &Model,
+        settings: &FireSettings,
+        dt: f64,
+        workgroup: u32,
+    ) -> Result<Self, String> {
+        let n = model.len();
+        let blocks = (n as u32).div_ceil(workgroup);
+        let mut control = vec![[0f32; 4]; CONTROL_ENTRIES + blocks as usize];
+        control[0] = [dt as f32, 0.1, f32::from_bits(0), f32::from_bits(0)];
+        control[1] = [0.0, 0.0, dt as f32, (10.0 * dt) as f32];
+        control[2] = [settings.ftol as f32, settings.dmax as f32, 0.0, f32::from_bits(blocks)];
+        let device = &ctx.device;
+        // wgpu zeroes a new buffer: the velocities start at rest.
+        let velocities = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("fire_v"),
+            size: 16 * n.max(1) as u64,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
+        let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("fire"),
+            contents: bytemuck::cast_slice(&control),
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        });
+        let side = SideGroup::new(ctx, main_layout, model, "minimize on the device", &[(5, false, &velocities), (6, false, &buffer)])?;
+        Ok(Self {
+            partials: side.pipeline(ctx, "fire_partials"),
+            control: side.pipeline(ctx, "fire_control"),
+            moves: side.pipeline(ctx, "fire_move"),
+            group: side.group,
+            buffer,
+        })
+    }
+
+    /// The iterations taken, from the first control entry's bytes.
+    pub(super) fn iterations(bytes: &[u8]) -> u64 {
+        let entry: [f32; 4] = bytemuck::pod_read_unaligned(&bytes[..16]);
+        u64::from(entry[3].to_bits())
+    }
+}
