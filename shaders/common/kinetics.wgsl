@@ -414,8 +414,10 @@ fn kin_scan(@builtin(local_invocation_index) local: u32) {
     }
     if local == 0u {
         atomicStore(&kin[KIN_CURSOR], cursor + total);
-        if total > 0u {
-            // Breaks and rebinds change the pair exclusions.
+        if total > 0u && !bind_on() {
+            // Breaks and rebinds change the pair exclusions. With `bind` on
+            // the device the list keeps bonded pairs (neighbor.wgsl): it does
+            // not depend on the bonds, and is not rebuilt for them.
             atomicStore(&status[ST_FORCE_REBUILD], 1u);
         }
     }
