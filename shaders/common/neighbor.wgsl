@@ -56,18 +56,32 @@ fn write_args(slot: u32, groups: u32, go: bool) {
     dispatch_args[3u * slot + 2u] = select(0u, 1u, go);
 }
 
-// Decides whether this step rebuilds; sizes the indirect dispatches.
-@compute @workgroup_size(1)
-fn nb_decide() {
-    let step = atomicLoad(&status[ST_STEPS_DONE]) + P.step_lo; // the `every` test only needs the low word
-    let moved = atomicLoad(&status[ST_MAX_DISP2]) != 0u;
-    let due = (step % P.neighbor_every) == 0u && (moved || P.neighbor_check == 0u);
-    let go = !halted() && (due || atomicLoad(&status[ST_FORCE_REBUILD]) != 0u);
-    // A list that overflowed when checked after the last `commit` (bind.wgsl)
-    // halts before any force reads it.
+// A list that overflowed when checked after the last `commit` (bind.wgsl)
+// halts before any force reads it.
+fn halt_if_list_overflowed() {
     if atomicLoad(&status[ST_LIST_AFTER_STEP]) == 0u && atomicLoad(&status[ST_OVERFLOW_NEED]) > P.nlist_cap {
         atomicOr(&status[ST_HALTED], HALT_OVERFLOW);
     }
+}
+
+// The start of a step whose list was checked after the last step's
+// `commit` (with `bind` on the device; that check was this step's).
+@compute @workgroup_size(1)
+fn nb_list_ready() {
+    halt_if_list_overflowed();
+}
+
+// Decides whether this step rebuilds; sizes the indirect dispatches. After
+// `commit` (bind.wgsl) the check is the next step's: its number decides
+// whether `every` is due.
+@compute @workgroup_size(1)
+fn nb_decide() {
+    let next = select(0u, 1u, atomicLoad(&status[ST_LIST_AFTER_STEP]) != 0u);
+    let step = atomicLoad(&status[ST_STEPS_DONE]) + P.step_lo + next; // the `every` test only needs the low word
+    let moved = atomicLoad(&status[ST_MAX_DISP2]) != 0u;
+    let due = (step % P.neighbor_every) == 0u && (moved || P.neighbor_check == 0u);
+    let go = !halted() && (due || atomicLoad(&status[ST_FORCE_REBUILD]) != 0u);
+    halt_if_list_overflowed();
     let particle_groups = (P.n + WORKGROUP - 1u) / WORKGROUP;
     let cell_groups = (P.grid.w + WORKGROUP - 1u) / WORKGROUP;
     write_args(0u, particle_groups, go);

@@ -111,9 +111,6 @@ pub struct PhaseTimes {
     /// Bond kinetics decided on the device and `bind` formation (0 without
     /// them; src/gpu/kinetics.rs, src/gpu/bind.rs), at the deck's start.
     pub kinetics: f64,
-    /// Neighbour checks per step: 2 with `bind` on the device (the list is
-    /// checked again after `commit`).
-    pub checks: u32,
 }
 
 /// Settings the kernels need besides the model.
@@ -139,6 +136,8 @@ struct Kernels {
     sort: wgpu::ComputePipeline,
     build: wgpu::ComputePipeline,
     after_step: wgpu::ComputePipeline,
+    /// The start of a step whose list was checked after the last `commit`: its overflow halt only.
+    list_ready: wgpu::ComputePipeline,
     surface_faces: wgpu::ComputePipeline,
     surface_bodies: wgpu::ComputePipeline,
     surface_edges: wgpu::ComputePipeline,
@@ -540,6 +539,7 @@ impl GpuBackend {
             sort: pipeline("nb_sort", &main_layout),
             build: pipeline("nb_build", &main_layout),
             after_step: pipeline("nb_after_step", &main_layout),
+            list_ready: pipeline("nb_list_ready", &main_layout),
             surface_faces: pipeline("surface_faces", &main_layout),
             surface_bodies: pipeline("surface_bodies", &main_layout),
             surface_edges: pipeline("surface_edges", &main_layout),
@@ -929,7 +929,7 @@ impl GpuBackend {
             0.0
         };
         let integrate = time(self, &[(&k.integrate, particles), (&k.commit, particles), (&k.advance, Over::Groups(1))], false);
-        let (kinetics, checks) = match &self.kinetics {
+        let kinetics = match &self.kinetics {
             Some((layout, kin)) => {
                 let bonds = Over::Groups(layout.bonds().div_ceil(WORKGROUP));
                 let mut passes = vec![(&kin.measure, bonds), (&kin.decide, bonds), (&kin.scan, Over::Groups(1)), (&kin.emit, bonds)];
@@ -941,9 +941,9 @@ impl GpuBackend {
                         (&kin.bind_accept, Over::Groups(1)),
                     ]);
                 }
-                (time(self, &passes, false), 1 + layout.binds() as u32)
+                time(self, &passes, false)
             }
-            None => (0.0, 1),
+            None => 0.0,
         };
         let started = std::time::Instant::now();
         for _ in 0..repetitions {
@@ -952,7 +952,7 @@ impl GpuBackend {
         let readback = started.elapsed().as_secs_f64() / repetitions as f64;
         self.ctx.queue.write_buffer(&self.state, 0, &saved);
         self.pending_rebuild = true;
-        Ok(PhaseTimes { check, neighbor_build, forces, integrate, readback, contact, adhesion, kinetics, checks })
+        Ok(PhaseTimes { check, neighbor_build, forces, integrate, readback, contact, adhesion, kinetics })
     }
 
     /// Dispatches `pipeline` over `over`: wider than the dispatch width,
@@ -983,8 +983,10 @@ impl GpuBackend {
     }
 
     /// Encodes one neighbour check/rebuild and force pass, and optionally the
-    /// integration of one step.
-    fn encode_step(&self, pass: &mut wgpu::ComputePass, integrate: bool) {
+    /// integration of one step. `checked_after_last`: the list was checked
+    /// after the last step's `commit` in this submission (`bind` on the
+    /// device), which was this step's check; only its overflow halt remains.
+    fn encode_step(&self, pass: &mut wgpu::ComputePass, integrate: bool, checked_after_last: bool) {
         let k = &self.kernels;
         pass.set_bind_group(0, &self.main_group, &self.nlist.offsets(0));
         let kinetics = self.kinetics.as_ref().map(|(layout, kernels)| (Over::Groups(layout.bonds().div_ceil(WORKGROUP)), kernels));
@@ -994,7 +996,9 @@ impl GpuBackend {
         if let Some((_, kin)) = kinetics.filter(|_| integrate) {
             self.dispatch(pass, &kin.room, Over::Groups(1));
         }
-        if self.has_pairs {
+        if self.has_pairs && checked_after_last {
+            self.dispatch(pass, &k.list_ready, Over::Groups(1));
+        } else if self.has_pairs {
             self.encode_neighbors(pass);
         }
         for (pipeline, over) in self.surface_passes() {
@@ -1194,7 +1198,7 @@ impl GpuBackend {
             let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
             {
                 let mut pass = encoder.begin_compute_pass(&Default::default());
-                self.encode_step(&mut pass, false);
+                self.encode_step(&mut pass, false, false);
             }
             self.ctx.queue.submit([encoder.finish()]);
             let status = self.status();
@@ -1238,14 +1242,17 @@ impl GpuBackend {
             self.set_clock(self.time + self.elapsed(done));
             self.write_params();
             self.reset_status(force_rebuild);
+            let binds = self.kinetics.as_ref().is_some_and(|(layout, _)| layout.binds());
             let mut encoded = 0;
             while encoded < chunk {
                 let batch = (chunk - encoded).min(STEPS_PER_SUBMIT);
                 let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
                 {
                     let mut pass = encoder.begin_compute_pass(&Default::default());
-                    for _ in 0..batch {
-                        self.encode_step(&mut pass, true);
+                    for k in 0..batch {
+                        // With `bind` on the device the list is checked after each
+                        // step's `commit`, for the next step: the chunk's first step checks it.
+                        self.encode_step(&mut pass, true, binds && encoded + k > 0);
                     }
                 }
                 self.ctx.queue.submit([encoder.finish()]);
