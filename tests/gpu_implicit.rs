@@ -15,6 +15,11 @@ use glam::DVec3;
 /// `steps` implicit steps of 1e-3 s (γ/dt = 3.5 pN/µm against bonds of
 /// 2000 pN/µm: 40× the explicit limit).
 fn filament(steps: u64, kt: f64) -> common::Case {
+    filament_with(steps, kt, "")
+}
+
+/// [`filament`] with `protocols` (deck lines) before its run.
+fn filament_with(steps: u64, kt: f64, protocols: &str) -> common::Case {
     let mut top = String::from("[ particles ]\n");
     for k in 0..12 {
         let x = 0.3 * k as f64;
@@ -34,7 +39,7 @@ fn filament(steps: u64, kt: f64) -> common::Case {
     let deck = format!(
         "units cell\ntopology t.top\nforcefield f.ff\nbox x -5 10 f y -5 5 f z -5 5 f\ngroup tip id 12\n\
          external push tip constant_force fx -2 fy 0.5\nexternal stop tip wall nx -1 d -3.28 k 1000\n\
-         integrator implicit\ntimestep 1e-3\ntemperature {kt}\nseed 3\nrun {steps}\n"
+         {protocols}integrator implicit\ntimestep 1e-3\ntemperature {kt}\nseed 3\nrun {steps}\n"
     );
     common::Case::new(&[("t.top", &top), ("f.ff", ff), ("deck.in", &deck)])
 }
@@ -52,11 +57,33 @@ fn run(case: &common::Case, device: DevicePreference) -> Simulation {
 /// |K̃|)/(γ/dt) (Gershgorin), computed here from the CPU's blocks.
 #[test]
 fn one_implicit_step_on_the_gpu_matches_the_cpu() {
-    let case = filament(1, 0.0);
+    one_step_matches(&filament(1, 0.0));
+}
+
+/// The same with protocols: bead 6 held in y (`freeze`), bead 9 moved at
+/// 0.5 µm/s along z (`move`), and the bending stiffness ramped: the held
+/// coordinates are identity rows of the solve on both, put back (or moved
+/// with their group) after it; the bound is the one above.
+#[test]
+fn one_implicit_step_with_held_and_moved_beads_matches_the_cpu() {
+    let protocols = "group mid id 6\nfreeze mid y\ngroup pushed id 9\nmove pushed linear 0 0 0.5\nramp angle bend kappa 2 4\n";
+    let case = filament_with(1, 0.0, protocols);
+    let gpu = one_step_matches(&case);
+    let start = case.plan().positions;
+    // Unmoved, to the device's fixed-point quantum (2⁻⁵² of the 15 µm box).
+    let quantum = 15.0 * 2f64.powi(-52);
+    assert!((gpu.state.positions[5].y - start[5].y).abs() <= 4.0 * quantum, "the held coordinate moved");
+    let moved = gpu.state.positions[8] - start[8];
+    assert!((moved - DVec3::new(0.0, 0.0, 0.5e-3)).length() < 1e-9, "the moved bead went {moved}");
+}
+
+/// Runs `case` (one implicit step) on both devices and asserts the bound
+/// above; returns the GPU's run.
+fn one_step_matches(case: &common::Case) -> Simulation {
     let plan = case.plan();
     let start = State::new(plan.positions.clone());
-    let cpu = run(&case, DevicePreference::Cpu);
-    let gpu = run(&case, DevicePreference::Gpu);
+    let cpu = run(case, DevicePreference::Cpu);
+    let gpu = run(case, DevicePreference::Gpu);
     let dx = |s: &State| -> Vec<DVec3> { s.positions.iter().zip(&start.positions).map(|(a, b)| *a - *b).collect() };
     let (dc, dg) = (dx(&cpu.state), dx(&gpu.state));
     let norm = |v: &[DVec3]| v.iter().map(|d| d.length_squared()).sum::<f64>().sqrt();
@@ -85,6 +112,7 @@ fn one_implicit_step_on_the_gpu_matches_the_cpu() {
     assert!(norm(&dc) > 1e-3, "the step moved nothing: {:e}", norm(&dc));
     assert!(gpu.last_solve.iterations > 1 && gpu.last_solve.relative_residual <= F32_TOLERANCE);
     assert!(error <= bound, "GPU − CPU {error:e} > {bound:e}");
+    gpu
 }
 
 /// At kT > 0 the same implicit run twice gives the same bits (no float

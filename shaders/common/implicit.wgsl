@@ -242,7 +242,8 @@ fn implicit_blocks(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocati
             diagonal[m] += angle_entry(a, (3u * role + m) * 10u);
         }
     }
-    imp[dinv] = vec4<f32>(1.0 / diagonal, 0.0);
+    // A held coordinate (`freeze`, `move`): the identity row.
+    imp[dinv] = vec4<f32>(select(vec3<f32>(1.0), 1.0 / diagonal, free_axes(i) != vec3<f32>(0.0)), 0.0);
 }
 
 fn imp_vec(section: u32, i: u32) -> vec3<f32> {
@@ -250,9 +251,9 @@ fn imp_vec(section: u32, i: u32) -> vec3<f32> {
 }
 
 // (A·v)_i for the vector in `section`: γ/dt·v_i plus particle i's rows of its
-// bond ends, externals and angles, in that order (a fixed particle: v_i).
-// Fixed particles' entries of every vector the solve forms are 0, so their
-// couplings drop out as in the CPU's matrix.
+// bond ends, externals and angles, in that order (a fixed particle, and a
+// held coordinate of `freeze` or `move`: v_i). Their entries of every vector
+// the solve forms are 0, so their couplings drop out as in the CPU's matrix.
 fn apply_row(i: u32, section: u32) -> vec3<f32> {
     let vi = imp_vec(section, i);
     let drag = imp_drag(i);
@@ -282,7 +283,7 @@ fn apply_row(i: u32, section: u32) -> vec3<f32> {
             }
         }
     }
-    return out;
+    return select(vi, out, free_axes(i) != vec3<f32>(0.0));
 }
 
 var<workgroup> partial_sums: array<vec3<f32>, 256>;
@@ -309,15 +310,17 @@ fn workgroup_sum(local: u32, v: vec3<f32>) -> vec3<f32> {
 }
 
 // Particle i's right-hand side F_i + √(2kT·γ/dt)·ξ_i (0 for a fixed particle).
+// Particle i's right-hand side F + √(2kT·γ/dt)·ξ, 0 on its held coordinates
+// (the CPU masks their forces; the protocols put them back after the step).
 fn implicit_rhs(i: u32) -> vec3<f32> {
     if imp_drag(i) == 0.0 {
         return vec3<f32>(0.0);
     }
     let kick = bitcast<f32>(imp_topo[imp_topo[IMP_OFF_KICK] + topo[i]]);
     if kick == 0.0 {
-        return force[i].xyz;
+        return free_axes(i) * force[i].xyz;
     }
-    return force[i].xyz + kick * unit_noise(i);
+    return free_axes(i) * (force[i].xyz + kick * unit_noise(i));
 }
 
 @compute @workgroup_size(256)

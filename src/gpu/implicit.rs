@@ -27,7 +27,11 @@
 //!   semi-definite as written (a wall's k·n̂n̂ᵀ inside it, 0 for a constant
 //!   force).
 //!
-//! Fixed particles have the identity row and no couplings, as on the CPU.
+//! Fixed particles have the identity row and no couplings, as on the CPU;
+//! so has each coordinate a protocol holds (`freeze`, `move`), whose
+//! right-hand side is 0 (the move's `prescribe` puts it back, or moves it
+//! with its group, after the solve). Ramps set their parameters before the
+//! force pass, so the blocks use them.
 //!
 //! # Which models ([`refusal`])
 //!

@@ -185,11 +185,6 @@ impl Protocols {
         }
     }
 
-    /// Whether no ramp, held or moved coordinate or driven indenter is in force.
-    pub(super) fn is_empty(&self) -> bool {
-        self.ramps.is_empty() && self.held.is_empty() && self.drives.is_empty()
-    }
-
     /// Whether a ramp is in force.
     pub(super) fn has_ramps(&self) -> bool {
         !self.ramps.is_empty()

@@ -344,9 +344,6 @@ impl Simulation {
     /// Why the implicit step cannot run on the device (src/gpu/implicit.rs).
     fn implicit_refusal(&self) -> Option<&'static str> {
         match &self.integrator {
-            Integrator::Implicit(..) if !self.protocols.is_empty() => {
-                Some("`freeze`, `move`, `indent` and ramps with `integrator implicit` run on the CPU backend only")
-            }
             Integrator::Implicit(_, implicit) => crate::gpu::implicit::refusal(&self.model, implicit),
             Integrator::Overdamped(_) => None,
         }
