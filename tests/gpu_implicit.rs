@@ -15,16 +15,25 @@ use glam::DVec3;
 /// `steps` implicit steps of 1e-3 s (γ/dt = 3.5 pN/µm against bonds of
 /// 2000 pN/µm: 40× the explicit limit).
 fn filament(steps: u64, kt: f64) -> common::Case {
-    filament_with(steps, kt, "")
+    filament_with(steps, kt, "", false)
 }
 
-/// [`filament`] with `protocols` (deck lines) before its run.
-fn filament_with(steps: u64, kt: f64, protocols: &str) -> common::Case {
+/// [`filament`] with `protocols` (deck lines) before its run, and with
+/// `obstacles`: fixed posts beside the beads that push them by
+/// `soft_repulsion` and fixed pillars above them by `wca`, overlapping at
+/// the start (pair terms with stiffness).
+fn filament_with(steps: u64, kt: f64, protocols: &str, obstacles: bool) -> common::Case {
     let mut top = String::from("[ particles ]\n");
     for k in 0..12 {
         let x = 0.3 * k as f64;
         let y = 0.05 * (std::f64::consts::PI * x / 3.3).sin() + 0.01 * (k % 3) as f64;
         top += &format!("{} {} {x} {y} {}\n", k + 1, if k == 0 { "anchor" } else { "bead" }, 0.002 * k as f64);
+    }
+    if obstacles {
+        for k in 1..11 {
+            let x = 0.3 * k as f64 + 0.1;
+            top += &format!("{} post {x} -0.2 0\n{} pillar {x} 0.05 0.24\n", 11 + 2 * k, 12 + 2 * k);
+        }
     }
     top += "[ bonds ]\n";
     for k in 1..12 {
@@ -34,14 +43,20 @@ fn filament_with(steps: u64, kt: f64, protocols: &str) -> common::Case {
     for k in 1..11 {
         top += &format!("bend {k} {} {}\n", k + 1, k + 2);
     }
-    let ff = "particle bead drag 0.0035\nparticle anchor fixed\n\
-              bond rod harmonic k 2000 r0 0.31\nangle bend wlc_bending kappa 2 l0 0.3\n";
+    let mut ff = String::from(
+        "particle bead drag 0.0035\nparticle anchor fixed\n\
+         bond rod harmonic k 2000 r0 0.31\nangle bend wlc_bending kappa 2 l0 0.3\n",
+    );
+    if obstacles {
+        ff += "particle post fixed\nparticle pillar fixed\n\
+               pair bead post soft_repulsion k 500 sigma 0.3\npair bead pillar wca epsilon 0.05 sigma 0.25\n";
+    }
     let deck = format!(
         "units cell\ntopology t.top\nforcefield f.ff\nbox x -5 10 f y -5 5 f z -5 5 f\ngroup tip id 12\n\
          external push tip constant_force fx -2 fy 0.5\nexternal stop tip wall nx -1 d -3.28 k 1000\n\
          {protocols}integrator implicit\ntimestep 1e-3\ntemperature {kt}\nseed 3\nrun {steps}\n"
     );
-    common::Case::new(&[("t.top", &top), ("f.ff", ff), ("deck.in", &deck)])
+    common::Case::new(&[("t.top", &top), ("f.ff", &ff), ("deck.in", &deck)])
 }
 
 fn run(case: &common::Case, device: DevicePreference) -> Simulation {
@@ -67,7 +82,7 @@ fn one_implicit_step_on_the_gpu_matches_the_cpu() {
 #[test]
 fn one_implicit_step_with_held_and_moved_beads_matches_the_cpu() {
     let protocols = "group mid id 6\nfreeze mid y\ngroup pushed id 9\nmove pushed linear 0 0 0.5\nramp angle bend kappa 2 4\n";
-    let case = filament_with(1, 0.0, protocols);
+    let case = filament_with(1, 0.0, protocols, false);
     let gpu = one_step_matches(&case);
     let start = case.plan().positions;
     // Unmoved, to the device's fixed-point quantum (2⁻⁵² of the 15 µm box).
@@ -75,6 +90,24 @@ fn one_implicit_step_with_held_and_moved_beads_matches_the_cpu() {
     assert!((gpu.state.positions[5].y - start[5].y).abs() <= 4.0 * quantum, "the held coordinate moved");
     let moved = gpu.state.positions[8] - start[8];
     assert!((moved - DVec3::new(0.0, 0.0, 0.5e-3)).length() < 1e-9, "the moved bead went {moved}");
+}
+
+/// The same with excluded volume: fixed posts push the beads by
+/// `soft_repulsion` and fixed pillars by `wca`, both overlapping the beads at
+/// the start, so pair blocks take part in the solve (gathered from the
+/// neighbour list); the bound is the one above, κ(A) from the CPU's blocks
+/// with the pairs'.
+#[test]
+fn one_implicit_step_with_pair_terms_matches_the_cpu() {
+    let case = filament_with(1, 0.0, "", true);
+    let plan = case.plan();
+    let mut backend = CpuBackend::new(&plan.model, &State::new(plan.positions.clone()), &plan.sim_box, 0.3).unwrap();
+    let mut forces = Forces::default();
+    backend.compute(&plan.model, &State::new(plan.positions.clone()), &plan.sim_box, &mut forces);
+    let acting =
+        |law: &str| forces.energy_by_interaction[cellmd::interactions::REGISTRY.iter().position(|i| i.name() == law).unwrap()] > 0.0;
+    assert!(acting("soft_repulsion") && acting("wca"), "both pair laws must act at the start: {:?}", forces.energy_by_interaction);
+    one_step_matches(&case);
 }
 
 /// Runs `case` (one implicit step) on both devices and asserts the bound

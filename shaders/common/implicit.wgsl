@@ -202,6 +202,53 @@ fn radial_block(kind: u32, p: array<f32, 8>, d: vec3<f32>) -> mat3x3<f32> {
     return uu * along + (identity3() - uu) * across;
 }
 
+// The block of every pair rule between particles i (of type ti) and j, each
+// rule's clamped as the CPU's (0 beyond the type pair's reach).
+fn pair_block(i: u32, j: u32, ti: u32) -> mat3x3<f32> {
+    let pair = ti * P.n_types + topo[j];
+    let d = separation(i, j);
+    var h = mat3x3<f32>();
+    if dot(d, d) >= fparams[P.off_skip2 + pair] {
+        return h;
+    }
+    let rules_end = topo[P.off_pair_start + pair + 1u];
+    for (var q = topo[P.off_pair_start + pair]; q < rules_end; q++) {
+        let term = topo[P.off_pair_terms + q];
+        h += radial_block(topo[P.off_term_kind + term], term_params(term), d);
+    }
+    return h;
+}
+
+// Particle i's pair rows applied to the vector in `section` (with v_i = vi):
+// Σ_j h_ij·(v_i − v_j) over its neighbour-list row and, weighted, its
+// fractional `special_bonds` partners; with `diagonal_only`, Σ_j diag(h_ij)
+// (the Jacobi diagonal's share). A pair's block is computed again at each
+// product from the positions (both ends get the same bits: the separation
+// is an exact fixed-point difference rounded once, the block even in it).
+fn pair_rows(i: u32, section: u32, vi: vec3<f32>, diagonal_only: bool) -> vec3<f32> {
+    var out = vec3<f32>(0.0);
+    let pair_rules = topo[P.off_pair_start + P.n_types * P.n_types];
+    if pair_rules == 0u {
+        return out;
+    }
+    let ti = topo[i];
+    let row = nlist_row(i);
+    let count = min(nlist[row], P.nlist_cap);
+    for (var k = 0u; k < count; k++) {
+        let j = nlist[row + 1u + k];
+        if j >= CONTACT_ONLY { continue; } // an excluded pair kept for the contact search
+        let h = pair_block(i, j, ti);
+        out += select(h * (vi - imp_vec(section, j)), vec3<f32>(h[0].x, h[1].y, h[2].z), diagonal_only);
+    }
+    let end = topo[P.off_special_offsets + i + 1u];
+    for (var s = topo[P.off_special_offsets + i]; s < end; s++) {
+        let w = bitcast<f32>(topo[P.off_special + 2u * s + 1u]);
+        let h = pair_block(i, topo[P.off_special + 2u * s], ti) * w;
+        out += select(h * (vi - imp_vec(section, topo[P.off_special + 2u * s])), vec3<f32>(h[0].x, h[1].y, h[2].z), diagonal_only);
+    }
+    return out;
+}
+
 @compute @workgroup_size(256)
 fn implicit_blocks(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) local: u32) {
     let i = linear_index(wg, local);
@@ -242,6 +289,7 @@ fn implicit_blocks(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocati
             diagonal[m] += angle_entry(a, (3u * role + m) * 10u);
         }
     }
+    diagonal += pair_rows(i, VEC_X, vec3<f32>(0.0), true);
     // A held coordinate (`freeze`, `move`): the identity row.
     imp[dinv] = vec4<f32>(select(vec3<f32>(1.0), 1.0 / diagonal, free_axes(i) != vec3<f32>(0.0)), 0.0);
 }
@@ -251,7 +299,7 @@ fn imp_vec(section: u32, i: u32) -> vec3<f32> {
 }
 
 // (A·v)_i for the vector in `section`: γ/dt·v_i plus particle i's rows of its
-// bond ends, externals and angles, in that order (a fixed particle, and a
+// bond ends, externals, angles and pairs, in that order (a fixed particle, and a
 // held coordinate of `freeze` or `move`: v_i). Their entries of every vector
 // the solve forms are 0, so their couplings drop out as in the CPU's matrix.
 fn apply_row(i: u32, section: u32) -> vec3<f32> {
@@ -283,6 +331,7 @@ fn apply_row(i: u32, section: u32) -> vec3<f32> {
             }
         }
     }
+    out += pair_rows(i, section, vi, false);
     return select(vi, out, free_axes(i) != vec3<f32>(0.0));
 }
 

@@ -12,3 +12,18 @@ fn lj_radial(p: array<f32, 8>, r: f32) -> Radial {
     }
     return RADIAL_ZERO;
 }
+
+// E″(r) = 4ε(156(σ/r)¹² − 42(σ/r)⁶)/r² (shared with wca), for the stiffness
+// block of the implicit step (shaders/common/implicit.wgsl).
+fn lennard_jones_curvature(epsilon: f32, sigma: f32, r: f32) -> f32 {
+    let s2 = sigma * sigma / (r * r);
+    let s6 = s2 * s2 * s2;
+    return 4.0 * epsilon * (156.0 * s6 * s6 - 42.0 * s6) / (r * r);
+}
+
+fn lj_curvature(p: array<f32, 8>, r: f32) -> f32 {
+    if r < p[LJ_RC] {
+        return lennard_jones_curvature(p[LJ_EPSILON], p[LJ_SIGMA], r);
+    }
+    return 0.0;
+}

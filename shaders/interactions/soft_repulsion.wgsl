@@ -6,3 +6,8 @@ fn soft_repulsion_radial(p: array<f32, 8>, r: f32) -> Radial {
     }
     return RADIAL_ZERO;
 }
+
+// E″(r) = k inside σ, for the stiffness block of the implicit step (shaders/common/implicit.wgsl).
+fn soft_repulsion_curvature(p: array<f32, 8>, r: f32) -> f32 {
+    return select(0.0, p[SOFT_REPULSION_K], r < p[SOFT_REPULSION_SIGMA]);
+}

@@ -291,7 +291,7 @@ impl GpuBackend {
         implicit: &ImplicitSettings,
     ) -> Result<(), String> {
         self.implicit = Some(ImplicitSolver::new(ctx, &self.layout, model, (settings.context.dt, settings.context.kt), implicit)?);
-        Ok(())
+        self.implicit_list_check()
     }
 
     /// Projects the constrained bonds after every step from now on
@@ -1176,6 +1176,20 @@ impl GpuBackend {
         self.main_group = self.bind_main();
         self.pending_rebuild = true;
         self.grown += 1;
+        self.implicit_list_check()
+    }
+
+    /// The implicit step's one-workgroup solve reads the pair rows from one
+    /// binding of the neighbour list (src/gpu/implicit.rs): a list bound in
+    /// chunks is refused.
+    fn implicit_list_check(&self) -> Result<(), String> {
+        if self.implicit.is_some() && self.has_pairs && self.nlist.chunks > 1 {
+            return Err(format!(
+                "integrator implicit with pair terms: the neighbour list ({} particles × {} neighbours) needs {} bindings on {}; \
+                 the device's implicit solve reads it from one (use `device cpu`)",
+                self.params.n, self.params.nlist_cap, self.nlist.chunks, self.ctx.info.name
+            ));
+        }
         Ok(())
     }
 

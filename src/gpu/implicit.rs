@@ -26,6 +26,11 @@
 //! - **Externals**: the law's 3×3 Hessian (`NAME_hessian`), positive
 //!   semi-definite as written (a wall's k·n̂n̂ᵀ inside it, 0 for a constant
 //!   force).
+//! - **Pairs**: the bonds' radial block for every rule between two
+//!   neighbours (and, weighted, fractional `special_bonds` partners),
+//!   computed again from the positions at each product K̃·v from the
+//!   particle's neighbour-list row (no storage per pair; the row must be in
+//!   one binding: a list bound in chunks stops the run).
 //!
 //! Fixed particles have the identity row and no couplings, as on the CPU;
 //! so has each coordinate a protocol holds (`freeze`, `move`), whose
@@ -35,11 +40,11 @@
 //!
 //! # Which models ([`refusal`])
 //!
-//! Every bond, angle and external law must have its device block (a WGSL
-//! function `NAME_curvature` or `NAME_hessian`; `harmonic`, `wlc_bending`,
-//! `wall` and `constant_force` have one); models with pair, body, contact or
-//! volume-element terms, custom terms, bond kinetics or constraints stay on
-//! the CPU with the reason. `solver cholesky` does too: its decks take Newton
+//! Every bond, angle, pair and external law must have its device block (a
+//! WGSL function `NAME_curvature` or `NAME_hessian`; `harmonic`,
+//! `soft_repulsion`, `lj`, `wca`, `wlc_bending`, `wall` and `constant_force`
+//! have one); models with body, contact or volume-element terms, custom
+//! terms, bond kinetics or constraints stay on the CPU with the reason. `solver cholesky` does too: its decks take Newton
 //! steps (γ/dt = 1e-6 against stiffnesses of 10²–10⁵), which f32 conjugate
 //! gradients cannot solve to a direct solver's accuracy.
 //!
@@ -102,17 +107,17 @@ pub fn refusal(model: &Model, implicit: &ImplicitSettings) -> Option<&'static st
     if model.has_kinetics() {
         return Some("bond kinetics with `integrator implicit` run on the CPU backend only");
     }
-    if !model.pair_rules.is_empty() || !model.body_rules.is_empty() || !model.tetras.is_empty() || model.has_contact_terms() {
+    if !model.body_rules.is_empty() || !model.tetras.is_empty() || model.has_contact_terms() {
         return Some(
-            "`integrator implicit` with pair, body, contact or volume-element terms runs on the CPU backend only \
-             (the GPU has stiffness blocks for bonds, angles and externals)",
+            "`integrator implicit` with body, contact or volume-element terms runs on the CPU backend only \
+             (the GPU has stiffness blocks for bonds, angles, pairs and externals)",
         );
     }
     let kinds = super::custom::gpu_kinds(model);
     if !kinds.iter().all(|&k| REGISTRY.get(k as usize).is_some_and(|i| stiffness_function(*i).is_some())) {
         return Some(
-            "`integrator implicit` with a bond, angle or external law that has no GPU stiffness block runs on the CPU backend only \
-             (harmonic, wlc_bending, wall and constant_force have one)",
+            "`integrator implicit` with a bond, angle, pair or external law that has no GPU stiffness block runs on the CPU backend only \
+             (harmonic, soft_repulsion, lj, wca, wlc_bending, wall and constant_force have one)",
         );
     }
     None
