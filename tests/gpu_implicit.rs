@@ -193,3 +193,69 @@ fn buckling_filament_timing() {
         println!("{device:?}: {} steps in {seconds:.2} s, last solve {} iterations", sim.state.step, sim.last_solve.iterations);
     }
 }
+
+/// Free particles and particles tethered to fixed anchors (harmonic, r0 = 0)
+/// at kT = 0.5 (lj units), `steps` implicit steps of `dt` on `device`:
+/// the free particles' mean squared displacement and the tethers' mean
+/// squared extension.
+fn thermal_tethers(device: DevicePreference, steps: u64, dt: f64) -> (f64, f64) {
+    let mut top = String::from("[ particles ]\n");
+    let mut bonds = String::from("[ bonds ]\n");
+    let n = 1500;
+    for k in 0..n {
+        let (x, y, z) = ((k % 15) as f64 * 4.0 + 2.0, ((k / 15) % 10) as f64 * 4.0 + 2.0, (k / 150) as f64 * 4.0 + 2.0);
+        top += &format!(
+            "{} free {x} {y} {z}\n{} bead {} {y} {z}\n{} anchor {} {y} {z}\n",
+            3 * k + 1,
+            3 * k + 2,
+            x + 1.0,
+            3 * k + 3,
+            x + 1.001
+        );
+        bonds += &format!("tether {} {}\n", 3 * k + 2, 3 * k + 3);
+    }
+    let ff = "particle free drag 2\nparticle bead drag 2\nparticle anchor fixed\nbond tether harmonic k 100 r0 0\n";
+    let deck = format!(
+        "units lj\ntopology t.top\nforcefield f.ff\nbox x 0 60 p y 0 40 p z 0 40 p\n\
+         integrator implicit\ntemperature 0.5\ntimestep {dt}\nseed 7\nrun {steps}\n"
+    );
+    let case = common::Case::new(&[("t.top", &(top + &bonds)), ("f.ff", ff), ("deck.in", &deck)]);
+    let plan = case.plan();
+    let sim = run(&case, device);
+    let unwrap = |s: &State, i: usize| plan.sim_box.unwrap(s.positions[i], s.images[i]);
+    let start = State::new(plan.positions.clone());
+    let msd = (0..n).map(|k| (unwrap(&sim.state, 3 * k) - start.positions[3 * k]).length_squared()).sum::<f64>() / n as f64;
+    let extension =
+        (0..n).map(|k| (unwrap(&sim.state, 3 * k + 1) - unwrap(&sim.state, 3 * k + 2)).length_squared()).sum::<f64>() / n as f64;
+    (msd, extension)
+}
+
+/// kT > 0 with the implicit step at k·dt/γ = 5 (five times the explicit
+/// step's stability limit of 2 for a tether): on both devices the free
+/// particles diffuse as 6Dt (their step is the explicit one), and each
+/// tether's extension has the exact stationary variance of the implicit
+/// step's own recursion x ← (1 − a′)x + b·ξ, a′ = k/(γ/dt + k),
+/// b = √(2kT·γ/dt)/(γ/dt + k): per axis b²/(1 − (1 − a′)²), here 0.29·kT/k
+/// (kT/k is the continuous value: the implicit step's stiff modes are
+/// colder). Within 4 relative standard errors √(2/(3n)) of a mean of n
+/// squared 3-D Gaussian norms.
+#[test]
+fn thermal_implicit_runs_have_the_exact_statistics_on_both_devices() {
+    let (kt, gamma, k, dt): (f64, f64, f64, f64) = (0.5, 2.0, 100.0, 0.1);
+    let steps = 60;
+    let drag = gamma / dt;
+    let a = k / (drag + k);
+    let b2 = 2.0 * kt * drag / ((drag + k) * (drag + k));
+    let expected_extension = 3.0 * b2 / (1.0 - (1.0 - a) * (1.0 - a));
+    let expected_msd = 6.0 * kt / gamma * dt * steps as f64;
+    let sigma = (2.0 / (3.0 * 1500.0f64)).sqrt();
+    for device in [DevicePreference::Cpu, DevicePreference::Gpu] {
+        let (msd, extension) = thermal_tethers(device, steps, dt);
+        println!(
+            "{device:?}: MSD {msd:.5} (6Dt {expected_msd:.5}), ⟨d²⟩ {extension:.6} (exact {expected_extension:.6}; kT/k·3 = {:.6}), σ {sigma:.3}",
+            3.0 * kt / k
+        );
+        assert!((msd / expected_msd - 1.0).abs() < 4.0 * sigma, "{device:?}: MSD {msd} vs {expected_msd}");
+        assert!((extension / expected_extension - 1.0).abs() < 4.0 * sigma, "{device:?}: ⟨d²⟩ {extension} vs {expected_extension}");
+    }
+}
