@@ -358,7 +358,19 @@ fn workgroup_sum(local: u32, v: vec3<f32>) -> vec3<f32> {
     return workgroupUniformLoad(&workgroup_total);
 }
 
-// Particle i's right-hand side F_i + √(2kT·γ/dt)·ξ_i (0 for a fixed particle).
+// q = A·p into VEC_Q; returns the curvature pᵀAp (the same in every
+// invocation).
+fn times_search_direction(local: u32) -> f32 {
+    storageBarrier();
+    var pq = 0.0;
+    for (var i = local; i < P.n; i += WORKGROUP) {
+        let q = apply_row(i, VEC_P);
+        imp[P.n * VEC_Q + i] = vec4<f32>(q, 0.0);
+        pq += dot(imp_vec(VEC_P, i), q);
+    }
+    return workgroup_sum(local, vec3<f32>(pq, 0.0, 0.0)).x;
+}
+
 // Particle i's right-hand side F + √(2kT·γ/dt)·ξ, 0 on its held coordinates
 // (the CPU masks their forces; the protocols put them back after the step).
 fn implicit_rhs(i: u32) -> vec3<f32> {
@@ -379,6 +391,12 @@ fn implicit_solve(@builtin(local_invocation_index) local: u32) {
         workgroup_limits = vec2<u32>(imp_topo[IMP_MAX_ITER], imp_topo[IMP_TOLERANCE]);
     }
     if workgroupUniformLoad(&workgroup_flag) != 0u {
+        return;
+    }
+    if imp_topo[IMP_CONSTRAINTS] > 0u {
+        // Constrained bonds: projected CG (shaders/common/implicit_constraints.wgsl).
+        let limits = workgroupUniformLoad(&workgroup_limits);
+        constrained_solve(local, bitcast<f32>(limits.y), limits.x);
         return;
     }
     let n = P.n;
@@ -412,14 +430,7 @@ fn implicit_solve(@builtin(local_invocation_index) local: u32) {
         if b_norm == 0.0 || residual < threshold || iterations >= cap {
             break;
         }
-        storageBarrier();
-        var pq = 0.0;
-        for (var i = local; i < n; i += WORKGROUP) {
-            let q = apply_row(i, VEC_P);
-            imp[n * VEC_Q + i] = vec4<f32>(q, 0.0);
-            pq += dot(imp_vec(VEC_P, i), q);
-        }
-        let curvature = workgroup_sum(local, vec3<f32>(pq, 0.0, 0.0)).x;
+        let curvature = times_search_direction(local);
         if !(curvature > 0.0) {
             break;
         }

@@ -289,8 +289,10 @@ impl GpuBackend {
         model: &Model,
         settings: &StepSettings,
         implicit: &ImplicitSettings,
+        constrained: &[[u32; 2]],
     ) -> Result<(), String> {
-        self.implicit = Some(ImplicitSolver::new(ctx, &self.layout, model, (settings.context.dt, settings.context.kt), implicit)?);
+        let context = (settings.context.dt, settings.context.kt);
+        self.implicit = Some(ImplicitSolver::new(ctx, &self.layout, model, context, implicit, constrained)?);
         self.implicit_list_check()
     }
 
@@ -309,7 +311,13 @@ impl GpuBackend {
     /// constraints).
     pub fn constraint_state(&self) -> Option<(Vec<f64>, ShakeReport)> {
         let shake = self.shake.as_ref()?;
-        Some(shake.read(&self.read(&shake.buffer, 4 * (shake.count as u64 + 4))))
+        let (mut tension, report) = shake.read(&self.read(&shake.buffer, 4 * (shake.count as u64 + 4)));
+        if let Some(solver) = self.implicit.as_ref().filter(|s| s.constraints > 0) {
+            // The implicit step's constraint forces, before SHAKE's (as the CPU sums them).
+            let bytes = self.read_at(&solver.buffer, solver.constraints_at, 48 * solver.constraints as u64);
+            tension.iter_mut().zip(solver.constraint_tensions(&bytes)).for_each(|(t, implicit)| *t += implicit);
+        }
+        Some((tension, report))
     }
 
     /// Takes FIRE iterations in place of steps from now on (`minimize`,

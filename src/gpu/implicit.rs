@@ -44,7 +44,16 @@
 //! WGSL function `NAME_curvature` or `NAME_hessian`; `harmonic`,
 //! `soft_repulsion`, `lj`, `wca`, `wlc_bending`, `wall` and `constant_force`
 //! have one); models with body, contact or volume-element terms, custom
-//! terms, bond kinetics or constraints stay on the CPU with the reason. `solver cholesky` does too: its decks take Newton
+//! terms or bond kinetics stay on the CPU with the reason.
+//!
+//! # Constrained bonds
+//!
+//! With `constrain`, the solve is the CPU's projected CG instead (min
+//! ½ΔxᵀAΔx − bᵀΔx subject to JΔx = 0, from Δx = 0; Gould, Hribar & Nocedal
+//! 2001), each projection's S = JD⁻¹Jᵀ solved by an inner Jacobi-CG in the
+//! same workgroup where the CPU factorises it, and the constraint tensions
+//! −λ kept for the thermo (shaders/common/implicit_constraints.wgsl); the
+//! device's SHAKE (src/gpu/shake.rs) then projects as after every step. `solver cholesky` does too: its decks take Newton
 //! steps (γ/dt = 1e-6 against stiffnesses of 10²–10⁵), which f32 conjugate
 //! gradients cannot solve to a direct solver's accuracy.
 //!
@@ -90,11 +99,16 @@ use crate::system::Model;
 /// decks' systems, ~10³, leaves a margin of ten).
 pub const F32_TOLERANCE: f64 = 1e-6;
 
-const HEADER_WORDS: usize = 12;
+const HEADER_WORDS: usize = 17;
 /// `imp` entries per particle (Δx, r, z, p, A·p, the Jacobi diagonal).
 const PARTICLE_VECTORS: usize = 6;
 /// `imp` entries of an angle's 9×9 block.
 const ANGLE_VEC4: usize = 21;
+/// `imp` entries of a constraint (û and its flag; μ, r, p, q of the inner
+/// CG; its z, S's inverse diagonal and its tension).
+const CONSTRAINT_VEC4: usize = 3;
+/// Slot bit: the particle is the constraint's second end.
+const J_END: u32 = 0x8000_0000;
 
 /// Why the model's implicit step cannot run on the device (None: it can).
 pub fn refusal(model: &Model, implicit: &ImplicitSettings) -> Option<&'static str> {
@@ -171,6 +185,9 @@ pub(super) struct ImplicitSolver {
     pub(super) buffer: wgpu::Buffer,
     pub(super) report_at: u64,
     angle_count: u32,
+    /// Constrained bonds, and the byte offset of their entries in `imp`.
+    pub(super) constraints: usize,
+    pub(super) constraints_at: u64,
     /// The relative residual the device solves to.
     tolerance: f64,
     max_iterations: usize,
@@ -185,6 +202,7 @@ impl ImplicitSolver {
         model: &Model,
         (dt, kt): (f64, f64),
         implicit: &ImplicitSettings,
+        constrained: &[[u32; 2]],
     ) -> Result<Self, String> {
         if let Some(why) = refusal(model, implicit) {
             return Err(why.into());
@@ -228,8 +246,25 @@ impl ImplicitSolver {
         header[9] = externals_at as u32;
         header[10] = angles_at as u32;
         header[11] = report as u32;
+        // Constrained bonds (shaders/common/implicit_constraints.wgsl):
+        // their ends, and each particle's slots (constraint, J_END where it is j).
+        header[12] = constrained.len() as u32;
+        header[13] = (HEADER_WORDS + words.len()) as u32;
+        words.extend(constrained.iter().flatten());
+        let mut constraint_rows = vec![Vec::new(); n];
+        for (k, &[i, j]) in constrained.iter().enumerate() {
+            constraint_rows[i as usize].push(k as u32);
+            constraint_rows[j as usize].push(k as u32 | J_END);
+        }
+        let (mut starts, mut slots) = (Vec::new(), Vec::new());
+        push_csr(&constraint_rows, &mut starts, &mut slots);
+        header[14] = (HEADER_WORDS + words.len()) as u32;
+        words.extend(&starts);
+        header[15] = (HEADER_WORDS + words.len()) as u32;
+        words.extend(&slots);
+        header[16] = (report + 1) as u32;
         let topo: Vec<u32> = header.into_iter().chain(words).collect();
-        let entries = (report + 1) as u64;
+        let entries = (report + 1 + CONSTRAINT_VEC4 * constrained.len()) as u64;
         let limit = ctx.limits.max_storage_buffer_binding_size.min(ctx.limits.max_buffer_size);
         if 16 * entries > limit || entries > u32::MAX as u64 {
             return Err(format!(
@@ -259,6 +294,8 @@ impl ImplicitSolver {
             buffer,
             report_at: 16 * report as u64,
             angle_count: model.angles.len() as u32,
+            constraints: constrained.len(),
+            constraints_at: 16 * (report + 1) as u64,
             tolerance,
             max_iterations: implicit.max_iterations,
         })
@@ -273,6 +310,13 @@ impl ImplicitSolver {
     pub(super) fn report(&self, bytes: &[u8]) -> SolveReport {
         let entry: [f32; 4] = bytemuck::pod_read_unaligned(&bytes[..16]);
         SolveReport { iterations: entry[0].to_bits() as usize, relative_residual: f64::from(entry[1]), step_fraction: 1.0 }
+    }
+
+    /// The constraint tensions of the last solve (the deck's list order),
+    /// from the constraints' `imp` entries.
+    pub(super) fn constraint_tensions(&self, bytes: &[u8]) -> Vec<f64> {
+        let entries: &[[f32; 4]] = bytemuck::cast_slice(bytes);
+        entries.chunks(CONSTRAINT_VEC4).map(|c| f64::from(c[2][2])).collect()
     }
 
     /// Why a solve halted the run.

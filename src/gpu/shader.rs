@@ -47,7 +47,7 @@ mod embedded {
 pub use embedded::{COMMON_SHADERS, INTERACTION_SHADERS};
 
 /// The common files in the order they must appear (declarations first).
-const COMMON_ORDER: [&str; 16] = [
+const COMMON_ORDER: [&str; 17] = [
     "layout",
     "philox",
     "neighbor",
@@ -62,6 +62,7 @@ const COMMON_ORDER: [&str; 16] = [
     "adhesion",
     "protocol",
     "implicit",
+    "implicit_constraints",
     "shake",
     "fire",
 ];

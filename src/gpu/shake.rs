@@ -38,10 +38,12 @@
 //!
 //! # Which runs ([`refusal`])
 //!
-//! The explicit step only: with `integrator implicit` the CPU solves the
-//! constrained system inside the step (src/integrate/implicit.rs), which the
-//! device's solver does not; and not with bond kinetics, whose breaking and
-//! forming would change the constrained bonds under the projection.
+//! With either integrator: with `integrator implicit` the step itself
+//! solves the constrained system first (projected CG on the device too,
+//! shaders/common/implicit_constraints.wgsl), then SHAKE removes the
+//! second-order drift, as on the CPU. Not with bond kinetics, whose
+//! breaking and forming would change the constrained bonds under the
+//! projection.
 
 use wgpu::util::DeviceExt;
 
@@ -57,13 +59,7 @@ pub const F32_TOLERANCE: f64 = 1e-6;
 const HEADER_WORDS: usize = 8;
 
 /// Why the constraints cannot be projected on the device (None: they can).
-pub fn refusal(model: &Model, implicit: bool) -> Option<&'static str> {
-    if implicit {
-        return Some(
-            "constrained bonds (`constrain`) with `integrator implicit` run on the CPU backend only \
-             (the CPU solves the constrained system inside the step)",
-        );
-    }
+pub fn refusal(model: &Model) -> Option<&'static str> {
     if model.has_kinetics() {
         return Some("constrained bonds (`constrain`) with bond kinetics run on the CPU backend only");
     }

@@ -68,7 +68,8 @@ impl GpuSteps {
                     implicit.tolerance
                 ));
             }
-            gpu.step_implicitly(context, model, &settings, implicit).map_err(RunError::Setup)?;
+            let constrained: Vec<[u32; 2]> = sim.constraints.list.iter().map(|c| model.bonds[c.bond]).collect();
+            gpu.step_implicitly(context, model, &settings, implicit, &constrained).map_err(RunError::Setup)?;
         }
         if !sim.constraints.list.is_empty() {
             // The constraints' projection on the device (src/gpu/shake.rs): f32 lengths have a tolerance floor.
@@ -337,8 +338,7 @@ impl Simulation {
 
     /// Why the constraints cannot be projected on the device (src/gpu/shake.rs).
     fn constraint_refusal(&self) -> Option<&'static str> {
-        let implicit = matches!(self.integrator, Integrator::Implicit(..));
-        (!self.constraints.list.is_empty()).then(|| crate::gpu::shake::refusal(&self.model, implicit)).flatten()
+        (!self.constraints.list.is_empty()).then(|| crate::gpu::shake::refusal(&self.model)).flatten()
     }
 
     /// Why the implicit step cannot run on the device (src/gpu/implicit.rs).
