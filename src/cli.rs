@@ -454,9 +454,20 @@ fn profile_gpu(plan: &crate::deck::Plan, repetitions: u32, rebuild_rate: Option<
     };
     // Bond kinetics on the device where the run would decide them there.
     let kinetics = sim.model.has_kinetics() && crate::gpu::kinetics::refusal(&sim.model).is_none();
-    let backend = || match kinetics {
-        true => GpuBackend::with_device_kinetics(&context, &sim.model, &sim.state, &sim.sim_box, &settings, &[]),
-        false => GpuBackend::new(&context, &sim.model, &sim.state, &sim.sim_box, &settings),
+    // The implicit step and the constraints' projection where the run would have them.
+    let constrained: Vec<[u32; 2]> = sim.constraints.list.iter().map(|c| sim.model.bonds[c.bond]).collect();
+    let backend = || -> Result<GpuBackend, String> {
+        let mut gpu = match kinetics {
+            true => GpuBackend::with_device_kinetics(&context, &sim.model, &sim.state, &sim.sim_box, &settings, &[])?,
+            false => GpuBackend::new(&context, &sim.model, &sim.state, &sim.sim_box, &settings)?,
+        };
+        if let crate::integrate::Integrator::Implicit(_, implicit) = &sim.integrator {
+            gpu.step_implicitly(&context, &sim.model, &settings, implicit, &constrained)?;
+        }
+        if !constrained.is_empty() {
+            gpu.constrain_bonds(&context, &sim.model, &sim.constraints)?;
+        }
+        Ok(gpu)
     };
     let mut gpu = backend()?;
     let rate = match rebuild_rate {
@@ -473,7 +484,7 @@ fn profile_gpu(plan: &crate::deck::Plan, repetitions: u32, rebuild_rate: Option<
         }
     };
     let t = gpu.profile(repetitions)?;
-    let step = t.check + rate * t.neighbor_build + t.forces + t.integrate + t.contact + t.adhesion + t.kinetics;
+    let step = t.check + rate * t.neighbor_build + t.forces + t.integrate + t.contact + t.adhesion + t.kinetics + t.constraints;
     let n = sim.model.len() as f64;
     let mut table = String::new();
     table += &format!("device: {}\n", context.describe());
@@ -483,7 +494,8 @@ fn profile_gpu(plan: &crate::deck::Plan, repetitions: u32, rebuild_rate: Option<
         ("neighbour check", t.check, t.check),
         ("neighbour rebuild", t.neighbor_build, rate * t.neighbor_build),
         ("forces", t.forces, t.forces),
-        ("integration", t.integrate, t.integrate),
+        ("integration / implicit", t.integrate, t.integrate),
+        ("constraint projection", t.constraints, t.constraints),
         ("contact and step clamp", t.contact, t.contact),
         ("adhesion node/weight", t.adhesion, t.adhesion),
         ("bond kinetics and bind", t.kinetics, t.kinetics),

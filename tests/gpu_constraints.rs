@@ -167,3 +167,24 @@ fn the_same_constrained_gpu_run_twice_gives_the_same_bits() {
     assert_eq!(bits(&first), bits(&second));
     assert!(first.constraints.tension.iter().any(|&t| t != 0.0));
 }
+
+/// `cellmd profile-gpu` times the implicit step and the projection of a
+/// constrained implicit deck in their own rows, each a positive share.
+#[test]
+fn profile_gpu_times_the_implicit_step_and_the_projection() {
+    let case = chain(10, 2, 1e-2, 10, (0.0, 0.02), "constrain rod\nintegrator implicit");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_cellmd"))
+        .current_dir(case.output_dir())
+        .args(["profile-gpu", "deck.in", "--repetitions", "3"])
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output()
+        .unwrap();
+    let table = String::from_utf8_lossy(&out.stdout);
+    println!("{table}{}", String::from_utf8_lossy(&out.stderr));
+    assert!(out.status.success());
+    for row in ["integration / implicit", "constraint projection"] {
+        let line = table.lines().find(|l| l.starts_with(row)).unwrap_or_else(|| panic!("no `{row}` row"));
+        let share: f64 = line.split_whitespace().last().unwrap().trim_end_matches('%').parse().unwrap();
+        assert!(share > 0.0, "{line}");
+    }
+}

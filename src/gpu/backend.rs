@@ -100,7 +100,8 @@ pub struct PhaseTimes {
     pub neighbor_build: f64,
     /// Pair, bonded, external and surface forces (the surface passes included).
     pub forces: f64,
-    /// Integration, commit and step counter.
+    /// Integration (or the implicit step's blocks, solve and moves), commit
+    /// and step counter.
     pub integrate: f64,
     /// Reading positions back to the host (thermo, dump, end of run).
     pub readback: f64,
@@ -111,6 +112,8 @@ pub struct PhaseTimes {
     /// Bond kinetics decided on the device and `bind` formation (0 without
     /// them; src/gpu/kinetics.rs, src/gpu/bind.rs), at the deck's start.
     pub kinetics: f64,
+    /// The constraints' projection (0 without `constrain`; src/gpu/shake.rs).
+    pub constraints: f64,
 }
 
 /// Settings the kernels need besides the model.
@@ -902,15 +905,17 @@ impl GpuBackend {
                 (&k.build, Over::Chunks),
             ];
         }
-        let time = |this: &Self, kernels: &[(&wgpu::ComputePipeline, Over)], decide: bool| {
+        // `group`: the bind group 1 the kernels read (the neighbour decision's
+        // arguments, the implicit solver's or the projection's buffers).
+        let time = |this: &Self, kernels: &[(&wgpu::ComputePipeline, Over)], group: Option<&wgpu::BindGroup>| {
             let run = |reps: u32| {
                 let started = std::time::Instant::now();
                 let mut encoder = this.ctx.device.create_command_encoder(&Default::default());
                 {
                     let mut pass = encoder.begin_compute_pass(&Default::default());
                     pass.set_bind_group(0, &this.main_group, &this.nlist.offsets(0));
-                    if decide {
-                        pass.set_bind_group(1, &this.args_group, &[]);
+                    if let Some(group) = group {
+                        pass.set_bind_group(1, group, &[]);
                     }
                     for _ in 0..reps {
                         for (pipeline, over) in kernels {
@@ -925,18 +930,36 @@ impl GpuBackend {
             run(1);
             run(repetitions) / repetitions as f64
         };
-        let check = if self.has_pairs { time(self, &[(&k.displacement, particles), (&k.decide, Over::Groups(1))], true) } else { 0.0 };
-        let neighbor_build = if self.has_pairs { time(self, &build, false) } else { 0.0 };
+        let args = Some(&self.args_group);
+        let check = if self.has_pairs { time(self, &[(&k.displacement, particles), (&k.decide, Over::Groups(1))], args) } else { 0.0 };
+        let neighbor_build = if self.has_pairs { time(self, &build, None) } else { 0.0 };
         let mut force_pass = self.surface_passes();
         force_pass.push((&k.forces, Over::Chunks));
-        let forces = time(self, &force_pass, false);
-        let contact = if self.has_contact() { time(self, &[(&k.contact_forces, Over::Chunks)], false) } else { 0.0 };
+        let forces = time(self, &force_pass, None);
+        let contact = if self.has_contact() { time(self, &[(&k.contact_forces, Over::Chunks)], None) } else { 0.0 };
         let adhesion = if self.adhesion.rules() > 0 {
-            time(self, &[(&k.adhesion_nodes, Over::Chunks), (&k.adhesion_weights, Over::Particles)], false)
+            time(self, &[(&k.adhesion_nodes, Over::Chunks), (&k.adhesion_weights, Over::Particles)], None)
         } else {
             0.0
         };
-        let integrate = time(self, &[(&k.integrate, particles), (&k.commit, particles), (&k.advance, Over::Groups(1))], false);
+        let integrate = match &self.implicit {
+            // The implicit step in place of `integrate` (src/gpu/implicit.rs).
+            Some(solver) => {
+                let mut passes = vec![(&solver.blocks, particles), (&solver.solve, Over::Groups(1)), (&solver.moves, particles)];
+                if solver.angle_groups(WORKGROUP) > 0 {
+                    passes.insert(0, (&solver.angles, Over::Groups(solver.angle_groups(WORKGROUP))));
+                }
+                time(self, &passes, Some(&solver.group)) + time(self, &[(&k.commit, particles), (&k.advance, Over::Groups(1))], None)
+            }
+            None => time(self, &[(&k.integrate, particles), (&k.commit, particles), (&k.advance, Over::Groups(1))], None),
+        };
+        let constraints = match &self.shake {
+            Some(shake) => {
+                let place = Over::Groups(shake.particles.div_ceil(WORKGROUP));
+                time(self, &[(&shake.solve, Over::Groups(1)), (&shake.place, place)], Some(&shake.group))
+            }
+            None => 0.0,
+        };
         let kinetics = match &self.kinetics {
             Some((layout, kin)) => {
                 let bonds = Over::Groups(layout.bonds().div_ceil(WORKGROUP));
@@ -949,7 +972,7 @@ impl GpuBackend {
                         (&kin.bind_accept, Over::Groups(1)),
                     ]);
                 }
-                time(self, &passes, false)
+                time(self, &passes, None)
             }
             None => 0.0,
         };
@@ -960,7 +983,7 @@ impl GpuBackend {
         let readback = started.elapsed().as_secs_f64() / repetitions as f64;
         self.ctx.queue.write_buffer(&self.state, 0, &saved);
         self.pending_rebuild = true;
-        Ok(PhaseTimes { check, neighbor_build, forces, integrate, readback, contact, adhesion, kinetics })
+        Ok(PhaseTimes { check, neighbor_build, forces, integrate, readback, contact, adhesion, kinetics, constraints })
     }
 
     /// Dispatches `pipeline` over `over`: wider than the dispatch width,
