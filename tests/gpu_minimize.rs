@@ -128,3 +128,18 @@ fn the_tensegrity_stage_relaxes_on_the_gpu_like_on_the_cpu() {
     println!("|ΔE| {:.3e} pN·µm, bound {:.3e}", (g.energy - c.energy).abs(), 2.0 * first_order);
     assert!((g.energy - c.energy).abs() < 2.0 * first_order, "energies part by {:e}", g.energy - c.energy);
 }
+
+/// What the device cannot step (here `integrator implicit solver
+/// cholesky`) does not keep `minimize` off it: only the forces and FIRE's
+/// moves decide, so the deck's minimisation runs on the GPU, the same bits
+/// as without that line.
+#[test]
+fn minimize_runs_on_the_gpu_whatever_the_integrator() {
+    let case = springs();
+    let plain = run(&case, DevicePreference::Gpu);
+    let deck = std::fs::read_to_string(case.path("deck.in")).unwrap();
+    std::fs::write(case.path("deck.in"), deck.replace("timestep 1e-3\n", "timestep 1e-3\nintegrator implicit solver cholesky\n")).unwrap();
+    let cholesky = run(&case, DevicePreference::Gpu);
+    assert!(cholesky.last_minimize.as_ref().is_some_and(|r| r.converged));
+    assert_eq!(common::position_bits(&plain), common::position_bits(&cholesky));
+}

@@ -43,7 +43,9 @@ const CONTROL_ENTRIES: usize = 3;
 
 /// Why FIRE cannot run on the device for this model (None: it can).
 pub fn refusal(model: &Model) -> Option<&'static str> {
-    model.has_contact_terms().then_some("`minimize` with contact between bodies runs on the CPU (its moves take the contact step clamp)")
+    model.has_contact_terms().then_some(
+        "contact between bodies scales FIRE's moves by the contact step clamp, which the device computes for the overdamped step only",
+    )
 }
 
 /// The device's FIRE: velocities, control words and partial sums, and the kernels.

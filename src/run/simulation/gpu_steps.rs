@@ -292,13 +292,17 @@ impl Simulation {
     /// |F| and energy from the CPU's f64 forces there (masked as the CPU's
     /// FIRE masks them). None: the CPU minimises.
     pub(super) fn minimize_on_gpu(&mut self, settings: &FireSettings) -> Result<Option<FireReport>, RunError> {
-        if let Some(why) = crate::gpu::fire::refusal(&self.model) {
-            if self.options.device.unwrap_or(self.device) != DevicePreference::Cpu {
-                self.say(why);
-            }
+        let device = self.options.device.unwrap_or(self.device);
+        if device == DevicePreference::Cpu {
             return Ok(None);
         }
-        let Some(context) = self.gpu_for_run()? else { return Ok(None) };
+        // Only what the forces or FIRE's moves need decides (not the integrator's or the constraints' refusals).
+        let custom = self.model.has_cpu_only_surface_terms().then_some("custom surface terms of bodies run on the CPU backend only");
+        if let Some(why) = crate::gpu::fire::refusal(&self.model).or(custom) {
+            self.say(&format!("minimize on the CPU: {why}"));
+            return Ok(None);
+        }
+        let Some(context) = self.open_gpu(device)? else { return Ok(None) };
         let settings_for_steps = self.step_settings();
         // Held axes only: a minimisation takes no step, so nothing moves or ramps.
         let full = self.protocols.for_device(&self.model);
@@ -365,6 +369,12 @@ impl Simulation {
                 }
             };
         }
+        self.open_gpu(device)
+    }
+
+    /// The adapter of `device` (gpu or auto), opened once and announced;
+    /// None where `device auto` found no hardware adapter.
+    fn open_gpu(&mut self, device: DevicePreference) -> Result<Option<GpuContext>, RunError> {
         let opened = match self.gpu.take() {
             Some(opened) => opened,
             None => {
