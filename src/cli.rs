@@ -11,7 +11,6 @@ use clap::{Parser, Subcommand};
 use crate::compare::{cellmd_probes, golden, run_lammps, Agreement, Lmp, Tolerance};
 use crate::deck::{validate_file_with, Plan, ValidateOptions};
 use crate::export::{self, ExportOptions};
-use crate::gpu::backend::StepSettings;
 use crate::gpu::{DevicePreference, GpuBackend, GpuContext};
 use crate::input::replaying;
 use crate::interactions::{documentation, lookup, REGISTRY};
@@ -446,16 +445,11 @@ fn build(what: Box<crate::build::Generator>) -> ExitCode {
 fn profile_gpu(plan: &crate::deck::Plan, repetitions: u32, rebuild_rate: Option<f64>) -> Result<String, String> {
     let sim = Simulation::before_first_run(plan, RunOptions::default()).map_err(|e| e.to_string())?;
     let context = GpuContext::open(false)?;
-    let settings = StepSettings {
-        context: sim.step_context(),
-        skin: sim.neighbor.skin,
-        neighbor_every: sim.neighbor.every,
-        neighbor_check: sim.neighbor.check,
-    };
+    let settings = sim.step_settings();
     // Bond kinetics on the device where the run would decide them there.
     let kinetics = sim.model.has_kinetics() && crate::gpu::kinetics::refusal(&sim.model).is_none();
     // The implicit step and the constraints' projection where the run would have them.
-    let constrained: Vec<[u32; 2]> = sim.constraints.list.iter().map(|c| sim.model.bonds[c.bond]).collect();
+    let constrained = sim.constraints.pairs(&sim.model);
     let backend = || -> Result<GpuBackend, String> {
         let mut gpu = match kinetics {
             true => GpuBackend::with_device_kinetics(&context, &sim.model, &sim.state, &sim.sim_box, &settings, &[])?,

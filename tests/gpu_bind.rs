@@ -153,7 +153,6 @@ fn bind_rules_the_device_refuses_say_why() {
 /// Measured: 1 build; 167 when every step with events forced one.
 #[test]
 fn bonds_forming_and_breaking_do_not_rebuild_the_device_list() {
-    use cellmd::gpu::backend::StepSettings;
     use cellmd::gpu::{GpuBackend, GpuContext};
     let ff = "particle a drag 0.5\nparticle b drag 0.5\n\
               bond link harmonic k 0.05 r0 0.3 kinetics slip k0 10 x_beta 0\n\
@@ -162,12 +161,7 @@ fn bonds_forming_and_breaking_do_not_rebuild_the_device_list() {
                 temperature 298\ntimestep 1e-3\nseed 3\nrun 0\n";
     let case = common::Case::new(&[("t.top", &scattered_particles()), ("f.ff", ff), ("deck.in", deck)]);
     let sim = Simulation::before_first_run(&case.plan(), RunOptions::default()).unwrap();
-    let settings = StepSettings {
-        context: sim.step_context(),
-        skin: sim.neighbor.skin,
-        neighbor_every: sim.neighbor.every,
-        neighbor_check: sim.neighbor.check,
-    };
+    let settings = sim.step_settings();
     let context = GpuContext::open(false).expect("a Vulkan adapter (scripts/test-all installs Mesa's)");
     let mut gpu = GpuBackend::with_device_kinetics(&context, &sim.model, &sim.state, &sim.sim_box, &settings, &[]).unwrap();
     let steps = 200;

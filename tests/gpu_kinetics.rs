@@ -25,12 +25,7 @@ fn context() -> GpuContext {
 fn sweep() -> (Simulation, StepSettings) {
     let plan = cellmd::deck::validate_file(std::path::Path::new("inputs/catch_slip_sweep.in"), &[]).unwrap();
     let sim = Simulation::before_first_run(&plan, RunOptions::default()).unwrap();
-    let settings = StepSettings {
-        context: sim.step_context(),
-        skin: sim.neighbor.skin,
-        neighbor_every: sim.neighbor.every,
-        neighbor_check: sim.neighbor.check,
-    };
+    let settings = sim.step_settings();
     (sim, settings)
 }
 
@@ -215,12 +210,7 @@ fn device_kinetics_with_contact_take_the_clamped_step_lengths() {
     let case = common::Case::new(&[("cells.top", &top), ("cells.ff", ff), ("deck.in", deck)]);
     let sim = Simulation::before_first_run(&case.plan(), RunOptions::default()).unwrap();
     assert!(sim.model.has_contact_terms());
-    let settings = StepSettings {
-        context: sim.step_context(),
-        skin: sim.neighbor.skin,
-        neighbor_every: sim.neighbor.every,
-        neighbor_check: sim.neighbor.check,
-    };
+    let settings = sim.step_settings();
     let steps = 20u64;
     let mut gpu = GpuBackend::with_device_kinetics(&context(), &sim.model, &sim.state, &sim.sim_box, &settings, &[]).unwrap();
     assert_eq!(gpu.run(0, steps), Ok(steps));

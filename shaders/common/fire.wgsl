@@ -27,6 +27,7 @@ const FIRE_PARTIALS: u32 = 3u; // one per workgroup of `fire_partials`: (P, Σ|v
 // Converged (status word ST_HALTED): max |F| < ftol.
 const HALT_CONVERGED: u32 = 256u;
 
+// FIRE's parameters, the CPU's (src/integrate/fire.rs; a test compares them).
 const FIRE_N_MIN: u32 = 5u;
 const FIRE_F_INC: f32 = 1.1;
 const FIRE_F_DEC: f32 = 0.5;

@@ -1080,7 +1080,7 @@ impl GpuBackend {
             if self.fire.is_none() {
                 self.dispatch(pass, &k.commit, Over::Particles);
             }
-            let binds = self.kinetics.as_ref().filter(|(layout, _)| layout.binds()).map(|(_, kernels)| kernels);
+            let binds = self.bind_kernels();
             if binds.is_some() {
                 // `bind` captures at the new positions (src/gpu/bind.rs): the
                 // list is checked (and rebuilt if due) now, for the capture
@@ -1109,6 +1109,11 @@ impl GpuBackend {
                 self.dispatch(pass, &kin.bind_halt, Over::Groups(1));
             }
         }
+    }
+
+    /// The kinetics kernels when `bind` forms bonds on the device (src/gpu/bind.rs).
+    fn bind_kernels(&self) -> Option<&KinKernels> {
+        self.kinetics.as_ref().filter(|(layout, _)| layout.binds()).map(|(_, kernels)| kernels)
     }
 
     /// The neighbour-list check and, when due, its rebuild (indirect dispatches).
@@ -1287,7 +1292,7 @@ impl GpuBackend {
             self.set_clock(self.time + self.elapsed(done));
             self.write_params();
             self.reset_status(force_rebuild);
-            let binds = self.kinetics.as_ref().is_some_and(|(layout, _)| layout.binds());
+            let binds = self.bind_kernels().is_some();
             let mut encoded = 0;
             while encoded < chunk {
                 let batch = (chunk - encoded).min(STEPS_PER_SUBMIT);
@@ -1430,4 +1435,44 @@ fn pack_state(
     let fields = contact.append(&mut packed.topo, packed.surf_entries);
     let adhesion_fields = adhesion.append(&mut packed.topo, packed.surf_entries + contact.surf_entries(), model.len() as u32);
     Ok((packed, exclusions, fields, adhesion_fields))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The status words and halt bits the host reads are the kernels' (each
+    /// kernel file declares the bits it raises).
+    #[test]
+    fn the_status_constants_match_the_kernels() {
+        let program = shader::compose();
+        let words = [
+            ("ST_HALTED", ST_HALTED),
+            ("ST_OVERFLOW_NEED", ST_OVERFLOW_NEED),
+            ("ST_BUILDS", ST_BUILDS),
+            ("ST_STEPS_DONE", ST_STEPS_DONE),
+            ("ST_BLOWUP_PARTICLE", ST_BLOWUP_PARTICLE),
+            ("ST_FORCE_REBUILD", ST_FORCE_REBUILD),
+            ("ST_SPAN_BODY", ST_SPAN_BODY),
+            ("ST_FRACTION", ST_FRACTION),
+            ("ST_ELAPSED", ST_ELAPSED),
+        ];
+        for (name, value) in words {
+            assert!(program.contains(&format!("const {name}: u32 = {value}u;")), "{name}");
+        }
+        let bits = [
+            ("HALT_OVERFLOW", HALT_OVERFLOW),
+            ("HALT_BLOWUP", HALT_BLOWUP),
+            ("HALT_SPAN", HALT_SPAN),
+            ("HALT_REACH", HALT_REACH),
+            ("HALT_EVENTS", HALT_EVENTS),
+            ("HALT_SOLVE", HALT_SOLVE),
+            ("HALT_FORMATION", HALT_FORMATION),
+            ("HALT_CONSTRAINT", HALT_CONSTRAINT),
+            ("HALT_CONVERGED", HALT_CONVERGED),
+        ];
+        for (name, value) in bits {
+            assert!(program.contains(&format!("const {name}: u32 = {value}u;")), "{name}");
+        }
+    }
 }

@@ -29,13 +29,14 @@
 //!
 //! Not with node–face contact between bodies: the CPU scales every move by
 //! the contact step clamp, computed on the device for the overdamped step
-//! only; nor with ramps or driven indenters (a minimisation takes no step).
+//! only. Protocols enter as their held axes alone (a minimisation takes no
+//! step, so nothing moves or ramps), as the CPU masks those forces.
 
 use wgpu::util::DeviceExt;
 
 use super::context::GpuContext;
 use super::side_group::SideGroup;
-use crate::integrate::fire::FireSettings;
+use crate::integrate::fire::{FireSettings, ALPHA0, DT_MAX_FACTOR};
 use crate::system::Model;
 
 /// `fire` entries before the per-workgroup partial sums.
@@ -72,8 +73,8 @@ impl DeviceFire {
         let n = model.len();
         let blocks = (n as u32).div_ceil(workgroup);
         let mut control = vec![[0f32; 4]; CONTROL_ENTRIES + blocks as usize];
-        control[0] = [dt as f32, 0.1, f32::from_bits(0), f32::from_bits(0)];
-        control[1] = [0.0, 0.0, dt as f32, (10.0 * dt) as f32];
+        control[0] = [dt as f32, ALPHA0 as f32, f32::from_bits(0), f32::from_bits(0)];
+        control[1] = [0.0, 0.0, dt as f32, (DT_MAX_FACTOR * dt) as f32];
         control[2] = [settings.ftol as f32, settings.dmax as f32, 0.0, f32::from_bits(blocks)];
         let device = &ctx.device;
         // wgpu zeroes a new buffer: the velocities start at rest.
@@ -102,5 +103,20 @@ impl DeviceFire {
     pub(super) fn iterations(bytes: &[u8]) -> u64 {
         let entry: [f32; 4] = bytemuck::pod_read_unaligned(&bytes[..16]);
         u64::from(entry[3].to_bits())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::integrate::fire::{ALPHA0, F_ALPHA, F_DEC, F_INC, N_MIN};
+
+    /// The kernels' FIRE parameters are the CPU's.
+    #[test]
+    fn the_shader_constants_match() {
+        let program = super::super::shader::compose();
+        assert!(program.contains(&format!("const FIRE_N_MIN: u32 = {N_MIN}u;")));
+        for (name, value) in [("F_INC", F_INC), ("F_DEC", F_DEC), ("ALPHA0", ALPHA0), ("F_ALPHA", F_ALPHA)] {
+            assert!(program.contains(&format!("const FIRE_{name}: f32 = {value:?};")), "FIRE_{name}");
+        }
     }
 }

@@ -44,7 +44,10 @@
 //! WGSL function `NAME_curvature` or `NAME_hessian`; `harmonic`,
 //! `soft_repulsion`, `lj`, `wca`, `wlc_bending`, `wall` and `constant_force`
 //! have one); models with body, contact or volume-element terms, custom
-//! terms or bond kinetics stay on the CPU with the reason.
+//! terms or bond kinetics stay on the CPU with the reason. `solver cholesky`
+//! does too: its decks take Newton steps (γ/dt = 1e-6 against stiffnesses
+//! of 10²–10⁵), which f32 conjugate gradients cannot solve to a direct
+//! solver's accuracy.
 //!
 //! # Constrained bonds
 //!
@@ -53,9 +56,7 @@
 //! 2001), each projection's S = JD⁻¹Jᵀ solved by an inner Jacobi-CG in the
 //! same workgroup where the CPU factorises it, and the constraint tensions
 //! −λ kept for the thermo (shaders/common/implicit_constraints.wgsl); the
-//! device's SHAKE (src/gpu/shake.rs) then projects as after every step. `solver cholesky` does too: its decks take Newton
-//! steps (γ/dt = 1e-6 against stiffnesses of 10²–10⁵), which f32 conjugate
-//! gradients cannot solve to a direct solver's accuracy.
+//! device's SHAKE (src/gpu/shake.rs) then projects as after every step.
 //!
 //! # Determinism and the read-back
 //!

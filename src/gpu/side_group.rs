@@ -1,6 +1,6 @@
 //! Kernels with buffers of their own in bind group 1, beside the backend's
-//! main group 0: the implicit step (src/gpu/implicit.rs) and the
-//! constraints' projection (src/gpu/shake.rs). One home for the check that
+//! main group 0: the implicit step (src/gpu/implicit.rs), the constraints'
+//! projection (src/gpu/shake.rs) and FIRE (src/gpu/fire.rs). One home for the check that
 //! the adapter can bind them, their bind group, and their pipelines compiled
 //! from the composed program (with the model's custom evaluators).
 

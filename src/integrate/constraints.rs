@@ -61,6 +61,11 @@ pub struct ConstraintFailure {
 }
 
 impl Constraints {
+    /// The particles of each constrained bond, in list order.
+    pub fn pairs(&self, model: &Model) -> Vec<[u32; 2]> {
+        self.list.iter().map(|c| model.bonds[c.bond]).collect()
+    }
+
     /// Projects `state` (just advanced from positions `before`) back onto the
     /// constraint lengths; the context's dt converts the corrections to tensions.
     pub fn project(

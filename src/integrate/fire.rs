@@ -29,6 +29,23 @@ use super::context::StepContext;
 use super::overdamped::clamp_fraction;
 use crate::system::{SimBox, State};
 
+/// FIRE's parameters (Bitzek et al. 2006), shared with the device's FIRE
+/// (src/gpu/fire.rs, shaders/common/fire.wgsl): positive steps before Δt
+/// grows, Δt's growth and cut factors, α's start and decay, and Δt's cap in
+/// units of Δt₀.
+pub const N_MIN: u32 = 5;
+pub const F_INC: f64 = 1.1;
+pub const F_DEC: f64 = 0.5;
+pub const ALPHA0: f64 = 0.1;
+pub const F_ALPHA: f64 = 0.99;
+pub const DT_MAX_FACTOR: f64 = 10.0;
+
+/// The residual FIRE converges on: the largest |F| over the particles of
+/// finite mass (a fixed particle's force is its anchor's reaction).
+pub fn max_residual_force(forces: &[DVec3], mass: &[f64]) -> f64 {
+    forces.iter().zip(mass).filter(|(_, m)| m.is_finite()).map(|(f, _)| f.length()).fold(0.0, f64::max)
+}
+
 /// Options of the deck `minimize` command.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FireSettings {
@@ -67,17 +84,12 @@ pub fn fire_minimize<E>(
     settings: &FireSettings,
     mut evaluate: impl FnMut(&State, &mut Vec<DVec3>, &mut Vec<f64>) -> Result<f64, E>,
 ) -> Result<FireReport, E> {
-    const N_MIN: u32 = 5;
-    const F_INC: f64 = 1.1;
-    const F_DEC: f64 = 0.5;
-    const ALPHA0: f64 = 0.1;
-    const F_ALPHA: f64 = 0.99;
     let n = state.len();
     let mut v = vec![DVec3::ZERO; n];
     let mut f = Vec::with_capacity(n);
     let (mut limits, mut moves) = (Vec::new(), vec![DVec3::ZERO; n]);
     let dt0 = ctx.dt;
-    let (mut dt, dt_max, mut alpha, mut positive_steps) = (dt0, 10.0 * dt0, ALPHA0, 0u32);
+    let (mut dt, dt_max, mut alpha, mut positive_steps) = (dt0, DT_MAX_FACTOR * dt0, ALPHA0, 0u32);
     let (mut iterations, mut clamped) = (0, 0);
     loop {
         limits.clear();
@@ -87,7 +99,7 @@ pub fn fire_minimize<E>(
                 *f = DVec3::ZERO;
             }
         }
-        let max_force = f.iter().map(|x| x.length()).fold(0.0, f64::max);
+        let max_force = max_residual_force(&f, mass);
         if max_force < settings.ftol || iterations >= settings.max_iterations {
             return Ok(FireReport { converged: max_force < settings.ftol, iterations, energy, max_force, clamped });
         }

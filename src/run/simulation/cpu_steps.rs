@@ -126,8 +126,7 @@ impl Simulation {
         let stiffness = backend.stiffness(&self.model, &self.state, &self.sim_box);
         let limited = backend.contact_step_limits(self.model.len(), &mut self.step_limits);
         let (model, forces, sim_box) = (&self.model, &self.forces.forces, &self.sim_box);
-        let mut constrained =
-            ConstrainedBonds { pairs: self.constraints.list.iter().map(|c| model.bonds[c.bond]).collect(), tension: Vec::new() };
+        let mut constrained = ConstrainedBonds { pairs: self.constraints.pairs(model), tension: Vec::new() };
         let outcome = implicit_step(
             model,
             &mut self.state,
@@ -184,10 +183,15 @@ impl Simulation {
         Ok(())
     }
 
+    /// FIRE's fictitious masses γ·Δt per particle (infinite for a fixed one).
+    pub(super) fn fire_masses(&self) -> Vec<f64> {
+        self.model.types.iter().map(|&t| self.model.type_drag[t as usize] * self.dt).collect()
+    }
+
     /// FIRE on the CPU backend, from current forces.
     fn minimize_on_cpu(&mut self, settings: &FireSettings) -> Result<FireReport, RunError> {
         let ctx = self.step_context();
-        let mass: Vec<f64> = self.model.types.iter().map(|&t| self.model.type_drag[t as usize] * ctx.dt).collect();
+        let mass = self.fire_masses();
         let mut state = self.state.clone();
         let backend = self.cpu.get(&self.model, &self.state, &self.sim_box, self.neighbor.skin)?;
         let (model, sim_box, forces, protocols) = (&self.model, &self.sim_box, &mut self.forces, &self.protocols);

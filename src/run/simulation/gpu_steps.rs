@@ -6,10 +6,13 @@ use super::Simulation;
 use crate::gpu::backend::StepSettings;
 use crate::gpu::protocol::{DeviceProtocol, HeldCoordinates};
 use crate::gpu::{DevicePreference, GpuBackend, GpuContext, GpuHalt};
-use crate::integrate::fire::{FireReport, FireSettings};
+use crate::integrate::fire::{max_residual_force, FireReport, FireSettings};
 use crate::integrate::Integrator;
 use crate::run::RunError;
 use crate::system::StepClock;
+
+/// Why custom surface terms of bodies keep a run (or a minimisation) on the CPU.
+const CUSTOM_SURFACE_TERMS: &str = "custom surface terms of bodies (`custom` body lines) run on the CPU backend only";
 
 /// The longest GPU segment between read-backs when no output is due.
 const GPU_SYNC_STEPS: u64 = 1000;
@@ -68,8 +71,7 @@ impl GpuSteps {
                     implicit.tolerance
                 ));
             }
-            let constrained: Vec<[u32; 2]> = sim.constraints.list.iter().map(|c| model.bonds[c.bond]).collect();
-            gpu.step_implicitly(context, model, &settings, implicit, &constrained).map_err(RunError::Setup)?;
+            gpu.step_implicitly(context, model, &settings, implicit, &sim.constraints.pairs(model)).map_err(RunError::Setup)?;
         }
         if !sim.constraints.list.is_empty() {
             // The constraints' projection on the device (src/gpu/shake.rs): f32 lengths have a tolerance floor.
@@ -270,14 +272,14 @@ impl Simulation {
         } else if let Some(why) = self.constraint_refusal() {
             Some(why)
         } else if self.model.has_cpu_only_surface_terms() {
-            Some("custom surface terms of bodies (`custom` body lines) run on the CPU backend only")
+            Some(CUSTOM_SURFACE_TERMS)
         } else {
             None
         }
     }
 
     /// The GPU backend's step settings: the step context and the neighbour list's.
-    fn step_settings(&self) -> StepSettings {
+    pub fn step_settings(&self) -> StepSettings {
         StepSettings {
             context: self.step_context(),
             skin: self.neighbor.skin,
@@ -297,7 +299,7 @@ impl Simulation {
             return Ok(None);
         }
         // Only what the forces or FIRE's moves need decides (not the integrator's or the constraints' refusals).
-        let custom = self.model.has_cpu_only_surface_terms().then_some("custom surface terms of bodies run on the CPU backend only");
+        let custom = self.model.has_cpu_only_surface_terms().then_some(CUSTOM_SURFACE_TERMS);
         if let Some(why) = crate::gpu::fire::refusal(&self.model).or(custom) {
             self.say(&format!("minimize on the CPU: {why}"));
             return Ok(None);
@@ -334,8 +336,7 @@ impl Simulation {
         self.ensure_forces()?;
         let mut forces = self.forces.forces.clone();
         self.protocols.mask(&mut forces);
-        let mobile = |i: &usize| self.model.type_drag[self.model.types[*i] as usize].is_finite();
-        let max_force = (0..forces.len()).filter(mobile).map(|i| forces[i].length()).fold(0.0, f64::max);
+        let max_force = max_residual_force(&forces, &self.fire_masses());
         let energy = self.forces.total_energy();
         Ok(Some(FireReport { converged: max_force < settings.ftol, iterations, energy, max_force, clamped: 0 }))
     }
