@@ -328,7 +328,8 @@ impl Simulation {
                     return Err(self.blowup(particle, "non-finite FIRE move on the GPU during minimisation".into()));
                 }
                 Err(GpuHalt::Capacity { message, .. }) => return Err(RunError::Setup(format!("device gpu: minimize: {message}"))),
-                Err(halt) => unreachable!("no contact search or `bind` in a device minimisation: {halt:?}"),
+                // No contact search or `bind` runs in a device minimisation; should one halt it, say so rather than panic.
+                Err(halt) => return Err(RunError::Setup(format!("device gpu: minimize stopped: {halt:?}"))),
             }
         }
         gpu.download(&mut self.state);
