@@ -24,11 +24,18 @@ ratio's growth, the band gain and the mid-half ratio's growth, asymmetric
 and symmetric, and of their paired difference. The README's table (*Collagen clustering study*) is its
 output. Needs numpy (`bash scripts/reference-venv`).
 
+A finished run leaves OUT/seedS_FIBRES/rows.json, and a second call with the
+same OUT and settings reads it instead of running again, so a long study can
+be stopped and resumed (or extended to more seeds). A run that cellmd stops
+(a blow-up) is reported with cellmd's message, and its realisation is left
+out of both columns, so the differences stay paired.
+
     python3 studies/collagen/asymmetry.py --cellmd target/release/cellmd --out out/collagen_asym --seeds 5 --steps 1000
 """
 
 import argparse
 import csv
+import json
 import math
 import sys
 from pathlib import Path
@@ -69,10 +76,33 @@ def paper_ratio(p):
     return p[first : first + PEAK].mean() / np.r_[p[:END], p[-END:]].mean()
 
 
+def settings(a):
+    """What a finished run's rows depend on: a stored run is reused only when these match."""
+    keys = ("steps", "stages", "bend", "dt", "density", "fibre_length", "node_spacing")
+    return {k: str(getattr(a, k)) for k in keys}
+
+
 def run(a, seed, fibres):
+    """The per-stage rows of one run (reused from rows.json when the
+    settings match), or None when cellmd stopped it."""
     name = f"seed{seed}_{fibres}"
     point = Path(a.out).resolve() / name
     point.mkdir(parents=True, exist_ok=True)
+    stored = point / "rows.json"
+    if stored.exists():
+        done = json.loads(stored.read_text())
+        if done["settings"] == settings(a):
+            return done["rows"]
+    try:
+        rows = simulate(a, seed, fibres, name, point)
+    except SystemExit as stop:  # run_command's exit: cellmd failed (a blow-up)
+        print(f"{name}: stopped, left out\n{stop}", flush=True)
+        return None
+    stored.write_text(json.dumps({"settings": settings(a), "rows": rows}))
+    return rows
+
+
+def simulate(a, seed, fibres, name, point):
     top = point / "collagen.top"
     network = NETWORK + ["--density", a.density, "--fibre-length", a.fibre_length, "--node-spacing", a.node_spacing]
     run_command([a.cellmd, "build", "collagen", *network, "--seed", seed, "-o", top])
@@ -110,17 +140,21 @@ def main():
     p.add_argument("--fibre-length", default="200")
     p.add_argument("--node-spacing", default="10")
     a = p.parse_args()
-    rows = [r for seed in range(1, a.seeds + 1) for fibres in FIBRES for r in run(a, seed, fibres)]
+    runs = {(seed, fibres): run(a, seed, fibres) for seed in range(1, a.seeds + 1) for fibres in FIBRES}
+    seeds = [s for s in range(1, a.seeds + 1) if all(runs[(s, f)] is not None for f in FIBRES)]
+    if len(seeds) < a.seeds:
+        print(f"left out (a run stopped): seeds {sorted(set(range(1, a.seeds + 1)) - set(seeds))}")
+    rows = [r for s in seeds for f in FIBRES for r in runs[(s, f)]]
     with open(Path(a.out) / "asymmetry.csv", "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=list(rows[0]))
         w.writeheader()
         w.writerows(rows)
     last = {(r["seed"], r["fibres"]): r for r in rows}
     first = {(r["seed"], r["fibres"]): r for r in rows if r["stage"] == 0}
-    growth = {f: [last[(s, f)]["paper"] - first[(s, f)]["paper"] for s in range(1, a.seeds + 1)] for f in FIBRES}
-    gain = {f: [last[(s, f)]["band_gain"] for s in range(1, a.seeds + 1)] for f in FIBRES}
-    mid = {f: [last[(s, f)]["mid_half"] - first[(s, f)]["mid_half"] for s in range(1, a.seeds + 1)] for f in FIBRES}
-    print(f"{a.seeds} realisations, {a.stages} stages × {a.steps} steps, K {a.bend}, dt {a.dt}: mean ± s.e.")
+    growth = {f: [last[(s, f)]["paper"] - first[(s, f)]["paper"] for s in seeds] for f in FIBRES}
+    gain = {f: [last[(s, f)]["band_gain"] for s in seeds] for f in FIBRES}
+    mid = {f: [last[(s, f)]["mid_half"] - first[(s, f)]["mid_half"] for s in seeds] for f in FIBRES}
+    print(f"{len(seeds)} realisations, {a.stages} stages × {a.steps} steps, K {a.bend}, dt {a.dt}: mean ± s.e.")
     for label, q in (("paper ratio growth", growth), ("band gain", gain), ("mid-half growth", mid)):
         diff = [x - y for x, y in zip(q["asymmetric"], q["symmetric"])]
         print(f"  {label}: asymmetric {mean_se(q['asymmetric'])}, symmetric {mean_se(q['symmetric'])}, difference {mean_se(diff)}")
