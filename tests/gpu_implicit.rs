@@ -160,21 +160,70 @@ fn the_same_implicit_gpu_run_twice_gives_the_same_bits() {
     assert!(moved > 1e-3, "nothing moved: {moved:e}");
 }
 
-/// A solver the device does not have, or a law without a device stiffness
-/// block, is refused with the reason.
+/// A law without a device stiffness block is refused with the reason.
 #[test]
 fn implicit_decks_the_device_cannot_solve_are_refused_with_the_reason() {
     let case = filament(1, 0.0);
-    let deck = std::fs::read_to_string(case.path("deck.in")).unwrap();
-    std::fs::write(case.path("deck.in"), deck.replace("integrator implicit", "integrator implicit solver cholesky")).unwrap();
     let options = RunOptions { output_dir: case.output_dir().to_path_buf(), device: Some(DevicePreference::Gpu), ..Default::default() };
-    let refused = Simulation::execute(case.plan(), options.clone()).err().map(|e| e.to_string()).unwrap_or_default();
-    assert!(refused.contains("solver cholesky` runs on the CPU backend only"), "{refused}");
     let ff = std::fs::read_to_string(case.path("f.ff")).unwrap();
     std::fs::write(case.path("f.ff"), ff.replace("harmonic k 2000 r0 0.31", "fene K 30 R0 1.5 epsilon 0 sigma 1")).unwrap();
-    std::fs::write(case.path("deck.in"), deck).unwrap();
     let refused = Simulation::execute(case.plan(), options).err().map(|e| e.to_string()).unwrap_or_default();
     assert!(refused.contains("has no GPU stiffness block"), "{refused}");
+}
+
+/// `solver cholesky` on the device: `inputs/force_dipole.in` (8 quasi-static
+/// Newton steps at γ/dt = 1e-6 pN/µm) on a diluted lattice of radius 10 µm,
+/// solved by the device's f32 CG. Its end state is the CPU's equilibrium:
+/// the CPU's f64 forces there are at most what the device cannot resolve,
+/// 6·k·a·ε_f32 (each bond's force rounds its separation a = 1 µm to f32, an
+/// error k·a·ε_f32 with the links' k = 100 pN/µm; up to 6 bonds a node),
+/// and, the lattice being linear at these strains, the positions agree with
+/// the CPU's Cholesky run within that force relative to the dipole's, times
+/// the largest displacement the dipole causes.
+#[test]
+fn newton_steps_of_a_cholesky_deck_reach_the_cpu_equilibrium_on_the_gpu() {
+    let args = cellmd::build::LatticeArgs {
+        radius: 10.0,
+        spacing: 1.0,
+        bond_probability: 0.8,
+        bending: true,
+        dipole: true,
+        common: cellmd::build::Common { seed: 1, output: "lattice.top".into(), rest_from_geometry: false },
+        ..Default::default()
+    };
+    let built = cellmd::build::lattice(&args).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let top = dir.path().join("lattice.top");
+    std::fs::write(&top, &built.text).unwrap();
+    let vars = [("topology".to_string(), top.display().to_string())];
+    let plan = cellmd::deck::validate_file(std::path::Path::new("inputs/force_dipole.in"), &vars).unwrap_or_else(|e| panic!("{e}"));
+    let start = plan.positions.clone();
+    let run_on = |device| {
+        let options = RunOptions { output_dir: dir.path().to_path_buf(), device: Some(device), ..Default::default() };
+        Simulation::execute(plan.clone(), options).unwrap_or_else(|e| panic!("{device:?}: {e}"))
+    };
+    let (cpu, gpu) = (run_on(DevicePreference::Cpu), run_on(DevicePreference::Gpu));
+    let model = &plan.model;
+    let mut backend = CpuBackend::new(model, &gpu.state, &plan.sim_box, 0.0).unwrap();
+    let mut forces = Forces::default();
+    backend.compute(model, &gpu.state, &plan.sim_box, &mut forces);
+    let free: Vec<usize> = (0..model.len()).filter(|&i| model.type_drag[model.types[i] as usize].is_finite()).collect();
+    let residual = free.iter().map(|&i| forces.forces[i].length()).fold(0.0, f64::max);
+    // fibre_lattice.ff: links k 100 r0 1 (built at length 1), the dipole k 1 r0 0 (built at length 2).
+    let length = |x: &[DVec3], [i, j]: [u32; 2]| (x[j as usize] - x[i as usize]).length();
+    let dipole = model.bonds.iter().find(|&&b| length(&start, b) > 1.5).map(|&b| length(&gpu.state.positions, b)).unwrap();
+    let moved = cpu.state.positions.iter().zip(&start).map(|(x, y)| (*x - *y).length()).fold(0.0, f64::max);
+    let apart = cpu.state.positions.iter().zip(&gpu.state.positions).map(|(x, y)| (*x - *y).length()).fold(0.0, f64::max);
+    let residual_bound = 6.0 * 100.0 * 1.0 * f32::EPSILON as f64;
+    println!(
+        "dipole {dipole:.4} pN, moved {moved:.4e} µm; GPU end: f64 residual {residual:.3e} pN (bound {residual_bound:.3e}), \
+         GPU − CPU {apart:.3e} µm; iterations GPU {} CPU {}",
+        gpu.last_solve.iterations, cpu.last_solve.iterations
+    );
+    assert!(moved > 1e-3, "the dipole moved nothing: {moved:e}");
+    assert!(residual <= residual_bound, "the GPU's end state is not an equilibrium: |F| {residual:e} > {residual_bound:e}");
+    let bound = residual_bound / dipole * moved;
+    assert!(apart <= bound, "GPU − CPU {apart:e} µm > {bound:e}");
 }
 
 /// Wall-clock time of `inputs/buckling_filament.in` (1500 implicit steps) on

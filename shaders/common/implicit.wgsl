@@ -400,12 +400,12 @@ fn implicit_solve(@builtin(local_invocation_index) local: u32) {
         return;
     }
     let n = P.n;
-    // The explicit step as the first guess: Δx = b·dt/γ.
+    // The Jacobi step as the first guess, Δx = D⁻¹b, as on the CPU (0 where b is:
+    // fixed particles and held coordinates).
     for (var i = local; i < n; i += WORKGROUP) {
         let b = implicit_rhs(i);
-        let drag = imp_drag(i);
         imp[n * VEC_R + i] = vec4<f32>(b, 0.0);
-        imp[n * VEC_X + i] = vec4<f32>(select(b / drag, vec3<f32>(0.0), drag == 0.0), 0.0);
+        imp[n * VEC_X + i] = vec4<f32>(imp[n * VEC_DINV + i].xyz * b, 0.0);
     }
     storageBarrier();
     var sums = vec3<f32>(0.0);

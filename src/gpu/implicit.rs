@@ -8,8 +8,8 @@
 //! (γ/dt·I + K̃)·Δx = F(x) + √(2·kT·γ/dt)·ξ,   x ← x + Δx,
 //!
 //! with K̃ the energy Hessian made positive semi-definite term by term, by
-//! conjugate gradients with a Jacobi preconditioner from the explicit step
-//! Δx₀ = b·dt/γ, to the relative residual |b − AΔx|/|b| ≤ tolerance, as
+//! conjugate gradients with a Jacobi preconditioner D⁻¹ from the Jacobi step
+//! Δx₀ = D⁻¹b, to the relative residual |b − AΔx|/|b| ≤ tolerance, as
 //! faer's CG does on the CPU. The blocks are the CPU's
 //! (src/backend/stiffness.rs), computed on the device in f32 after the
 //! force pass of each step:
@@ -44,10 +44,15 @@
 //! WGSL function `NAME_curvature` or `NAME_hessian`; `harmonic`,
 //! `soft_repulsion`, `lj`, `wca`, `wlc_bending`, `wall` and `constant_force`
 //! have one); models with body, contact or volume-element terms, custom
-//! terms or bond kinetics stay on the CPU with the reason. `solver cholesky`
-//! does too: its decks take Newton steps (γ/dt = 1e-6 against stiffnesses
-//! of 10²–10⁵), which f32 conjugate gradients cannot solve to a direct
-//! solver's accuracy.
+//! terms or bond kinetics stay on the CPU with the reason.
+//!
+//! `solver cholesky` has no device form: its decks take quasi-static Newton
+//! steps (γ/dt = 1e-6 against stiffnesses of 10²–10⁵), and the device
+//! solves them by the same f32 CG, saying so in the log. From the Jacobi
+//! first guess CG reaches the Newton step (on the CPU to 1e-12 of the
+//! Cholesky step: tests/implicit.rs), so a stage relaxes to the same
+//! equilibrium within the f32 rounding of the forces (tests/gpu_implicit.rs,
+//! the force dipole).
 //!
 //! # Constrained bonds
 //!
@@ -91,7 +96,7 @@ use super::context::GpuContext;
 use super::pack::push_csr;
 use super::shader;
 use super::side_group::SideGroup;
-use crate::integrate::implicit::{ImplicitSettings, LinearSolver, SolveReport};
+use crate::integrate::implicit::{ImplicitSettings, SolveReport};
 use crate::interactions::{Law, REGISTRY};
 use crate::system::Model;
 
@@ -112,13 +117,7 @@ const CONSTRAINT_VEC4: usize = 3;
 const J_END: u32 = 0x8000_0000;
 
 /// Why the model's implicit step cannot run on the device (None: it can).
-pub fn refusal(model: &Model, implicit: &ImplicitSettings) -> Option<&'static str> {
-    if implicit.solver == LinearSolver::Cholesky {
-        return Some(
-            "`integrator implicit solver cholesky` runs on the CPU backend only (the GPU solves by f32 conjugate gradients, \
-             which cannot reach a direct solve's accuracy)",
-        );
-    }
+pub fn refusal(model: &Model) -> Option<&'static str> {
     if model.has_kinetics() {
         return Some("bond kinetics with `integrator implicit` run on the CPU backend only");
     }
@@ -205,7 +204,7 @@ impl ImplicitSolver {
         implicit: &ImplicitSettings,
         constrained: &[[u32; 2]],
     ) -> Result<Self, String> {
-        if let Some(why) = refusal(model, implicit) {
+        if let Some(why) = refusal(model) {
             return Err(why.into());
         }
         let n = model.len();

@@ -13,9 +13,15 @@
 //! while the error per step stays O(dt²) as for the explicit step.
 //!
 //! The system is symmetric positive definite and is solved by faer's
-//! conjugate gradients with a Jacobi preconditioner (`solver cg`, the
+//! conjugate gradients with a Jacobi preconditioner D⁻¹ (`solver cg`, the
 //! default; relative residual `tolerance`, at most `max_iterations`), or by a
-//! sparse Cholesky factorisation (`solver cholesky`). A `fixed` particle
+//! sparse Cholesky factorisation (`solver cholesky`). CG starts from the
+//! Jacobi step Δx₀ = D⁻¹b: the explicit step b·dt/γ where K̃ is small
+//! against γ/dt, and well scaled at any dt. (The explicit step itself is not:
+//! at the quasi-static γ/dt = 1e-6 of the Hertz decks it starts 10¹³ µm from
+//! the answer, and CG's relative residual cannot recover the 10¹⁻² µm step
+//! under that cancellation; measured on `inputs/hertz_block.in`: a node moved
+//! 10.2 µm where the Cholesky step moves it < 1 µm.) A `fixed` particle
 //! (infinite drag) has Δx = 0: its row is the identity and its couplings are
 //! dropped; so has a held coordinate (`freeze`, `move`: the protocols put it
 //! back after the step), so the solve moves the free coordinates as the
@@ -118,7 +124,6 @@ pub fn implicit_step(
     let drag: Vec<f64> = (0..n).map(gamma).collect();
     let matrix = SystemMatrix::new(&drag, held, dt, stiffness).map_err(ImplicitError::Solve)?;
     let mut rhs = Col::<f64>::zeros(dim);
-    let mut guess = Mat::<f64>::zeros(dim, 1);
     for i in (0..n).filter(|&i| !fixed(i)) {
         let mut b = forces[i];
         if kt > 0.0 {
@@ -126,9 +131,10 @@ pub fn implicit_step(
         }
         for a in (0..3).filter(|&a| !held.get(3 * i + a).copied().unwrap_or(false)) {
             rhs[3 * i + a] = b[a];
-            guess[(3 * i + a, 0)] = b[a] * dt / gamma(i); // the explicit step
         }
     }
+    let diagonal = matrix.diagonal();
+    let mut guess = Mat::<f64>::from_fn(dim, 1, |k, _| rhs[k] / diagonal[k]); // the Jacobi step D⁻¹b
     let report = match implicit.solver {
         _ if !constrained.pairs.is_empty() => {
             let mobile: Vec<bool> = (0..n).map(|i| !fixed(i)).collect();
@@ -143,8 +149,8 @@ pub fn implicit_step(
             SolveReport { iterations: 1, relative_residual: relative_residual(&matrix, &guess, &rhs), step_fraction: 1.0 }
         }
         LinearSolver::Cg => {
-            let diagonal: Col<f64> = matrix.diagonal().iter().map(|d| 1.0 / d).collect();
-            let precond = diagonal.as_diagonal();
+            let inverse: Col<f64> = diagonal.iter().map(|d| 1.0 / d).collect();
+            let precond = inverse.as_diagonal();
             let params = CgParams {
                 initial_guess: InitialGuessStatus::MaybeNonZero,
                 abs_tolerance: 0.0,
