@@ -432,8 +432,8 @@ fn hertz_block_study() {
 }
 
 /// Volume elements are no CPU-only feature (GPU parity: `tests/gpu.rs`,
-/// `a_squeezed_ball_runs_on_the_gpu_like_on_the_cpu`); the hertz decks stay
-/// on the CPU for their implicit integrator.
+/// `a_squeezed_ball_runs_on_the_gpu_like_on_the_cpu`; their implicit blocks:
+/// `tests/gpu_implicit.rs`).
 #[test]
 fn volume_elements_may_run_on_the_gpu() {
     let dir = tempfile::tempdir().unwrap();

@@ -6,6 +6,8 @@
 //   1. `implicit_angles` (one invocation per angle): the angle's exact 9×9
 //      Hessian from its law's `NAME_hessian`, projected onto its positive
 //      semi-definite part (cyclic Jacobi), as the CPU's blocks.
+//   1b. `implicit_tetras` (one invocation per volume element): its exact
+//      12×12 Hessian from its law's `NAME_tetra_hessian`, projected likewise.
 //   2. `implicit_blocks` (one per particle): the projected radial block of
 //      each of its bond ends and the Hessian of each of its externals, and
 //      the Jacobi diagonal from them and its angles' diagonal blocks.
@@ -33,6 +35,7 @@ const IMP_V_BONDS: u32 = 8u;        // `imp` entry of the bond-end blocks (2 per
 const IMP_V_EXTERNALS: u32 = 9u;    // … of the external blocks (2 per external entry)
 const IMP_V_ANGLES: u32 = 10u;      // … of the angle blocks (21 per angle)
 const IMP_V_REPORT: u32 = 11u;      // … of the last solve's report
+const IMP_V_TETRAS: u32 = 17u;      // … of the volume elements' blocks (36 per element)
 
 // Per-particle vectors of `imp`: section s of particle i is imp[s·n + i].
 const VEC_X: u32 = 0u;    // Δx
@@ -42,6 +45,9 @@ const VEC_P: u32 = 3u;    // search direction
 const VEC_Q: u32 = 4u;    // A·p
 const VEC_DINV: u32 = 5u; // inverse Jacobi diagonal
 const ANGLE_VEC4: u32 = 21u;
+const TETRA_VEC4: u32 = 36u;
+// Row stride of the matrices `project_psd` works on.
+const PSD_STRIDE: u32 = 12u;
 
 // The solve did not converge (status word ST_HALTED).
 const HALT_SOLVE: u32 = 32u;
@@ -65,24 +71,25 @@ fn put_block(h: ptr<function, array<f32, 81>>, rb: u32, cb: u32, m: mat3x3<f32>)
 }
 
 // The positive semi-definite part Σ max(λ, 0)·v vᵀ of the symmetric
-// leading dim×dim block of a row-major 9×9 matrix (cyclic Jacobi rotations,
+// leading dim×dim block of a row-major 12×12 matrix (an angle's 9×9, a volume
+// element's 12×12) (cyclic Jacobi rotations,
 // Numerical Recipes §11.1, until the off-diagonal mass is below 1e-14 of the
 // whole); left as it is when no eigenvalue is negative, as on the CPU.
-fn project_psd(h: ptr<function, array<f32, 81>>, dim: u32) {
+fn project_psd(h: ptr<function, array<f32, 144>>, dim: u32) {
     var a = *h;
-    var v: array<f32, 81>;
+    var v: array<f32, 144>;
     var whole = 0.0;
     for (var k = 0u; k < dim; k++) {
-        v[k * 9u + k] = 1.0;
+        v[k * PSD_STRIDE + k] = 1.0;
         for (var l = 0u; l < dim; l++) {
-            whole += a[k * 9u + l] * a[k * 9u + l];
+            whole += a[k * PSD_STRIDE + l] * a[k * PSD_STRIDE + l];
         }
     }
     for (var sweep = 0u; sweep < 16u; sweep++) {
         var off = 0.0;
         for (var p = 0u; p < dim; p++) {
             for (var q = p + 1u; q < dim; q++) {
-                off += a[p * 9u + q] * a[p * 9u + q];
+                off += a[p * PSD_STRIDE + q] * a[p * PSD_STRIDE + q];
             }
         }
         if !(off > 1e-14 * whole) {
@@ -90,11 +97,11 @@ fn project_psd(h: ptr<function, array<f32, 81>>, dim: u32) {
         }
         for (var p = 0u; p < dim; p++) {
             for (var q = p + 1u; q < dim; q++) {
-                let apq = a[p * 9u + q];
+                let apq = a[p * PSD_STRIDE + q];
                 if apq == 0.0 {
                     continue;
                 }
-                let theta = (a[q * 9u + q] - a[p * 9u + p]) / (2.0 * apq);
+                let theta = (a[q * PSD_STRIDE + q] - a[p * PSD_STRIDE + p]) / (2.0 * apq);
                 let direction = select(1.0, -1.0, theta < 0.0);
                 var t = direction / (abs(theta) + sqrt(theta * theta + 1.0));
                 if abs(theta) > 1e18 {
@@ -103,29 +110,29 @@ fn project_psd(h: ptr<function, array<f32, 81>>, dim: u32) {
                 let c = 1.0 / sqrt(t * t + 1.0);
                 let s = t * c;
                 for (var k = 0u; k < dim; k++) {
-                    let kp = a[k * 9u + p];
-                    let kq = a[k * 9u + q];
-                    a[k * 9u + p] = c * kp - s * kq;
-                    a[k * 9u + q] = s * kp + c * kq;
+                    let kp = a[k * PSD_STRIDE + p];
+                    let kq = a[k * PSD_STRIDE + q];
+                    a[k * PSD_STRIDE + p] = c * kp - s * kq;
+                    a[k * PSD_STRIDE + q] = s * kp + c * kq;
                 }
                 for (var k = 0u; k < dim; k++) {
-                    let pk = a[p * 9u + k];
-                    let qk = a[q * 9u + k];
-                    a[p * 9u + k] = c * pk - s * qk;
-                    a[q * 9u + k] = s * pk + c * qk;
+                    let pk = a[p * PSD_STRIDE + k];
+                    let qk = a[q * PSD_STRIDE + k];
+                    a[p * PSD_STRIDE + k] = c * pk - s * qk;
+                    a[q * PSD_STRIDE + k] = s * pk + c * qk;
                 }
                 for (var k = 0u; k < dim; k++) {
-                    let kp = v[k * 9u + p];
-                    let kq = v[k * 9u + q];
-                    v[k * 9u + p] = c * kp - s * kq;
-                    v[k * 9u + q] = s * kp + c * kq;
+                    let kp = v[k * PSD_STRIDE + p];
+                    let kq = v[k * PSD_STRIDE + q];
+                    v[k * PSD_STRIDE + p] = c * kp - s * kq;
+                    v[k * PSD_STRIDE + q] = s * kp + c * kq;
                 }
             }
         }
     }
     var negative = false;
     for (var e = 0u; e < dim; e++) {
-        negative = negative || a[e * 9u + e] < 0.0;
+        negative = negative || a[e * PSD_STRIDE + e] < 0.0;
     }
     if !negative {
         return;
@@ -134,9 +141,9 @@ fn project_psd(h: ptr<function, array<f32, 81>>, dim: u32) {
         for (var c = 0u; c < dim; c++) {
             var sum = 0.0;
             for (var e = 0u; e < dim; e++) {
-                sum += max(a[e * 9u + e], 0.0) * v[r * 9u + e] * v[c * 9u + e];
+                sum += max(a[e * PSD_STRIDE + e], 0.0) * v[r * PSD_STRIDE + e] * v[c * PSD_STRIDE + e];
             }
-            (*h)[r * 9u + c] = sum;
+            (*h)[r * PSD_STRIDE + c] = sum;
         }
     }
 }
@@ -179,13 +186,78 @@ fn implicit_angles(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocati
     // The vertex j at the origin, i and k at their minimum images (as the force pass).
     let ri = separation(pj, imp_topo[rec]);
     let rk = separation(pj, imp_topo[rec + 2u]);
-    var h = three_body_hessian(topo[P.off_term_kind + term], term_params(term), ri, vec3<f32>(0.0), rk);
+    let hessian = three_body_hessian(topo[P.off_term_kind + term], term_params(term), ri, vec3<f32>(0.0), rk);
+    var h: array<f32, 144>;
+    for (var r = 0u; r < 9u; r++) {
+        for (var c = 0u; c < 9u; c++) {
+            h[r * PSD_STRIDE + c] = hessian[r * 9u + c];
+        }
+    }
     project_psd(&h, 9u);
+    var packed: array<f32, 84>;
+    for (var r = 0u; r < 9u; r++) {
+        for (var c = 0u; c < 9u; c++) {
+            packed[r * 9u + c] = h[r * PSD_STRIDE + c];
+        }
+    }
     let base = imp_topo[IMP_V_ANGLES] + ANGLE_VEC4 * a;
-    for (var k = 0u; k < 20u; k++) {
+    for (var k = 0u; k < ANGLE_VEC4; k++) {
+        imp[base + k] = vec4<f32>(packed[4u * k], packed[4u * k + 1u], packed[4u * k + 2u], packed[4u * k + 3u]);
+    }
+}
+
+// Entry f of volume element e's row-major 12×12 block.
+fn tetra_entry(e: u32, f: u32) -> f32 {
+    return imp[imp_topo[IMP_V_TETRAS] + TETRA_VEC4 * e + f / 4u][f % 4u];
+}
+
+// One invocation per volume element: its exact 12×12 Hessian
+// V_0·Σ_AB g_c[A]·g_d[B]·∂²W/∂F_αA∂F_βB (g_k the row k − 1 of D_m⁻¹ for
+// corners k = 1–3, g_0 = −(g_1 + g_2 + g_3): ∂F_αA/∂x_kα = g_k[A]), with
+// ∂²W/∂F∂F from the law's `NAME_tetra_hessian`, projected onto its positive
+// semi-definite part as the angles' (the CPU takes the same Hessian by
+// central differences of the element's forces). An element turned inside out
+// (J ≤ 0) has no block: its forces stop the run first.
+@compute @workgroup_size(256)
+fn implicit_tetras(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    let e = linear_index(wg, local);
+    if e >= P.n_tetras || halted() {
+        return;
+    }
+    let shape = tetra_shape(e);
+    var h: array<f32, 144>;
+    if shape.j > 0.0 {
+        let c = tetra_hessian(topo[P.off_term_kind + shape.term], term_params(shape.term), shape.f, shape.j, shape.cofactor * (1.0 / shape.j));
+        let rows = transpose(shape.dm_inv);
+        let g = array<vec3<f32>, 4>(-(rows[0] + rows[1] + rows[2]), rows[0], rows[1], rows[2]);
+        for (var k = 0u; k < 4u; k++) {
+            for (var al = 0u; al < 3u; al++) {
+                for (var l = 0u; l < 4u; l++) {
+                    for (var be = 0u; be < 3u; be++) {
+                        var sum = 0.0;
+                        for (var a = 0u; a < 3u; a++) {
+                            for (var b = 0u; b < 3u; b++) {
+                                sum += g[k][a] * g[l][b] * c[(3u * a + al) * 9u + 3u * b + be];
+                            }
+                        }
+                        h[(3u * k + al) * PSD_STRIDE + 3u * l + be] = shape.v0 * sum;
+                    }
+                }
+            }
+        }
+        project_psd(&h, 12u);
+    }
+    let base = imp_topo[IMP_V_TETRAS] + TETRA_VEC4 * e;
+    for (var k = 0u; k < TETRA_VEC4; k++) {
         imp[base + k] = vec4<f32>(h[4u * k], h[4u * k + 1u], h[4u * k + 2u], h[4u * k + 3u]);
     }
-    imp[base + 20u] = vec4<f32>(h[80], 0.0, 0.0, 0.0);
+}
+
+// Particle i's volume-element slots (the forces' node → (element, corner)
+// CSR, ascending element): element and corner of slot s.
+fn tetra_slot(s: u32) -> vec2<u32> {
+    let slot = topo[P.off_tetra_slots + s] - P.tetra_surf_base;
+    return vec2<u32>(slot / 4u, slot % 4u);
 }
 
 // The projected block of a radial term along d (as src/backend/stiffness.rs):
@@ -289,6 +361,13 @@ fn implicit_blocks(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocati
             diagonal[m] += angle_entry(a, (3u * role + m) * 10u);
         }
     }
+    let tetras_end = topo[P.off_tetra_slot_offsets + i + 1u];
+    for (var s = topo[P.off_tetra_slot_offsets + i]; s < tetras_end; s++) {
+        let slot = tetra_slot(s);
+        for (var m = 0u; m < 3u; m++) {
+            diagonal[m] += tetra_entry(slot.x, (3u * slot.y + m) * 13u);
+        }
+    }
     diagonal += pair_rows(i, VEC_X, vec3<f32>(0.0), true);
     // A held coordinate (`freeze`, `move`): the identity row.
     imp[dinv] = vec4<f32>(select(vec3<f32>(1.0), 1.0 / diagonal, free_axes(i) != vec3<f32>(0.0)), 0.0);
@@ -299,7 +378,7 @@ fn imp_vec(section: u32, i: u32) -> vec3<f32> {
 }
 
 // (A·v)_i for the vector in `section`: γ/dt·v_i plus particle i's rows of its
-// bond ends, externals, angles and pairs, in that order (a fixed particle, and a
+// bond ends, externals, angles, volume elements and pairs, in that order (a fixed particle, and a
 // held coordinate of `freeze` or `move`: v_i). Their entries of every vector
 // the solve forms are 0, so their couplings drop out as in the CPU's matrix.
 fn apply_row(i: u32, section: u32) -> vec3<f32> {
@@ -328,6 +407,18 @@ fn apply_row(i: u32, section: u32) -> vec3<f32> {
             for (var m = 0u; m < 3u; m++) {
                 let row = (3u * role + m) * 9u + 3u * c;
                 out[m] += angle_entry(a, row) * vc.x + angle_entry(a, row + 1u) * vc.y + angle_entry(a, row + 2u) * vc.z;
+            }
+        }
+    }
+    let tetras_end = topo[P.off_tetra_slot_offsets + i + 1u];
+    for (var s = topo[P.off_tetra_slot_offsets + i]; s < tetras_end; s++) {
+        let slot = tetra_slot(s);
+        let rec = P.off_tetras + TETRA_WORDS * slot.x;
+        for (var c = 0u; c < 4u; c++) {
+            let vc = imp_vec(section, topo[rec + c]);
+            for (var m = 0u; m < 3u; m++) {
+                let row = (3u * slot.y + m) * 12u + 3u * c;
+                out[m] += tetra_entry(slot.x, row) * vc.x + tetra_entry(slot.x, row + 1u) * vc.y + tetra_entry(slot.x, row + 2u) * vc.z;
             }
         }
     }

@@ -946,6 +946,9 @@ impl GpuBackend {
             // The implicit step in place of `integrate` (src/gpu/implicit.rs).
             Some(solver) => {
                 let mut passes = vec![(&solver.blocks, particles), (&solver.solve, Over::Groups(1)), (&solver.moves, particles)];
+                if solver.tetra_groups(WORKGROUP) > 0 {
+                    passes.insert(0, (&solver.tetras, Over::Groups(solver.tetra_groups(WORKGROUP))));
+                }
                 if solver.angle_groups(WORKGROUP) > 0 {
                     passes.insert(0, (&solver.angles, Over::Groups(solver.angle_groups(WORKGROUP))));
                 }
@@ -1064,6 +1067,9 @@ impl GpuBackend {
                 pass.set_bind_group(1, &solver.group, &[]);
                 if solver.angle_groups(WORKGROUP) > 0 {
                     self.dispatch(pass, &solver.angles, Over::Groups(solver.angle_groups(WORKGROUP)));
+                }
+                if solver.tetra_groups(WORKGROUP) > 0 {
+                    self.dispatch(pass, &solver.tetras, Over::Groups(solver.tetra_groups(WORKGROUP)));
                 }
                 self.dispatch(pass, &solver.blocks, Over::Particles);
                 self.dispatch(pass, &solver.solve, Over::Groups(1));

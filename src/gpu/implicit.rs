@@ -25,7 +25,14 @@
 //!   differ by the f32 rounding only.
 //! - **Externals**: the law's 3×3 Hessian (`NAME_hessian`), positive
 //!   semi-definite as written (a wall's k·n̂n̂ᵀ inside it, 0 for a constant
-//!   force).
+//!   force) or its positive part written out (an indenter's 2K(R − r)·ûûᵀ,
+//!   without the negative transverse −K(R − r)²/r the CPU's projection drops).
+//! - **Volume elements**: the element's exact 12×12 Hessian
+//!   V_0·Σ_AB g_c[A]·g_d[B]·∂²W/∂F_αA∂F_βB (g_k the rows of D_m⁻¹, g_0 their
+//!   negative sum), with ∂²W/∂F∂F from the law's `NAME_tetra_hessian`,
+//!   projected like the angles' (kernel `implicit_tetras`; the CPU takes it
+//!   by central differences of the element's forces); each product gathers a
+//!   particle's rows through the forces' node → (element, corner) slots.
 //! - **Pairs**: the bonds' radial block for every rule between two
 //!   neighbours (and, weighted, fractional `special_bonds` partners),
 //!   computed again from the positions at each product K̃·v from the
@@ -40,10 +47,11 @@
 //!
 //! # Which models ([`refusal`])
 //!
-//! Every bond, angle, pair and external law must have its device block (a
-//! WGSL function `NAME_curvature` or `NAME_hessian`; `harmonic`,
-//! `soft_repulsion`, `lj`, `wca`, `wlc_bending`, `wall` and `constant_force`
-//! have one); models with body, contact or volume-element terms, custom
+//! Every bond, angle, pair, external and volume-element law must have its
+//! device block (a WGSL function `NAME_curvature`, `NAME_hessian` or
+//! `NAME_tetra_hessian`; `harmonic`, `soft_repulsion`, `lj`, `wca`,
+//! `wlc_bending`, `wall`, `indenter`, `constant_force`, `neo_hookean` and
+//! `linear_elastic` have one); models with body or contact terms, custom
 //! terms or bond kinetics stay on the CPU with the reason.
 //!
 //! `solver cholesky` has no device form: its decks take quasi-static Newton
@@ -105,11 +113,13 @@ use crate::system::Model;
 /// decks' systems, ~10³, leaves a margin of ten).
 pub const F32_TOLERANCE: f64 = 1e-6;
 
-const HEADER_WORDS: usize = 17;
+const HEADER_WORDS: usize = 18;
 /// `imp` entries per particle (Δx, r, z, p, A·p, the Jacobi diagonal).
 const PARTICLE_VECTORS: usize = 6;
 /// `imp` entries of an angle's 9×9 block.
 const ANGLE_VEC4: usize = 21;
+/// `imp` entries of a volume element's 12×12 block.
+const TETRA_VEC4: usize = 36;
 /// `imp` entries of a constraint (û and its flag; μ, r, p, q of the inner
 /// CG; its z, S's inverse diagonal and its tension).
 const CONSTRAINT_VEC4: usize = 3;
@@ -121,17 +131,20 @@ pub fn refusal(model: &Model) -> Option<&'static str> {
     if model.has_kinetics() {
         return Some("bond kinetics with `integrator implicit` run on the CPU backend only");
     }
-    if !model.body_rules.is_empty() || !model.tetras.is_empty() || model.has_contact_terms() {
+    if !model.body_rules.is_empty() || model.has_contact_terms() {
         return Some(
-            "`integrator implicit` with body, contact or volume-element terms runs on the CPU backend only \
-             (the GPU has stiffness blocks for bonds, angles, pairs and externals)",
+            "`integrator implicit` with body or contact terms runs on the CPU backend only \
+             (the GPU has stiffness blocks for bonds, angles, pairs, externals and volume elements)",
         );
     }
     let kinds = super::custom::gpu_kinds(model);
-    if !kinds.iter().all(|&k| REGISTRY.get(k as usize).is_some_and(|i| stiffness_function(*i).is_some())) {
+    let tetras = model.tetra_types.iter().map(|t| t.term().interaction);
+    if !kinds.iter().all(|&k| REGISTRY.get(k as usize).is_some_and(|i| stiffness_function(*i).is_some()))
+        || !tetras.into_iter().all(|i| stiffness_function(i).is_some())
+    {
         return Some(
-            "`integrator implicit` with a bond, angle, pair or external law that has no GPU stiffness block runs on the CPU backend only \
-             (harmonic, soft_repulsion, lj, wca, wlc_bending, wall and constant_force have one)",
+            "`integrator implicit` with a bond, angle, pair, external or volume-element law that has no GPU stiffness block runs on the CPU backend only \
+             (harmonic, soft_repulsion, lj, wca, wlc_bending, wall, indenter, constant_force, neo_hookean and linear_elastic have one)",
         );
     }
     None
@@ -145,13 +158,14 @@ fn stiffness_function(interaction: &dyn crate::interactions::Interaction) -> Opt
     let function = match interaction.law() {
         Law::Radial { .. } => format!("{name}_curvature"),
         Law::ThreeBody(_) | Law::OneBody(_) => format!("{name}_hessian"),
+        Law::Tetra(_) => format!("{name}_tetra_hessian"),
         _ => return None,
     };
     shader::interaction_source(name).filter(|s| s.contains(&format!("fn {function}("))).map(|_| function)
 }
 
 /// The stiffness dispatch functions over the registry: `radial_curvature`,
-/// `three_body_hessian` and `one_body_hessian` (0 for laws without one,
+/// `three_body_hessian`, `one_body_hessian` and `tetra_hessian` (0 for laws without one,
 /// which [`refusal`] keeps off the device).
 pub fn stiffness_dispatch() -> String {
     let mut radial = String::from("fn radial_curvature(kind: u32, p: array<f32, 8>, r: f32) -> f32 {\n    switch kind {\n");
@@ -159,11 +173,15 @@ pub fn stiffness_dispatch() -> String {
         "fn three_body_hessian(kind: u32, p: array<f32, 8>, ri: vec3<f32>, rj: vec3<f32>, rk: vec3<f32>) -> array<f32, 81> {\n    switch kind {\n",
     );
     let mut one = String::from("fn one_body_hessian(kind: u32, p: array<f32, 8>, x: vec3<f32>) -> mat3x3<f32> {\n    switch kind {\n");
+    let mut tetra = String::from(
+        "fn tetra_hessian(kind: u32, p: array<f32, 8>, f: mat3x3<f32>, j: f32, f_inv_t: mat3x3<f32>) -> array<f32, 81> {\n    switch kind {\n",
+    );
     for (index, interaction) in REGISTRY.iter().enumerate() {
         let Some(function) = stiffness_function(*interaction) else { continue };
         let (out, args) = match interaction.law() {
             Law::Radial { .. } => (&mut radial, "p, r"),
             Law::ThreeBody(_) => (&mut three, "p, ri, rj, rk"),
+            Law::Tetra(_) => (&mut tetra, "p, f, j, f_inv_t"),
             _ => (&mut one, "p, x"),
         };
         out.push_str(&format!("        case {index}u: {{ return {function}({args}); }}\n"));
@@ -171,13 +189,15 @@ pub fn stiffness_dispatch() -> String {
     radial.push_str("        default: { return 0.0; }\n    }\n}\n");
     three.push_str("        default: { return array<f32, 81>(); }\n    }\n}\n");
     one.push_str("        default: { return mat3x3<f32>(); }\n    }\n}\n");
-    radial + &three + &one
+    tetra.push_str("        default: { return array<f32, 81>(); }\n    }\n}\n");
+    radial + &three + &one + &tetra
 }
 
 /// The device's implicit solver: its buffers, bind group (group 1) and kernels.
 pub(super) struct ImplicitSolver {
     pub(super) group: wgpu::BindGroup,
     pub(super) angles: wgpu::ComputePipeline,
+    pub(super) tetras: wgpu::ComputePipeline,
     pub(super) blocks: wgpu::ComputePipeline,
     pub(super) solve: wgpu::ComputePipeline,
     pub(super) moves: wgpu::ComputePipeline,
@@ -185,6 +205,7 @@ pub(super) struct ImplicitSolver {
     pub(super) buffer: wgpu::Buffer,
     pub(super) report_at: u64,
     angle_count: u32,
+    tetra_count: u32,
     /// Constrained bonds, and the byte offset of their entries in `imp`.
     pub(super) constraints: usize,
     pub(super) constraints_at: u64,
@@ -236,12 +257,14 @@ impl ImplicitSolver {
         header[7] = (HEADER_WORDS + words.len()) as u32;
         words.extend(model.type_drag.iter().map(|&g| kick(g).to_bits()));
         // `imp`: the particle vectors, then 2 entries per bond end and per
-        // external entry, 21 per angle, then the report.
+        // external entry, 21 per angle, 36 per volume element, then the report.
         let externals: usize = model.externals.iter().map(|e| e.members.len()).sum();
         let bonds_at = PARTICLE_VECTORS * n;
         let externals_at = bonds_at + 2 * 2 * model.bonds.len();
         let angles_at = externals_at + 2 * externals;
-        let report = angles_at + ANGLE_VEC4 * model.angles.len();
+        let tetras_at = angles_at + ANGLE_VEC4 * model.angles.len();
+        let report = tetras_at + TETRA_VEC4 * model.tetras.len();
+        header[17] = tetras_at as u32;
         header[8] = bonds_at as u32;
         header[9] = externals_at as u32;
         header[10] = angles_at as u32;
@@ -287,6 +310,7 @@ impl ImplicitSolver {
         let side = SideGroup::new(ctx, main_layout, model, "the implicit step", &[(1, true, &imp_topo), (2, false, &buffer)])?;
         Ok(Self {
             angles: side.pipeline(ctx, "implicit_angles"),
+            tetras: side.pipeline(ctx, "implicit_tetras"),
             blocks: side.pipeline(ctx, "implicit_blocks"),
             solve: side.pipeline(ctx, "implicit_solve"),
             moves: side.pipeline(ctx, "implicit_move"),
@@ -294,6 +318,7 @@ impl ImplicitSolver {
             buffer,
             report_at: 16 * report as u64,
             angle_count: model.angles.len() as u32,
+            tetra_count: model.tetras.len() as u32,
             constraints: constrained.len(),
             constraints_at: 16 * (report + 1) as u64,
             tolerance,
@@ -304,6 +329,11 @@ impl ImplicitSolver {
     /// Workgroups of the per-angle kernel (0 without angles).
     pub(super) fn angle_groups(&self, workgroup: u32) -> u32 {
         self.angle_count.div_ceil(workgroup)
+    }
+
+    /// Workgroups of the per-element kernel (0 without volume elements).
+    pub(super) fn tetra_groups(&self, workgroup: u32) -> u32 {
+        self.tetra_count.div_ceil(workgroup)
     }
 
     /// The last solve's report, from the 16 bytes of its entry.

@@ -163,6 +163,24 @@ pub fn chain_of_rods(n: usize, anchors: usize) -> (String, &'static str) {
     (top, ff)
 }
 
+/// `cellmd build ball --radius 5 --cells 4` (125 nodes of type `node`, 384
+/// elements of tetra type `solid`), centred at the origin.
+pub fn small_ball() -> String {
+    let args = cellmd::build::BallArgs {
+        radius: 5.0,
+        cells: 4,
+        centre: vec![0.0; 3],
+        particle_type: "node".into(),
+        octant: false,
+        spacing: None,
+        core_cells: 0,
+        surface_type: None,
+        tetra_type: "solid".into(),
+        output: "ball.top".into(),
+    };
+    cellmd::build::ball(&args).unwrap().text
+}
+
 /// The bits of every position (for bit-identity checks).
 pub fn position_bits(sim: &Simulation) -> Vec<[u64; 3]> {
     sim.state.positions.iter().map(|x| x.to_array().map(f64::to_bits)).collect()
