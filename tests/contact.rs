@@ -250,7 +250,7 @@ fn implicit_squeeze_time_step_table() {
 #[test]
 fn fire_relaxes_squeezed_cells_without_interpenetration() {
     let mut sim = simulation(&squeezed_case("temperature 0\ntimestep 1e-3\nrun 0\n"));
-    sim.minimize(&FireSettings { ftol: 1e-2, max_iterations: 30_000, dmax: 0.05 }).unwrap();
+    sim.minimize(&FireSettings { ftol: 1e-2, max_iterations: 30_000, dmax: 0.05, ..Default::default() }).unwrap();
     let report = sim.last_minimize.clone().unwrap();
     let exact = brute_force_min_distance(&sim);
     println!("FIRE: {report:?}, min distance {exact:.4e} µm");

@@ -129,6 +129,61 @@ fn one_implicit_step_with_volume_elements_matches_the_cpu() {
     }
 }
 
+/// Newton steps of a `solver cholesky` deck with volume elements:
+/// `inputs/hertz_octant.in` (one stage, 8 quasi-static steps to δ = 0.1·R)
+/// on the octant of `cellmd build ball --cells 8` (125 nodes, 384 elements),
+/// its plate a wall of k = 10⁵ pN/µm, solved by the device's f32 CG. The
+/// device resolves a plate force to k·ε_f32·(|d| + |x|) ≤ 2k·ε_f32·R (the
+/// depth d − n̂·x rounded in f32); the plate is the stiffest term a contact
+/// node has, so the equilibria differ by about that force over k, 2ε_f32·R
+/// per node, and the plate's load by that force per contact node.
+#[test]
+fn newton_steps_with_volume_elements_reach_the_cpu_equilibrium_on_the_gpu() {
+    let args = cellmd::build::BallArgs {
+        radius: 5.0,
+        cells: 8,
+        centre: vec![0.0; 3],
+        particle_type: "node".into(),
+        octant: true,
+        spacing: None,
+        core_cells: 0,
+        surface_type: None,
+        tetra_type: "solid".into(),
+        output: "octant.top".into(),
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let top = dir.path().join("octant.top");
+    std::fs::write(&top, cellmd::build::ball(&args).unwrap().text).unwrap();
+    let vars = [
+        ("topology".to_string(), top.display().to_string()),
+        ("stages".to_string(), "1".to_string()),
+        ("relax_steps".to_string(), "8".to_string()),
+    ];
+    let plan = cellmd::deck::validate_file(std::path::Path::new("inputs/hertz_octant.in"), &vars).unwrap_or_else(|e| panic!("{e}"));
+    let run_on = |device| {
+        let options = RunOptions { output_dir: dir.path().to_path_buf(), device: Some(device), ..Default::default() };
+        Simulation::execute(plan.clone(), options).unwrap_or_else(|e| panic!("{device:?}: {e}"))
+    };
+    let (mut cpu, mut gpu) = (run_on(DevicePreference::Cpu), run_on(DevicePreference::Gpu));
+    let start = &plan.positions;
+    let moved = cpu.state.positions.iter().zip(start).map(|(x, y)| (*x - *y).length()).fold(0.0, f64::max);
+    let apart = cpu.state.positions.iter().zip(&gpu.state.positions).map(|(x, y)| (*x - *y).length()).fold(0.0, f64::max);
+    let columns =
+        plan.actions.iter().find_map(|a| if let cellmd::deck::Action::Thermo { columns, .. } = a { Some(columns.clone()) } else { None });
+    let plate = columns.unwrap().into_iter().find(|c| cellmd::run::thermo::column_label(c, &plan.model) == "fz/top").unwrap();
+    let (load_cpu, load_gpu) = (cpu.thermo_value(&plate).unwrap(), gpu.thermo_value(&plate).unwrap());
+    let (k, radius, eps) = (1e5, 5.0, f32::EPSILON as f64);
+    let contact = cpu.state.positions.iter().filter(|x| x.z > 0.9 * radius - 1e-3).count() as f64;
+    let (position_bound, load_bound) = (2.0 * eps * radius, contact * 2.0 * k * eps * radius);
+    println!(
+        "moved {moved:.4e} µm, GPU − CPU {apart:.3e} µm (bound {position_bound:.3e}); load CPU {load_cpu:.6} GPU {load_gpu:.6} pN \
+         (bound ±{load_bound:.3e}, {contact} nodes in contact)"
+    );
+    assert!(moved > 0.1, "the plate moved nothing: {moved:e}");
+    assert!(apart <= position_bound, "GPU − CPU {apart:e} µm > {position_bound:e}");
+    assert!((load_gpu - load_cpu).abs() <= load_bound, "loads GPU {load_gpu} and CPU {load_cpu}");
+}
+
 /// Runs `case` (one implicit step) on both devices and asserts the bound
 /// above; returns the GPU's run.
 fn one_step_matches(case: &common::Case) -> Simulation {

@@ -38,8 +38,8 @@ class Simulation:
         """Executes deck lines against the live system, validated in the deck's context."""
     def run(self, steps: int, callback: Optional[Callable[["Simulation"], Optional[bool]]] = None, every: Optional[int] = None) -> None:
         """Runs `steps` steps, calling `callback(sim)` at multiples of `every` (False stops the run)."""
-    def minimize(self, ftol: Optional[float] = None, maxiter: Optional[int] = None, dmax: Optional[float] = None) -> None:
-        """FIRE energy minimisation; the step counter does not advance."""
+    def minimize(self, ftol: Optional[float] = None, maxiter: Optional[int] = None, dmax: Optional[float] = None, style: Optional[str] = None) -> None:
+        """Energy minimisation, FIRE or (style="newton") damped Newton steps; the step counter does not advance."""
     @property
     def minimize_converged(self) -> Optional[bool]:
         """Whether the last minimisation converged (None before any)."""

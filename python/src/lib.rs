@@ -258,16 +258,25 @@ impl PySimulation {
         outcome.and(ended)
     }
 
-    /// FIRE energy minimisation (the deck's `minimize [ftol F] [maxiter N]
-    /// [dmax D]`); the step counter does not advance.
-    #[pyo3(signature = (ftol=None, maxiter=None, dmax=None))]
-    fn minimize(&mut self, py: Python<'_>, ftol: Option<f64>, maxiter: Option<u64>, dmax: Option<f64>) -> PyResult<()> {
+    /// Energy minimisation (the deck's `minimize [ftol F] [maxiter N] [dmax D]
+    /// [style fire|newton]`: FIRE, or damped Newton steps); the step counter
+    /// does not advance.
+    #[pyo3(signature = (ftol=None, maxiter=None, dmax=None, style=None))]
+    fn minimize(
+        &mut self,
+        py: Python<'_>,
+        ftol: Option<f64>,
+        maxiter: Option<u64>,
+        dmax: Option<f64>,
+        style: Option<String>,
+    ) -> PyResult<()> {
         self.not_running("minimize()")?;
         let mut line = String::from("minimize");
         for (key, value) in [
             ("ftol", ftol.map(|v| format!("{v:e}"))),
             ("maxiter", maxiter.map(|v| v.to_string())),
             ("dmax", dmax.map(|v| format!("{v:e}"))),
+            ("style", style),
         ] {
             if let Some(value) = value {
                 line.push_str(&format!(" {key} {value}"));

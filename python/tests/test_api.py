@@ -236,3 +236,24 @@ def test_the_installed_command_line_is_the_executables():
     assert bad.returncode == 1 and "tests/decks/bad/bad_number.in:7:10: found `1e-3x`" in bad.stderr
     listed = subprocess.run([cellmd_command(), "list"], cwd=REPO, capture_output=True, text=True)
     assert listed.returncode == 0 and "turgor" in listed.stdout
+
+
+def test_both_minimisers_relax_a_cell_to_the_same_state(tmp_path):
+    # The single cell's first 10 steps leave it off balance; FIRE and damped
+    # Newton steps (`style="newton"`) both relax it to max |F| < 1e-6 pN: the
+    # same energy (a difference is second order in the residual forces) and
+    # the same shape up to the cell's free sliding and turning on its wall
+    # (sorted node distances from the centroid; measured apart by < 5e-7 µm).
+    relaxed = []
+    for style in ["fire", "newton"]:
+        sim = cellmd.Simulation(SINGLE_CELL, vars={"steps": 10}, output_dir=tmp_path / style)
+        sim.run(10)
+        sim.minimize(ftol=1e-6, maxiter=100000, style=style)
+        assert sim.minimize_converged
+        x = sim.positions
+        relaxed.append((sim.thermo_value("pe"), np.sort(np.linalg.norm(x - x.mean(axis=0), axis=1))))
+    (e_fire, r_fire), (e_newton, r_newton) = relaxed
+    assert abs(e_fire - e_newton) <= 1e-9 * abs(e_fire)
+    assert np.abs(r_fire - r_newton).max() < 1e-5
+    with pytest.raises(cellmd.InputError, match="found minimize style `cg`"):
+        sim.minimize(style="cg")

@@ -46,6 +46,16 @@ pub fn max_residual_force(forces: &[DVec3], mass: &[f64]) -> f64 {
     forces.iter().zip(mass).filter(|(_, m)| m.is_finite()).map(|(f, _)| f.length()).fold(0.0, f64::max)
 }
 
+/// The minimiser of the deck `minimize` command (`style`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum MinimizeStyle {
+    /// FIRE (this module), on the CPU or the device.
+    #[default]
+    Fire,
+    /// Damped Newton steps with sparse Cholesky ([`super::newton`]), on the CPU.
+    Newton,
+}
+
 /// Options of the deck `minimize` command.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FireSettings {
@@ -54,11 +64,12 @@ pub struct FireSettings {
     pub max_iterations: u64,
     /// Largest move of a particle in one iteration (length units).
     pub dmax: f64,
+    pub style: MinimizeStyle,
 }
 
 impl Default for FireSettings {
     fn default() -> Self {
-        Self { ftol: 1e-6, max_iterations: 10_000, dmax: 0.1 }
+        Self { ftol: 1e-6, max_iterations: 10_000, dmax: 0.1, style: MinimizeStyle::Fire }
     }
 }
 
@@ -174,7 +185,7 @@ mod tests {
         let sim_box = SimBox::new(DVec3::splat(-10.0), DVec3::splat(10.0), [false; 3]);
         let mut state = State::new(vec![DVec3::new(3.0, 0.0, 0.0)]);
         let mut lowest = f64::INFINITY;
-        let settings = FireSettings { ftol: 1e-12, max_iterations: 60, dmax: 0.5 };
+        let settings = FireSettings { ftol: 1e-12, max_iterations: 60, dmax: 0.5, ..Default::default() };
         let report = fire_minimize::<()>(&mut state, &sim_box, &[1.0], &timestep(0.1), &settings, |s, f, limits| {
             lowest = lowest.min(s.positions[0].x);
             f.clear();

@@ -1,11 +1,12 @@
 //! Integrators: the explicit overdamped step, the linearly implicit step,
-//! bond constraints and FIRE minimisation. Their random numbers come from the
+//! bond constraints, and FIRE and Newton minimisation. Their random numbers come from the
 //! leaf module `rng`.
 
 pub mod constraints;
 pub mod context;
 pub mod fire;
 pub mod implicit;
+pub mod newton;
 pub mod overdamped;
 pub mod system_matrix;
 

@@ -21,10 +21,17 @@ Writes OUT/calibration.csv, OUT/indentation.csv, OUT/curvature.csv and, with
 plot.py, the PNGs. Not part of CI (tests/tensegrity_substrate.rs runs a
 reduced case).
 
-    python3 studies/tensegrity_substrate/sweep.py --cellmd target/release/cellmd --out out/tensegrity_substrate [--level 2] [--device gpu]
+    python3 studies/tensegrity_substrate/sweep.py --cellmd target/release/cellmd --out out/tensegrity_substrate [--level 2] [--device gpu] [--min-style newton] [--jobs 2]
+
+`--min-style newton` relaxes each stage by damped Newton steps (`minimize …
+style newton`, sparse Cholesky) instead of FIRE: at level 2 the whole
+protocol takes 542 iterations instead of FIRE's 35 488 (4.1 s against 10.0 s),
+and it is what makes the paper's scale (level 5) affordable on a CPU.
+`--jobs N` runs the curvature points N at a time (each on one thread).
 """
 
 import argparse
+import concurrent.futures
 import csv
 import re
 import sys
@@ -105,6 +112,8 @@ def main():
     p.add_argument("--level", type=int, default=2)
     p.add_argument("--indent-stages", type=int, default=10)
     p.add_argument("--device", choices=["cpu", "gpu", "auto"], help="cellmd's --device for every run (runs and FIRE relaxations on the GPU)")
+    p.add_argument("--min-style", choices=["fire", "newton"], default="fire", help="the deck's minimiser (min_style)")
+    p.add_argument("--jobs", type=int, default=1, help="curvature points run at once")
     args = p.parse_args()
     out = Path(args.out).resolve()
     out.mkdir(parents=True, exist_ok=True)
@@ -115,13 +124,14 @@ def main():
         tops[curvature] = (top, build(args.cellmd, args.level, curvature, top))
 
     top, volumes = tops["flat"]
-    raw = run(args.cellmd, top, out / "calibrate", "flat", volumes, args.device, scale=1, spread_area=AREA, steps=0)
+    style = {"min_style": args.min_style}
+    raw = run(args.cellmd, top, out / "calibrate", "flat", volumes, args.device, scale=1, spread_area=AREA, steps=0, **style)
     force = crossing(raw["spread"], "hullarea/cortex", AREA, "fabs/fa")
     scale = F_SPRD / force
     print(f"calibration: Σ|f| = {force:.1f} pN at {AREA} µm² with unit stiffnesses; scale {scale:.4f}", file=sys.stderr)
 
     checked = run(args.cellmd, top, out / "indent", "flat", volumes, args.device, scale=scale, f_sprd=F_SPRD,
-                  indent_stages=args.indent_stages)
+                  indent_stages=args.indent_stages, **style)
     area = crossing(checked["spread"], "fabs/fa", F_SPRD, "hullarea/cortex")
     with open(out / "calibration.csv", "w", newline="") as f:
         w = csv.writer(f)
@@ -140,11 +150,15 @@ def main():
         for n, r in enumerate(r for r in rows if r["time"] >= t_contact):
             w.writerow([f"{n * indent_step:.3f}", f"{r['load/tip']:.6g}", f"{r['depth/tip']:.6g}"])
 
+    def point(curvature):
+        top, volumes = tops[curvature]
+        return run(args.cellmd, top, out / f"R_{curvature}", curvature, volumes, args.device, scale=scale, f_sprd=F_SPRD, **style)
+
+    with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
+        points = list(pool.map(point, CURVATURES))
     with open(out / "curvature.csv", "w", newline="") as f:
         w = None
-        for curvature in CURVATURES:
-            top, volumes = tops[curvature]
-            phases = run(args.cellmd, top, out / f"R_{curvature}", curvature, volumes, args.device, scale=scale, f_sprd=F_SPRD)
+        for curvature, phases in zip(CURVATURES, points):
             result = {"curvature_um": curvature, "inverse_radius_per_um": 0.0 if curvature == "flat" else 1 / float(curvature)}
             result.update({k: f"{v:.6g}" for k, v in readouts(phases).items()})
             if w is None:

@@ -100,7 +100,7 @@ const COMMANDS: &[Command] = &[
     }),
     line("constrain", "constrain BONDTYPE [tolerance T] [max_iterations N]", Validator::constrain),
     line("unconstrain", "unconstrain BONDTYPE", Validator::constrain),
-    line("minimize", "minimize [ftol F] [maxiter N] [dmax D]", Validator::minimize),
+    line("minimize", "minimize [ftol F] [maxiter N] [dmax D] [style fire|newton]", Validator::minimize),
     line("run", "run N", Validator::run),
     line("write_state", "write_state FILE [every N [keep K]]", Validator::write_state),
     line("read_state", "read_state FILE", Validator::read_state),

@@ -6,7 +6,7 @@ use super::{expect_len, non_negative, options, positive, yes_no, Validator};
 use crate::deck::plan::{Action, NeighborSettings};
 use crate::gpu::DevicePreference;
 use crate::input::{parse_u64, InputError, Token};
-use crate::integrate::fire::FireSettings;
+use crate::integrate::fire::{FireSettings, MinimizeStyle};
 use crate::integrate::implicit::{ImplicitSettings, LinearSolver};
 use crate::integrate::overdamped::OverdampedSettings;
 use crate::integrate::Integrator;
@@ -117,8 +117,15 @@ impl Validator {
 
     pub(super) fn minimize(&mut self, s: &[Token], usage: &str) -> Result<(), InputError> {
         let kw = &s[0];
-        let opts = options(&s[1..], &["ftol", "maxiter", "dmax"], usage)?;
+        let opts = options(&s[1..], &["ftol", "maxiter", "dmax", "style"], usage)?;
         let mut f = FireSettings::default();
+        if let Some(t) = opts.get("style") {
+            f.style = match t.text.as_str() {
+                "fire" => MinimizeStyle::Fire,
+                "newton" => MinimizeStyle::Newton,
+                other => return Err(t.error(format!("found minimize style `{other}`, expected `fire` or `newton`"))),
+            };
+        }
         if let Some(t) = opts.get("ftol") {
             f.ftol = positive(t, "a force tolerance")?;
         }

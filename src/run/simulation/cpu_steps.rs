@@ -7,14 +7,18 @@ use glam::DVec3;
 use super::reference::finite_force;
 use super::step_loop::{Stepper, Taken};
 use super::Simulation;
+use crate::backend::{CpuBackend, Forces};
 use crate::integrate::constraints::failure_message;
 use crate::integrate::context::StepContext;
-use crate::integrate::fire::{fire_minimize, FireReport, FireSettings};
+use crate::integrate::fire::{fire_minimize, FireReport, FireSettings, MinimizeStyle};
 use crate::integrate::implicit::{implicit_step, ConstrainedBonds, ImplicitError, ImplicitSettings};
+use crate::integrate::newton::newton_minimize;
 use crate::integrate::overdamped::{overdamped_step, Blowup};
 use crate::integrate::Integrator;
 use crate::output::run_log::{Clock, Phase};
+use crate::run::protocol::Protocols;
 use crate::run::RunError;
+use crate::system::{Model, SimBox, State};
 
 /// The CPU backend as a [`Stepper`]: one step per call, timed by phase
 /// for the run log.
@@ -161,17 +165,24 @@ impl Simulation {
     /// the CPU. The step counter does not advance.
     pub fn minimize(&mut self, settings: &FireSettings) -> Result<(), RunError> {
         self.ensure_forces()?;
-        let report = match self.minimize_on_gpu(settings)? {
-            Some(report) => report,
-            None => self.minimize_on_cpu(settings)?,
+        let report = match settings.style {
+            MinimizeStyle::Newton => self.minimize_by_newton(settings)?,
+            MinimizeStyle::Fire => match self.minimize_on_gpu(settings)? {
+                Some(report) => report,
+                None => self.minimize_on_cpu(settings)?,
+            },
         };
         if let Some(i) = self.forces.forces.iter().position(|f| !finite_force(*f)) {
             return Err(self.blowup(i, "non-finite force during minimisation".into()));
         }
         self.check_in_box()?;
         let verdict = if report.converged { "converged" } else { "stopped at maxiter without converging" };
+        let style = match settings.style {
+            MinimizeStyle::Fire => "FIRE",
+            MinimizeStyle::Newton => "Newton, on the CPU",
+        };
         self.say(&format!(
-            "minimize (FIRE): {verdict} after {} iterations: max |F| = {:e} (ftol {:e}), pe = {:e}{}",
+            "minimize ({style}): {verdict} after {} iterations: max |F| = {:e} (ftol {:e}), pe = {:e}{}",
             report.iterations,
             report.max_force,
             settings.ftol,
@@ -196,17 +207,60 @@ impl Simulation {
         let backend = self.cpu.get(&self.model, &self.state, &self.sim_box, self.neighbor.skin)?;
         let (model, sim_box, forces, protocols) = (&self.model, &self.sim_box, &mut self.forces, &self.protocols);
         let report = fire_minimize(&mut state, sim_box, &mass, &ctx, settings, |s, f, limits| {
-            backend.update_neighbors(s, sim_box, true).map_err(RunError::Setup)?;
-            backend.update_contacts(model, s, sim_box).map_err(RunError::Setup)?;
-            backend.compute(model, s, sim_box, forces);
-            backend.contact_step_limits(s.len(), limits);
-            f.clone_from(&forces.forces);
-            protocols.mask(f);
-            Ok::<f64, RunError>(forces.total_energy())
+            minimizer_forces(backend, model, sim_box, protocols, forces, s, f, limits)
         })?;
         self.state = state;
         self.forces_current = true;
         self.energies_current = true;
         Ok(report)
     }
+
+    /// Newton minimisation (src/integrate/newton.rs) on the CPU backend, from current forces.
+    fn minimize_by_newton(&mut self, settings: &FireSettings) -> Result<FireReport, RunError> {
+        let fixed: Vec<bool> = self.fire_masses().iter().map(|m| m.is_infinite()).collect();
+        let held = self.protocols.held_coordinates(self.model.len());
+        let mut state = self.state.clone();
+        let backend = self.cpu.get(&self.model, &self.state, &self.sim_box, self.neighbor.skin)?;
+        let (model, sim_box, forces, protocols) = (&self.model, &self.sim_box, &mut self.forces, &self.protocols);
+        // The backend is borrowed by both closures: the forces', then K̃'s at the state taken.
+        let backend = std::cell::RefCell::new(backend);
+        let report = newton_minimize(
+            &mut state,
+            sim_box,
+            &fixed,
+            &held,
+            settings,
+            |s, f, limits| minimizer_forces(&mut backend.borrow_mut(), model, sim_box, protocols, forces, s, f, limits),
+            |s| backend.borrow().stiffness(model, s, sim_box),
+            |why| RunError::Setup(format!("minimize style newton: {why}")),
+        )?;
+        self.state = state;
+        self.forces_current = false;
+        self.ensure_forces()?;
+        Ok(report)
+    }
+}
+
+/// A minimiser's evaluation at state `s` on the CPU backend: the neighbour
+/// list and contacts brought up to date, the forces into `forces` and, with
+/// the protocols' held coordinates masked to 0, into `f`, the contact step
+/// limits into `limits`; returns the energy.
+#[allow(clippy::too_many_arguments)]
+fn minimizer_forces(
+    backend: &mut CpuBackend,
+    model: &Model,
+    sim_box: &SimBox,
+    protocols: &Protocols,
+    forces: &mut Forces,
+    s: &State,
+    f: &mut Vec<DVec3>,
+    limits: &mut Vec<f64>,
+) -> Result<f64, RunError> {
+    backend.update_neighbors(s, sim_box, true).map_err(RunError::Setup)?;
+    backend.update_contacts(model, s, sim_box).map_err(RunError::Setup)?;
+    backend.compute(model, s, sim_box, forces);
+    backend.contact_step_limits(s.len(), limits);
+    f.clone_from(&forces.forces);
+    protocols.mask(f);
+    Ok(forces.total_energy())
 }
