@@ -766,7 +766,8 @@ fn every_input_deck_runs_on_the_gpu_like_on_the_cpu() {
         };
         // The shortest horizon on the GPU first (cheap on llvmpipe): it finds
         // the decks refused at a later run before any long run.
-        match run_deck_deterministic(&deck, DevicePreference::Gpu, 100, false) {
+        let first = horizon.min(100);
+        match run_deck_deterministic(&deck, DevicePreference::Gpu, first, false) {
             Ok((_, shortest)) => {
                 // The horizon is chosen from the CPU runs before the GPU runs it,
                 // cut by tenths while
@@ -815,7 +816,7 @@ fn every_input_deck_runs_on_the_gpu_like_on_the_cpu() {
                         steps /= 10;
                         continue;
                     }
-                    let gpu = if steps == 100 {
+                    let gpu = if steps == first {
                         shortest.clone()
                     } else {
                         match run_deck_deterministic(&deck, DevicePreference::Gpu, steps, false) {
