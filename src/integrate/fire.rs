@@ -52,7 +52,7 @@ pub enum MinimizeStyle {
     /// FIRE (this module), on the CPU or the device.
     #[default]
     Fire,
-    /// Damped Newton steps with sparse Cholesky ([`super::newton`]), on the CPU.
+    /// Damped Newton steps with sparse Cholesky (src/integrate/newton.rs), on the CPU.
     Newton,
 }
 
