@@ -139,18 +139,7 @@ fn one_implicit_step_with_volume_elements_matches_the_cpu() {
 /// per node, and the plate's load by that force per contact node.
 #[test]
 fn newton_steps_with_volume_elements_reach_the_cpu_equilibrium_on_the_gpu() {
-    let args = cellmd::build::BallArgs {
-        radius: 5.0,
-        cells: 8,
-        centre: vec![0.0; 3],
-        particle_type: "node".into(),
-        octant: true,
-        spacing: None,
-        core_cells: 0,
-        surface_type: None,
-        tetra_type: "solid".into(),
-        output: "octant.top".into(),
-    };
+    let args = cellmd::build::BallArgs { cells: 8, octant: true, ..Default::default() };
     let dir = tempfile::tempdir().unwrap();
     let top = dir.path().join("octant.top");
     std::fs::write(&top, cellmd::build::ball(&args).unwrap().text).unwrap();

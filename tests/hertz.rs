@@ -102,18 +102,7 @@ fn tatara(delta: f64) -> f64 {
 /// Runs the whole-ball deck (`octant` false) or the octant deck on a ball of
 /// `cells` lattice cells across.
 fn sweep(cells: u32, octant: bool) -> Vec<Stage> {
-    let args = BallArgs {
-        radius: RADIUS,
-        cells,
-        centre: vec![0.0; 3],
-        particle_type: "node".into(),
-        octant,
-        spacing: None,
-        core_cells: 0,
-        surface_type: None,
-        tetra_type: "solid".into(),
-        output: "ball.top".into(),
-    };
+    let args = BallArgs { radius: RADIUS, cells, octant, ..Default::default() };
     let text = ball(&args).unwrap().text;
     if octant {
         // The whole ball's load: four octants' share of the upper plate's.
@@ -324,14 +313,11 @@ fn block_sweep(b: Block) -> Vec<Stage> {
         let args = BallArgs {
             radius: b.half_width,
             cells: 2 * b.cells,
-            centre: vec![0.0; 3],
-            particle_type: "node".into(),
             octant: true,
             spacing: Some(b.spacing),
             core_cells: b.core,
             surface_type: Some("node_far".into()),
-            tetra_type: "solid".into(),
-            output: "halfspace.top".into(),
+            ..Default::default()
         };
         let text = ball(&args).unwrap_or_else(|e| panic!("{e}")).text;
         relax("inputs/hertz_halfspace.in", &text, &vars, &["fz/tip", "depth/tip"], |v| (4.0 * v[0], 0.0))

@@ -71,6 +71,25 @@ pub struct BallArgs {
     pub output: PathBuf,
 }
 
+/// The command line's defaults, for the library's callers: radius 5, 4
+/// cells across, centred at the origin, `node` particles, `solid` elements.
+impl Default for BallArgs {
+    fn default() -> Self {
+        Self {
+            radius: 5.0,
+            cells: 4,
+            centre: vec![0.0; 3],
+            particle_type: "node".into(),
+            octant: false,
+            spacing: None,
+            core_cells: 0,
+            surface_type: None,
+            tetra_type: "solid".into(),
+            output: "ball.top".into(),
+        }
+    }
+}
+
 /// The cubed-sphere image of lattice point `p` ∈ [−1, 1]³ on the unit ball.
 fn cube_to_ball(p: DVec3) -> DVec3 {
     let s = p.abs().max_element();
@@ -188,18 +207,7 @@ mod tests {
     use crate::mesh::tetra_edges;
 
     fn args(cells: u32) -> BallArgs {
-        BallArgs {
-            radius: 2.0,
-            cells,
-            centre: vec![0.5, 0.0, -1.0],
-            particle_type: "node".into(),
-            octant: false,
-            spacing: None,
-            core_cells: 0,
-            surface_type: None,
-            tetra_type: "solid".into(),
-            output: "ball.top".into(),
-        }
+        BallArgs { radius: 2.0, cells, centre: vec![0.5, 0.0, -1.0], ..Default::default() }
     }
 
     #[test]

@@ -166,19 +166,7 @@ pub fn chain_of_rods(n: usize, anchors: usize) -> (String, &'static str) {
 /// `cellmd build ball --radius 5 --cells 4` (125 nodes of type `node`, 384
 /// elements of tetra type `solid`), centred at the origin.
 pub fn small_ball() -> String {
-    let args = cellmd::build::BallArgs {
-        radius: 5.0,
-        cells: 4,
-        centre: vec![0.0; 3],
-        particle_type: "node".into(),
-        octant: false,
-        spacing: None,
-        core_cells: 0,
-        surface_type: None,
-        tetra_type: "solid".into(),
-        output: "ball.top".into(),
-    };
-    cellmd::build::ball(&args).unwrap().text
+    cellmd::build::ball(&cellmd::build::BallArgs::default()).unwrap().text
 }
 
 /// The bits of every position (for bit-identity checks).
