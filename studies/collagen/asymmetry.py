@@ -78,7 +78,7 @@ def paper_ratio(p):
 
 def settings(a):
     """What a finished run's rows depend on: a stored run is reused only when these match."""
-    keys = ("steps", "stages", "bend", "dt", "density", "fibre_length", "node_spacing")
+    keys = ("steps", "stages", "bend", "dt", "density", "fibre_length", "node_spacing", "temperature")
     return {k: str(getattr(a, k)) for k in keys}
 
 
@@ -91,6 +91,7 @@ def run(a, seed, fibres):
     stored = point / "rows.json"
     if stored.exists():
         done = json.loads(stored.read_text())
+        done["settings"].setdefault("temperature", "0.0")  # rows stored before the option existed
         if done["settings"] == settings(a):
             return done["rows"]
     try:
@@ -106,7 +107,8 @@ def simulate(a, seed, fibres, name, point):
     top = point / "collagen.top"
     network = NETWORK + ["--density", a.density, "--fibre-length", a.fibre_length, "--node-spacing", a.node_spacing]
     run_command([a.cellmd, "build", "collagen", *network, "--seed", seed, "-o", top])
-    variables = {"top": top, "kc": FIBRES[fibres], "bend": a.bend, "dt": a.dt, "steps": a.steps, "stages": a.stages, "name": name}
+    variables = {"top": top, "kc": FIBRES[fibres], "bend": a.bend, "dt": a.dt, "steps": a.steps, "stages": a.stages, "name": name,
+                 "T": a.temperature, "noise_seed": seed}
     wall = run_deck(a.cellmd, DECK, point, variables)
     paper = [r["clustering/fibre/cell1/cell2"] for r in thermo_rows(point / f"{name}.thermo.csv")]
     bonds = fibres_of(top)
@@ -139,6 +141,7 @@ def main():
     p.add_argument("--density", default="0.1")
     p.add_argument("--fibre-length", default="200")
     p.add_argument("--node-spacing", default="10")
+    p.add_argument("--temperature", type=float, default=0.0, help="K, the deck's T (kT = 1.380649e-5·T pN·µm; 72 429 K: kT = 1 pN·µm)")
     a = p.parse_args()
     runs = {(seed, fibres): run(a, seed, fibres) for seed in range(1, a.seeds + 1) for fibres in FIBRES}
     seeds = [s for s in range(1, a.seeds + 1) if all(runs[(s, f)] is not None for f in FIBRES)]
