@@ -25,7 +25,7 @@ reduced case).
 
 `--min-style newton` relaxes each stage by damped Newton steps (`minimize …
 style newton`, sparse Cholesky) instead of FIRE: at level 2 the whole
-protocol takes 542 iterations instead of FIRE's 35 488 (4.1 s against 10.0 s);
+protocol takes 523 iterations instead of FIRE's 35 488 (4.1 s against 10.0 s);
 at level 5 it is slower than FIRE (README, *Dynamics*).
 `--jobs N` runs the curvature points N at a time (each on one thread).
 """
