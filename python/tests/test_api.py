@@ -18,7 +18,7 @@ REPO = Path(__file__).resolve().parents[2]
 DIMER = REPO / "inputs" / "dimer.in"
 SINGLE_CELL = REPO / "inputs" / "single_cell.in"
 CATCH_SLIP = REPO / "inputs" / "catch_slip_sweep.in"
-FORCE_DIPOLE = REPO / "inputs" / "force_dipole.in"
+NETWORK_SHEAR = REPO / "inputs" / "network_shear.in"
 NO_GPU = os.environ.get("CELLMD_NO_GPU") == "1"
 
 
@@ -218,8 +218,8 @@ def test_gpu_device_runs_the_same_system(tmp_path):
 
 
 def test_device_gpu_refuses_cpu_only_features(tmp_path):
-    sim = cellmd.Simulation(FORCE_DIPOLE, output_dir=tmp_path, device="gpu")
-    with pytest.raises(cellmd.RunError, match="`integrator implicit solver cholesky` runs on the CPU backend only"):
+    sim = cellmd.Simulation(NETWORK_SHEAR, output_dir=tmp_path, device="gpu")
+    with pytest.raises(cellmd.RunError, match="bond kinetics with `integrator implicit` run on the CPU backend only"):
         sim.run(1)
 
 
