@@ -206,7 +206,7 @@ fn implicit_angles(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocati
     }
 }
 
-// Entry f of volume element e's row-major 12×12 block.
+// Entry f of volume element e's row-major 12×12 block (`project_psd`'s storage, row stride PSD_STRIDE).
 fn tetra_entry(e: u32, f: u32) -> f32 {
     return imp[imp_topo[IMP_V_TETRAS] + TETRA_VEC4 * e + f / 4u][f % 4u];
 }
@@ -365,7 +365,7 @@ fn implicit_blocks(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocati
     for (var s = topo[P.off_tetra_slot_offsets + i]; s < tetras_end; s++) {
         let slot = tetra_slot(s);
         for (var m = 0u; m < 3u; m++) {
-            diagonal[m] += tetra_entry(slot.x, (3u * slot.y + m) * 13u);
+            diagonal[m] += tetra_entry(slot.x, (3u * slot.y + m) * (PSD_STRIDE + 1u));
         }
     }
     diagonal += pair_rows(i, VEC_X, vec3<f32>(0.0), true);
@@ -417,7 +417,7 @@ fn apply_row(i: u32, section: u32) -> vec3<f32> {
         for (var c = 0u; c < 4u; c++) {
             let vc = imp_vec(section, topo[rec + c]);
             for (var m = 0u; m < 3u; m++) {
-                let row = (3u * slot.y + m) * 12u + 3u * c;
+                let row = (3u * slot.y + m) * PSD_STRIDE + 3u * c;
                 out[m] += tetra_entry(slot.x, row) * vc.x + tetra_entry(slot.x, row + 1u) * vc.y + tetra_entry(slot.x, row + 2u) * vc.z;
             }
         }

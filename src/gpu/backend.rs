@@ -945,13 +945,11 @@ impl GpuBackend {
         let integrate = match &self.implicit {
             // The implicit step in place of `integrate` (src/gpu/implicit.rs).
             Some(solver) => {
-                let mut passes = vec![(&solver.blocks, particles), (&solver.solve, Over::Groups(1)), (&solver.moves, particles)];
-                if solver.tetra_groups(WORKGROUP) > 0 {
-                    passes.insert(0, (&solver.tetras, Over::Groups(solver.tetra_groups(WORKGROUP))));
-                }
-                if solver.angle_groups(WORKGROUP) > 0 {
-                    passes.insert(0, (&solver.angles, Over::Groups(solver.angle_groups(WORKGROUP))));
-                }
+                // In the step's order (`encode_step`): angles, elements, then the per-particle passes.
+                let per_term = [(&solver.angles, solver.angle_groups(WORKGROUP)), (&solver.tetras, solver.tetra_groups(WORKGROUP))];
+                let mut passes: Vec<_> =
+                    per_term.into_iter().filter(|&(_, groups)| groups > 0).map(|(k, groups)| (k, Over::Groups(groups))).collect();
+                passes.extend([(&solver.blocks, particles), (&solver.solve, Over::Groups(1)), (&solver.moves, particles)]);
                 time(self, &passes, Some(&solver.group)) + time(self, &[(&k.commit, particles), (&k.advance, Over::Groups(1))], None)
             }
             None => time(self, &[(&k.integrate, particles), (&k.commit, particles), (&k.advance, Over::Groups(1))], None),

@@ -46,6 +46,12 @@ pub fn max_residual_force(forces: &[DVec3], mass: &[f64]) -> f64 {
     forces.iter().zip(mass).filter(|(_, m)| m.is_finite()).map(|(f, _)| f.length()).fold(0.0, f64::max)
 }
 
+/// Zeroes the forces of the particles of infinite mass (`fixed`): reactions,
+/// which no minimiser may follow.
+pub fn zero_fixed_forces(forces: &mut [DVec3], mass: &[f64]) {
+    forces.iter_mut().zip(mass).filter(|(_, m)| m.is_infinite()).for_each(|(f, _)| *f = DVec3::ZERO);
+}
+
 /// The minimiser of the deck `minimize` command (`style`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum MinimizeStyle {
@@ -105,11 +111,7 @@ pub fn fire_minimize<E>(
     loop {
         limits.clear();
         let energy = evaluate(state, &mut f, &mut limits)?;
-        for (f, m) in f.iter_mut().zip(mass) {
-            if m.is_infinite() {
-                *f = DVec3::ZERO;
-            }
-        }
+        zero_fixed_forces(&mut f, mass);
         let max_force = max_residual_force(&f, mass);
         if max_force < settings.ftol || iterations >= settings.max_iterations {
             return Ok(FireReport { converged: max_force < settings.ftol, iterations, energy, max_force, clamped });

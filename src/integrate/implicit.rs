@@ -133,22 +133,22 @@ pub fn implicit_step(
             rhs[3 * i + a] = b[a];
         }
     }
-    let diagonal = matrix.diagonal();
-    let mut guess = Mat::<f64>::from_fn(dim, 1, |k, _| rhs[k] / diagonal[k]); // the Jacobi step D⁻¹b
-    let report = match implicit.solver {
+    let (solution, report) = match implicit.solver {
         _ if !constrained.pairs.is_empty() => {
             let mobile: Vec<bool> = (0..n).map(|i| !fixed(i)).collect();
             let solve = projected_cg(&matrix, &rhs, &mobile, constrained, &state.positions, sim_box, implicit)?;
-            guess = solve.x;
             constrained.tension.clear();
             constrained.tension.extend(solve.lambda.iter().map(|l| -l));
-            solve.report
+            (solve.x, solve.report)
         }
         LinearSolver::Cholesky => {
-            guess = matrix.solve_direct(&rhs).map_err(ImplicitError::Solve)?;
-            SolveReport { iterations: 1, relative_residual: relative_residual(&matrix, &guess, &rhs), step_fraction: 1.0 }
+            let x = matrix.solve_direct(&rhs).map_err(ImplicitError::Solve)?;
+            let report = SolveReport { iterations: 1, relative_residual: relative_residual(&matrix, &x, &rhs), step_fraction: 1.0 };
+            (x, report)
         }
         LinearSolver::Cg => {
+            let diagonal = matrix.diagonal();
+            let mut x = Mat::<f64>::from_fn(dim, 1, |k, _| rhs[k] / diagonal[k]); // the Jacobi step D⁻¹b
             let inverse: Col<f64> = diagonal.iter().map(|d| 1.0 / d).collect();
             let precond = inverse.as_diagonal();
             let params = CgParams {
@@ -159,13 +159,13 @@ pub fn implicit_step(
                 ..Default::default()
             };
             let mut memory = MemBuffer::new(conjugate_gradient_scratch(precond, &matrix, 1, Par::Seq));
-            let info =
-                conjugate_gradient(guess.as_mut(), precond, &matrix, rhs.as_mat(), params, |_| {}, Par::Seq, MemStack::new(&mut memory))
-                    .map_err(|e| ImplicitError::Solve(format!("conjugate gradients: {e:?}")))?;
-            SolveReport { iterations: info.iter_count, relative_residual: info.rel_residual, step_fraction: 1.0 }
+            let info = conjugate_gradient(x.as_mut(), precond, &matrix, rhs.as_mat(), params, |_| {}, Par::Seq, MemStack::new(&mut memory))
+                .map_err(|e| ImplicitError::Solve(format!("conjugate gradients: {e:?}")))?;
+            (x, SolveReport { iterations: info.iter_count, relative_residual: info.rel_residual, step_fraction: 1.0 })
         }
     };
-    let mut step: Vec<DVec3> = (0..n).map(|i| DVec3::new(guess[(3 * i, 0)], guess[(3 * i + 1, 0)], guess[(3 * i + 2, 0)])).collect();
+    let mut step: Vec<DVec3> =
+        (0..n).map(|i| DVec3::new(solution[(3 * i, 0)], solution[(3 * i + 1, 0)], solution[(3 * i + 2, 0)])).collect();
     if let Some(particle) = step.iter().position(|d| !d.is_finite() || d.length() > ctx.max_displacement) {
         return Err(ImplicitError::Blowup(Blowup { particle, displacement: step[particle].length() }));
     }

@@ -40,7 +40,7 @@
 
 use glam::DVec3;
 
-use super::fire::{FireReport, FireSettings};
+use super::fire::{max_residual_force, zero_fixed_forces, FireReport, FireSettings};
 use super::overdamped::clamp_fraction;
 use super::system_matrix::SystemMatrix;
 use crate::backend::Stiffness;
@@ -55,22 +55,18 @@ const MU_UP: f64 = 4.0;
 /// Halvings of a step that does not lower the energy, before a new solve.
 const BACKTRACKS: i32 = 3;
 
-/// The largest residual force: over the particles that may move.
-fn residual(forces: &[DVec3], fixed: &[bool]) -> f64 {
-    forces.iter().zip(fixed).filter(|(_, &fixed)| !fixed).map(|(f, _)| f.length()).fold(0.0, f64::max)
-}
-
 /// Minimises by damped Newton steps. `evaluate` fills the forces at a state
 /// (held coordinates already masked to 0) and the per-particle step limits
 /// if the model has any (else leaves them empty), and returns the energy;
-/// `stiffness` gives K̃ at a state; `fixed` marks the particles that never
-/// move and `held` (3 per particle, or empty) the held coordinates. A failed
+/// `stiffness` gives K̃ at a state; `mass` is FIRE's (infinite for a particle
+/// that never moves, [`super::fire::max_residual_force`]) and `held` (3 per
+/// particle, or empty) marks the held coordinates. A failed
 /// factorisation is returned through `failed`.
 #[allow(clippy::too_many_arguments)]
 pub fn newton_minimize<E>(
     state: &mut State,
     sim_box: &SimBox,
-    fixed: &[bool],
+    mass: &[f64],
     held: &[bool],
     settings: &FireSettings,
     mut evaluate: impl FnMut(&State, &mut Vec<DVec3>, &mut Vec<f64>) -> Result<f64, E>,
@@ -80,13 +76,12 @@ pub fn newton_minimize<E>(
     let n = state.len();
     let (mut forces, mut limits) = (Vec::with_capacity(n), Vec::new());
     let (mut trial_forces, mut trial_limits) = (Vec::with_capacity(n), Vec::new());
-    let mask = |f: &mut Vec<DVec3>| f.iter_mut().zip(fixed).filter(|(_, &fixed)| fixed).for_each(|(f, _)| *f = DVec3::ZERO);
     let mut energy = evaluate(state, &mut forces, &mut limits)?;
-    mask(&mut forces);
+    zero_fixed_forces(&mut forces, mass);
     let (mut iterations, mut clamped) = (0, 0);
     let mut mu = None;
     loop {
-        let max_force = residual(&forces, fixed);
+        let max_force = max_residual_force(&forces, mass);
         if max_force < settings.ftol || iterations >= settings.max_iterations {
             return Ok(FireReport { converged: max_force < settings.ftol, iterations, energy, max_force, clamped });
         }
@@ -104,7 +99,7 @@ pub fn newton_minimize<E>(
         // Solve, and solve again with more damping until a step lowers the energy.
         loop {
             iterations += 1;
-            let drag: Vec<f64> = fixed.iter().map(|&fixed| if fixed { f64::INFINITY } else { damping }).collect();
+            let drag: Vec<f64> = mass.iter().map(|m| if m.is_infinite() { f64::INFINITY } else { damping }).collect();
             let matrix = SystemMatrix::new(&drag, held, 1.0, &k).map_err(&failed)?;
             let solution = matrix.solve_direct(&rhs).map_err(&failed)?;
             let mut step: Vec<DVec3> =
@@ -124,7 +119,7 @@ pub fn newton_minimize<E>(
             // Backtrack along the solved direction (a force evaluation each)
             // before paying for another factorisation with more damping.
             let mut taken = None;
-            for halving in 0..=BACKTRACKS {
+            for halving in (0..=BACKTRACKS).filter(|_| s > 0.0) {
                 let h = 0.5f64.powi(halving);
                 let mut trial = state.clone();
                 for ((x, image), d) in trial.positions.iter_mut().zip(trial.images.iter_mut()).zip(&step) {
@@ -133,9 +128,9 @@ pub fn newton_minimize<E>(
                 }
                 trial_limits.clear();
                 let trial_energy = evaluate(&trial, &mut trial_forces, &mut trial_limits)?;
-                mask(&mut trial_forces);
+                zero_fixed_forces(&mut trial_forces, mass);
                 let level = trial_energy - energy <= 1e-12 * energy.abs().max(f64::MIN_POSITIVE);
-                if s > 0.0 && (trial_energy < energy || (level && residual(&trial_forces, fixed) < max_force)) {
+                if trial_energy < energy || (level && max_residual_force(&trial_forces, mass) < max_force) {
                     taken = Some((trial, trial_energy, halving));
                     break;
                 }
@@ -179,7 +174,7 @@ mod tests {
         let report = newton_minimize::<String>(
             &mut state,
             &open_box(),
-            &[false, false],
+            &[1.0, 1.0],
             &[],
             &settings,
             |s, f, _| {
@@ -213,7 +208,7 @@ mod tests {
         let report = newton_minimize::<String>(
             &mut state,
             &open_box(),
-            &[true, false],
+            &[f64::INFINITY, 1.0],
             &held,
             &settings,
             |s, f, _| {

@@ -217,7 +217,7 @@ impl Simulation {
 
     /// Newton minimisation (src/integrate/newton.rs) on the CPU backend, from current forces.
     fn minimize_by_newton(&mut self, settings: &FireSettings) -> Result<FireReport, RunError> {
-        let fixed: Vec<bool> = self.fire_masses().iter().map(|m| m.is_infinite()).collect();
+        let mass = self.fire_masses();
         let held = self.protocols.held_coordinates(self.model.len());
         let mut state = self.state.clone();
         let backend = self.cpu.get(&self.model, &self.state, &self.sim_box, self.neighbor.skin)?;
@@ -227,7 +227,7 @@ impl Simulation {
         let report = newton_minimize(
             &mut state,
             sim_box,
-            &fixed,
+            &mass,
             &held,
             settings,
             |s, f, limits| minimizer_forces(&mut backend.borrow_mut(), model, sim_box, protocols, forces, s, f, limits),
