@@ -51,8 +51,11 @@
 //! device block (a WGSL function `NAME_curvature`, `NAME_hessian` or
 //! `NAME_tetra_hessian`; `harmonic`, `soft_repulsion`, `lj`, `wca`,
 //! `wlc_bending`, `wall`, `indenter`, `constant_force`, `neo_hookean` and
-//! `linear_elastic` have one); models with body or contact terms, custom
-//! terms or bond kinetics stay on the CPU with the reason.
+//! `linear_elastic` have one); models with body or contact terms or custom
+//! terms stay on the CPU with the reason. Bond kinetics run: a kinetic
+//! bond's block is scaled by its bound state as its force is (`bond_on`),
+//! and rules the host decides (`plastic`, `maturation`, …) upload their new
+//! rest lengths and scales before the next step's blocks are built.
 //!
 //! `solver cholesky` has no device form: its decks take quasi-static Newton
 //! steps (γ/dt = 1e-6 against stiffnesses of 10²–10⁵), and the device
@@ -128,9 +131,6 @@ const J_END: u32 = 0x8000_0000;
 
 /// Why the model's implicit step cannot run on the device (None: it can).
 pub fn refusal(model: &Model) -> Option<&'static str> {
-    if model.has_kinetics() {
-        return Some("bond kinetics with `integrator implicit` run on the CPU backend only");
-    }
     if !model.body_rules.is_empty() || model.has_contact_terms() {
         return Some(
             "`integrator implicit` with body or contact terms runs on the CPU backend only \
