@@ -129,6 +129,26 @@ fn one_implicit_step_with_volume_elements_matches_the_cpu() {
     }
 }
 
+/// The same with surface terms: two bodies (the area_conservation golden
+/// case, a cell and its nucleus), the cell under turgor, surface tension and
+/// global and local area elasticity, the nucleus under turgor_log, surface
+/// shear and local area elasticity, 40 and 16 times the drag γ/dt: each
+/// face's stencils (`NAME_face_hessian`) projected term by term on the
+/// device, and the bodies' Gauss–Newton terms (K/V0)·∇V∇Vᵀ, (K/V)·∇V∇Vᵀ and
+/// (k_a/A0)·∇A∇Aᵀ applied rank one; the bound is the one above, κ(A) from the
+/// CPU's blocks and rank-one terms.
+#[test]
+fn one_implicit_step_with_surface_terms_matches_the_cpu() {
+    let top = std::fs::read_to_string("reference/area_conservation/random.top").unwrap();
+    let ff = "particle a drag 0.01\nparticle b drag 0.025\n\
+              body cell turgor k 50 dp0 2 v0 60\nbody cell surface_tension gamma 1.5\nbody cell area_conservation ka 20 kl 10 a0 65\n\
+              body nucleus turgor_log k 80 v0 40\nbody nucleus surface_shear k 0.5\nbody nucleus area_conservation kl 15 a0 41\n";
+    let deck =
+        "units cell\ntopology t.top\nforcefield f.ff\nbox x -4 10 f y -4 10 f z -4 10 f\nintegrator implicit\ntimestep 1e-3\nrun 1\n";
+    let case = common::Case::new(&[("t.top", &top), ("f.ff", ff), ("deck.in", deck)]);
+    one_step_matches(&case);
+}
+
 /// The same with a rigid spherical indenter (`indenter`, K = 10⁴ pN/µm²,
 /// 0.2 µm into the ball's top) instead of the walls: its block is the
 /// positive part 2K(R − r)·ûûᵀ of its Hessian, as the CPU's projection
@@ -230,6 +250,15 @@ fn condition_bound(plan: &cellmd::deck::Plan, state: &State) -> f64 {
     for b in &stiffness.blocks {
         for r in 0..3 {
             rows[3 * b.i as usize + r] += (0..3).map(|c| b.block.col(c)[r].abs()).sum::<f64>();
+        }
+    }
+    // A body's rank-one term w·g gᵀ: row (i, r) sums w·|g_i,r|·Σ_j ‖g_j‖₁.
+    for term in &stiffness.rank_one {
+        let total: f64 = term.gradient.iter().map(|g| g.abs().element_sum()).sum();
+        for (&i, g) in term.particles.iter().zip(&term.gradient) {
+            for r in 0..3 {
+                rows[3 * i as usize + r] += term.weight * g[r].abs() * total;
+            }
         }
     }
     let drag = model.type_drag.iter().copied().filter(|g| g.is_finite()).fold(f64::INFINITY, f64::min) / 1e-3;

@@ -8,13 +8,20 @@
 //      semi-definite part (cyclic Jacobi), as the CPU's blocks.
 //   1b. `implicit_tetras` (one invocation per volume element): its exact
 //      12×12 Hessian from its law's `NAME_tetra_hessian`, projected likewise.
+//   1c. `implicit_faces` (one invocation per face of a body with surface
+//      terms): each term's 9×9 stencil from its law's `NAME_face_hessian`,
+//      projected term by term and summed, as the CPU's blocks.
 //   2. `implicit_blocks` (one per particle): the projected radial block of
 //      each of its bond ends and the Hessian of each of its externals, and
 //      the Jacobi diagonal from them and its angles' diagonal blocks.
 //   3. `implicit_solve` (ONE workgroup): the whole CG, every product K̃·v
 //      gathered per particle from its own terms in a fixed order, every dot
 //      product a fixed tree over the workgroup; the convergence test is
-//      taken on the device each iteration and nothing is read back.
+//      taken on the device each iteration and nothing is read back. A body's
+//      Gauss–Newton terms over all its nodes (turgor's (K/V0)·∇V∇Vᵀ, the
+//      global area term's (k_a/A0)·∇A∇Aᵀ) stay rank one: before each
+//      product the body's ∇V·v and ∇A·v are summed face by face
+//      (`body_dots`), and each node gathers w·(g·v)·g_i from its faces.
 //   4. `implicit_move` (one per particle): x ← x + Δx in fixed point, the
 //      blow-up check of the explicit step (`step_particle`).
 // No float atomics: the same run gives the same bits.
@@ -36,6 +43,8 @@ const IMP_V_EXTERNALS: u32 = 9u;    // … of the external blocks (2 per externa
 const IMP_V_ANGLES: u32 = 10u;      // … of the angle blocks (21 per angle)
 const IMP_V_REPORT: u32 = 11u;      // … of the last solve's report
 const IMP_V_TETRAS: u32 = 17u;      // … of the volume elements' blocks (36 per element)
+const IMP_V_FACES: u32 = 18u;       // … of the faces' blocks (21 per face of the surface pack)
+const IMP_V_BODIES: u32 = 19u;      // … per packed body: (w_V, w_A, ∇V·v, ∇A·v)
 
 // Per-particle vectors of `imp`: section s of particle i is imp[s·n + i].
 const VEC_X: u32 = 0u;    // Δx
@@ -46,6 +55,7 @@ const VEC_Q: u32 = 4u;    // A·p
 const VEC_DINV: u32 = 5u; // inverse Jacobi diagonal
 const ANGLE_VEC4: u32 = 21u;
 const TETRA_VEC4: u32 = 36u;
+const FACE_VEC4: u32 = 21u;
 // Row stride of the matrices `project_psd` works on.
 const PSD_STRIDE: u32 = 12u;
 
@@ -253,6 +263,157 @@ fn implicit_tetras(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocati
     }
 }
 
+// Entry f of face e's row-major 9×9 block.
+fn face_entry(e: u32, f: u32) -> f32 {
+    return imp[imp_topo[IMP_V_FACES] + FACE_VEC4 * e + f / 4u][f % 4u];
+}
+
+// Packed body b's volume, area and face count at the step's force pass.
+fn body_totals(b: u32) -> BodyTotals {
+    let totals = surf[surf_body(b)];
+    return BodyTotals(totals.x, totals.y, f32(topo[P.off_body_faces + b + 1u] - topo[P.off_body_faces + b]));
+}
+
+// One invocation per face: Σ over its body's terms of the PSD part of each
+// term's 9×9 stencil (`NAME_face_hessian`), as the CPU projects each term's
+// stencil alone.
+@compute @workgroup_size(256)
+fn implicit_faces(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    let f = linear_index(wg, local);
+    if f >= P.n_faces || halted() {
+        return;
+    }
+    let b = face_word(f, 3u);
+    let g = face_geometry(f);
+    let body = body_totals(b);
+    var sum: array<f32, 84>;
+    let terms_end = topo[P.off_body_term_start + b + 1u];
+    for (var t = topo[P.off_body_term_start + b]; t < terms_end; t++) {
+        let term = topo[P.off_body_terms + t];
+        let stencil = face_hessian(topo[P.off_term_kind + term], term_params(term), body, g);
+        var h: array<f32, 144>;
+        for (var r = 0u; r < 9u; r++) {
+            for (var c = 0u; c < 9u; c++) {
+                h[r * PSD_STRIDE + c] = stencil[r * 9u + c];
+            }
+        }
+        project_psd(&h, 9u);
+        for (var r = 0u; r < 9u; r++) {
+            for (var c = 0u; c < 9u; c++) {
+                sum[r * 9u + c] += h[r * PSD_STRIDE + c];
+            }
+        }
+    }
+    let base = imp_topo[IMP_V_FACES] + FACE_VEC4 * f;
+    for (var k = 0u; k < FACE_VEC4; k++) {
+        imp[base + k] = vec4<f32>(sum[4u * k], sum[4u * k + 1u], sum[4u * k + 2u], sum[4u * k + 3u]);
+    }
+}
+
+// The weights (w_V, w_A) of packed body b's Gauss–Newton terms over all its
+// nodes, w_V·∇V∇Vᵀ + w_A·∇A∇Aᵀ (`NAME_body_weights` of its terms, summed).
+fn body_weight_sum(b: u32) -> vec2<f32> {
+    let body = body_totals(b);
+    var w = vec2<f32>(0.0);
+    let terms_end = topo[P.off_body_term_start + b + 1u];
+    for (var t = topo[P.off_body_term_start + b]; t < terms_end; t++) {
+        let term = topo[P.off_body_terms + t];
+        w += body_weights(topo[P.off_term_kind + term], term_params(term), body);
+    }
+    return w;
+}
+
+// Particle i's surface slot s as (face, corner), or NO_NODE in x for a slot
+// that is not a face corner.
+fn corner_slot(s: u32) -> vec2<u32> {
+    let c = topo[P.off_node_slots + s] - surf_corner(0u);
+    return select(vec2<u32>(NO_NODE, 0u), vec2<u32>(c / 3u, c % 3u), c < 3u * P.n_faces);
+}
+
+// ∂A_t/∂x at corner k of a face.
+fn corner_area_gradient(g: FaceGeometry, k: u32) -> vec3<f32> {
+    return select(select(g.ga2, g.ga1, k == 1u), g.ga0, k == 0u);
+}
+
+// For every packed body: (w_V, w_A, ∇V·v, ∇A·v) of the vector in `section`,
+// each body's sums taken face by face in order by one invocation; then a
+// barrier, so that `apply_row` can gather them (call before each product).
+fn body_dots(local: u32, section: u32) {
+    for (var b = local; b < P.n_bodies; b += WORKGROUP) {
+        var dots = vec2<f32>(0.0);
+        let faces_end = topo[P.off_body_faces + b + 1u];
+        for (var f = topo[P.off_body_faces + b]; f < faces_end; f++) {
+            let g = face_geometry(f);
+            let va = imp_vec(section, face_word(f, 0u));
+            let vb = imp_vec(section, face_word(f, 1u));
+            let vc = imp_vec(section, face_word(f, 2u));
+            dots += vec2<f32>(dot(g.gv, va + vb + vc), dot(g.ga0, va) + dot(g.ga1, vb) + dot(g.ga2, vc));
+        }
+        imp[imp_topo[IMP_V_BODIES] + b] = vec4<f32>(body_weight_sum(b), dots);
+    }
+    storageBarrier();
+}
+
+// Particle i's rows of its faces' blocks and of its bodies' rank-one terms
+// applied to the vector in `section`: Σ_faces block·v over the face's corners
+// plus w_V·(∇V·v)·∂V_t/∂x_i + w_A·(∇A·v)·∂A_t/∂x_i (`body_dots` first).
+fn surface_rows(i: u32, section: u32) -> vec3<f32> {
+    var out = vec3<f32>(0.0);
+    let slots_end = topo[P.off_node_slot_offsets + i + 1u];
+    for (var s = topo[P.off_node_slot_offsets + i]; s < slots_end; s++) {
+        let slot = corner_slot(s);
+        if slot.x == NO_NODE {
+            continue;
+        }
+        for (var c = 0u; c < 3u; c++) {
+            let vc = imp_vec(section, face_word(slot.x, c));
+            for (var m = 0u; m < 3u; m++) {
+                let row = (3u * slot.y + m) * 9u + 3u * c;
+                out[m] += face_entry(slot.x, row) * vc.x + face_entry(slot.x, row + 1u) * vc.y + face_entry(slot.x, row + 2u) * vc.z;
+            }
+        }
+        let rank_one = imp[imp_topo[IMP_V_BODIES] + face_word(slot.x, 3u)];
+        if rank_one.x != 0.0 || rank_one.y != 0.0 {
+            let g = face_geometry(slot.x);
+            out += rank_one.x * rank_one.z * g.gv + rank_one.y * rank_one.w * corner_area_gradient(g, slot.y);
+        }
+    }
+    return out;
+}
+
+// Particle i's share of the Jacobi diagonal from its faces' blocks and its
+// bodies' rank-one terms, w·g_i² with g_i = Σ over its faces (its slots
+// are in ascending body order, so each body's faces are consecutive).
+fn surface_diagonal(i: u32) -> vec3<f32> {
+    var diagonal = vec3<f32>(0.0);
+    var body = NO_NODE;
+    var w = vec2<f32>(0.0);
+    var gv = vec3<f32>(0.0);
+    var ga = vec3<f32>(0.0);
+    let slots_end = topo[P.off_node_slot_offsets + i + 1u];
+    for (var s = topo[P.off_node_slot_offsets + i]; s < slots_end; s++) {
+        let slot = corner_slot(s);
+        if slot.x == NO_NODE {
+            continue;
+        }
+        for (var m = 0u; m < 3u; m++) {
+            diagonal[m] += face_entry(slot.x, (3u * slot.y + m) * 10u);
+        }
+        let b = face_word(slot.x, 3u);
+        if b != body {
+            diagonal += w.x * gv * gv + w.y * ga * ga;
+            body = b;
+            w = body_weight_sum(b);
+            gv = vec3<f32>(0.0);
+            ga = vec3<f32>(0.0);
+        }
+        let g = face_geometry(slot.x);
+        gv += g.gv;
+        ga += corner_area_gradient(g, slot.y);
+    }
+    return diagonal + w.x * gv * gv + w.y * ga * ga;
+}
+
 // Particle i's volume-element slots (the forces' node → (element, corner)
 // CSR, ascending element): element and corner of slot s.
 fn tetra_slot(s: u32) -> vec2<u32> {
@@ -368,6 +529,7 @@ fn implicit_blocks(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocati
             diagonal[m] += tetra_entry(slot.x, (3u * slot.y + m) * (PSD_STRIDE + 1u));
         }
     }
+    diagonal += surface_diagonal(i);
     diagonal += pair_rows(i, VEC_X, vec3<f32>(0.0), true);
     // A held coordinate (`freeze`, `move`): the identity row.
     imp[dinv] = vec4<f32>(select(vec3<f32>(1.0), 1.0 / diagonal, free_axes(i) != vec3<f32>(0.0)), 0.0);
@@ -378,7 +540,8 @@ fn imp_vec(section: u32, i: u32) -> vec3<f32> {
 }
 
 // (A·v)_i for the vector in `section`: γ/dt·v_i plus particle i's rows of its
-// bond ends, externals, angles, volume elements and pairs, in that order (a fixed particle, and a
+// bond ends, externals, angles, volume elements, faces and bodies, and pairs,
+// in that order (`body_dots` of the section first; a fixed particle, and a
 // held coordinate of `freeze` or `move`: v_i). Their entries of every vector
 // the solve forms are 0, so their couplings drop out as in the CPU's matrix.
 fn apply_row(i: u32, section: u32) -> vec3<f32> {
@@ -422,6 +585,7 @@ fn apply_row(i: u32, section: u32) -> vec3<f32> {
             }
         }
     }
+    out += surface_rows(i, section);
     out += pair_rows(i, section, vi, false);
     return select(vi, out, free_axes(i) != vec3<f32>(0.0));
 }
@@ -453,6 +617,7 @@ fn workgroup_sum(local: u32, v: vec3<f32>) -> vec3<f32> {
 // invocation).
 fn times_search_direction(local: u32) -> f32 {
     storageBarrier();
+    body_dots(local, VEC_P);
     var pq = 0.0;
     for (var i = local; i < P.n; i += WORKGROUP) {
         let q = apply_row(i, VEC_P);
@@ -499,6 +664,7 @@ fn implicit_solve(@builtin(local_invocation_index) local: u32) {
         imp[n * VEC_X + i] = vec4<f32>(imp[n * VEC_DINV + i].xyz * b, 0.0);
     }
     storageBarrier();
+    body_dots(local, VEC_X);
     var sums = vec3<f32>(0.0);
     for (var i = local; i < n; i += WORKGROUP) {
         let b = imp_vec(VEC_R, i);

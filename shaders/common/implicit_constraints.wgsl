@@ -201,6 +201,7 @@ fn constrained_solve(local: u32, tolerance: f32, cap: u32) {
     }
     // The constraint forces: μ of the residual AΔx − b; tension −μ.
     storageBarrier();
+    body_dots(local, VEC_X);
     for (var i = local; i < n; i += WORKGROUP) {
         imp[n * VEC_Q + i] = vec4<f32>(apply_row(i, VEC_X) - implicit_rhs(i), 0.0);
     }

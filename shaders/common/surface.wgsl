@@ -242,3 +242,55 @@ fn surface_forces(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocatio
     surf[surf_corner(3u * f + 1u)] = vec4<f32>(out.f1, e);
     surf[surf_corner(3u * f + 2u)] = vec4<f32>(out.f2, e);
 }
+
+// The cross-product matrix [v]ₓ: [v]ₓ·u = v × u.
+fn cross_matrix(v: vec3<f32>) -> mat3x3<f32> {
+    return mat3x3<f32>(vec3<f32>(0.0, v.z, -v.y), vec3<f32>(-v.z, 0.0, v.x), vec3<f32>(v.y, -v.x, 0.0));
+}
+
+// The Hessian ∂²A/∂x_k∂x_l of a face's area, block 3k + l (the CPU's
+// `triangle_area_hessian`, src/mesh.rs): −[e_k]ₓ(I − n̂n̂ᵀ)[e_l]ₓ/(2|n|)
+// with e = (x_b − x_c, x_c − x_a, x_a − x_b), plus ∓½[n̂]ₓ off the diagonal.
+fn triangle_area_hessian(g: FaceGeometry) -> array<mat3x3<f32>, 9> {
+    let n = cross(g.x1, g.x2);
+    let twice = length(n);
+    let unit = n / twice;
+    let projector = mat3x3<f32>(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(0.0, 0.0, 1.0))
+        - mat3x3<f32>(unit * unit.x, unit * unit.y, unit * unit.z);
+    var edges = array<mat3x3<f32>, 3>(cross_matrix(g.x1 - g.x2), cross_matrix(g.x2), cross_matrix(-g.x1));
+    let turn = cross_matrix(unit);
+    var out: array<mat3x3<f32>, 9>;
+    for (var k = 0u; k < 3u; k++) {
+        for (var l = 0u; l < 3u; l++) {
+            var second = mat3x3<f32>();
+            let offset = (l + 3u - k) % 3u;
+            if offset == 1u {
+                second = turn * -0.5;
+            } else if offset == 2u {
+                second = turn * 0.5;
+            }
+            out[3u * k + l] = edges[k] * projector * edges[l] * (-1.0 / (2.0 * twice)) + second;
+        }
+    }
+    return out;
+}
+
+// The 9×9 Hessian (row-major, corner-major) c·∇A_t∇A_tᵀ + τ·∇²A_t of a face
+// energy e(A_t) with e′ = `tension` and e″ = `curvature` (the CPU's
+// `SurfaceHessian::push_face`, src/hessian.rs).
+fn face_area_stencil(g: FaceGeometry, tension: f32, curvature: f32) -> array<f32, 81> {
+    var ga = array<vec3<f32>, 3>(g.ga0, g.ga1, g.ga2);
+    var second = triangle_area_hessian(g);
+    var h: array<f32, 81>;
+    for (var k = 0u; k < 3u; k++) {
+        for (var l = 0u; l < 3u; l++) {
+            let block = second[3u * k + l];
+            for (var i = 0u; i < 3u; i++) {
+                for (var j = 0u; j < 3u; j++) {
+                    h[(3u * k + i) * 9u + 3u * l + j] = curvature * ga[k][i] * ga[l][j] + tension * block[j][i];
+                }
+            }
+        }
+    }
+    return h;
+}

@@ -11,3 +11,12 @@ fn turgor_log_face(p: array<f32, 8>, body: BodyTotals, g: FaceGeometry) -> Surfa
     let f = pressure * g.gv;
     return SurfaceFace(energy / body.faces, f, f, f);
 }
+// Its stiffness (the implicit step): no face stencil; the Gauss–Newton term
+// (K/V)·∇V∇Vᵀ over the whole body (nothing for V ≤ 0), as (volume weight,
+// area weight).
+fn turgor_log_face_hessian(p: array<f32, 8>, body: BodyTotals, g: FaceGeometry) -> array<f32, 81> {
+    return array<f32, 81>();
+}
+fn turgor_log_body_weights(p: array<f32, 8>, body: BodyTotals) -> vec2<f32> {
+    return vec2<f32>(select(0.0, p[TURGOR_LOG_K] / body.volume, p[TURGOR_LOG_K] > 0.0 && body.volume > 0.0), 0.0);
+}

@@ -945,10 +945,8 @@ impl GpuBackend {
         let integrate = match &self.implicit {
             // The implicit step in place of `integrate` (src/gpu/implicit.rs).
             Some(solver) => {
-                // In the step's order (`encode_step`): angles, elements, then the per-particle passes.
-                let per_term = [(&solver.angles, solver.angle_groups(WORKGROUP)), (&solver.tetras, solver.tetra_groups(WORKGROUP))];
-                let mut passes: Vec<_> =
-                    per_term.into_iter().filter(|&(_, groups)| groups > 0).map(|(k, groups)| (k, Over::Groups(groups))).collect();
+                // In the step's order (`encode_step`): angles, elements, faces, then the per-particle passes.
+                let mut passes: Vec<_> = solver.term_passes(WORKGROUP).into_iter().map(|(k, groups)| (k, Over::Groups(groups))).collect();
                 passes.extend([(&solver.blocks, particles), (&solver.solve, Over::Groups(1)), (&solver.moves, particles)]);
                 time(self, &passes, Some(&solver.group)) + time(self, &[(&k.commit, particles), (&k.advance, Over::Groups(1))], None)
             }
@@ -1063,11 +1061,8 @@ impl GpuBackend {
             } else if let Some(solver) = &self.implicit {
                 // The implicit step (src/gpu/implicit.rs) in place of `integrate`.
                 pass.set_bind_group(1, &solver.group, &[]);
-                if solver.angle_groups(WORKGROUP) > 0 {
-                    self.dispatch(pass, &solver.angles, Over::Groups(solver.angle_groups(WORKGROUP)));
-                }
-                if solver.tetra_groups(WORKGROUP) > 0 {
-                    self.dispatch(pass, &solver.tetras, Over::Groups(solver.tetra_groups(WORKGROUP)));
+                for (kernel, groups) in solver.term_passes(WORKGROUP) {
+                    self.dispatch(pass, kernel, Over::Groups(groups));
                 }
                 self.dispatch(pass, &solver.blocks, Over::Particles);
                 self.dispatch(pass, &solver.solve, Over::Groups(1));

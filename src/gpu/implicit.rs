@@ -33,6 +33,19 @@
 //!   projected like the angles' (kernel `implicit_tetras`; the CPU takes it
 //!   by central differences of the element's forces); each product gathers a
 //!   particle's rows through the forces' node → (element, corner) slots.
+//! - **Body surfaces** (per-face laws): each face's 9×9 stencil of each
+//!   term (`NAME_face_hessian`: γ·∇²A_t for `surface_tension`,
+//!   (k_l/a0)·∇A_t∇A_tᵀ + (dE/dA_t)·∇²A_t for `area_conservation`, the exact
+//!   Hessian of `surface_shear`'s face energy), projected term by term as on
+//!   the CPU and summed (kernel `implicit_faces`), gathered through the
+//!   forces' node → face-corner slots; and the Gauss–Newton terms over a
+//!   whole body, w_V·∇V∇Vᵀ (`turgor`: K/V0, `turgor_log`: K/V) and
+//!   w_A·∇A∇Aᵀ (the global area term: k_a/A0), weights from
+//!   `NAME_body_weights`, applied rank one as the CPU's `SystemMatrix` does:
+//!   before each product one invocation per body sums ∇V·v and ∇A·v face by
+//!   face, in order, and each node adds w·(g·v)·∂g/∂x_i over its faces. The
+//!   Jacobi diagonal takes w·g_i², g_i summed over the node's faces.
+//!   `helfrich_bending` (Gauss–Newton over each node's one-ring) has none.
 //! - **Pairs**: the bonds' radial block for every rule between two
 //!   neighbours (and, weighted, fractional `special_bonds` partners),
 //!   computed again from the positions at each product K̃·v from the
@@ -51,8 +64,10 @@
 //! device block (a WGSL function `NAME_curvature`, `NAME_hessian` or
 //! `NAME_tetra_hessian`; `harmonic`, `soft_repulsion`, `lj`, `wca`,
 //! `wlc_bending`, `wall`, `indenter`, `constant_force`, `neo_hookean` and
-//! `linear_elastic` have one); models with body or contact terms or custom
-//! terms stay on the CPU with the reason. Bond kinetics run: a kinetic
+//! `linear_elastic` have one), and every body term its face stencil and
+//! body weights (`turgor`, `turgor_log`, `surface_tension`,
+//! `area_conservation`, `surface_shear`); models with contact terms,
+//! `helfrich_bending` or custom terms stay on the CPU with the reason. Bond kinetics run: a kinetic
 //! bond's block is scaled by its bound state as its force is (`bond_on`),
 //! and rules the host decides (`plastic`, `maturation`, …) upload their new
 //! rest lengths and scales before the next step's blocks are built.
@@ -108,7 +123,7 @@ use super::pack::push_csr;
 use super::shader;
 use super::side_group::SideGroup;
 use crate::integrate::implicit::{ImplicitSettings, SolveReport};
-use crate::interactions::{Law, REGISTRY};
+use crate::interactions::{Law, SurfaceGpu, REGISTRY};
 use crate::system::Model;
 
 /// The smallest relative residual the device's f32 conjugate gradients are
@@ -116,13 +131,15 @@ use crate::system::Model;
 /// decks' systems, ~10³, leaves a margin of ten).
 pub const F32_TOLERANCE: f64 = 1e-6;
 
-const HEADER_WORDS: usize = 18;
+const HEADER_WORDS: usize = 20;
 /// `imp` entries per particle (Δx, r, z, p, A·p, the Jacobi diagonal).
 const PARTICLE_VECTORS: usize = 6;
 /// `imp` entries of an angle's 9×9 block.
 const ANGLE_VEC4: usize = 21;
 /// `imp` entries of a volume element's 12×12 block.
 const TETRA_VEC4: usize = 36;
+/// `imp` entries of a face's 9×9 block (its body's surface terms).
+const FACE_VEC4: usize = 21;
 /// `imp` entries of a constraint (û and its flag; μ, r, p, q of the inner
 /// CG; its z, S's inverse diagonal and its tension).
 const CONSTRAINT_VEC4: usize = 3;
@@ -131,10 +148,16 @@ const J_END: u32 = 0x8000_0000;
 
 /// Why the model's implicit step cannot run on the device (None: it can).
 pub fn refusal(model: &Model) -> Option<&'static str> {
-    if !model.body_rules.is_empty() || model.has_contact_terms() {
+    if model.has_contact_terms() {
         return Some(
-            "`integrator implicit` with body or contact terms runs on the CPU backend only \
-             (the GPU has stiffness blocks for bonds, angles, pairs, externals and volume elements)",
+            "`integrator implicit` with contact terms runs on the CPU backend only \
+             (the GPU has stiffness blocks for bonds, angles, pairs, externals, volume elements and per-face body terms)",
+        );
+    }
+    if !model.body_rules.iter().all(|r| stiffness_function(r.interaction).is_some()) {
+        return Some(
+            "`integrator implicit` with a body term that has no GPU stiffness block runs on the CPU backend only \
+             (turgor, turgor_log, surface_tension, area_conservation and surface_shear have one; helfrich_bending and custom body terms not)",
         );
     }
     let kinds = super::custom::gpu_kinds(model);
@@ -151,22 +174,28 @@ pub fn refusal(model: &Model) -> Option<&'static str> {
 }
 
 /// The WGSL function giving an interaction's stiffness, if its evaluator
-/// file has one: `NAME_curvature` (E″ of a radial law) or `NAME_hessian`
-/// (a three- or one-body law's Hessian).
+/// file has one: `NAME_curvature` (E″ of a radial law), `NAME_hessian`
+/// (a three- or one-body law's Hessian), `NAME_tetra_hessian` (a volume
+/// element's ∂²W/∂F∂F) or, for a per-face body law, `NAME_face_hessian`
+/// (its 9×9 stencil on one face) with `NAME_body_weights` (the weights of
+/// its Gauss–Newton terms over the whole body, on ∇V∇Vᵀ and ∇A∇Aᵀ).
 fn stiffness_function(interaction: &dyn crate::interactions::Interaction) -> Option<String> {
     let name = interaction.name();
-    let function = match interaction.law() {
-        Law::Radial { .. } => format!("{name}_curvature"),
-        Law::ThreeBody(_) | Law::OneBody(_) => format!("{name}_hessian"),
-        Law::Tetra(_) => format!("{name}_tetra_hessian"),
+    let functions = match interaction.law() {
+        Law::Radial { .. } => vec![format!("{name}_curvature")],
+        Law::ThreeBody(_) | Law::OneBody(_) => vec![format!("{name}_hessian")],
+        Law::Tetra(_) => vec![format!("{name}_tetra_hessian")],
+        Law::Surface { gpu: SurfaceGpu::PerFace, .. } => vec![format!("{name}_face_hessian"), format!("{name}_body_weights")],
         _ => return None,
     };
-    shader::interaction_source(name).filter(|s| s.contains(&format!("fn {function}("))).map(|_| function)
+    let source = shader::interaction_source(name)?;
+    functions.iter().all(|f| source.contains(&format!("fn {f}("))).then(|| functions[0].clone())
 }
 
 /// The stiffness dispatch functions over the registry: `radial_curvature`,
-/// `three_body_hessian`, `one_body_hessian` and `tetra_hessian` (0 for laws without one,
-/// which [`refusal`] keeps off the device).
+/// `three_body_hessian`, `one_body_hessian`, `tetra_hessian`, `face_hessian`
+/// and `body_weights` (0 for laws without one, which [`refusal`] keeps off
+/// the device).
 pub fn stiffness_dispatch() -> String {
     let mut radial = String::from("fn radial_curvature(kind: u32, p: array<f32, 8>, r: f32) -> f32 {\n    switch kind {\n");
     let mut three = String::from(
@@ -176,12 +205,21 @@ pub fn stiffness_dispatch() -> String {
     let mut tetra = String::from(
         "fn tetra_hessian(kind: u32, p: array<f32, 8>, f: mat3x3<f32>, j: f32, f_inv_t: mat3x3<f32>) -> array<f32, 81> {\n    switch kind {\n",
     );
+    let mut face = String::from(
+        "fn face_hessian(kind: u32, p: array<f32, 8>, body: BodyTotals, g: FaceGeometry) -> array<f32, 81> {\n    switch kind {\n",
+    );
+    let mut weights = String::from("fn body_weights(kind: u32, p: array<f32, 8>, body: BodyTotals) -> vec2<f32> {\n    switch kind {\n");
     for (index, interaction) in REGISTRY.iter().enumerate() {
         let Some(function) = stiffness_function(*interaction) else { continue };
         let (out, args) = match interaction.law() {
             Law::Radial { .. } => (&mut radial, "p, r"),
             Law::ThreeBody(_) => (&mut three, "p, ri, rj, rk"),
             Law::Tetra(_) => (&mut tetra, "p, f, j, f_inv_t"),
+            Law::Surface { .. } => {
+                let name = interaction.name();
+                weights.push_str(&format!("        case {index}u: {{ return {name}_body_weights(p, body); }}\n"));
+                (&mut face, "p, body, g")
+            }
             _ => (&mut one, "p, x"),
         };
         out.push_str(&format!("        case {index}u: {{ return {function}({args}); }}\n"));
@@ -190,7 +228,9 @@ pub fn stiffness_dispatch() -> String {
     three.push_str("        default: { return array<f32, 81>(); }\n    }\n}\n");
     one.push_str("        default: { return mat3x3<f32>(); }\n    }\n}\n");
     tetra.push_str("        default: { return array<f32, 81>(); }\n    }\n}\n");
-    radial + &three + &one + &tetra
+    face.push_str("        default: { return array<f32, 81>(); }\n    }\n}\n");
+    weights.push_str("        default: { return vec2<f32>(0.0); }\n    }\n}\n");
+    radial + &three + &one + &tetra + &face + &weights
 }
 
 /// The device's implicit solver: its buffers, bind group (group 1) and kernels.
@@ -198,6 +238,7 @@ pub(super) struct ImplicitSolver {
     pub(super) group: wgpu::BindGroup,
     pub(super) angles: wgpu::ComputePipeline,
     pub(super) tetras: wgpu::ComputePipeline,
+    pub(super) faces: wgpu::ComputePipeline,
     pub(super) blocks: wgpu::ComputePipeline,
     pub(super) solve: wgpu::ComputePipeline,
     pub(super) moves: wgpu::ComputePipeline,
@@ -206,6 +247,7 @@ pub(super) struct ImplicitSolver {
     pub(super) report_at: u64,
     angle_count: u32,
     tetra_count: u32,
+    face_count: u32,
     /// Constrained bonds, and the byte offset of their entries in `imp`.
     pub(super) constraints: usize,
     pub(super) constraints_at: u64,
@@ -257,14 +299,21 @@ impl ImplicitSolver {
         header[7] = (HEADER_WORDS + words.len()) as u32;
         words.extend(model.type_drag.iter().map(|&g| kick(g).to_bits()));
         // `imp`: the particle vectors, then 2 entries per bond end and per
-        // external entry, 21 per angle, 36 per volume element, then the report.
+        // external entry, 21 per angle, 36 per volume element, 21 per face
+        // and 1 per body of the surface terms (in the surface pack's order,
+        // src/gpu/surface.rs), then the report.
         let externals: usize = model.externals.iter().map(|e| e.members.len()).sum();
         let bonds_at = PARTICLE_VECTORS * n;
         let externals_at = bonds_at + 2 * 2 * model.bonds.len();
         let angles_at = externals_at + 2 * externals;
         let tetras_at = angles_at + ANGLE_VEC4 * model.angles.len();
-        let report = tetras_at + TETRA_VEC4 * model.tetras.len();
+        let faces_at = tetras_at + TETRA_VEC4 * model.tetras.len();
+        let (faces, bodies) = super::surface::packed_counts(model);
+        let bodies_at = faces_at + FACE_VEC4 * faces;
+        let report = bodies_at + bodies;
         header[17] = tetras_at as u32;
+        header[18] = faces_at as u32;
+        header[19] = bodies_at as u32;
         header[8] = bonds_at as u32;
         header[9] = externals_at as u32;
         header[10] = angles_at as u32;
@@ -311,6 +360,7 @@ impl ImplicitSolver {
         Ok(Self {
             angles: side.pipeline(ctx, "implicit_angles"),
             tetras: side.pipeline(ctx, "implicit_tetras"),
+            faces: side.pipeline(ctx, "implicit_faces"),
             blocks: side.pipeline(ctx, "implicit_blocks"),
             solve: side.pipeline(ctx, "implicit_solve"),
             moves: side.pipeline(ctx, "implicit_move"),
@@ -319,6 +369,7 @@ impl ImplicitSolver {
             report_at: 16 * report as u64,
             angle_count: model.angles.len() as u32,
             tetra_count: model.tetras.len() as u32,
+            face_count: faces as u32,
             constraints: constrained.len(),
             constraints_at: 16 * (report + 1) as u64,
             tolerance,
@@ -326,14 +377,14 @@ impl ImplicitSolver {
         })
     }
 
-    /// Workgroups of the per-angle kernel (0 without angles).
-    pub(super) fn angle_groups(&self, workgroup: u32) -> u32 {
-        self.angle_count.div_ceil(workgroup)
-    }
-
-    /// Workgroups of the per-element kernel (0 without volume elements).
-    pub(super) fn tetra_groups(&self, workgroup: u32) -> u32 {
-        self.tetra_count.div_ceil(workgroup)
+    /// The per-term block kernels that have terms, in the step's order
+    /// (angles, volume elements, faces), with their workgroups.
+    pub(super) fn term_passes(&self, workgroup: u32) -> Vec<(&wgpu::ComputePipeline, u32)> {
+        [(&self.angles, self.angle_count), (&self.tetras, self.tetra_count), (&self.faces, self.face_count)]
+            .into_iter()
+            .filter(|&(_, count)| count > 0)
+            .map(|(kernel, count)| (kernel, count.div_ceil(workgroup)))
+            .collect()
     }
 
     /// The last solve's report, from the 16 bytes of its entry.

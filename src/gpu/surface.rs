@@ -129,17 +129,24 @@ impl SurfacePack {
     }
 }
 
+/// The bodies [`pack_surfaces`] packs (those with surface terms), in its
+/// order, with their terms.
+fn packed_bodies(model: &Model) -> impl Iterator<Item = (&crate::system::Body, Vec<usize>)> {
+    model.bodies.iter().enumerate().map(|(b, body)| (body, model.rules_of_body(b).collect::<Vec<_>>())).filter(|(_, r)| !r.is_empty())
+}
+
+/// The faces and bodies [`pack_surfaces`] packs.
+pub fn packed_counts(model: &Model) -> (usize, usize) {
+    packed_bodies(model).fold((0, 0), |(faces, bodies), (body, _)| (faces + body.mesh.triangles().len(), bodies + 1))
+}
+
 /// Packs the bodies that have surface terms; the model's surface term r is
 /// term `term_base + r` of the packed term list.
 pub fn pack_surfaces(model: &Model, term_base: usize) -> SurfacePack {
     let mut out = SurfacePack { body_faces: vec![0], body_term_start: vec![0], ..Default::default() };
     let mut rows: Vec<Vec<Slot>> = vec![Vec::new(); model.len()];
     let (mut node_edges, mut node_faces) = (Vec::new(), Vec::new());
-    for (b, body) in model.bodies.iter().enumerate() {
-        let rules: Vec<usize> = model.rules_of_body(b).collect();
-        if rules.is_empty() {
-            continue;
-        }
+    for (body, rules) in packed_bodies(model) {
         let packed_body = out.body_ids.len() as u32;
         let curvature =
             rules.iter().any(|&r| matches!(model.body_rules[r].interaction.law(), Law::Surface { gpu: SurfaceGpu::NodeCurvature, .. }));
