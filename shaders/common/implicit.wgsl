@@ -11,6 +11,9 @@
 //   1c. `implicit_faces` (one invocation per face of a body with surface
 //      terms): each term's 9×9 stencil from its law's `NAME_face_hessian`,
 //      projected term by term and summed, as the CPU's blocks.
+//   1d. `implicit_nodes` (one invocation per node of a body with a
+//      curvature law): the weights w, β of its Gauss–Newton term
+//      w·g gᵀ, g = ∇M_i − β·∇A_i over its one-ring (`NAME_node_weights`).
 //   2. `implicit_blocks` (one per particle): the projected radial block of
 //      each of its bond ends and the Hessian of each of its externals, and
 //      the Jacobi diagonal from them and its angles' diagonal blocks.
@@ -21,7 +24,9 @@
 //      Gauss–Newton terms over all its nodes (turgor's (K/V0)·∇V∇Vᵀ, the
 //      global area term's (k_a/A0)·∇A∇Aᵀ) stay rank one: before each
 //      product the body's ∇V·v and ∇A·v are summed face by face
-//      (`body_dots`), and each node gathers w·(g·v)·g_i from its faces.
+//      (`body_dots`), and each node gathers w·(g·v)·g_i from its faces; so
+//      do the curvature nodes' one-ring terms, g·v per node from its edges
+//      and faces, gathered through the edge and face-corner slots.
 //   4. `implicit_move` (one per particle): x ← x + Δx in fixed point, the
 //      blow-up check of the explicit step (`step_particle`).
 // No float atomics: the same run gives the same bits.
@@ -45,6 +50,7 @@ const IMP_V_REPORT: u32 = 11u;      // … of the last solve's report
 const IMP_V_TETRAS: u32 = 17u;      // … of the volume elements' blocks (36 per element)
 const IMP_V_FACES: u32 = 18u;       // … of the faces' blocks (21 per face of the surface pack)
 const IMP_V_BODIES: u32 = 19u;      // … per packed body: (w_V, w_A, ∇V·v, ∇A·v)
+const IMP_V_NODES: u32 = 20u;       // … per curvature node: (w, β, g·v)
 
 // Per-particle vectors of `imp`: section s of particle i is imp[s·n + i].
 const VEC_X: u32 = 0u;    // Δx
@@ -335,10 +341,66 @@ fn corner_area_gradient(g: FaceGeometry, k: u32) -> vec3<f32> {
     return select(select(g.ga2, g.ga1, k == 1u), g.ga0, k == 0u);
 }
 
+// One invocation per curvature node k: its M_k = ¼Σ ℓθ and A_k = ⅓Σ A_t (as
+// `surface_nodes`, from the force pass's edge and face values) and the
+// weights (w, β) of its body's curvature term there.
+@compute @workgroup_size(256)
+fn implicit_nodes(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    let k = linear_index(wg, local);
+    if k >= P.n_body_nodes || halted() {
+        return;
+    }
+    var m = 0.0;
+    let edges_end = topo[P.off_node_edge_offsets + k + 1u];
+    for (var q = topo[P.off_node_edge_offsets + k]; q < edges_end; q++) {
+        m += surf[surf_edge(topo[P.off_node_edges + q])].x;
+    }
+    var a = 0.0;
+    let faces_end = topo[P.off_node_face_offsets + k + 1u];
+    for (var q = topo[P.off_node_face_offsets + k]; q < faces_end; q++) {
+        a += surf[topo[P.off_node_faces + q]].x;
+    }
+    let b = topo[P.off_node_body + k];
+    var w = vec2<f32>(0.0);
+    let terms_end = topo[P.off_body_term_start + b + 1u];
+    for (var t = topo[P.off_body_term_start + b]; t < terms_end; t++) {
+        let term = topo[P.off_body_terms + t];
+        w += node_weights(topo[P.off_term_kind + term], term_params(term), 0.25 * m, a / 3.0);
+    }
+    imp[imp_topo[IMP_V_NODES] + k] = vec4<f32>(w, 0.0, 0.0);
+}
+
+// ∂(ℓθ)/∂x at role r (0, 1: ends; 2, 3: wings) of an edge.
+fn edge_gradient_at(g: EdgeBending, r: u32) -> vec3<f32> {
+    return select(select(select(g.gb, g.ga, r == 2u), g.gj, r == 1u), g.gi, r == 0u);
+}
+
 // For every packed body: (w_V, w_A, ∇V·v, ∇A·v) of the vector in `section`,
-// each body's sums taken face by face in order by one invocation; then a
-// barrier, so that `apply_row` can gather them (call before each product).
+// each body's sums taken face by face in order by one invocation; for every
+// curvature node k: g_k·v = ¼Σ_edges ∂(ℓθ)·v − β_k·⅓Σ_faces ∇A_t·v over its
+// edges and faces in order; then a barrier, so that `apply_row` can gather
+// them (call before each product).
 fn body_dots(local: u32, section: u32) {
+    for (var k = local; k < P.n_body_nodes; k += WORKGROUP) {
+        var dm = 0.0;
+        let edges_end = topo[P.off_node_edge_offsets + k + 1u];
+        for (var q = topo[P.off_node_edge_offsets + k]; q < edges_end; q++) {
+            let e = topo[P.off_node_edges + q];
+            let g = edge_bending(e);
+            dm += dot(g.gi, imp_vec(section, edge_word(e, 0u))) + dot(g.gj, imp_vec(section, edge_word(e, 1u)))
+                + dot(g.ga, imp_vec(section, edge_word(e, 2u))) + dot(g.gb, imp_vec(section, edge_word(e, 3u)));
+        }
+        var da = 0.0;
+        let faces_end = topo[P.off_node_face_offsets + k + 1u];
+        for (var q = topo[P.off_node_face_offsets + k]; q < faces_end; q++) {
+            let f = topo[P.off_node_faces + q];
+            let g = face_geometry(f);
+            da += dot(g.ga0, imp_vec(section, face_word(f, 0u))) + dot(g.ga1, imp_vec(section, face_word(f, 1u)))
+                + dot(g.ga2, imp_vec(section, face_word(f, 2u)));
+        }
+        let at = imp_topo[IMP_V_NODES] + k;
+        imp[at].z = 0.25 * dm - imp[at].y * da / 3.0;
+    }
     for (var b = local; b < P.n_bodies; b += WORKGROUP) {
         var dots = vec2<f32>(0.0);
         let faces_end = topo[P.off_body_faces + b + 1u];
@@ -377,13 +439,50 @@ fn surface_rows(i: u32, section: u32) -> vec3<f32> {
             let g = face_geometry(slot.x);
             out += rank_one.x * rank_one.z * g.gv + rank_one.y * rank_one.w * corner_area_gradient(g, slot.y);
         }
+        if face_word(slot.x, 4u) != NO_NODE {
+            // −w_k·(g_k·v)·β_k·⅓∇A_t for each corner k of the face (curvature nodes).
+            var coef = 0.0;
+            for (var c = 0u; c < 3u; c++) {
+                let node = imp[imp_topo[IMP_V_NODES] + face_word(slot.x, 4u + c)];
+                coef -= node.x * node.z * node.y / 3.0;
+            }
+            out += coef * corner_area_gradient(face_geometry(slot.x), slot.y);
+        }
+    }
+    return out + curvature_edge_rows(i);
+}
+
+// Particle i's edge slots (bodies with a curvature law) as (edge, role), or
+// NO_NODE in x for a slot that is not an edge slot.
+fn edge_slot(s: u32) -> vec2<u32> {
+    let c = topo[P.off_node_slots + s] - surf_edge_slot(0u);
+    return select(vec2<u32>(NO_NODE, 0u), vec2<u32>(c / 4u, c % 4u), c < 4u * P.n_edges);
+}
+
+// Σ over particle i's edge slots of w_k·(g_k·v)·¼∂(ℓθ)/∂x_i for each end k
+// of the edge (`body_dots` first).
+fn curvature_edge_rows(i: u32) -> vec3<f32> {
+    var out = vec3<f32>(0.0);
+    let slots_end = topo[P.off_node_slot_offsets + i + 1u];
+    for (var s = topo[P.off_node_slot_offsets + i]; s < slots_end; s++) {
+        let slot = edge_slot(s);
+        if slot.x == NO_NODE {
+            continue;
+        }
+        let k0 = imp[imp_topo[IMP_V_NODES] + edge_word(slot.x, 4u)];
+        let k1 = imp[imp_topo[IMP_V_NODES] + edge_word(slot.x, 5u)];
+        out += 0.25 * (k0.x * k0.z + k1.x * k1.z) * edge_gradient_at(edge_bending(slot.x), slot.y);
     }
     return out;
 }
 
 // Particle i's share of the Jacobi diagonal from its faces' blocks and its
 // bodies' rank-one terms, w·g_i² with g_i = Σ over its faces (its slots
-// are in ascending body order, so each body's faces are consecutive).
+// are in ascending body order, so each body's faces are consecutive). The
+// curvature nodes' terms add w_k·c² for each face and edge contribution c
+// to g_k at i, without the cross terms between contributions of one node
+// (a preconditioner only: the CPU's exact diagonal changes the iterations,
+// not the solution).
 fn surface_diagonal(i: u32) -> vec3<f32> {
     var diagonal = vec3<f32>(0.0);
     var body = NO_NODE;
@@ -410,6 +509,21 @@ fn surface_diagonal(i: u32) -> vec3<f32> {
         let g = face_geometry(slot.x);
         gv += g.gv;
         ga += corner_area_gradient(g, slot.y);
+        if face_word(slot.x, 4u) != NO_NODE {
+            for (var c = 0u; c < 3u; c++) {
+                let node = imp[imp_topo[IMP_V_NODES] + face_word(slot.x, 4u + c)];
+                let part = node.y / 3.0 * corner_area_gradient(g, slot.y);
+                diagonal += node.x * part * part;
+            }
+        }
+    }
+    for (var s = topo[P.off_node_slot_offsets + i]; s < slots_end; s++) {
+        let slot = edge_slot(s);
+        if slot.x == NO_NODE {
+            continue;
+        }
+        let part = 0.25 * edge_gradient_at(edge_bending(slot.x), slot.y);
+        diagonal += (imp[imp_topo[IMP_V_NODES] + edge_word(slot.x, 4u)].x + imp[imp_topo[IMP_V_NODES] + edge_word(slot.x, 5u)].x) * part * part;
     }
     return diagonal + w.x * gv * gv + w.y * ga * ga;
 }

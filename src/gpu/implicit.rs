@@ -45,7 +45,16 @@
 //!   before each product one invocation per body sums ∇V·v and ∇A·v face by
 //!   face, in order, and each node adds w·(g·v)·∂g/∂x_i over its faces. The
 //!   Jacobi diagonal takes w·g_i², g_i summed over the node's faces.
-//!   `helfrich_bending` (Gauss–Newton over each node's one-ring) has none.
+//! - **Body curvature** (`helfrich_bending`): per node k the generalised
+//!   Gauss–Newton term w_k·g_k g_kᵀ over its one-ring, g_k = ∇M_k − β_k·∇A_k
+//!   (w, β from `NAME_node_weights` at the node's M and A, kernel
+//!   `implicit_nodes`), applied matrix-free like the bodies' terms: before
+//!   each product one invocation per node sums g_k·v over its edges
+//!   (¼∂(ℓθ)) and faces (⅓∇A_t), and each particle gathers w_k·(g_k·v)·g_k
+//!   through its edge and face-corner slots. The Jacobi diagonal leaves out
+//!   the cross terms between one node's edge and face contributions (a
+//!   preconditioner: it changes the iterations, not the solution). One
+//!   curvature term per body.
 //! - **Pairs**: the bonds' radial block for every rule between two
 //!   neighbours (and, weighted, fractional `special_bonds` partners),
 //!   computed again from the positions at each product K̃·v from the
@@ -66,8 +75,9 @@
 //! `wlc_bending`, `wall`, `indenter`, `constant_force`, `neo_hookean` and
 //! `linear_elastic` have one), and every body term its face stencil and
 //! body weights (`turgor`, `turgor_log`, `surface_tension`,
-//! `area_conservation`, `surface_shear`); models with contact terms,
-//! `helfrich_bending` or custom terms stay on the CPU with the reason. Bond kinetics run: a kinetic
+//! `area_conservation`, `surface_shear`) or node weights
+//! (`helfrich_bending`); models with contact terms or custom terms stay on
+//! the CPU with the reason. Bond kinetics run: a kinetic
 //! bond's block is scaled by its bound state as its force is (`bond_on`),
 //! and rules the host decides (`plastic`, `maturation`, …) upload their new
 //! rest lengths and scales before the next step's blocks are built.
@@ -131,7 +141,7 @@ use crate::system::Model;
 /// decks' systems, ~10³, leaves a margin of ten).
 pub const F32_TOLERANCE: f64 = 1e-6;
 
-const HEADER_WORDS: usize = 20;
+const HEADER_WORDS: usize = 21;
 /// `imp` entries per particle (Δx, r, z, p, A·p, the Jacobi diagonal).
 const PARTICLE_VECTORS: usize = 6;
 /// `imp` entries of an angle's 9×9 block.
@@ -157,8 +167,12 @@ pub fn refusal(model: &Model) -> Option<&'static str> {
     if !model.body_rules.iter().all(|r| stiffness_function(r.interaction).is_some()) {
         return Some(
             "`integrator implicit` with a body term that has no GPU stiffness block runs on the CPU backend only \
-             (turgor, turgor_log, surface_tension, area_conservation and surface_shear have one; helfrich_bending and custom body terms not)",
+             (turgor, turgor_log, surface_tension, area_conservation, surface_shear and helfrich_bending have one; custom body terms not)",
         );
+    }
+    let curvature = |r: usize| matches!(model.body_rules[r].interaction.law(), Law::Surface { gpu: SurfaceGpu::NodeCurvature, .. });
+    if (0..model.bodies.len()).any(|b| model.rules_of_body(b).filter(|&r| curvature(r)).count() > 1) {
+        return Some("`integrator implicit` with two curvature terms on one body runs on the CPU backend only (the device keeps one Gauss–Newton term per node)");
     }
     let kinds = super::custom::gpu_kinds(model);
     let tetras = model.tetra_types.iter().map(|t| t.term().interaction);
@@ -178,7 +192,9 @@ pub fn refusal(model: &Model) -> Option<&'static str> {
 /// (a three- or one-body law's Hessian), `NAME_tetra_hessian` (a volume
 /// element's ∂²W/∂F∂F) or, for a per-face body law, `NAME_face_hessian`
 /// (its 9×9 stencil on one face) with `NAME_body_weights` (the weights of
-/// its Gauss–Newton terms over the whole body, on ∇V∇Vᵀ and ∇A∇Aᵀ).
+/// its Gauss–Newton terms over the whole body, on ∇V∇Vᵀ and ∇A∇Aᵀ), or, for
+/// a curvature law, `NAME_node_weights` (w and β of its Gauss–Newton term
+/// w·g gᵀ per node, g = ∇M_i − β·∇A_i).
 fn stiffness_function(interaction: &dyn crate::interactions::Interaction) -> Option<String> {
     let name = interaction.name();
     let functions = match interaction.law() {
@@ -186,6 +202,7 @@ fn stiffness_function(interaction: &dyn crate::interactions::Interaction) -> Opt
         Law::ThreeBody(_) | Law::OneBody(_) => vec![format!("{name}_hessian")],
         Law::Tetra(_) => vec![format!("{name}_tetra_hessian")],
         Law::Surface { gpu: SurfaceGpu::PerFace, .. } => vec![format!("{name}_face_hessian"), format!("{name}_body_weights")],
+        Law::Surface { gpu: SurfaceGpu::NodeCurvature, .. } => vec![format!("{name}_node_weights")],
         _ => return None,
     };
     let source = shader::interaction_source(name)?;
@@ -193,9 +210,9 @@ fn stiffness_function(interaction: &dyn crate::interactions::Interaction) -> Opt
 }
 
 /// The stiffness dispatch functions over the registry: `radial_curvature`,
-/// `three_body_hessian`, `one_body_hessian`, `tetra_hessian`, `face_hessian`
-/// and `body_weights` (0 for laws without one, which [`refusal`] keeps off
-/// the device).
+/// `three_body_hessian`, `one_body_hessian`, `tetra_hessian`, `face_hessian`,
+/// `body_weights` and `node_weights` (0 for laws without one, which
+/// [`refusal`] keeps off the device).
 pub fn stiffness_dispatch() -> String {
     let mut radial = String::from("fn radial_curvature(kind: u32, p: array<f32, 8>, r: f32) -> f32 {\n    switch kind {\n");
     let mut three = String::from(
@@ -209,17 +226,19 @@ pub fn stiffness_dispatch() -> String {
         "fn face_hessian(kind: u32, p: array<f32, 8>, body: BodyTotals, g: FaceGeometry) -> array<f32, 81> {\n    switch kind {\n",
     );
     let mut weights = String::from("fn body_weights(kind: u32, p: array<f32, 8>, body: BodyTotals) -> vec2<f32> {\n    switch kind {\n");
+    let mut node = String::from("fn node_weights(kind: u32, p: array<f32, 8>, m: f32, a: f32) -> vec2<f32> {\n    switch kind {\n");
     for (index, interaction) in REGISTRY.iter().enumerate() {
         let Some(function) = stiffness_function(*interaction) else { continue };
         let (out, args) = match interaction.law() {
             Law::Radial { .. } => (&mut radial, "p, r"),
             Law::ThreeBody(_) => (&mut three, "p, ri, rj, rk"),
             Law::Tetra(_) => (&mut tetra, "p, f, j, f_inv_t"),
-            Law::Surface { .. } => {
+            Law::Surface { gpu: SurfaceGpu::PerFace, .. } => {
                 let name = interaction.name();
                 weights.push_str(&format!("        case {index}u: {{ return {name}_body_weights(p, body); }}\n"));
                 (&mut face, "p, body, g")
             }
+            Law::Surface { .. } => (&mut node, "p, m, a"),
             _ => (&mut one, "p, x"),
         };
         out.push_str(&format!("        case {index}u: {{ return {function}({args}); }}\n"));
@@ -230,7 +249,8 @@ pub fn stiffness_dispatch() -> String {
     tetra.push_str("        default: { return array<f32, 81>(); }\n    }\n}\n");
     face.push_str("        default: { return array<f32, 81>(); }\n    }\n}\n");
     weights.push_str("        default: { return vec2<f32>(0.0); }\n    }\n}\n");
-    radial + &three + &one + &tetra + &face + &weights
+    node.push_str("        default: { return vec2<f32>(0.0); }\n    }\n}\n");
+    radial + &three + &one + &tetra + &face + &weights + &node
 }
 
 /// The device's implicit solver: its buffers, bind group (group 1) and kernels.
@@ -239,6 +259,7 @@ pub(super) struct ImplicitSolver {
     pub(super) angles: wgpu::ComputePipeline,
     pub(super) tetras: wgpu::ComputePipeline,
     pub(super) faces: wgpu::ComputePipeline,
+    pub(super) nodes: wgpu::ComputePipeline,
     pub(super) blocks: wgpu::ComputePipeline,
     pub(super) solve: wgpu::ComputePipeline,
     pub(super) moves: wgpu::ComputePipeline,
@@ -248,6 +269,7 @@ pub(super) struct ImplicitSolver {
     angle_count: u32,
     tetra_count: u32,
     face_count: u32,
+    node_count: u32,
     /// Constrained bonds, and the byte offset of their entries in `imp`.
     pub(super) constraints: usize,
     pub(super) constraints_at: u64,
@@ -299,21 +321,23 @@ impl ImplicitSolver {
         header[7] = (HEADER_WORDS + words.len()) as u32;
         words.extend(model.type_drag.iter().map(|&g| kick(g).to_bits()));
         // `imp`: the particle vectors, then 2 entries per bond end and per
-        // external entry, 21 per angle, 36 per volume element, 21 per face
-        // and 1 per body of the surface terms (in the surface pack's order,
-        // src/gpu/surface.rs), then the report.
+        // external entry, 21 per angle, 36 per volume element, 21 per face,
+        // 1 per body and 1 per curvature node of the surface terms (in the
+        // surface pack's order, src/gpu/surface.rs), then the report.
         let externals: usize = model.externals.iter().map(|e| e.members.len()).sum();
         let bonds_at = PARTICLE_VECTORS * n;
         let externals_at = bonds_at + 2 * 2 * model.bonds.len();
         let angles_at = externals_at + 2 * externals;
         let tetras_at = angles_at + ANGLE_VEC4 * model.angles.len();
         let faces_at = tetras_at + TETRA_VEC4 * model.tetras.len();
-        let (faces, bodies) = super::surface::packed_counts(model);
+        let (faces, bodies, body_nodes) = super::surface::packed_counts(model);
         let bodies_at = faces_at + FACE_VEC4 * faces;
-        let report = bodies_at + bodies;
+        let nodes_at = bodies_at + bodies;
+        let report = nodes_at + body_nodes;
         header[17] = tetras_at as u32;
         header[18] = faces_at as u32;
         header[19] = bodies_at as u32;
+        header[20] = nodes_at as u32;
         header[8] = bonds_at as u32;
         header[9] = externals_at as u32;
         header[10] = angles_at as u32;
@@ -361,6 +385,7 @@ impl ImplicitSolver {
             angles: side.pipeline(ctx, "implicit_angles"),
             tetras: side.pipeline(ctx, "implicit_tetras"),
             faces: side.pipeline(ctx, "implicit_faces"),
+            nodes: side.pipeline(ctx, "implicit_nodes"),
             blocks: side.pipeline(ctx, "implicit_blocks"),
             solve: side.pipeline(ctx, "implicit_solve"),
             moves: side.pipeline(ctx, "implicit_move"),
@@ -370,6 +395,7 @@ impl ImplicitSolver {
             angle_count: model.angles.len() as u32,
             tetra_count: model.tetras.len() as u32,
             face_count: faces as u32,
+            node_count: body_nodes as u32,
             constraints: constrained.len(),
             constraints_at: 16 * (report + 1) as u64,
             tolerance,
@@ -378,9 +404,9 @@ impl ImplicitSolver {
     }
 
     /// The per-term block kernels that have terms, in the step's order
-    /// (angles, volume elements, faces), with their workgroups.
+    /// (angles, volume elements, faces, curvature nodes), with their workgroups.
     pub(super) fn term_passes(&self, workgroup: u32) -> Vec<(&wgpu::ComputePipeline, u32)> {
-        [(&self.angles, self.angle_count), (&self.tetras, self.tetra_count), (&self.faces, self.face_count)]
+        [(&self.angles, self.angle_count), (&self.tetras, self.tetra_count), (&self.faces, self.face_count), (&self.nodes, self.node_count)]
             .into_iter()
             .filter(|&(_, count)| count > 0)
             .map(|(kernel, count)| (kernel, count.div_ceil(workgroup)))

@@ -135,9 +135,18 @@ fn packed_bodies(model: &Model) -> impl Iterator<Item = (&crate::system::Body, V
     model.bodies.iter().enumerate().map(|(b, body)| (body, model.rules_of_body(b).collect::<Vec<_>>())).filter(|(_, r)| !r.is_empty())
 }
 
-/// The faces and bodies [`pack_surfaces`] packs.
-pub fn packed_counts(model: &Model) -> (usize, usize) {
-    packed_bodies(model).fold((0, 0), |(faces, bodies), (body, _)| (faces + body.mesh.triangles().len(), bodies + 1))
+/// The faces, bodies and body nodes (those of bodies with a curvature law)
+/// [`pack_surfaces`] packs.
+pub fn packed_counts(model: &Model) -> (usize, usize, usize) {
+    packed_bodies(model).fold((0, 0, 0), |(faces, bodies, nodes), (body, rules)| {
+        let curvature = if has_curvature(model, &rules) { body.nodes.len() } else { 0 };
+        (faces + body.mesh.triangles().len(), bodies + 1, nodes + curvature)
+    })
+}
+
+/// Whether any of `rules` (a body's terms) is a curvature law.
+fn has_curvature(model: &Model, rules: &[usize]) -> bool {
+    rules.iter().any(|&r| matches!(model.body_rules[r].interaction.law(), Law::Surface { gpu: SurfaceGpu::NodeCurvature, .. }))
 }
 
 /// Packs the bodies that have surface terms; the model's surface term r is
@@ -148,8 +157,7 @@ pub fn pack_surfaces(model: &Model, term_base: usize) -> SurfacePack {
     let (mut node_edges, mut node_faces) = (Vec::new(), Vec::new());
     for (body, rules) in packed_bodies(model) {
         let packed_body = out.body_ids.len() as u32;
-        let curvature =
-            rules.iter().any(|&r| matches!(model.body_rules[r].interaction.law(), Law::Surface { gpu: SurfaceGpu::NodeCurvature, .. }));
+        let curvature = has_curvature(model, &rules);
         let node_base = out.node_body.len() as u32;
         let body_node = |k: u32| if curvature { node_base + k } else { u32::MAX };
         let particle = |k: u32| body.nodes[k as usize];
