@@ -855,6 +855,8 @@ fn every_input_deck_runs_on_the_gpu_like_on_the_cpu() {
     }
     println!("{compared} decks compared, {refused} refused for CPU-only features");
     assert!(compared >= 5, "only {compared} decks compared");
+    // Issue #15: every deck in inputs/ runs with `--device gpu`.
+    assert_eq!(refused, 0, "decks refused by the GPU");
 }
 
 /// Whether a run's error is the GPU refusing a CPU-only feature

@@ -341,31 +341,22 @@ fn corner_area_gradient(g: FaceGeometry, k: u32) -> vec3<f32> {
     return select(select(g.ga2, g.ga1, k == 1u), g.ga0, k == 0u);
 }
 
-// One invocation per curvature node k: its M_k = ¼Σ ℓθ and A_k = ⅓Σ A_t (as
-// `surface_nodes`, from the force pass's edge and face values) and the
-// weights (w, β) of its body's curvature term there.
+// One invocation per curvature node k: its M_k and A_k (`node_curvature_sums`,
+// from the force pass's edge and face values) and the weights (w, β) of its
+// body's curvature term there.
 @compute @workgroup_size(256)
 fn implicit_nodes(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) local: u32) {
     let k = linear_index(wg, local);
     if k >= P.n_body_nodes || halted() {
         return;
     }
-    var m = 0.0;
-    let edges_end = topo[P.off_node_edge_offsets + k + 1u];
-    for (var q = topo[P.off_node_edge_offsets + k]; q < edges_end; q++) {
-        m += surf[surf_edge(topo[P.off_node_edges + q])].x;
-    }
-    var a = 0.0;
-    let faces_end = topo[P.off_node_face_offsets + k + 1u];
-    for (var q = topo[P.off_node_face_offsets + k]; q < faces_end; q++) {
-        a += surf[topo[P.off_node_faces + q]].x;
-    }
+    let sums = node_curvature_sums(k);
     let b = topo[P.off_node_body + k];
     var w = vec2<f32>(0.0);
     let terms_end = topo[P.off_body_term_start + b + 1u];
     for (var t = topo[P.off_body_term_start + b]; t < terms_end; t++) {
         let term = topo[P.off_body_terms + t];
-        w += node_weights(topo[P.off_term_kind + term], term_params(term), 0.25 * m, a / 3.0);
+        w += node_weights(topo[P.off_term_kind + term], term_params(term), sums.x, sums.y);
     }
     imp[imp_topo[IMP_V_NODES] + k] = vec4<f32>(w, 0.0, 0.0);
 }

@@ -158,15 +158,9 @@ fn surface_edges(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation
     surf[surf_edge(e)] = vec4<f32>(edge_bending(e).l_theta, 0.0, 0.0, 0.0);
 }
 
-// Pass 3b: body node k's M = ¼Σ ℓθ over its edges and A = ⅓Σ A_t over its
-// faces (mesh order), and its body's curvature terms at (M, A):
-// surf[surf_node(k)] = (∂E/∂M, ∂E/∂A), surf[surf_node_energy(k)].w = E.
-@compute @workgroup_size(256)
-fn surface_nodes(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) local: u32) {
-    let k = linear_index(wg, local);
-    if k >= P.n_body_nodes || halted() {
-        return;
-    }
+// Body node k's M = ¼Σ ℓθ over its edges and A = ⅓Σ A_t over its faces
+// (mesh order), from passes 1 and 3a's values.
+fn node_curvature_sums(k: u32) -> vec2<f32> {
     var m = 0.0;
     let edges_end = topo[P.off_node_edge_offsets + k + 1u];
     for (var q = topo[P.off_node_edge_offsets + k]; q < edges_end; q++) {
@@ -177,8 +171,21 @@ fn surface_nodes(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation
     for (var q = topo[P.off_node_face_offsets + k]; q < faces_end; q++) {
         a += surf[topo[P.off_node_faces + q]].x;
     }
-    m *= 0.25;
-    a /= 3.0;
+    return vec2<f32>(0.25 * m, a / 3.0);
+}
+
+// Pass 3b: body node k's M and A (`node_curvature_sums`), and its body's
+// curvature terms at (M, A):
+// surf[surf_node(k)] = (∂E/∂M, ∂E/∂A), surf[surf_node_energy(k)].w = E.
+@compute @workgroup_size(256)
+fn surface_nodes(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    let k = linear_index(wg, local);
+    if k >= P.n_body_nodes || halted() {
+        return;
+    }
+    let sums = node_curvature_sums(k);
+    let m = sums.x;
+    let a = sums.y;
     let b = topo[P.off_node_body + k];
     var out = NodeCurvature(0.0, 0.0, 0.0);
     let terms_end = topo[P.off_body_term_start + b + 1u];
