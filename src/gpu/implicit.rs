@@ -161,7 +161,7 @@ pub fn refusal(model: &Model) -> Option<&'static str> {
     if model.has_contact_terms() {
         return Some(
             "`integrator implicit` with contact terms runs on the CPU backend only \
-             (the GPU has stiffness blocks for bonds, angles, pairs, externals, volume elements and per-face body terms)",
+             (the GPU has stiffness blocks for bonds, angles, pairs, externals, volume elements and body terms)",
         );
     }
     if !model.body_rules.iter().all(|r| stiffness_function(r.interaction).is_some()) {
