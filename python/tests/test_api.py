@@ -18,7 +18,7 @@ REPO = Path(__file__).resolve().parents[2]
 DIMER = REPO / "inputs" / "dimer.in"
 SINGLE_CELL = REPO / "inputs" / "single_cell.in"
 CATCH_SLIP = REPO / "inputs" / "catch_slip_sweep.in"
-NETWORK_SHEAR = REPO / "inputs" / "network_shear.in"
+CELL_CONTACT = REPO / "inputs" / "cell_contact.in"
 NO_GPU = os.environ.get("CELLMD_NO_GPU") == "1"
 
 
@@ -218,9 +218,11 @@ def test_gpu_device_runs_the_same_system(tmp_path):
 
 
 def test_device_gpu_refuses_cpu_only_features(tmp_path):
-    sim = cellmd.Simulation(NETWORK_SHEAR, output_dir=tmp_path, device="gpu")
-    with pytest.raises(cellmd.RunError, match="bond kinetics with `integrator implicit` run on the CPU backend only"):
+    sim = cellmd.Simulation(CELL_CONTACT, output_dir=tmp_path, device="gpu")
+    sim.command("integrator implicit")
+    with pytest.raises(cellmd.RunError, match="`integrator implicit` with contact terms runs on the CPU backend only"):
         sim.run(1)
+    assert sim.step == 0
 
 
 def cellmd_command():
