@@ -366,8 +366,9 @@ fn edge_gradient_at(g: EdgeBending, r: u32) -> vec3<f32> {
     return select(select(select(g.gb, g.ga, r == 2u), g.gj, r == 1u), g.gi, r == 0u);
 }
 
-// For every packed body: (w_V, w_A, ∇V·v, ∇A·v) of the vector in `section`,
-// each body's sums taken face by face in order by one invocation; for every
+// For every packed body: (∇V·v, ∇A·v) of the vector in `section` beside its
+// weights (`store_body_weights`), each body's sums taken face by face in
+// order by one invocation; for every
 // curvature node k: g_k·v = ¼Σ_edges ∂(ℓθ)·v − β_k·⅓Σ_faces ∇A_t·v over its
 // edges and faces in order; then a barrier, so that `apply_row` can gather
 // them (call before each product).
@@ -402,9 +403,19 @@ fn body_dots(local: u32, section: u32) {
             let vc = imp_vec(section, face_word(f, 2u));
             dots += vec2<f32>(dot(g.gv, va + vb + vc), dot(g.ga0, va) + dot(g.ga1, vb) + dot(g.ga2, vc));
         }
-        imp[imp_topo[IMP_V_BODIES] + b] = vec4<f32>(body_weight_sum(b), dots);
+        let at = imp_topo[IMP_V_BODIES] + b;
+        imp[at].z = dots.x;
+        imp[at].w = dots.y;
     }
     storageBarrier();
+}
+
+// Every packed body's weights (w_V, w_A), fixed within a step: stored once
+// before the solve's first product (`body_dots` adds the dots beside them).
+fn store_body_weights(local: u32) {
+    for (var b = local; b < P.n_bodies; b += WORKGROUP) {
+        imp[imp_topo[IMP_V_BODIES] + b] = vec4<f32>(body_weight_sum(b), 0.0, 0.0);
+    }
 }
 
 // Particle i's rows of its faces' blocks and of its bodies' rank-one terms
@@ -426,18 +437,17 @@ fn surface_rows(i: u32, section: u32) -> vec3<f32> {
             }
         }
         let rank_one = imp[imp_topo[IMP_V_BODIES] + face_word(slot.x, 3u)];
-        if rank_one.x != 0.0 || rank_one.y != 0.0 {
-            let g = face_geometry(slot.x);
-            out += rank_one.x * rank_one.z * g.gv + rank_one.y * rank_one.w * corner_area_gradient(g, slot.y);
-        }
+        var area_coef = rank_one.y * rank_one.w;
         if face_word(slot.x, 4u) != NO_NODE {
             // −w_k·(g_k·v)·β_k·⅓∇A_t for each corner k of the face (curvature nodes).
-            var coef = 0.0;
             for (var c = 0u; c < 3u; c++) {
                 let node = imp[imp_topo[IMP_V_NODES] + face_word(slot.x, 4u + c)];
-                coef -= node.x * node.z * node.y / 3.0;
+                area_coef -= node.x * node.z * node.y / 3.0;
             }
-            out += coef * corner_area_gradient(face_geometry(slot.x), slot.y);
+        }
+        if rank_one.x != 0.0 || area_coef != 0.0 {
+            let g = face_geometry(slot.x);
+            out += rank_one.x * rank_one.z * g.gv + area_coef * corner_area_gradient(g, slot.y);
         }
     }
     return out + curvature_edge_rows(i);
@@ -690,7 +700,9 @@ fn apply_row(i: u32, section: u32) -> vec3<f32> {
             }
         }
     }
-    out += surface_rows(i, section);
+    if BODY_TERMS {
+        out += surface_rows(i, section);
+    }
     out += pair_rows(i, section, vi, false);
     return select(vi, out, free_axes(i) != vec3<f32>(0.0));
 }
@@ -718,18 +730,39 @@ fn workgroup_sum(local: u32, v: vec3<f32>) -> vec3<f32> {
     return workgroupUniformLoad(&workgroup_total);
 }
 
-// q = A·p into VEC_Q; returns the curvature pᵀAp (the same in every
-// invocation).
-fn times_search_direction(local: u32) -> f32 {
+// q = A·v into VEC_Q for the vector v in `section`; returns vᵀAv (the same
+// in every invocation). Each solve kernel calls it at ONE place in its loop:
+// llvmpipe compiles every call site's inlined copy of `apply_row` (about a
+// minute each on a 2-core CI machine), so the first product (A·x₀) and the
+// last (the constrained step's residual) go through the same call.
+fn multiply(local: u32, section: u32) -> f32 {
     storageBarrier();
-    body_dots(local, VEC_P);
-    var pq = 0.0;
-    for (var i = local; i < P.n; i += WORKGROUP) {
-        let q = apply_row(i, VEC_P);
-        imp[P.n * VEC_Q + i] = vec4<f32>(q, 0.0);
-        pq += dot(imp_vec(VEC_P, i), q);
+    if BODY_TERMS {
+        body_dots(local, section);
     }
-    return workgroup_sum(local, vec3<f32>(pq, 0.0, 0.0)).x;
+    var vq = 0.0;
+    for (var i = local; i < P.n; i += WORKGROUP) {
+        let q = apply_row(i, section);
+        imp[P.n * VEC_Q + i] = vec4<f32>(q, 0.0);
+        vq += dot(imp_vec(section, i), q);
+    }
+    return workgroup_sum(local, vec3<f32>(vq, 0.0, 0.0)).x;
+}
+
+// Whether the solve kernel should return at once: the run halted (every
+// invocation sees the same flag). Loads the iteration cap and tolerance.
+fn solve_halted(local: u32) -> bool {
+    if local == 0u {
+        workgroup_flag = atomicLoad(&status[ST_HALTED]);
+        workgroup_limits = vec2<u32>(imp_topo[IMP_MAX_ITER], imp_topo[IMP_TOLERANCE]);
+    }
+    if workgroupUniformLoad(&workgroup_flag) != 0u {
+        return true;
+    }
+    if BODY_TERMS {
+        store_body_weights(local);
+    }
+    return false;
 }
 
 // Particle i's right-hand side F + √(2kT·γ/dt)·ξ, 0 on its held coordinates
@@ -747,17 +780,7 @@ fn implicit_rhs(i: u32) -> vec3<f32> {
 
 @compute @workgroup_size(256)
 fn implicit_solve(@builtin(local_invocation_index) local: u32) {
-    if local == 0u {
-        workgroup_flag = atomicLoad(&status[ST_HALTED]);
-        workgroup_limits = vec2<u32>(imp_topo[IMP_MAX_ITER], imp_topo[IMP_TOLERANCE]);
-    }
-    if workgroupUniformLoad(&workgroup_flag) != 0u {
-        return;
-    }
-    if imp_topo[IMP_CONSTRAINTS] > 0u {
-        // Constrained bonds: projected CG (shaders/common/implicit_constraints.wgsl).
-        let limits = workgroupUniformLoad(&workgroup_limits);
-        constrained_solve(local, bitcast<f32>(limits.y), limits.x);
+    if solve_halted(local) {
         return;
     }
     let n = P.n;
@@ -768,53 +791,61 @@ fn implicit_solve(@builtin(local_invocation_index) local: u32) {
         imp[n * VEC_R + i] = vec4<f32>(b, 0.0);
         imp[n * VEC_X + i] = vec4<f32>(imp[n * VEC_DINV + i].xyz * b, 0.0);
     }
-    storageBarrier();
-    body_dots(local, VEC_X);
-    var sums = vec3<f32>(0.0);
-    for (var i = local; i < n; i += WORKGROUP) {
-        let b = imp_vec(VEC_R, i);
-        let r = b - apply_row(i, VEC_X);
-        let z = imp[n * VEC_DINV + i].xyz * r;
-        imp[n * VEC_R + i] = vec4<f32>(r, 0.0);
-        imp[n * VEC_Z + i] = vec4<f32>(z, 0.0);
-        imp[n * VEC_P + i] = vec4<f32>(z, 0.0);
-        sums += vec3<f32>(dot(r, z), dot(r, r), dot(b, b));
-    }
-    let start = workgroup_sum(local, sums);
-    var rz = start.x;
-    var residual = sqrt(start.y);
-    let b_norm = sqrt(start.z);
     let limits = workgroupUniformLoad(&workgroup_limits);
-    let threshold = bitcast<f32>(limits.y) * b_norm;
     let cap = limits.x;
+    var threshold = 0.0;
+    var b_norm = 0.0;
+    var rz = 0.0;
+    var residual = 0.0;
     var iterations = 0u;
+    // The first pass multiplies x₀ (the residual b − Ax₀), the others p.
+    var section = VEC_X;
     loop {
+        let curvature = multiply(local, section);
+        if section == VEC_X {
+            var sums = vec3<f32>(0.0);
+            for (var i = local; i < n; i += WORKGROUP) {
+                let b = imp_vec(VEC_R, i);
+                let r = b - imp_vec(VEC_Q, i);
+                let z = imp[n * VEC_DINV + i].xyz * r;
+                imp[n * VEC_R + i] = vec4<f32>(r, 0.0);
+                imp[n * VEC_Z + i] = vec4<f32>(z, 0.0);
+                imp[n * VEC_P + i] = vec4<f32>(z, 0.0);
+                sums += vec3<f32>(dot(r, z), dot(r, r), dot(b, b));
+            }
+            let start = workgroup_sum(local, sums);
+            rz = start.x;
+            residual = sqrt(start.y);
+            b_norm = sqrt(start.z);
+            threshold = bitcast<f32>(limits.y) * b_norm;
+            section = VEC_P;
+        } else {
+            if !(curvature > 0.0) {
+                break;
+            }
+            let alpha = rz / curvature;
+            var next = vec3<f32>(0.0);
+            for (var i = local; i < n; i += WORKGROUP) {
+                let x = imp_vec(VEC_X, i) + alpha * imp_vec(VEC_P, i);
+                let r = imp_vec(VEC_R, i) - alpha * imp_vec(VEC_Q, i);
+                let z = imp[n * VEC_DINV + i].xyz * r;
+                imp[n * VEC_X + i] = vec4<f32>(x, 0.0);
+                imp[n * VEC_R + i] = vec4<f32>(r, 0.0);
+                imp[n * VEC_Z + i] = vec4<f32>(z, 0.0);
+                next += vec3<f32>(dot(r, z), dot(r, r), 0.0);
+            }
+            let after = workgroup_sum(local, next);
+            let beta = after.x / rz;
+            rz = after.x;
+            residual = sqrt(after.y);
+            for (var i = local; i < n; i += WORKGROUP) {
+                imp[n * VEC_P + i] = vec4<f32>(imp_vec(VEC_Z, i) + beta * imp_vec(VEC_P, i), 0.0);
+            }
+            iterations += 1u;
+        }
         if b_norm == 0.0 || residual < threshold || iterations >= cap {
             break;
         }
-        let curvature = times_search_direction(local);
-        if !(curvature > 0.0) {
-            break;
-        }
-        let alpha = rz / curvature;
-        var next = vec3<f32>(0.0);
-        for (var i = local; i < n; i += WORKGROUP) {
-            let x = imp_vec(VEC_X, i) + alpha * imp_vec(VEC_P, i);
-            let r = imp_vec(VEC_R, i) - alpha * imp_vec(VEC_Q, i);
-            let z = imp[n * VEC_DINV + i].xyz * r;
-            imp[n * VEC_X + i] = vec4<f32>(x, 0.0);
-            imp[n * VEC_R + i] = vec4<f32>(r, 0.0);
-            imp[n * VEC_Z + i] = vec4<f32>(z, 0.0);
-            next += vec3<f32>(dot(r, z), dot(r, r), 0.0);
-        }
-        let after = workgroup_sum(local, next);
-        let beta = after.x / rz;
-        rz = after.x;
-        residual = sqrt(after.y);
-        for (var i = local; i < n; i += WORKGROUP) {
-            imp[n * VEC_P + i] = vec4<f32>(imp_vec(VEC_Z, i) + beta * imp_vec(VEC_P, i), 0.0);
-        }
-        iterations += 1u;
     }
     if local == 0u {
         let relative = select(residual / b_norm, 0.0, b_norm == 0.0);

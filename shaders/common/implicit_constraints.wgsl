@@ -5,7 +5,7 @@
 // gradients û_k at the current positions, with the projected Jacobi
 // preconditioner. Every projection r ← r − Jᵀμ, μ = S⁻¹JD⁻¹r with
 // S = JD⁻¹Jᵀ, solves S by an inner Jacobi-preconditioned CG (the CPU
-// factorises S by sparse Cholesky), all inside `implicit_solve`'s one
+// factorises S by sparse Cholesky), all inside `implicit_solve_constrained`'s one
 // workgroup. D⁻¹ is the Jacobi diagonal's inverse, 0 for a fixed particle.
 // At the end the constraint tensions are −μ of the residual AΔx − b. SHAKE
 // (shaders/common/shake.wgsl) then removes the second-order drift of the
@@ -142,11 +142,17 @@ fn constraint_directions(local: u32) {
     storageBarrier();
 }
 
-// The constrained step (called by `implicit_solve` when the model has
-// constraints; workgroup-uniform): as the CPU, from Δx = 0, converged when
-// |z|/|z₀| ≤ tolerance; then the tensions −μ(AΔx − b) into the
-// constraints' third entries (z).
-fn constrained_solve(local: u32, tolerance: f32, cap: u32) {
+// The constrained step (the solve kernel of a model with constraints): as
+// the CPU, from Δx = 0, converged when |z|/|z₀| ≤ tolerance; then the
+// tensions −μ(AΔx − b) into the constraints' third entries (z).
+@compute @workgroup_size(256)
+fn implicit_solve_constrained(@builtin(local_invocation_index) local: u32) {
+    if solve_halted(local) {
+        return;
+    }
+    let limits = workgroupUniformLoad(&workgroup_limits);
+    let tolerance = bitcast<f32>(limits.y);
+    let cap = limits.x;
     let n = P.n;
     constraint_directions(local);
     for (var i = local; i < n; i += WORKGROUP) {
@@ -168,13 +174,20 @@ fn constrained_solve(local: u32, tolerance: f32, cap: u32) {
     let reference = max(sqrt(start.y), 1.1754944e-38);
     var residual = sqrt(start.y) / reference;
     var iterations = 0u;
+    // Products of p until converged, then one of Δx (the residual AΔx − b
+    // for the constraint forces) through the same call.
+    var section = VEC_P;
+    if residual <= tolerance || iterations >= cap {
+        section = VEC_X;
+    }
     loop {
-        if residual <= tolerance || iterations >= cap {
+        let curvature = multiply(local, section);
+        if section == VEC_X {
             break;
         }
-        let curvature = times_search_direction(local);
         if !(curvature > 0.0) {
-            break;
+            section = VEC_X;
+            continue;
         }
         let alpha = rz / curvature;
         for (var i = local; i < n; i += WORKGROUP) {
@@ -198,12 +211,13 @@ fn constrained_solve(local: u32, tolerance: f32, cap: u32) {
             imp[n * VEC_P + i] = vec4<f32>(imp_vec(VEC_Z, i) + beta * imp_vec(VEC_P, i), 0.0);
         }
         iterations += 1u;
+        if residual <= tolerance || iterations >= cap {
+            section = VEC_X;
+        }
     }
     // The constraint forces: μ of the residual AΔx − b; tension −μ.
-    storageBarrier();
-    body_dots(local, VEC_X);
     for (var i = local; i < n; i += WORKGROUP) {
-        imp[n * VEC_Q + i] = vec4<f32>(apply_row(i, VEC_X) - implicit_rhs(i), 0.0);
+        imp[n * VEC_Q + i] = vec4<f32>(imp_vec(VEC_Q, i) - implicit_rhs(i), 0.0);
     }
     storageBarrier();
     constraint_multipliers(local, VEC_Q, tolerance);

@@ -85,11 +85,15 @@ pub struct CustomSource {
     pub one_cases: String,
     /// `mover_velocity` cases of moving groups with velocity fields (src/gpu/protocol.rs).
     pub mover_cases: String,
+    /// Whether the model has body surface terms: the WGSL constant
+    /// `BODY_TERMS`, so that a model without them compiles its implicit
+    /// step's products without their gathers and their barrier.
+    pub body_terms: bool,
 }
 
 /// The WGSL of every custom term of `model`.
 pub fn source(model: &Model) -> Result<CustomSource, String> {
-    let mut out = CustomSource::default();
+    let mut out = CustomSource { body_terms: super::surface::packed_counts(model).1 > 0, ..Default::default() };
     for (k, term) in terms(model).filter(|t| is_custom(t)).enumerate() {
         let index = REGISTRY.len() + k;
         let energy = term.interaction.expression().expect("a custom term has its expression");

@@ -96,7 +96,8 @@
 //! ½ΔxᵀAΔx − bᵀΔx subject to JΔx = 0, from Δx = 0; Gould, Hribar & Nocedal
 //! 2001), each projection's S = JD⁻¹Jᵀ solved by an inner Jacobi-CG in the
 //! same workgroup where the CPU factorises it, and the constraint tensions
-//! −λ kept for the thermo (shaders/common/implicit_constraints.wgsl); the
+//! −λ kept for the thermo (kernel `implicit_solve_constrained`,
+//! shaders/common/implicit_constraints.wgsl); the
 //! device's SHAKE (src/gpu/shake.rs) then projects as after every step.
 //!
 //! # Determinism and the read-back
@@ -387,7 +388,8 @@ impl ImplicitSolver {
             faces: side.pipeline(ctx, "implicit_faces"),
             nodes: side.pipeline(ctx, "implicit_nodes"),
             blocks: side.pipeline(ctx, "implicit_blocks"),
-            solve: side.pipeline(ctx, "implicit_solve"),
+            // Only the solve kernel the model uses: llvmpipe compiles a kernel at its first dispatch.
+            solve: side.pipeline(ctx, if constrained.is_empty() { "implicit_solve" } else { "implicit_solve_constrained" }),
             moves: side.pipeline(ctx, "implicit_move"),
             group: side.group,
             buffer,

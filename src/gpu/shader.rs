@@ -159,6 +159,7 @@ pub fn compose_with(custom: &CustomSource) -> String {
         program.push_str(source);
     }
     program.push_str(&custom.functions);
+    writeln!(program, "const BODY_TERMS: bool = {};", custom.body_terms).unwrap();
     program.push_str(&dispatch(custom));
     // The stiffness laws of the implicit step (src/gpu/implicit.rs).
     program.push_str(&super::implicit::stiffness_dispatch());
