@@ -21,18 +21,16 @@ fn surface_shear_face_hessian(p: array<f32, 8>, body: BodyTotals, g: FaceGeometr
     let x21 = g.x2 - g.x1;
     let s = dot(g.x1, g.x1) + dot(x21, x21) + dot(g.x2, g.x2);
     let a = g.area;
+    // c·S·(2∇A∇Aᵀ/A³ − ∇²A/A²): the area stencil of e(A) = cS/A at fixed S.
+    var h = face_area_stencil(g, -c * s / (a * a), 2.0 * c * s / (a * a * a));
     var gs = array<vec3<f32>, 3>(-2.0 * (g.x1 + g.x2), 2.0 * (2.0 * g.x1 - g.x2), 2.0 * (2.0 * g.x2 - g.x1));
     var ga = array<vec3<f32>, 3>(g.ga0, g.ga1, g.ga2);
-    var second = triangle_area_hessian(g);
-    var h: array<f32, 81>;
     for (var k = 0u; k < 3u; k++) {
         for (var l = 0u; l < 3u; l++) {
-            let block = second[3u * k + l];
             for (var i = 0u; i < 3u; i++) {
                 for (var j = 0u; j < 3u; j++) {
                     let laplacian = select(0.0, select(-2.0, 4.0, k == l), i == j);
-                    h[(3u * k + i) * 9u + 3u * l + j] = c * (laplacian / a - (gs[k][i] * ga[l][j] + ga[k][i] * gs[l][j]) / (a * a)
-                        + s * (2.0 * ga[k][i] * ga[l][j] / (a * a * a) - block[j][i] / (a * a)));
+                    h[(3u * k + i) * 9u + 3u * l + j] += c * (laplacian / a - (gs[k][i] * ga[l][j] + ga[k][i] * gs[l][j]) / (a * a));
                 }
             }
         }

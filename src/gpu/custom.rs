@@ -93,7 +93,7 @@ pub struct CustomSource {
 
 /// The WGSL of every custom term of `model`.
 pub fn source(model: &Model) -> Result<CustomSource, String> {
-    let mut out = CustomSource { body_terms: super::surface::packed_counts(model).1 > 0, ..Default::default() };
+    let mut out = CustomSource { body_terms: model.has_surface_terms(), ..Default::default() };
     for (k, term) in terms(model).filter(|t| is_custom(t)).enumerate() {
         let index = REGISTRY.len() + k;
         let energy = term.interaction.expression().expect("a custom term has its expression");
