@@ -731,10 +731,12 @@ fn workgroup_sum(local: u32, v: vec3<f32>) -> vec3<f32> {
 }
 
 // q = A·v into VEC_Q for the vector v in `section`; returns vᵀAv (the same
-// in every invocation). Each solve kernel calls it at ONE place in its loop:
-// llvmpipe compiles every call site's inlined copy of `apply_row` (about a
-// minute each on a 2-core CI machine), so the first product (A·x₀) and the
-// last (the constrained step's residual) go through the same call.
+// in every invocation). Each solve kernel calls it at ONE place in its loop,
+// so the first product (A·x₀) and the last (the constrained step's
+// residual) go through the same call: llvmpipe compiles every call site's
+// inlined copy of `apply_row` at the first dispatch (hertz_octant's first
+// run on a clean shader cache: 150 s with four call sites and the body-term
+// gathers in every model, 38 s with one and `BODY_TERMS`).
 fn multiply(local: u32, section: u32) -> f32 {
     storageBarrier();
     if BODY_TERMS {
@@ -749,20 +751,21 @@ fn multiply(local: u32, section: u32) -> f32 {
     return workgroup_sum(local, vec3<f32>(vq, 0.0, 0.0)).x;
 }
 
-// Whether the solve kernel should return at once: the run halted (every
-// invocation sees the same flag). Loads the iteration cap and tolerance.
-fn solve_halted(local: u32) -> bool {
+// The start of a solve kernel: loads the iteration cap and tolerance and
+// stores the bodies' weights; false when the run has halted (every
+// invocation sees the same flag), and the kernel returns at once.
+fn begin_solve(local: u32) -> bool {
     if local == 0u {
         workgroup_flag = atomicLoad(&status[ST_HALTED]);
         workgroup_limits = vec2<u32>(imp_topo[IMP_MAX_ITER], imp_topo[IMP_TOLERANCE]);
     }
     if workgroupUniformLoad(&workgroup_flag) != 0u {
-        return true;
+        return false;
     }
     if BODY_TERMS {
         store_body_weights(local);
     }
-    return false;
+    return true;
 }
 
 // Particle i's right-hand side F + √(2kT·γ/dt)·ξ, 0 on its held coordinates
@@ -780,7 +783,7 @@ fn implicit_rhs(i: u32) -> vec3<f32> {
 
 @compute @workgroup_size(256)
 fn implicit_solve(@builtin(local_invocation_index) local: u32) {
-    if solve_halted(local) {
+    if !begin_solve(local) {
         return;
     }
     let n = P.n;

@@ -147,7 +147,7 @@ fn constraint_directions(local: u32) {
 // tensions −μ(AΔx − b) into the constraints' third entries (z).
 @compute @workgroup_size(256)
 fn implicit_solve_constrained(@builtin(local_invocation_index) local: u32) {
-    if solve_halted(local) {
+    if !begin_solve(local) {
         return;
     }
     let limits = workgroupUniformLoad(&workgroup_limits);
