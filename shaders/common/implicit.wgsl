@@ -371,7 +371,7 @@ fn edge_gradient_at(g: EdgeBending, r: u32) -> vec3<f32> {
 // order by one invocation; for every
 // curvature node k: g_k·v = ¼Σ_edges ∂(ℓθ)·v − β_k·⅓Σ_faces ∇A_t·v over its
 // edges and faces in order; then a barrier, so that `apply_row` can gather
-// them (call before each product).
+// them (`multiply` calls it before each product).
 fn body_dots(local: u32, section: u32) {
     for (var k = local; k < P.n_body_nodes; k += WORKGROUP) {
         var dm = 0.0;
