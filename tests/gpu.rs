@@ -15,7 +15,7 @@ use cellmd::integrate::Integrator;
 use cellmd::rng::Noise;
 use cellmd::run::{RunOptions, Simulation};
 use cellmd::system::State;
-use common::random_case;
+use common::{contact_case, random_case, CONTACT_ADHESION, CONTACT_BARRIER, CONTACT_SHELLS};
 use glam::DVec3;
 
 fn context() -> GpuContext {
@@ -1378,23 +1378,6 @@ fn device_auto_announces_its_choice_and_runs_on_it() {
     assert!(auto_files == announced_files, "the auto run differs from the run on the device it announced");
 }
 
-/// Two 162-node icosphere cells (R = 2 µm, `gap` apart, nodes of drag 1)
-/// with force-field lines `ff`, pushed together by `push` pN per node, in a
-/// box periodic along x with the cells straddling its boundary (so the
-/// contact search works across it).
-fn contact_case(ff: &str, gap: f64, push: f64, settings: &str) -> common::Case {
-    let top = common::two_cells(2, 2.0, gap);
-    let deck = format!(
-        "units cell\ntopology cells.top\nforcefield cells.ff\nbox x 0 20 p y -10 10 f z -10 10 f\n\
-         group left id 1:162\ngroup right id 163:324\n\
-         external push_left left constant_force fx {push}\nexternal push_right right constant_force fx -{push}\n{settings}"
-    );
-    common::Case::new(&[("cells.top", &top), ("cells.ff", &format!("particle node drag 1\n{ff}")), ("deck.in", &deck)])
-}
-
-const CONTACT_BARRIER: &str = "contact cell cell contact_barrier dhat 0.1 kappa 200\n";
-const CONTACT_SHELLS: &str = "body cell turgor k 1000 dp0 100 v0 32.4\nbody cell surface_tension gamma 100\n";
-
 /// `contact_barrier` on the GPU (src/gpu/contact.rs) against the CPU f64
 /// backend: two cells 0.03 µm apart (many node–face pairs within d̂ = 0.1 µm,
 /// in every Voronoi region), the barrier alone and with the cells' surface
@@ -1532,9 +1515,6 @@ fn a_face_that_outgrows_the_contact_search_rebuilds_the_gpu_backend() {
     assert!(travelled > 1.0, "the node hardly moved: {travelled}");
     assert!(deviation <= 1e-5 * travelled, "GPU − CPU {deviation:e} > 1e-5 × {travelled:e}");
 }
-
-/// Adhesion whose switch (0.05–0.4 µm) reaches four times beyond the barrier's d̂.
-const CONTACT_ADHESION: &str = "contact cell cell contact_adhesion w 50 d_on 0.05 d_off 0.4\n";
 
 /// CPU (f64) and GPU forces of the two cells of [`contact_case`] `gap` apart
 /// under `ff`: (force error, energy error, particles with a force, the CPU's

@@ -8,6 +8,7 @@ use cellmd::gpu::implicit::F32_TOLERANCE;
 use cellmd::gpu::DevicePreference;
 use cellmd::run::{RunOptions, Simulation};
 use cellmd::system::State;
+use common::{contact_case, CONTACT_ADHESION, CONTACT_BARRIER, CONTACT_SHELLS};
 use glam::DVec3;
 
 /// A bent 12-bead filament (stiff harmonic bonds, wlc_bending angles),
@@ -186,6 +187,58 @@ fn one_implicit_step_with_an_indenter_matches_the_cpu() {
     one_step_matches(&case);
 }
 
+/// The same with contact between bodies: the two pressurised cells of
+/// [`contact_case`] 0.06 µm apart across the periodic boundary, under the
+/// barrier (d̂ = 0.1 µm) and adhesion (switch 0.05–0.4 µm), so that many
+/// node–face pairs are in range of both; dt = 2e-4 s, short enough that the
+/// contact clamp leaves the step whole (at 1e-3 s the adhesion's pull moves
+/// nodes 2.4 times farther than it allows). The
+/// device applies each pair's Gauss–Newton term max(Σ b″, 0)·g gᵀ and each
+/// node's adhesion term max(ε·s″·B, 0)·g gᵀ at its nearest face matrix-free,
+/// as the CPU's blocks; the bound is the one above (κ(A) from the CPU's
+/// blocks, contact included). The step is not clamped, on either device.
+#[test]
+fn one_implicit_step_with_contact_matches_the_cpu() {
+    let ff = format!("{CONTACT_SHELLS}{CONTACT_BARRIER}{CONTACT_ADHESION}");
+    let case = contact_case(&ff, 0.06, 1.0, "integrator implicit\ntimestep 2e-4\nrun 1\n");
+    let gpu = one_step_matches(&case);
+    assert_eq!(gpu.contact_clamps, 0, "a clamped step would test the clamp, not the blocks");
+}
+
+/// The implicit step's contact clamp on the device: the cells of
+/// [`contact_case`] 0.1 µm apart pushed together by 50 pN per node at
+/// dt = 1e-2 s (0.5 µm a step without the barrier, five times d̂), 10
+/// steps. The solve's step is shortened to s·Δx, s = min(1, min_i L_i/|Δx_i|)
+/// (L_i = 0.4 × particle i's closest contact distance), on the device by a
+/// min-reduction after the solve: the same steps are clamped as on the CPU,
+/// the clock advances by the same shortened steps, the positions follow the
+/// CPU's within 1e-4 of the distance travelled, and the cells never
+/// interpenetrate.
+#[test]
+fn the_implicit_contact_clamp_runs_on_the_gpu_like_on_the_cpu() {
+    let run = |device: DevicePreference| {
+        let ff = format!("{CONTACT_SHELLS}{CONTACT_BARRIER}");
+        let case = contact_case(&ff, 0.1, 50.0, "integrator implicit\ntemperature 0\ntimestep 1e-2\nrun 10\n");
+        let options = RunOptions { output_dir: case.output_dir().to_path_buf(), device: Some(device), ..Default::default() };
+        let start = Simulation::new(&case.plan(), RunOptions::default()).state;
+        (start, Simulation::execute(case.plan(), options).unwrap_or_else(|e| panic!("{device:?}: {e}")))
+    };
+    let ((start, cpu), (_, gpu)) = (run(DevicePreference::Cpu), run(DevicePreference::Gpu));
+    let sim_box = cpu.sim_box;
+    let unwrap = |s: &State, i: usize| sim_box.unwrap(s.positions[i], s.images[i]);
+    let travelled = (0..start.len()).map(|i| (unwrap(&cpu.state, i) - unwrap(&start, i)).length()).fold(0.0, f64::max);
+    let deviation = (0..start.len()).map(|i| (unwrap(&cpu.state, i) - unwrap(&gpu.state, i)).length()).fold(0.0, f64::max);
+    println!(
+        "CPU: {} clamped steps, t = {:.6e} s, mindist {:.4e}; GPU: {} clamped, t = {:.6e} s, mindist {:.4e}; GPU − CPU {deviation:.3e} after {travelled:.3e}",
+        cpu.contact_clamps, cpu.state.time, cpu.min_contact_distance(), gpu.contact_clamps, gpu.state.time, gpu.min_contact_distance()
+    );
+    assert!(cpu.contact_clamps > 0, "the clamp never acted");
+    assert_eq!(gpu.contact_clamps, cpu.contact_clamps);
+    assert!((gpu.state.time - cpu.state.time).abs() <= 1e-4 * cpu.state.time, "{} vs {}", gpu.state.time, cpu.state.time);
+    assert!(deviation <= 1e-4 * travelled, "GPU − CPU {deviation:e} > 1e-4 × {travelled:e}");
+    assert!(gpu.min_contact_distance() > 0.0 && gpu.min_contact_distance() < 0.1);
+}
+
 /// Newton steps of a `solver cholesky` deck with volume elements:
 /// `inputs/hertz_octant.in` (one stage, 8 quasi-static steps to δ = 0.1·R)
 /// on the octant of `cellmd build ball --cells 8` (125 nodes, 384 elements),
@@ -237,7 +290,8 @@ fn one_step_matches(case: &common::Case) -> Simulation {
     let start = State::new(plan.positions.clone());
     let cpu = run(case, DevicePreference::Cpu);
     let gpu = run(case, DevicePreference::Gpu);
-    let dx = |s: &State| -> Vec<DVec3> { s.positions.iter().zip(&start.positions).map(|(a, b)| *a - *b).collect() };
+    let images = plan.sim_box.images();
+    let dx = |s: &State| -> Vec<DVec3> { s.positions.iter().zip(&start.positions).map(|(a, b)| images.minimum_image(*a - *b)).collect() };
     let (dc, dg) = (dx(&cpu.state), dx(&gpu.state));
     let norm = |v: &[DVec3]| v.iter().map(|d| d.length_squared()).sum::<f64>().sqrt();
     let error = norm(&dc.iter().zip(&dg).map(|(c, g)| *c - *g).collect::<Vec<_>>());
@@ -257,8 +311,9 @@ fn one_step_matches(case: &common::Case) -> Simulation {
 }
 
 /// κ(A) ≤ (γ/dt + max row sum of |K̃|)/(γ/dt) by Gershgorin, from the CPU's
-/// stiffness at `state` (dt = 1e-3 s, the time step of every case here).
+/// stiffness at `state` (dt: the deck's time step).
 fn condition_bound(plan: &cellmd::deck::Plan, state: &State) -> f64 {
+    let dt = plan.actions.iter().find_map(|a| if let cellmd::deck::Action::Timestep(dt) = a { Some(*dt) } else { None }).unwrap();
     let model = &plan.model;
     let mut backend = CpuBackend::new(model, state, &plan.sim_box, 0.0).unwrap();
     backend.compute(model, state, &plan.sim_box, &mut Forces::default());
@@ -278,7 +333,7 @@ fn condition_bound(plan: &cellmd::deck::Plan, state: &State) -> f64 {
             }
         }
     }
-    let drag = model.type_drag.iter().copied().filter(|g| g.is_finite()).fold(f64::INFINITY, f64::min) / 1e-3;
+    let drag = model.type_drag.iter().copied().filter(|g| g.is_finite()).fold(f64::INFINITY, f64::min) / dt;
     (drag + rows.iter().cloned().fold(0.0, f64::max)) / drag
 }
 

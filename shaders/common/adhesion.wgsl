@@ -6,7 +6,8 @@
 
 // Where each value lives in `surf`: particle i's closest contact distance
 // (x), and per rule slot j its (s or, during the node pass, the nearest
-// distance; s′; nearest face as an exact f32, −1 for none) and its pull b′.
+// distance; s′; nearest face as an exact f32, −1 for none; s″) and its
+// (pull b′ = ε·s′·B; the implicit step's Gauss–Newton weight ε·s″·B).
 fn adhesion_closest(i: u32) -> u32 {
     return P.off_aclosest + i;
 }
@@ -63,8 +64,9 @@ fn adhesion_nodes(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocatio
     for (var j = 0u; j < P.n_arules; j++) {
         let best = surf[adhesion_switch(i, j)];
         if best.z >= 0.0 {
-            let s = contact_area_switch(area_kind(j), contact_rule_params(area_rule(j)), best.x);
-            surf[adhesion_switch(i, j)] = vec4<f32>(s.energy, s.de_dr, best.z, 0.0);
+            let p = contact_rule_params(area_rule(j));
+            let s = contact_area_switch(area_kind(j), p, best.x);
+            surf[adhesion_switch(i, j)] = vec4<f32>(s.energy, s.de_dr, best.z, contact_area_switch_curvature(area_kind(j), p, best.x));
         } else {
             surf[adhesion_switch(i, j)] = vec4<f32>(0.0, 0.0, -1.0, 0.0);
         }
@@ -81,7 +83,7 @@ fn contact_face_geometry(f: u32) -> FaceGeometry {
 }
 
 // Pass 2, per particle: B_k = Σ_{t ∋ k} A_t·Π_{c ≠ k} s_c per rule (face
-// order) and the pull ε·s′_k·B_k (0 where s′ = 0).
+// order), the pull ε·s′_k·B_k and the weight ε·s″_k·B_k (0 where s′ = 0).
 @compute @workgroup_size(256)
 fn adhesion_weights(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) local: u32) {
     let i = linear_index(wg, local);
@@ -89,9 +91,9 @@ fn adhesion_weights(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocat
         return;
     }
     for (var j = 0u; j < P.n_arules; j++) {
-        let ds = surf[adhesion_switch(i, j)].y;
-        var pull = 0.0;
-        if ds != 0.0 {
+        let found = surf[adhesion_switch(i, j)];
+        var pull = vec2<f32>(0.0);
+        if found.y != 0.0 {
             var sum = 0.0;
             let end = topo[P.off_corner_start + i + 1u];
             for (var q = topo[P.off_corner_start + i]; q < end; q++) {
@@ -101,9 +103,10 @@ fn adhesion_weights(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocat
                 let others = adhesion_s(contact_face(face, (role + 1u) % 3u), j) * adhesion_s(contact_face(face, (role + 2u) % 3u), j);
                 sum += contact_face_geometry(face).area * others;
             }
-            pull = contact_area_density(area_kind(j), contact_rule_params(area_rule(j))) * ds * sum;
+            let density = contact_area_density(area_kind(j), contact_rule_params(area_rule(j)));
+            pull = vec2<f32>(density * found.y * sum, density * found.w * sum);
         }
-        surf[adhesion_pull(i, j)] = vec4<f32>(pull, 0.0, 0.0, 0.0);
+        surf[adhesion_pull(i, j)] = vec4<f32>(pull, 0.0, 0.0);
     }
 }
 

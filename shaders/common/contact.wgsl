@@ -123,6 +123,43 @@ fn face_outgrew_search(f: u32) -> bool {
 // Faces of one corner tested per walk of its neighbour list.
 const CORNER_BATCH: u32 = 8u;
 
+// Up to CORNER_BATCH faces of corner i, its face slots from `first` to `end`
+// (face·4 + role), each with its bounding sphere relative to i: a node within
+// d̂ of the face is within d̂ + r of its centre c. The test only skips pairs
+// farther than d̂ (zero force, above the clamp's cap), with a margin of 1e-3
+// for f32 rounding.
+struct CornerBatch {
+    count: u32,
+    slots: array<u32, CORNER_BATCH>,
+    centres: array<vec3<f32>, CORNER_BATCH>,
+    reach2: array<f32, CORNER_BATCH>,
+}
+
+fn corner_batch(i: u32, first: u32, end: u32) -> CornerBatch {
+    var out: CornerBatch;
+    out.count = min(end - first, CORNER_BATCH);
+    for (var q = 0u; q < out.count; q++) {
+        let slot = topo[P.off_corner_faces + first + q];
+        let face = slot / 4u;
+        let xa = separation(i, contact_face(face, 0u));
+        let xb = separation(i, contact_face(face, 1u));
+        let xc = separation(i, contact_face(face, 2u));
+        let centre = (xa + xb + xc) / 3.0;
+        let radius2 = max(max(dot(xa - centre, xa - centre), dot(xb - centre, xb - centre)), dot(xc - centre, xc - centre));
+        let reach = 1.001 * (P.contact_dhat + sqrt(radius2));
+        out.slots[q] = slot;
+        out.centres[q] = centre;
+        out.reach2[q] = reach * reach;
+    }
+    return out;
+}
+
+// Whether a node at x (relative to the batch's corner) may be within d̂ of face q of the batch.
+fn batch_reaches(batch: ptr<function, CornerBatch>, q: u32, x: vec3<f32>) -> bool {
+    let off_centre = x - (*batch).centres[q];
+    return dot(off_centre, off_centre) < (*batch).reach2[q];
+}
+
 // The largest s ∈ (0, 1] with s·a + √s·b ≤ limit (src/integrate/overdamped.rs, `step_fraction`).
 fn contact_step_fraction(a: f32, b: f32, limit: f32) -> f32 {
     if a + b <= limit {
@@ -203,32 +240,16 @@ fn contact_forces(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocatio
     // As a corner: its faces against the neighbours of other bodies, up to
     // CORNER_BATCH faces per walk of the neighbour list (one walk for a mesh
     // node's 5–6 faces).
+    let corner_start = topo[P.off_corner_start + i];
     let corner_end = topo[P.off_corner_start + i + 1u];
-    for (var first = topo[P.off_corner_start + i]; first < corner_end; first += CORNER_BATCH) {
-        let batch = min(corner_end - first, CORNER_BATCH);
-        // Each face's bounding sphere (centre c, radius r, relative to this
-        // corner): a node within d̂ of the face is within d̂ + r of c. The
-        // test only skips pairs farther than d̂ (zero force, above the clamp's
-        // cap), with a margin of 1e-3 for f32 rounding.
-        var centres: array<vec3<f32>, CORNER_BATCH>;
-        var reach2: array<f32, CORNER_BATCH>;
-        var slots: array<u32, CORNER_BATCH>;
-        for (var q = 0u; q < batch; q++) {
-            let slot = topo[P.off_corner_faces + first + q];
-            let face = slot / 4u;
-            if slot % 4u == 0u && face_outgrew_search(face) {
-                atomicOr(&status[ST_HALTED], HALT_REACH);
-            }
-            let xa = separation(i, contact_face(face, 0u));
-            let xb = separation(i, contact_face(face, 1u));
-            let xc = separation(i, contact_face(face, 2u));
-            let centre = (xa + xb + xc) / 3.0;
-            let radius2 = max(max(dot(xa - centre, xa - centre), dot(xb - centre, xb - centre)), dot(xc - centre, xc - centre));
-            let reach = 1.001 * (P.contact_dhat + sqrt(radius2));
-            centres[q] = centre;
-            reach2[q] = reach * reach;
-            slots[q] = slot;
+    for (var q = corner_start; q < corner_end; q++) {
+        let slot = topo[P.off_corner_faces + q];
+        if slot % 4u == 0u && face_outgrew_search(slot / 4u) {
+            atomicOr(&status[ST_HALTED], HALT_REACH);
         }
+    }
+    for (var first = corner_start; first < corner_end; first += CORNER_BATCH) {
+        var batch = corner_batch(i, first, corner_end);
         for (var k = 0u; k < count; k++) {
             let node = nlist[row + 1u + k] & ~CONTACT_ONLY;
             let other = contact_body(node);
@@ -240,13 +261,12 @@ fn contact_forces(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocatio
                 continue;
             }
             let x = separation(i, node);
-            for (var q = 0u; q < batch; q++) {
-                let off_centre = x - centres[q];
-                if dot(off_centre, off_centre) >= reach2[q] {
+            for (var q = 0u; q < batch.count; q++) {
+                if !batch_reaches(&batch, q, x) {
                     continue;
                 }
-                let face = slots[q] / 4u;
-                let role = slots[q] % 4u;
+                let face = batch.slots[q] / 4u;
+                let role = batch.slots[q] % 4u;
                 let pair = contact_pair(node, face);
                 closest = min(closest, pair.d);
                 let b = contact_radial(types, pair.d);

@@ -27,7 +27,10 @@
 //      (`body_dots`), and each node gathers w·(g·v)·g_i from its faces; so
 //      do the curvature nodes' one-ring terms, g·v per node from its edges
 //      and faces, gathered through the edge and face-corner slots.
-//   4. `implicit_move` (one per particle): x ← x + Δx in fixed point, the
+//      With contact between bodies, the pairs' Gauss–Newton terms join each
+//      product and the step clamp s follows the solve
+//      (shaders/common/implicit_contact.wgsl).
+//   4. `implicit_move` (one per particle): x ← x + s·Δx in fixed point, the
 //      blow-up check of the explicit step (`step_particle`).
 // No float atomics: the same run gives the same bits.
 
@@ -646,8 +649,16 @@ fn implicit_blocks(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocati
     }
     diagonal += surface_diagonal(i);
     diagonal += pair_rows(i, VEC_X, vec3<f32>(0.0), true);
+    // The contact step clamp's limit L_i = 0.4·min(d̂, closest distance) in w
+    // (shaders/common/implicit_contact.wgsl; −1: not a contact body's node).
+    var limit = -1.0;
+    if CONTACT_TERMS && contact_body(i) != NO_BODY {
+        let contact = contact_rows(i, VEC_X, true);
+        diagonal += contact.v;
+        limit = STEP_FRACTION * contact.closest;
+    }
     // A held coordinate (`freeze`, `move`): the identity row.
-    imp[dinv] = vec4<f32>(select(vec3<f32>(1.0), 1.0 / diagonal, free_axes(i) != vec3<f32>(0.0)), 0.0);
+    imp[dinv] = vec4<f32>(select(vec3<f32>(1.0), 1.0 / diagonal, free_axes(i) != vec3<f32>(0.0)), limit);
 }
 
 fn imp_vec(section: u32, i: u32) -> vec3<f32> {
@@ -655,8 +666,8 @@ fn imp_vec(section: u32, i: u32) -> vec3<f32> {
 }
 
 // (A·v)_i for the vector in `section`: γ/dt·v_i plus particle i's rows of its
-// bond ends, externals, angles, volume elements, faces and bodies, and pairs,
-// in that order (`body_dots` of the section first; a fixed particle, and a
+// bond ends, externals, angles, volume elements, faces and bodies, pairs and
+// contacts between bodies, in that order (`body_dots` of the section first; a fixed particle, and a
 // held coordinate of `freeze` or `move`: v_i). Their entries of every vector
 // the solve forms are 0, so their couplings drop out as in the CPU's matrix.
 fn apply_row(i: u32, section: u32) -> vec3<f32> {
@@ -704,6 +715,9 @@ fn apply_row(i: u32, section: u32) -> vec3<f32> {
         out += surface_rows(i, section);
     }
     out += pair_rows(i, section, vi, false);
+    if CONTACT_TERMS {
+        out += contact_rows(i, section, false).v;
+    }
     return select(vi, out, free_axes(i) != vec3<f32>(0.0));
 }
 
@@ -850,6 +864,7 @@ fn implicit_solve(@builtin(local_invocation_index) local: u32) {
             break;
         }
     }
+    clamp_step(local);
     if local == 0u {
         let relative = select(residual / b_norm, 0.0, b_norm == 0.0);
         imp[imp_topo[IMP_V_REPORT]] = vec4<f32>(bitcast<f32>(iterations), relative, 0.0, 0.0);
@@ -865,5 +880,7 @@ fn implicit_move(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation
     if i >= P.n || halted() {
         return;
     }
-    step_particle(i, imp_vec(VEC_X, i));
+    // s < 1 only where the contact step clamp shortened the step (`clamp_step`).
+    let s = bitcast<f32>(atomicLoad(&status[ST_FRACTION]));
+    step_particle(i, s * imp_vec(VEC_X, i));
 }

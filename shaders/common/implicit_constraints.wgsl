@@ -224,6 +224,7 @@ fn implicit_solve_constrained(@builtin(local_invocation_index) local: u32) {
     for (var k = local; k < imp_topo[IMP_CONSTRAINTS]; k += WORKGROUP) {
         imp[c_entry(k, 2u)].z = -imp[c_entry(k, 1u)][C_MU];
     }
+    clamp_step(local);
     if local == 0u {
         imp[imp_topo[IMP_V_REPORT]] = vec4<f32>(bitcast<f32>(iterations), residual, 0.0, 0.0);
         if residual > tolerance {

@@ -17,6 +17,18 @@ fn contact_adhesion_switch(p: array<f32, 8>, d: f32) -> Radial {
     return Radial(1.0 - t2 * t * (10.0 - 15.0 * t + 6.0 * t2), -30.0 * t2 * (1.0 - t) * (1.0 - t) / width);
 }
 
+// s″(d), for the implicit step's Gauss–Newton weight ε·s″·B (src/gpu/implicit.rs).
+fn contact_adhesion_switch_curvature(p: array<f32, 8>, d: f32) -> f32 {
+    let on = p[CONTACT_ADHESION_D_ON];
+    let off = p[CONTACT_ADHESION_D_OFF];
+    if d >= off || d <= on {
+        return 0.0;
+    }
+    let width = off - on;
+    let t = (d - on) / width;
+    return -60.0 * t * (1.0 - t) * (1.0 - 2.0 * t) / (width * width);
+}
+
 // Energy per area of a face in full contact: ε = −w.
 fn contact_adhesion_density(p: array<f32, 8>) -> f32 {
     return -p[CONTACT_ADHESION_W];

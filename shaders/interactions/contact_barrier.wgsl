@@ -15,3 +15,16 @@ fn contact_barrier_contact(p: array<f32, 8>, d: f32) -> Radial {
     let log = log(d / dhat);
     return Radial(-kappa * gap * gap * log, -kappa * (2.0 * gap * log + gap * gap / d));
 }
+
+// b″(d), the Gauss–Newton weight of the implicit step (src/gpu/implicit.rs).
+fn contact_barrier_contact_curvature(p: array<f32, 8>, d: f32) -> f32 {
+    let dhat = p[CONTACT_BARRIER_DHAT];
+    if d >= dhat {
+        return 0.0;
+    }
+    if d <= 0.0 {
+        return bitcast<f32>(0x7f800000u);
+    }
+    let gap = d - dhat;
+    return -p[CONTACT_BARRIER_KAPPA] * (2.0 * log(d / dhat) + 4.0 * gap / d - gap * gap / (d * d));
+}

@@ -53,7 +53,9 @@
 //! result does not depend on the order). `integrate` moves every particle by
 //! s·a + √s·b; `advance` stores each step's s in a ring of
 //! [`FRACTION_SLOTS`] entries of `surf`, which the host reads at every sync
-//! to advance the clock by s·dt and count clamped steps (`nclamp`).
+//! to advance the clock by s·dt and count clamped steps (`nclamp`). With
+//! `integrator implicit` the solve replaces s by the implicit step's clamp
+//! and the pairs join its products (src/gpu/implicit.rs).
 //!
 //! # Cost
 //!

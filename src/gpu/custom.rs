@@ -89,11 +89,14 @@ pub struct CustomSource {
     /// `BODY_TERMS`, so that a model without them compiles its implicit
     /// step's products without their gathers and their barrier.
     pub body_terms: bool,
+    /// Whether the model has contact terms between bodies: the WGSL constant
+    /// `CONTACT_TERMS`, likewise for the implicit step's contact rows and clamp.
+    pub contact_terms: bool,
 }
 
 /// The WGSL of every custom term of `model`.
 pub fn source(model: &Model) -> Result<CustomSource, String> {
-    let mut out = CustomSource { body_terms: model.has_surface_terms(), ..Default::default() };
+    let mut out = CustomSource { body_terms: model.has_surface_terms(), contact_terms: model.has_contact_terms(), ..Default::default() };
     for (k, term) in terms(model).filter(|t| is_custom(t)).enumerate() {
         let index = REGISTRY.len() + k;
         let energy = term.interaction.expression().expect("a custom term has its expression");

@@ -55,6 +55,25 @@
 //!   the cross terms between one node's edge and face contributions (a
 //!   preconditioner: it changes the iterations, not the solution). One
 //!   curvature term per body.
+//! - **Contact between bodies** (shaders/common/implicit_contact.wgsl): each
+//!   node–face pair in range adds the CPU's Gauss–Newton term c·g gᵀ,
+//!   g = (n̂, −w_0·n̂, −w_1·n̂, −w_2·n̂) over (node, corners) at its closest
+//!   point (src/backend/contact_mesh.rs, `push_pair_blocks`), with
+//!   c = max(Σ_rules b″(d), 0) for the node–face rules (`NAME_contact_curvature`)
+//!   and c = max(ε·s″·B, 0) per area-weighted rule at the node's nearest face
+//!   (`NAME_switch_curvature`; the adhesion passes keep s″ and ε·s″·B beside
+//!   s′ and the pull). Applied matrix-free like the pairs: each product walks
+//!   the pairs as the force pass does (`contact_forces`: the node's row, then
+//!   the corner's faces against its row) and computes each pair's d, w and n̂
+//!   again from its face's first corner, so the four participants see the
+//!   same bits and K̃ stays symmetric. **The step clamp** follows the
+//!   solve: `implicit_blocks` keeps each contact node's limit
+//!   L_i = 0.4·min(d̂, its closest distance) beside its Jacobi entry, the
+//!   solve's workgroup min-reduces s = min(1, min_i L_i/|Δx_i|) on the bits
+//!   of positive f32s (order-independent) into the step's fraction,
+//!   replacing the explicit step's that the force pass left there, and
+//!   `implicit_move` moves by s·Δx; `advance` records s for the clock, as
+//!   for the explicit step (src/gpu/contact.rs).
 //! - **Pairs**: the bonds' radial block for every rule between two
 //!   neighbours (and, weighted, fractional `special_bonds` partners),
 //!   computed again from the positions at each product K̃·v from the
@@ -76,7 +95,8 @@
 //! `linear_elastic` have one), and every body term its face stencil and
 //! body weights (`turgor`, `turgor_log`, `surface_tension`,
 //! `area_conservation`, `surface_shear`) or node weights
-//! (`helfrich_bending`); models with contact terms or custom terms stay on
+//! (`helfrich_bending`), and every contact law its curvature
+//! (`contact_barrier`, `contact_adhesion`); models with custom terms stay on
 //! the CPU with the reason. Bond kinetics run: a kinetic
 //! bond's block is scaled by its bound state as its force is (`bond_on`),
 //! and rules the host decides (`plastic`, `maturation`, …) upload their new
@@ -159,10 +179,10 @@ const J_END: u32 = 0x8000_0000;
 
 /// Why the model's implicit step cannot run on the device (None: it can).
 pub fn refusal(model: &Model) -> Option<&'static str> {
-    if model.has_contact_terms() {
+    if !model.contact_rules.iter().all(|r| stiffness_function(r.interaction).is_some()) {
         return Some(
-            "`integrator implicit` with contact terms runs on the CPU backend only \
-             (the GPU has stiffness blocks for bonds, angles, pairs, externals, volume elements and body terms)",
+            "`integrator implicit` with a contact law that has no GPU stiffness block runs on the CPU backend only \
+             (contact_barrier and contact_adhesion have one)",
         );
     }
     if !model.body_rules.iter().all(|r| stiffness_function(r.interaction).is_some()) {
@@ -195,7 +215,9 @@ pub fn refusal(model: &Model) -> Option<&'static str> {
 /// (its 9×9 stencil on one face) with `NAME_body_weights` (the weights of
 /// its Gauss–Newton terms over the whole body, on ∇V∇Vᵀ and ∇A∇Aᵀ), or, for
 /// a curvature law, `NAME_node_weights` (w and β of its Gauss–Newton term
-/// w·g gᵀ per node, g = ∇M_i − β·∇A_i).
+/// w·g gᵀ per node, g = ∇M_i − β·∇A_i), or, for contact between bodies,
+/// `NAME_contact_curvature` (b″ of a node–face law) or
+/// `NAME_switch_curvature` (s″ of an area-weighted law's switch).
 fn stiffness_function(interaction: &dyn crate::interactions::Interaction) -> Option<String> {
     let name = interaction.name();
     let functions = match interaction.law() {
@@ -204,6 +226,8 @@ fn stiffness_function(interaction: &dyn crate::interactions::Interaction) -> Opt
         Law::Tetra(_) => vec![format!("{name}_tetra_hessian")],
         Law::Surface { gpu: SurfaceGpu::PerFace, .. } => vec![format!("{name}_face_hessian"), format!("{name}_body_weights")],
         Law::Surface { gpu: SurfaceGpu::NodeCurvature, .. } => vec![format!("{name}_node_weights")],
+        Law::Contact { .. } => vec![format!("{name}_contact_curvature")],
+        Law::ContactArea { .. } => vec![format!("{name}_switch_curvature")],
         _ => return None,
     };
     let source = shader::interaction_source(name)?;
@@ -212,7 +236,8 @@ fn stiffness_function(interaction: &dyn crate::interactions::Interaction) -> Opt
 
 /// The stiffness dispatch functions over the registry: `radial_curvature`,
 /// `three_body_hessian`, `one_body_hessian`, `tetra_hessian`, `face_hessian`,
-/// `body_weights` and `node_weights` (0 for laws without one, which
+/// `body_weights`, `node_weights`, `contact_curvature` and
+/// `contact_area_switch_curvature` (0 for laws without one, which
 /// [`refusal`] keeps off the device).
 pub fn stiffness_dispatch() -> String {
     let mut radial = String::from("fn radial_curvature(kind: u32, p: array<f32, 8>, r: f32) -> f32 {\n    switch kind {\n");
@@ -228,6 +253,8 @@ pub fn stiffness_dispatch() -> String {
     );
     let mut weights = String::from("fn body_weights(kind: u32, p: array<f32, 8>, body: BodyTotals) -> vec2<f32> {\n    switch kind {\n");
     let mut node = String::from("fn node_weights(kind: u32, p: array<f32, 8>, m: f32, a: f32) -> vec2<f32> {\n    switch kind {\n");
+    let mut contact = String::from("fn contact_curvature(kind: u32, p: array<f32, 8>, d: f32) -> f32 {\n    switch kind {\n");
+    let mut area = String::from("fn contact_area_switch_curvature(kind: u32, p: array<f32, 8>, d: f32) -> f32 {\n    switch kind {\n");
     for (index, interaction) in REGISTRY.iter().enumerate() {
         let Some(function) = stiffness_function(*interaction) else { continue };
         let (out, args) = match interaction.law() {
@@ -240,6 +267,8 @@ pub fn stiffness_dispatch() -> String {
                 (&mut face, "p, body, g")
             }
             Law::Surface { .. } => (&mut node, "p, m, a"),
+            Law::Contact { .. } => (&mut contact, "p, d"),
+            Law::ContactArea { .. } => (&mut area, "p, d"),
             _ => (&mut one, "p, x"),
         };
         out.push_str(&format!("        case {index}u: {{ return {function}({args}); }}\n"));
@@ -251,7 +280,9 @@ pub fn stiffness_dispatch() -> String {
     face.push_str("        default: { return array<f32, 81>(); }\n    }\n}\n");
     weights.push_str("        default: { return vec2<f32>(0.0); }\n    }\n}\n");
     node.push_str("        default: { return vec2<f32>(0.0); }\n    }\n}\n");
-    radial + &three + &one + &tetra + &face + &weights + &node
+    contact.push_str("        default: { return 0.0; }\n    }\n}\n");
+    area.push_str("        default: { return 0.0; }\n    }\n}\n");
+    radial + &three + &one + &tetra + &face + &weights + &node + &contact + &area
 }
 
 /// The device's implicit solver: its buffers, bind group (group 1) and kernels.

@@ -47,7 +47,7 @@ mod embedded {
 pub use embedded::{COMMON_SHADERS, INTERACTION_SHADERS};
 
 /// The common files in the order they must appear (declarations first).
-const COMMON_ORDER: [&str; 17] = [
+const COMMON_ORDER: [&str; 18] = [
     "layout",
     "philox",
     "neighbor",
@@ -62,6 +62,7 @@ const COMMON_ORDER: [&str; 17] = [
     "adhesion",
     "protocol",
     "implicit",
+    "implicit_contact",
     "implicit_constraints",
     "shake",
     "fire",
@@ -160,6 +161,7 @@ pub fn compose_with(custom: &CustomSource) -> String {
     }
     program.push_str(&custom.functions);
     writeln!(program, "const BODY_TERMS: bool = {};", custom.body_terms).unwrap();
+    writeln!(program, "const CONTACT_TERMS: bool = {};", custom.contact_terms).unwrap();
     program.push_str(&dispatch(custom));
     // The stiffness laws of the implicit step (src/gpu/implicit.rs).
     program.push_str(&super::implicit::stiffness_dispatch());
@@ -248,9 +250,12 @@ mod tests {
 
     #[test]
     fn composed_program_validates_with_naga() {
-        let program = compose();
-        if let Err(e) = validate(&program) {
-            panic!("{e}");
+        // With and without the code behind `BODY_TERMS` and `CONTACT_TERMS`.
+        for (body_terms, contact_terms) in [(false, false), (true, true)] {
+            let program = compose_with(&CustomSource { body_terms, contact_terms, ..Default::default() });
+            if let Err(e) = validate(&program) {
+                panic!("BODY_TERMS {body_terms}, CONTACT_TERMS {contact_terms}: {e}");
+            }
         }
     }
 

@@ -274,3 +274,23 @@ pub fn ks_exponential_steps(steps: &[u64], rate_dt: f64, horizon: Option<u64>) -
     }
     d * nn.sqrt()
 }
+
+/// Two 162-node icosphere cells (R = 2 µm, `gap` apart, nodes of drag 1)
+/// with force-field lines `ff`, pushed together by `push` pN per node, in a
+/// box periodic along x with the cells straddling its boundary (so the
+/// contact search works across it).
+pub fn contact_case(ff: &str, gap: f64, push: f64, settings: &str) -> Case {
+    let top = two_cells(2, 2.0, gap);
+    let deck = format!(
+        "units cell\ntopology cells.top\nforcefield cells.ff\nbox x 0 20 p y -10 10 f z -10 10 f\n\
+         group left id 1:162\ngroup right id 163:324\n\
+         external push_left left constant_force fx {push}\nexternal push_right right constant_force fx -{push}\n{settings}"
+    );
+    Case::new(&[("cells.top", &top), ("cells.ff", &format!("particle node drag 1\n{ff}")), ("deck.in", &deck)])
+}
+
+pub const CONTACT_BARRIER: &str = "contact cell cell contact_barrier dhat 0.1 kappa 200\n";
+pub const CONTACT_SHELLS: &str = "body cell turgor k 1000 dp0 100 v0 32.4\nbody cell surface_tension gamma 100\n";
+
+/// Adhesion whose switch (0.05–0.4 µm) reaches four times beyond the barrier's d̂.
+pub const CONTACT_ADHESION: &str = "contact cell cell contact_adhesion w 50 d_on 0.05 d_off 0.4\n";

@@ -1,0 +1,157 @@
+// Contact between bodies in the implicit step (the equations, the order and
+// the determinism argument: src/gpu/implicit.rs, "Contact between bodies").
+// Every node–face pair in range adds the Gauss–Newton term c·g gᵀ,
+// g = (n̂, −w_0·n̂, −w_1·n̂, −w_2·n̂) over (node, corners 0–2) at its closest
+// point, c = max(Σ_rules b″(d), 0) for the node–face rules and
+// c = max(ε·s″·B, 0) per area-weighted rule at the node's nearest face (as
+// the CPU's `push_pair_blocks`). The terms are applied matrix-free: each
+// product walks the pairs as the force pass does (`contact_forces`), from
+// the node's row and from each corner's faces, and computes every pair's
+// d, w and n̂ again relative to the face's first corner, so the four
+// participants of a pair see the same bits and K̃ stays symmetric.
+
+// Particle i's contact rows applied to a vector (or their diagonal) and its
+// closest contact distance (at most d̂).
+struct ContactRows {
+    v: vec3<f32>,
+    closest: f32,
+}
+
+// max(Σ b″(d), 0) over the node–face rules of type pair `types`, in rule order.
+fn contact_stiffness(types: u32, d: f32) -> f32 {
+    var c = 0.0;
+    let end = topo[P.off_crule_start + types + 1u];
+    for (var q = topo[P.off_crule_start + types]; q < end; q++) {
+        let rule = topo[P.off_crule_list + q];
+        c += contact_curvature(topo[P.off_crules + CONTACT_RULE_WORDS * rule], contact_rule_params(rule), d);
+    }
+    return max(c, 0.0);
+}
+
+// The area-weighted rules' weights max(ε·s″·B, 0) at `node` whose nearest face is f.
+fn adhesion_stiffness(node: u32, f: u32, types: u32) -> f32 {
+    var c = 0.0;
+    let end = topo[P.off_arule_start + types + 1u];
+    for (var q = topo[P.off_arule_start + types]; q < end; q++) {
+        let j = topo[P.off_arule_list + q];
+        if surf[adhesion_switch(node, j)].z == f32(f) {
+            c += max(surf[adhesion_pull(node, j)].y, 0.0);
+        }
+    }
+    return c;
+}
+
+// The row of the participant with coefficient `g` (1 for the node, −w_k for
+// corner k) of the pair (node, face) with weight c: c·g·(g_pair·v)·n̂, with
+// g_pair·v = n̂·(v_node − Σ_k w_k·v_k) for the vector in `section`; with
+// `diagonal_only`, its diagonal c·g²·n̂∘n̂.
+fn contact_term(c: f32, g: f32, node: u32, face: u32, pair: ContactPair, section: u32, diagonal_only: bool) -> vec3<f32> {
+    if c == 0.0 {
+        return vec3<f32>(0.0);
+    }
+    if diagonal_only {
+        return c * g * g * pair.n * pair.n;
+    }
+    let corners = pair.w.x * imp_vec(section, contact_face(face, 0u)) + pair.w.y * imp_vec(section, contact_face(face, 1u))
+        + pair.w.z * imp_vec(section, contact_face(face, 2u));
+    return c * g * dot(pair.n, imp_vec(section, node) - corners) * pair.n;
+}
+
+// Particle i's contact rows: as a node, over the faces whose first corner is
+// a neighbour of another body (then its area-weighted rules' nearest faces);
+// as a corner, over its faces and the other bodies' nodes of its row, culled
+// by the faces' bounding spheres — the force pass's walks and order.
+fn contact_rows(i: u32, section: u32, diagonal_only: bool) -> ContactRows {
+    var out = ContactRows(vec3<f32>(0.0), P.contact_dhat);
+    let body = contact_body(i);
+    if body == NO_BODY {
+        return out;
+    }
+    let row = nlist_row(i);
+    let count = min(nlist[row], P.nlist_cap);
+    for (var k = 0u; k < count; k++) {
+        let j = nlist[row + 1u + k] & ~CONTACT_ONLY;
+        let other = contact_body(j);
+        if other == NO_BODY || other == body {
+            break;
+        }
+        let types = contact_types(body, other);
+        if topo[P.off_cany + types] == 0u {
+            continue;
+        }
+        let faces_end = topo[P.off_first_start + j + 1u];
+        for (var q = topo[P.off_first_start + j]; q < faces_end; q++) {
+            let face = topo[P.off_first_faces + q];
+            let pair = contact_pair(i, face);
+            out.closest = min(out.closest, pair.d);
+            out.v += contact_term(contact_stiffness(types, pair.d), 1.0, i, face, pair, section, diagonal_only);
+        }
+    }
+    for (var j = 0u; j < P.n_arules; j++) {
+        let c = max(surf[adhesion_pull(i, j)].y, 0.0);
+        if c > 0.0 {
+            let face = u32(surf[adhesion_switch(i, j)].z);
+            out.v += contact_term(c, 1.0, i, face, contact_pair(i, face), section, diagonal_only);
+        }
+    }
+    let corner_end = topo[P.off_corner_start + i + 1u];
+    for (var first = topo[P.off_corner_start + i]; first < corner_end; first += CORNER_BATCH) {
+        var batch = corner_batch(i, first, corner_end);
+        for (var k = 0u; k < count; k++) {
+            let node = nlist[row + 1u + k] & ~CONTACT_ONLY;
+            let other = contact_body(node);
+            if other == NO_BODY || other == body {
+                break;
+            }
+            let types = contact_types(other, body);
+            if topo[P.off_cany + types] == 0u {
+                continue;
+            }
+            let x = separation(i, node);
+            for (var q = 0u; q < batch.count; q++) {
+                if !batch_reaches(&batch, q, x) {
+                    continue;
+                }
+                let face = batch.slots[q] / 4u;
+                let pair = contact_pair(node, face);
+                out.closest = min(out.closest, pair.d);
+                var c = contact_stiffness(types, pair.d);
+                if P.n_arules > 0u {
+                    c += adhesion_stiffness(node, face, types);
+                }
+                out.v += contact_term(c, -pair.w[batch.slots[q] % 4u], node, face, pair, section, diagonal_only);
+            }
+        }
+    }
+    return out;
+}
+
+var<workgroup> workgroup_fraction: atomic<u32>;
+
+// The contact step clamp of the solved step (in the solve's one workgroup):
+// s = min(1, min_i L_i/|Δx_i|) over the limits L_i that `implicit_blocks`
+// left in the Jacobi entries' w (−1: no contact body), min-reduced through
+// the bits of positive f32s (the order does not matter), into ST_FRACTION —
+// replacing the explicit step's fraction the force pass left there.
+// `implicit_move` moves by s·Δx, and `advance` records s for the clock.
+fn clamp_step(local: u32) {
+    if !CONTACT_TERMS {
+        return;
+    }
+    if local == 0u {
+        atomicStore(&workgroup_fraction, 0x3f800000u);
+    }
+    workgroupBarrier();
+    for (var i = local; i < P.n; i += WORKGROUP) {
+        let limit = imp[P.n * VEC_DINV + i].w;
+        let dx = imp_vec(VEC_X, i);
+        let length2 = dot(dx, dx);
+        if limit >= 0.0 && length2 > limit * limit {
+            atomicMin(&workgroup_fraction, bitcast<u32>(limit / sqrt(length2)));
+        }
+    }
+    workgroupBarrier();
+    if local == 0u {
+        atomicStore(&status[ST_FRACTION], atomicLoad(&workgroup_fraction));
+    }
+}
