@@ -15,7 +15,9 @@ use cellmd::integrate::Integrator;
 use cellmd::rng::Noise;
 use cellmd::run::{RunOptions, Simulation};
 use cellmd::system::State;
-use common::{contact_case, random_case, CONTACT_ADHESION, CONTACT_BARRIER, CONTACT_SHELLS};
+use common::{
+    assert_clamped_runs_agree, contact_case, random_case, CONTACT_ADHESION, CONTACT_BARRIER, CONTACT_GPU_EPSILON, CONTACT_SHELLS,
+};
 use glam::DVec3;
 
 fn context() -> GpuContext {
@@ -1378,18 +1380,8 @@ fn device_auto_announces_its_choice_and_runs_on_it() {
     assert!(auto_files == announced_files, "the auto run differs from the run on the device it announced");
 }
 
-/// `contact_barrier` on the GPU (src/gpu/contact.rs) against the CPU f64
-/// backend: two cells 0.03 µm apart (many node–face pairs within d̂ = 0.1 µm,
-/// in every Voronoi region), the barrier alone and with the cells' surface
-/// terms. Tolerance from f32 arithmetic (u = 2⁻²⁴ ≈ 6e-8): a pair's
-/// separations from the face's first corner (≤ ℓ + d̂ ≈ 0.6 µm) are rounded
-/// once, the closest point and d take ≈ 10 more roundings, so d is off by
-/// ≈ 10u·0.6 µm ≈ 4e-7 µm, 1.2e-5 of the smallest d (0.03 µm); the force
-/// b′(d) changes by d·|b″/b′| ≤ 3 times that relative change, ≈ 4e-5; the
-/// energy by d·|b′/b| ≤ 3 times, also ≈ 4e-5. A particle sums a few pairs of
-/// the same sign, so relative to the largest force and the total energy: 1e-4.
-const CONTACT_GPU_EPSILON: f64 = 1e-4;
-
+/// `contact_barrier` on the GPU against the CPU f64 backend, forces and
+/// energies within [`CONTACT_GPU_EPSILON`] (its derivation is this case).
 #[test]
 fn contact_barrier_forces_match_the_cpu() {
     // The kernel's step clamp is the CPU's.
@@ -1436,19 +1428,7 @@ fn the_contact_step_clamp_runs_on_the_gpu_like_on_the_cpu() {
     };
     let (start, cpu) = run(DevicePreference::Cpu, 0.0, 10);
     let (_, gpu) = run(DevicePreference::Gpu, 0.0, 10);
-    let sim_box = cpu.sim_box;
-    let unwrap = |s: &State, i: usize| sim_box.unwrap(s.positions[i], s.images[i]);
-    let travelled = (0..start.len()).map(|i| (unwrap(&cpu.state, i) - unwrap(&start, i)).length()).fold(0.0, f64::max);
-    let deviation = (0..start.len()).map(|i| (unwrap(&cpu.state, i) - unwrap(&gpu.state, i)).length()).fold(0.0, f64::max);
-    println!(
-        "CPU: {} clamped steps, t = {:.6e} s, mindist {:.4e}; GPU: {} clamped, t = {:.6e} s, mindist {:.4e}; GPU − CPU {deviation:.3e} after {travelled:.3e}",
-        cpu.contact_clamps, cpu.state.time, cpu.min_contact_distance(), gpu.contact_clamps, gpu.state.time, gpu.min_contact_distance()
-    );
-    assert!(cpu.contact_clamps > 5, "the clamp hardly acted: {} steps", cpu.contact_clamps);
-    assert_eq!(gpu.contact_clamps, cpu.contact_clamps);
-    assert!((gpu.state.time - cpu.state.time).abs() <= CONTACT_GPU_EPSILON * cpu.state.time, "{} vs {}", gpu.state.time, cpu.state.time);
-    assert!(deviation <= CONTACT_GPU_EPSILON * travelled, "GPU − CPU {deviation:e} > {CONTACT_GPU_EPSILON:e} × {travelled:e}");
-    assert!(gpu.min_contact_distance() > 0.0 && gpu.min_contact_distance() < 0.1);
+    assert_clamped_runs_agree(&start, &cpu, &gpu, 6);
     let (_, a) = run(DevicePreference::Gpu, 0.0041, 60);
     let (_, b) = run(DevicePreference::Gpu, 0.0041, 60);
     let bits = |s: &Simulation| s.state.positions.iter().map(|x| x.to_array().map(f64::to_bits)).collect::<Vec<_>>();
@@ -1591,21 +1571,8 @@ fn adhesion_runs_on_the_gpu_like_on_the_cpu_and_twice_alike() {
     };
     let (start, cpu) = run(DevicePreference::Cpu, 0.0, STEPS);
     let (_, gpu) = run(DevicePreference::Gpu, 0.0, STEPS);
-    let sim_box = cpu.sim_box;
-    let unwrap = |s: &State, i: usize| sim_box.unwrap(s.positions[i], s.images[i]);
-    let travelled = (0..start.len()).map(|i| (unwrap(&cpu.state, i) - unwrap(&start, i)).length()).fold(0.0, f64::max);
-    let deviation = (0..start.len()).map(|i| (unwrap(&cpu.state, i) - unwrap(&gpu.state, i)).length()).fold(0.0, f64::max);
-    println!(
-        "CPU: {} clamped steps, mindist {:.4e}; GPU: {} clamped, mindist {:.4e}; GPU − CPU {deviation:.3e} after {travelled:.3e}",
-        cpu.contact_clamps,
-        cpu.min_contact_distance(),
-        gpu.contact_clamps,
-        gpu.min_contact_distance()
-    );
+    let travelled = assert_clamped_runs_agree(&start, &cpu, &gpu, 1);
     assert!(travelled > 1e-3, "the cells hardly moved: {travelled:e}");
-    assert_eq!(gpu.contact_clamps, cpu.contact_clamps);
-    assert!((gpu.state.time - cpu.state.time).abs() <= CONTACT_GPU_EPSILON * cpu.state.time, "{} vs {}", gpu.state.time, cpu.state.time);
-    assert!(deviation <= CONTACT_GPU_EPSILON * travelled, "GPU − CPU {deviation:e} > {CONTACT_GPU_EPSILON:e} × {travelled:e}");
     let (_, a) = run(DevicePreference::Gpu, 0.0041, 40);
     let (_, b) = run(DevicePreference::Gpu, 0.0041, 40);
     let bits = |s: &Simulation| s.state.positions.iter().map(|x| x.to_array().map(f64::to_bits)).collect::<Vec<_>>();

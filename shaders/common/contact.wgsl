@@ -154,10 +154,136 @@ fn corner_batch(i: u32, first: u32, end: u32) -> CornerBatch {
     return out;
 }
 
-// Whether a node at x (relative to the batch's corner) may be within d̂ of face q of the batch.
-fn batch_reaches(batch: ptr<function, CornerBatch>, q: u32, x: vec3<f32>) -> bool {
-    let off_centre = x - (*batch).centres[q];
-    return dot(off_centre, off_centre) < (*batch).reach2[q];
+// The node–face pairs of particle i as a node, one per `next_node_pair`
+// (false when done): the faces (CSR by first corner, in face order) of each
+// node of another body in its row, in row order, where a contact rule acts
+// between the two bodies' types. The list holds the other bodies' nodes
+// first (shaders/common/neighbor.wgsl), so the walk stops at the first entry
+// that is not one. The force pass and the implicit step's products walk alike.
+struct NodeWalk {
+    body: u32,
+    row: u32,
+    count: u32,
+    k: u32,     // the next row entry
+    q: u32,     // the next face slot of the current neighbour, and its end
+    end: u32,
+    face: u32,  // the pair: its face and (node type, face type) index
+    types: u32,
+}
+
+fn node_walk(i: u32, body: u32) -> NodeWalk {
+    let row = nlist_row(i);
+    return NodeWalk(body, row, min(nlist[row], P.nlist_cap), 0u, 0u, 0u, 0u, 0u);
+}
+
+fn next_node_pair(w: ptr<function, NodeWalk>) -> bool {
+    var found = false;
+    loop {
+        if (*w).q < (*w).end {
+            (*w).face = topo[P.off_first_faces + (*w).q];
+            (*w).q += 1u;
+            found = true;
+            break;
+        }
+        if (*w).k >= (*w).count {
+            break;
+        }
+        let j = nlist[(*w).row + 1u + (*w).k] & ~CONTACT_ONLY;
+        (*w).k += 1u;
+        let other = contact_body(j);
+        if other == NO_BODY || other == (*w).body {
+            (*w).k = (*w).count;
+            break;
+        }
+        (*w).types = contact_types((*w).body, other);
+        if topo[P.off_cany + (*w).types] != 0u {
+            (*w).q = topo[P.off_first_start + j];
+            (*w).end = topo[P.off_first_start + j + 1u];
+        }
+    }
+    return found;
+}
+
+// The node–face pairs of particle i as a face corner, one per
+// `next_corner_pair` (false when done): its faces (CSR, in face order) in
+// batches of CORNER_BATCH — one walk of its row per batch, a mesh node's
+// 5–6 faces in one — against each node of another body in its row with a
+// contact rule, in row order, skipping the faces whose bounding sphere the
+// node is outside (`corner_batch`); `role` is i's corner of the face.
+struct CornerWalk {
+    i: u32,
+    body: u32,
+    row: u32,
+    count: u32,
+    first: u32,        // the batch's first face slot, and the end of i's slots
+    end: u32,
+    batch: CornerBatch,
+    k: u32,            // the next row entry
+    q: u32,            // the next face of the batch for the current node
+    node: u32,         // the pair: the node, its separation from i, the
+    x: vec3<f32>,      // (node type, face type) index, the face and i's corner
+    types: u32,
+    face: u32,
+    role: u32,
+}
+
+fn corner_walk(i: u32, body: u32) -> CornerWalk {
+    var w: CornerWalk;
+    w.i = i;
+    w.body = body;
+    w.row = nlist_row(i);
+    w.count = min(nlist[w.row], P.nlist_cap);
+    w.first = topo[P.off_corner_start + i];
+    w.end = topo[P.off_corner_start + i + 1u];
+    if w.first < w.end {
+        w.batch = corner_batch(i, w.first, w.end);
+    }
+    w.q = CORNER_BATCH; // no node yet
+    return w;
+}
+
+fn next_corner_pair(w: ptr<function, CornerWalk>) -> bool {
+    var found = false;
+    loop {
+        while (*w).q < (*w).batch.count {
+            let q = (*w).q;
+            (*w).q += 1u;
+            let off_centre = (*w).x - (*w).batch.centres[q];
+            if dot(off_centre, off_centre) < (*w).batch.reach2[q] {
+                (*w).face = (*w).batch.slots[q] / 4u;
+                (*w).role = (*w).batch.slots[q] % 4u;
+                found = true;
+                break;
+            }
+        }
+        if found || (*w).first >= (*w).end {
+            break;
+        }
+        if (*w).k < (*w).count {
+            let node = nlist[(*w).row + 1u + (*w).k] & ~CONTACT_ONLY;
+            (*w).k += 1u;
+            let other = contact_body(node);
+            if other == NO_BODY || other == (*w).body {
+                (*w).k = (*w).count; // the other bodies' nodes come first in the list
+            } else {
+                (*w).types = contact_types(other, (*w).body);
+                if topo[P.off_cany + (*w).types] != 0u {
+                    (*w).node = node;
+                    (*w).x = separation((*w).i, node);
+                    (*w).q = 0u;
+                }
+            }
+            continue;
+        }
+        (*w).first += CORNER_BATCH;
+        if (*w).first >= (*w).end {
+            break;
+        }
+        (*w).batch = corner_batch((*w).i, (*w).first, (*w).end);
+        (*w).k = 0u;
+        (*w).q = CORNER_BATCH;
+    }
+    return found;
 }
 
 // The largest s ∈ (0, 1] with s·a + √s·b ≤ limit (src/integrate/overdamped.rs, `step_fraction`).
@@ -181,33 +307,17 @@ struct ContactNode {
 
 fn contact_node_part(i: u32, body: u32, track: bool) -> ContactNode {
     var out = ContactNode(vec3<f32>(0.0), 0.0, P.contact_dhat);
-    let row = nlist_row(i);
-    let count = min(nlist[row], P.nlist_cap);
-    // The faces whose first corner is a neighbour of another body (the
-    // list holds those first, shaders/common/neighbor.wgsl).
-    for (var k = 0u; k < count; k++) {
-        let j = nlist[row + 1u + k] & ~CONTACT_ONLY;
-        let other = contact_body(j);
-        if other == NO_BODY || other == body {
-            break;
+    var walk = node_walk(i, body);
+    while next_node_pair(&walk) {
+        let pair = contact_pair(i, walk.face);
+        out.closest = min(out.closest, pair.d);
+        let b = contact_radial(walk.types, pair.d);
+        if b.de_dr != 0.0 {
+            out.f -= b.de_dr * pair.n;
+            out.e += b.energy;
         }
-        let types = contact_types(body, other);
-        if topo[P.off_cany + types] == 0u {
-            continue;
-        }
-        let faces_end = topo[P.off_first_start + j + 1u];
-        for (var q = topo[P.off_first_start + j]; q < faces_end; q++) {
-            let face = topo[P.off_first_faces + q];
-            let pair = contact_pair(i, face);
-            out.closest = min(out.closest, pair.d);
-            let b = contact_radial(types, pair.d);
-            if b.de_dr != 0.0 {
-                out.f -= b.de_dr * pair.n;
-                out.e += b.energy;
-            }
-            if track && pair.d < P.contact_dhat {
-                adhesion_track(i, types, face, pair.d);
-            }
+        if track && pair.d < P.contact_dhat {
+            adhesion_track(i, walk.types, walk.face, pair.d);
         }
     }
     return out;
@@ -235,48 +345,25 @@ fn contact_forces(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocatio
     var f = part.f;
     var e = part.e;
     var closest = part.closest;
-    let row = nlist_row(i);
-    let count = min(nlist[row], P.nlist_cap);
-    // As a corner: its faces against the neighbours of other bodies, up to
-    // CORNER_BATCH faces per walk of the neighbour list (one walk for a mesh
-    // node's 5–6 faces).
-    let corner_start = topo[P.off_corner_start + i];
+    // As a corner: its faces against the other bodies' nodes (a face edge
+    // longer than the search covers halts the run first).
     let corner_end = topo[P.off_corner_start + i + 1u];
-    for (var q = corner_start; q < corner_end; q++) {
+    for (var q = topo[P.off_corner_start + i]; q < corner_end; q++) {
         let slot = topo[P.off_corner_faces + q];
         if slot % 4u == 0u && face_outgrew_search(slot / 4u) {
             atomicOr(&status[ST_HALTED], HALT_REACH);
         }
     }
-    for (var first = corner_start; first < corner_end; first += CORNER_BATCH) {
-        var batch = corner_batch(i, first, corner_end);
-        for (var k = 0u; k < count; k++) {
-            let node = nlist[row + 1u + k] & ~CONTACT_ONLY;
-            let other = contact_body(node);
-            if other == NO_BODY || other == body {
-                break; // the other bodies' nodes come first in the list
-            }
-            let types = contact_types(other, body);
-            if topo[P.off_cany + types] == 0u {
-                continue;
-            }
-            let x = separation(i, node);
-            for (var q = 0u; q < batch.count; q++) {
-                if !batch_reaches(&batch, q, x) {
-                    continue;
-                }
-                let face = batch.slots[q] / 4u;
-                let role = batch.slots[q] % 4u;
-                let pair = contact_pair(node, face);
-                closest = min(closest, pair.d);
-                let b = contact_radial(types, pair.d);
-                if b.de_dr != 0.0 {
-                    f += b.de_dr * pair.w[role] * pair.n;
-                }
-                if P.n_arules > 0u {
-                    f += adhesion_corner(node, face, role, types, pair);
-                }
-            }
+    var walk = corner_walk(i, body);
+    while next_corner_pair(&walk) {
+        let pair = contact_pair(walk.node, walk.face);
+        closest = min(closest, pair.d);
+        let b = contact_radial(walk.types, pair.d);
+        if b.de_dr != 0.0 {
+            f += b.de_dr * pair.w[walk.role] * pair.n;
+        }
+        if P.n_arules > 0u {
+            f += adhesion_corner(walk.node, walk.face, walk.role, walk.types, pair);
         }
     }
     let total = force[i] + vec4<f32>(f, e);

@@ -57,35 +57,20 @@ fn contact_term(c: f32, g: f32, node: u32, face: u32, pair: ContactPair, section
     return c * g * dot(pair.n, imp_vec(section, node) - corners) * pair.n;
 }
 
-// Particle i's contact rows: as a node, over the faces whose first corner is
-// a neighbour of another body (then its area-weighted rules' nearest faces);
-// as a corner, over its faces and the other bodies' nodes of its row, culled
-// by the faces' bounding spheres — the force pass's walks and order.
+// Particle i's contact rows: as a node, over its pairs (`next_node_pair`)
+// and its area-weighted rules' nearest faces; as a corner, over its pairs
+// (`next_corner_pair`) — the force pass's walks, in its order.
 fn contact_rows(i: u32, section: u32, diagonal_only: bool) -> ContactRows {
     var out = ContactRows(vec3<f32>(0.0), P.contact_dhat);
     let body = contact_body(i);
     if body == NO_BODY {
         return out;
     }
-    let row = nlist_row(i);
-    let count = min(nlist[row], P.nlist_cap);
-    for (var k = 0u; k < count; k++) {
-        let j = nlist[row + 1u + k] & ~CONTACT_ONLY;
-        let other = contact_body(j);
-        if other == NO_BODY || other == body {
-            break;
-        }
-        let types = contact_types(body, other);
-        if topo[P.off_cany + types] == 0u {
-            continue;
-        }
-        let faces_end = topo[P.off_first_start + j + 1u];
-        for (var q = topo[P.off_first_start + j]; q < faces_end; q++) {
-            let face = topo[P.off_first_faces + q];
-            let pair = contact_pair(i, face);
-            out.closest = min(out.closest, pair.d);
-            out.v += contact_term(contact_stiffness(types, pair.d), 1.0, i, face, pair, section, diagonal_only);
-        }
+    var nodes = node_walk(i, body);
+    while next_node_pair(&nodes) {
+        let pair = contact_pair(i, nodes.face);
+        out.closest = min(out.closest, pair.d);
+        out.v += contact_term(contact_stiffness(nodes.types, pair.d), 1.0, i, nodes.face, pair, section, diagonal_only);
     }
     for (var j = 0u; j < P.n_arules; j++) {
         let c = max(surf[adhesion_pull(i, j)].y, 0.0);
@@ -94,34 +79,15 @@ fn contact_rows(i: u32, section: u32, diagonal_only: bool) -> ContactRows {
             out.v += contact_term(c, 1.0, i, face, contact_pair(i, face), section, diagonal_only);
         }
     }
-    let corner_end = topo[P.off_corner_start + i + 1u];
-    for (var first = topo[P.off_corner_start + i]; first < corner_end; first += CORNER_BATCH) {
-        var batch = corner_batch(i, first, corner_end);
-        for (var k = 0u; k < count; k++) {
-            let node = nlist[row + 1u + k] & ~CONTACT_ONLY;
-            let other = contact_body(node);
-            if other == NO_BODY || other == body {
-                break;
-            }
-            let types = contact_types(other, body);
-            if topo[P.off_cany + types] == 0u {
-                continue;
-            }
-            let x = separation(i, node);
-            for (var q = 0u; q < batch.count; q++) {
-                if !batch_reaches(&batch, q, x) {
-                    continue;
-                }
-                let face = batch.slots[q] / 4u;
-                let pair = contact_pair(node, face);
-                out.closest = min(out.closest, pair.d);
-                var c = contact_stiffness(types, pair.d);
-                if P.n_arules > 0u {
-                    c += adhesion_stiffness(node, face, types);
-                }
-                out.v += contact_term(c, -pair.w[batch.slots[q] % 4u], node, face, pair, section, diagonal_only);
-            }
+    var corners = corner_walk(i, body);
+    while next_corner_pair(&corners) {
+        let pair = contact_pair(corners.node, corners.face);
+        out.closest = min(out.closest, pair.d);
+        var c = contact_stiffness(corners.types, pair.d);
+        if P.n_arules > 0u {
+            c += adhesion_stiffness(corners.node, corners.face, corners.types);
         }
+        out.v += contact_term(c, -pair.w[corners.role], corners.node, corners.face, pair, section, diagonal_only);
     }
     return out;
 }

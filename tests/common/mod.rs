@@ -294,3 +294,37 @@ pub const CONTACT_SHELLS: &str = "body cell turgor k 1000 dp0 100 v0 32.4\nbody 
 
 /// Adhesion whose switch (0.05–0.4 µm) reaches four times beyond the barrier's d̂.
 pub const CONTACT_ADHESION: &str = "contact cell cell contact_adhesion w 50 d_on 0.05 d_off 0.4\n";
+
+/// How closely GPU contact follows the CPU f64 backend (`contact_barrier`,
+/// tests/gpu.rs): two cells 0.03 µm apart (many node–face pairs within d̂ = 0.1 µm,
+/// in every Voronoi region), the barrier alone and with the cells' surface
+/// terms. Tolerance from f32 arithmetic (u = 2⁻²⁴ ≈ 6e-8): a pair's
+/// separations from the face's first corner (≤ ℓ + d̂ ≈ 0.6 µm) are rounded
+/// once, the closest point and d take ≈ 10 more roundings, so d is off by
+/// ≈ 10u·0.6 µm ≈ 4e-7 µm, 1.2e-5 of the smallest d (0.03 µm); the force
+/// b′(d) changes by d·|b″/b′| ≤ 3 times that relative change, ≈ 4e-5; the
+/// energy by d·|b′/b| ≤ 3 times, also ≈ 4e-5. A particle sums a few pairs of
+/// the same sign, so relative to the largest force and the total energy: 1e-4.
+pub const CONTACT_GPU_EPSILON: f64 = 1e-4;
+
+/// Asserts that a contact-clamped run on the GPU followed the CPU's from
+/// `start`: the same clamped steps (at least `min_clamps`), the clock within
+/// [`CONTACT_GPU_EPSILON`] relative, the unwrapped positions within it of the
+/// largest distance travelled, and the cells apart (0 < mindist < d̂ = 0.1 µm).
+/// Returns that distance.
+pub fn assert_clamped_runs_agree(start: &cellmd::system::State, cpu: &Simulation, gpu: &Simulation, min_clamps: u64) -> f64 {
+    let unwrap = |s: &cellmd::system::State, i: usize| cpu.sim_box.unwrap(s.positions[i], s.images[i]);
+    let travelled = (0..start.len()).map(|i| (unwrap(&cpu.state, i) - unwrap(start, i)).length()).fold(0.0, f64::max);
+    let deviation = (0..start.len()).map(|i| (unwrap(&cpu.state, i) - unwrap(&gpu.state, i)).length()).fold(0.0, f64::max);
+    println!(
+        "CPU: {} clamped steps, t = {:.6e} s, mindist {:.4e}; GPU: {} clamped, t = {:.6e} s, mindist {:.4e}; GPU − CPU {deviation:.3e} after {travelled:.3e}",
+        cpu.contact_clamps, cpu.state.time, cpu.min_contact_distance(), gpu.contact_clamps, gpu.state.time, gpu.min_contact_distance()
+    );
+    assert!(cpu.contact_clamps >= min_clamps, "the clamp hardly acted: {} steps", cpu.contact_clamps);
+    assert_eq!(gpu.contact_clamps, cpu.contact_clamps);
+    let (t_cpu, t_gpu) = (cpu.state.time, gpu.state.time);
+    assert!((t_gpu - t_cpu).abs() <= CONTACT_GPU_EPSILON * t_cpu, "{t_gpu} vs {t_cpu}");
+    assert!(deviation <= CONTACT_GPU_EPSILON * travelled, "GPU − CPU {deviation:e} > {CONTACT_GPU_EPSILON:e} × {travelled:e}");
+    assert!(gpu.min_contact_distance() > 0.0 && gpu.min_contact_distance() < 0.1);
+    travelled
+}
