@@ -651,9 +651,10 @@ fn a_body_spanning_half_the_periodic_box_halts_the_gpu_with_its_id() {
 fn run_deck_deterministic(
     deck: &std::path::Path,
     device: DevicePreference,
-    steps: u64,
+    horizon: impl Into<Horizon>,
     round_start_to_f32: bool,
 ) -> Result<(State, State), String> {
+    let Horizon { steps, first_run_only } = horizon.into();
     let plan = cellmd::deck::validate_file(deck, &[("steps".into(), "10".into()), ("fire_iterations".into(), "100".into())])
         .map_err(|e| e.to_string())?;
     let dir = tempfile::tempdir().unwrap();
@@ -663,8 +664,11 @@ fn run_deck_deterministic(
         sim.state.positions.iter_mut().for_each(|x| *x = x.as_vec3().as_dvec3());
     }
     let start = sim.state.clone();
-    let last_run = plan.actions.iter().rposition(|a| matches!(a, Action::Run(_))).map_or(plan.actions.len(), |k| k + 1);
     let first_run = plan.actions.iter().position(|a| matches!(a, Action::Run(_))).unwrap_or(plan.actions.len());
+    let last_run = match first_run_only {
+        true => first_run + 1,
+        false => plan.actions.iter().rposition(|a| matches!(a, Action::Run(_))).map_or(plan.actions.len(), |k| k + 1),
+    };
     let minimize_after_run =
         plan.actions.iter().skip(first_run).position(|a| matches!(a, Action::Minimize(_))).map_or(plan.actions.len(), |k| first_run + k);
     for action in &plan.actions[..last_run.min(minimize_after_run)] {
@@ -677,6 +681,20 @@ fn run_deck_deterministic(
     }
     sim.close_outputs().map_err(|e| e.to_string())?;
     Ok((start, sim.state))
+}
+
+/// How far [`run_deck_deterministic`] takes a deck: `steps` for each of its
+/// `run`s, or for its first `run` only (a plain step count: every run).
+#[derive(Clone, Copy)]
+struct Horizon {
+    steps: u64,
+    first_run_only: bool,
+}
+
+impl From<u64> for Horizon {
+    fn from(steps: u64) -> Self {
+        Horizon { steps, first_run_only: false }
+    }
 }
 
 /// An upper bound on the condition number of the implicit step's matrix
@@ -703,17 +721,17 @@ fn implicit_condition_bound(sim: &Simulation) -> f64 {
 /// solve (src/gpu/implicit.rs), which it refuses with the message of
 /// `Simulation::cpu_only_feature`): at kT = 0, GPU positions stay within
 /// 1e-5 of the distance the particles travelled, after 10⁴ steps per `run`
-/// (10³ for decks of more than 1 000 particles; measured on llvmpipe: ≤ 1.5e-6 of the path, within the spread
-/// between two CPU runs whose starts differ by f32 rounding, ≤ 6.3e-6); over a tenth, a hundredth … of the steps where that
-/// spread itself exceeds the bound (a chaotic deck: cell_contact.in, whose
-/// CPU runs part by 7.9e-2 µm in 10⁴ clamped steps; adhesive_doublet.in, 10
+/// (10³ for decks of more than 300 particles; measured on llvmpipe: ≤ 1.8e-6 of the path, within the spread
+/// between two CPU runs whose starts differ by f32 rounding, ≤ 5.3e-6); over a tenth, a hundredth … of the steps where that
+/// spread itself exceeds the bound (a chaotic deck: adhesive_doublet.in, 10
 /// steps) or the deck's prescribed
 /// motion wrecks it within the horizon (tensegrity_substrate.in). An implicit deck
 /// (buckling_filament.in) is compared over 10² steps, within κ(A)·(the device's
 /// CG tolerance + 8ε_f32) of the distance travelled ([`implicit_condition_bound`]):
 /// its f32 solve is only that exact (measured: 2.5e-6 of the path). For the
 /// quasi-static Newton steps of a `solver cholesky` deck (force_dipole.in,
-/// γ/dt = 1e-6) that bound says nothing (κ(A) ~ 10⁸); their check is that the
+/// hertz_*.in; γ/dt = 1e-6) that bound says nothing (κ(A) ~ 10⁸): such a deck
+/// takes one step of its first stage here, and its check is that the
 /// GPU's end state is the CPU's equilibrium
 /// (tests/gpu_implicit.rs, `newton_steps_of_a_cholesky_deck_reach_the_cpu_equilibrium_on_the_gpu`).
 #[test]
@@ -760,9 +778,10 @@ fn every_input_deck_runs_on_the_gpu_like_on_the_cpu() {
         };
         // Quasi-static Newton steps (the `solver cholesky` decks: force_dipole,
         // hertz_*; κ(A) ~ 10⁸, so the bound above is vacuous and their check is
-        // the equilibrium tests of tests/gpu_implicit.rs) take one step here: the
-        // device runs them (10 steps took 107 s for force_dipole and 176 s for
-        // hertz_ball here, `cargo test --release`, llvmpipe on 2 loaded cores).
+        // the equilibrium tests of tests/gpu_implicit.rs) take one step of their
+        // first stage only here: the device runs them (10 steps a stage took
+        // 107 s for force_dipole and 176 s for hertz_ball, one step in each of
+        // hertz_block's 5 stages 36 s; `cargo test --release`, llvmpipe, 2 cores).
         // Implicit decks of more than 1 000 particles (0.7–2 s a step on
         // llvmpipe) are compared over 10 steps.
         let horizon = match setup.integrator {
@@ -774,8 +793,10 @@ fn every_input_deck_runs_on_the_gpu_like_on_the_cpu() {
         };
         // The shortest horizon on the GPU first (cheap on llvmpipe): it finds
         // the decks refused at a later run before any long run.
+        let first_run_only = bound >= 1.0;
+        let stage = |steps: u64| Horizon { steps, first_run_only };
         let first = horizon.min(100);
-        match run_deck_deterministic(&deck, DevicePreference::Gpu, first, false) {
+        match run_deck_deterministic(&deck, DevicePreference::Gpu, stage(first), false) {
             Ok((_, shortest)) => {
                 // The horizon is chosen from the CPU runs before the GPU runs it,
                 // cut by tenths while
@@ -794,8 +815,8 @@ fn every_input_deck_runs_on_the_gpu_like_on_the_cpu() {
                 let mut wrecked = false;
                 let mut comparable = true;
                 loop {
-                    let runs = run_deck_deterministic(&deck, DevicePreference::Cpu, steps, false).and_then(|(start, cpu)| {
-                        run_deck_deterministic(&deck, DevicePreference::Cpu, steps, true).map(|(_, cpu32)| (start, cpu, cpu32))
+                    let runs = run_deck_deterministic(&deck, DevicePreference::Cpu, stage(steps), false).and_then(|(start, cpu)| {
+                        run_deck_deterministic(&deck, DevicePreference::Cpu, stage(steps), true).map(|(_, cpu32)| (start, cpu, cpu32))
                     });
                     let (start, cpu, cpu32) = match runs {
                         Ok(runs) => runs,
@@ -827,11 +848,13 @@ fn every_input_deck_runs_on_the_gpu_like_on_the_cpu() {
                     let gpu = if steps == first {
                         shortest.clone()
                     } else {
-                        match run_deck_deterministic(&deck, DevicePreference::Gpu, steps, false) {
+                        match run_deck_deterministic(&deck, DevicePreference::Gpu, stage(steps), false) {
                             Ok((_, gpu)) => gpu,
                             // Wrecked on the CPU within 10× the steps (tried now where the
-                            // horizon started below that: a deck of more than 1 000 particles).
-                            Err(e) if wrecked || run_deck_deterministic(&deck, DevicePreference::Cpu, 10 * steps, false).is_err() => {
+                            // horizon started below that: a deck of more than 300 particles).
+                            Err(e)
+                                if wrecked || run_deck_deterministic(&deck, DevicePreference::Cpu, stage(10 * steps), false).is_err() =>
+                            {
                                 println!(
                                     "{:40} fails within {steps} steps on the GPU ({e}), as within {} on the CPU: a tenth of the steps",
                                     deck.display(),
