@@ -21,7 +21,7 @@ use cellmd::deck::validate_file;
 use cellmd::integrate::fire::FireSettings;
 use cellmd::mesh::point_triangle;
 use cellmd::run::{RunOptions, Simulation};
-use common::{merge_topologies, position_bits, two_cells, two_cells_with_edges, Case};
+use common::{merge_topologies, position_bits, squeezed_cells, two_cells, Case};
 use glam::DVec3;
 
 const SHELLS: &str = "body cell turgor k 1000 dp0 100 v0 32.4\nbody cell surface_tension gamma 100\n";
@@ -202,24 +202,11 @@ fn simulation(case: &Case) -> Simulation {
     Simulation::before_first_run(&case.plan(), RunOptions { output_dir: case.output_dir().to_path_buf(), ..Default::default() }).unwrap()
 }
 
-/// Two meshed cells (edge springs) squeezed between plates at x = ±3.6 µm
-/// inside a square tube of half-width 2.3 µm (so they cannot slide past each
-/// other): a bounded energy with a minimum where the barrier is active.
-fn squeezed_case(settings: &str) -> Case {
-    let top = two_cells_with_edges(2, 2.0, 0.1, Some("edge"));
-    let ff = format!("{SHELLS}{BARRIER}bond edge harmonic k 20 r0 0.37\n");
-    let walls = "group both id 1:324\n\
-                 external wy0 both wall ny 1 d -2.3 k 100\nexternal wy1 both wall ny -1 d -2.3 k 100\n\
-                 external wz0 both wall nz 1 d -2.3 k 100\nexternal wz1 both wall nz -1 d -2.3 k 100\n\
-                 external px0 both wall nx 1 d -3.6 k 1000\nexternal px1 both wall nx -1 d -3.6 k 1000\n";
-    case_on(&top, &ff, 0.0, &format!("{walls}{settings}"))
-}
-
 /// Squeezes the cells with `integrator implicit` at time step `dt` for 2.4 s,
 /// checking after every step that they stay apart; returns the smallest
 /// distance, the clamped steps and the final max |F| (pN).
 fn implicit_squeeze(dt: f64) -> (f64, u64, f64) {
-    let mut sim = simulation(&squeezed_case(&format!("integrator implicit\ntemperature 0\ntimestep {dt}\nrun 0\n")));
+    let mut sim = simulation(&squeezed_cells(&format!("integrator implicit\ntemperature 0\ntimestep {dt}\nrun 0\n")));
     let smallest = run_checking_every_step(&mut sim, (2.4 / dt).round() as u64, 0.1);
     assert!(sim.min_contact_distance() < 0.1, "dt = {dt}: the barrier never acted");
     (smallest, sim.contact_clamps, sim.forces.forces.iter().map(|f| f.length()).fold(0.0, f64::max))
@@ -249,7 +236,7 @@ fn implicit_squeeze_time_step_table() {
 
 #[test]
 fn fire_relaxes_squeezed_cells_without_interpenetration() {
-    let mut sim = simulation(&squeezed_case("temperature 0\ntimestep 1e-3\nrun 0\n"));
+    let mut sim = simulation(&squeezed_cells("temperature 0\ntimestep 1e-3\nrun 0\n"));
     sim.minimize(&FireSettings { ftol: 1e-2, max_iterations: 30_000, dmax: 0.05, ..Default::default() }).unwrap();
     let report = sim.last_minimize.clone().unwrap();
     let exact = brute_force_min_distance(&sim);

@@ -143,3 +143,37 @@ fn minimize_runs_on_the_gpu_whatever_the_integrator() {
     assert!(cholesky.last_minimize.as_ref().is_some_and(|r| r.converged));
     assert_eq!(common::position_bits(&plain), common::position_bits(&cholesky));
 }
+
+/// FIRE with contact between bodies on the device: the meshed cells of
+/// [`common::squeezed_cells`] between plates in a tube (the FIRE test of
+/// tests/contact.rs), relaxed to max |F| < 10⁻² pN. Each move is scaled by
+/// the contact step clamp s = min(1, min_i L_i/|Δx_i|) (L_i = 0.4 × the
+/// closest contact distance the contact pass keeps), min-reduced on the
+/// device: both devices converge, both clamp moves, the cells stay apart,
+/// and the device's endpoint has the energy of the CPU's within twice the
+/// first-order bound of the tensegrity test above.
+#[test]
+fn fire_with_contact_relaxes_on_the_gpu_like_on_the_cpu() {
+    let case = common::squeezed_cells("temperature 0\ntimestep 1e-3\nminimize ftol 1e-2 maxiter 30000 dmax 0.05\n");
+    let (cpu, gpu) = (run(&case, DevicePreference::Cpu), run(&case, DevicePreference::Gpu));
+    let (c, g) = (cpu.last_minimize.clone().unwrap(), gpu.last_minimize.clone().unwrap());
+    let images = cpu.sim_box.images();
+    let apart =
+        cpu.state.positions.iter().zip(&gpu.state.positions).map(|(a, b)| images.minimum_image(*a - *b).length()).fold(0.0, f64::max);
+    println!(
+        "CPU {c:?}, mindist {:.4e}\nGPU {g:?}, mindist {:.4e}\nlargest position difference {apart:.3e} µm",
+        cpu.min_contact_distance(),
+        gpu.min_contact_distance()
+    );
+    assert!(c.converged && g.converged);
+    assert!(c.clamped > 0 && g.clamped > 0, "the clamp never acted: CPU {}, GPU {}", c.clamped, g.clamped);
+    assert!(gpu.min_contact_distance() > 0.0 && gpu.min_contact_distance() < 0.1);
+    let first_order: f64 = (0..cpu.state.len())
+        .map(|i| {
+            let dx = images.minimum_image(gpu.state.positions[i] - cpu.state.positions[i]);
+            (0.5 * (cpu.forces.forces[i] + gpu.forces.forces[i]).dot(dx)).abs()
+        })
+        .sum();
+    println!("|ΔE| {:.3e} pN·µm, bound {:.3e}", (g.energy - c.energy).abs(), 2.0 * first_order);
+    assert!((g.energy - c.energy).abs() < 2.0 * first_order, "energies part by {:e}", g.energy - c.energy);
+}

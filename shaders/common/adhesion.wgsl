@@ -4,14 +4,9 @@
 // index of the rule's interaction type to `NAME_switch` and `NAME_density`
 // (shaders/interactions/NAME.wgsl).
 
-// Where each value lives in `surf`: particle i's closest contact distance
-// (x), and per rule slot j its (s or, during the node pass, the nearest
+// Where each value lives in `surf`: per rule slot j particle i's (s or, during the node pass, the nearest
 // distance; s′; nearest face as an exact f32, −1 for none; s″) and its
 // (pull b′ = ε·s′·B; the implicit step's Gauss–Newton weight ε·s″·B).
-fn adhesion_closest(i: u32) -> u32 {
-    return P.off_aclosest + i;
-}
-
 fn adhesion_switch(i: u32, j: u32) -> u32 {
     return P.off_aswitch + i * P.n_arules + j;
 }
@@ -60,7 +55,7 @@ fn adhesion_nodes(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocatio
     }
     let part = contact_node_part(i, body, true);
     force[i] += vec4<f32>(part.f, part.e);
-    surf[adhesion_closest(i)] = vec4<f32>(part.closest, 0.0, 0.0, 0.0);
+    surf[contact_closest(i)] = vec4<f32>(part.closest, 0.0, 0.0, 0.0);
     for (var j = 0u; j < P.n_arules; j++) {
         let best = surf[adhesion_switch(i, j)];
         if best.z >= 0.0 {

@@ -11,6 +11,13 @@ const STEP_FRACTION: f32 = 0.4;
 // Entries of the ring of step fractions in `surf` (FRACTION_SLOTS in src/gpu/contact.rs).
 const FRACTION_SLOTS: u32 = 1024u;
 
+// Where particle i's closest contact distance lives in `surf` (x): written by
+// the contact pass (its node part first, with area-weighted rules), read by
+// FIRE's step clamp.
+fn contact_closest(i: u32) -> u32 {
+    return P.off_closest + i;
+}
+
 fn contact_body(i: u32) -> u32 {
     return topo[P.off_cbody + i];
 }
@@ -340,7 +347,7 @@ fn contact_forces(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocatio
         part = contact_node_part(i, body, false);
     } else {
         let own = adhesion_own(i);
-        part = ContactNode(own.xyz, own.w, surf[adhesion_closest(i)].x);
+        part = ContactNode(own.xyz, own.w, surf[contact_closest(i)].x);
     }
     var f = part.f;
     var e = part.e;
@@ -368,6 +375,7 @@ fn contact_forces(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocatio
     }
     let total = force[i] + vec4<f32>(f, e);
     force[i] = total;
+    surf[contact_closest(i)] = vec4<f32>(closest, 0.0, 0.0, 0.0);
     // The step clamp: this particle's largest s, min-reduced through the bits.
     let s = contact_step_fraction(length(drift(i)), length(noise(i)), STEP_FRACTION * closest);
     atomicMin(&status[ST_FRACTION], bitcast<u32>(s));

@@ -11,6 +11,13 @@
 //      the count of positive steps updated as on the CPU.
 //   3. `fire_move` (one per particle): the mixing, v ← v + Δt·F/m with
 //      m = γ·Δt₀, x ← x + Δt·v with the move capped at dmax, in fixed point.
+//      With contact between bodies it only takes the step clamp: each contact
+//      particle's s_i = L_i/|Δx_i| where it would move farther than
+//      L_i = 0.4 × its closest contact distance (the contact pass's), the
+//      minimum over particles by an integer atomicMin on the bits (order-free),
+//      and then
+//   4. `fire_clamped_move` (one per particle): x ← x + s·Δx, the CPU's line
+//      search along the move (src/integrate/fire.rs); the velocities are kept.
 // A `fixed` particle (mobility 0) and the held axes of a protocol's
 // particles have no force here, as the CPU masks them. No float atomics:
 // the same minimisation gives the same bits.
@@ -22,7 +29,8 @@
 const FIRE_STATE: u32 = 0u;    // (Δt, α, positive steps (bits), iterations (bits))
 const FIRE_MIXING: u32 = 1u;   // (1 − α or 0, α|v|/|F| or 0, Δt₀, Δt_max)
 const FIRE_LIMITS: u32 = 2u;   // (ftol, dmax, max |F| of the last evaluation, blocks (bits))
-const FIRE_PARTIALS: u32 = 3u; // one per workgroup of `fire_partials`: (P, Σ|v|², Σ|F|², max |F|)
+const FIRE_CLAMPED: u32 = 3u;  // (moves the contact step clamp shortened (bits), 0, 0, 0)
+const FIRE_PARTIALS: u32 = 4u; // one per workgroup of `fire_partials`: (P, Σ|v|², Σ|F|², max |F|)
 
 // Converged (status word ST_HALTED): max |F| < ftol.
 const HALT_CONVERGED: u32 = 256u;
@@ -102,6 +110,10 @@ fn fire_control(@builtin(local_invocation_index) local: u32) {
         atomicOr(&status[ST_HALTED], HALT_CONVERGED);
         return;
     }
+    if CONTACT_TERMS {
+        // The move's clamp starts at 1 (the force pass left the overdamped step's there).
+        atomicStore(&status[ST_FRACTION], 0x3f800000u);
+    }
     var state = fire[FIRE_STATE];
     var mixing = fire[FIRE_MIXING];
     var dt = state.x;
@@ -126,6 +138,25 @@ fn fire_control(@builtin(local_invocation_index) local: u32) {
     fire[FIRE_MIXING] = mixing;
 }
 
+// The move Δt·v, capped at dmax.
+fn fire_displacement(v: vec3<f32>) -> vec3<f32> {
+    var dx = fire[FIRE_STATE].x * v;
+    let moved = length(dx);
+    let dmax = fire[FIRE_LIMITS].y;
+    if moved > dmax {
+        dx *= dmax / moved;
+    }
+    return dx;
+}
+
+// Moves particle i by dx, in fixed point.
+fn fire_place(i: u32, dx: vec3<f32>) {
+    let placed = wrap_into_box(fixed_add(fixed_of(i), fixed_of_length(dx)), image_of(i));
+    state[i] = vec4<u32>(bitcast<vec3<u32>>(placed.x.h), 0u);
+    state[P.n + i] = vec4<u32>(placed.x.f, 0u);
+    state[2u * P.n + i] = vec4<u32>(bitcast<vec3<u32>>(placed.img), 0u);
+}
+
 @compute @workgroup_size(256)
 fn fire_move(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) local: u32) {
     let i = linear_index(wg, local);
@@ -138,20 +169,35 @@ fn fire_move(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_ind
     let dt0 = mixing.z;
     // F/m = F·(Δt₀/γ)/Δt₀², the mobility Δt₀/γ per type.
     let v = mixing.x * fire_v[i].xyz + mixing.y * f + dt * f * (fparams[P.off_mobility + topo[i]] / dt0) / dt0;
-    var dx = dt * v;
-    let moved = length(dx);
-    let dmax = fire[FIRE_LIMITS].y;
-    if moved > dmax {
-        dx *= dmax / moved;
-    }
+    let dx = fire_displacement(v);
     if !(dot(dx, dx) < 1e36) || !(dot(v, v) < 1e36) {
         atomicMin(&status[ST_BLOWUP_PARTICLE], i);
         atomicOr(&status[ST_HALTED], HALT_BLOWUP);
         return;
     }
     fire_v[i] = vec4<f32>(v, 0.0);
-    let placed = wrap_into_box(fixed_add(fixed_of(i), fixed_of_length(dx)), image_of(i));
-    state[i] = vec4<u32>(bitcast<vec3<u32>>(placed.x.h), 0u);
-    state[P.n + i] = vec4<u32>(placed.x.f, 0u);
-    state[2u * P.n + i] = vec4<u32>(bitcast<vec3<u32>>(placed.img), 0u);
+    if !CONTACT_TERMS {
+        fire_place(i, dx);
+        return;
+    }
+    if contact_body(i) != NO_BODY {
+        let limit = STEP_FRACTION * surf[contact_closest(i)].x;
+        let moved = length(dx);
+        if moved > limit {
+            atomicMin(&status[ST_FRACTION], bitcast<u32>(limit / moved));
+        }
+    }
+}
+
+@compute @workgroup_size(256)
+fn fire_clamped_move(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    let i = linear_index(wg, local);
+    if i >= P.n || halted() {
+        return;
+    }
+    let s = bitcast<f32>(atomicLoad(&status[ST_FRACTION]));
+    fire_place(i, s * fire_displacement(fire_v[i].xyz));
+    if i == 0u && s < 1.0 {
+        fire[FIRE_CLAMPED].x = bitcast<f32>(bitcast<u32>(fire[FIRE_CLAMPED].x) + 1u);
+    }
 }

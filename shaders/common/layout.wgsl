@@ -54,8 +54,9 @@ struct Params {
     // fractional `special_bonds` partners (src/gpu/special.rs): `topo` offsets (CSR by particle), entries
     off_special_offsets: u32, off_special: u32, special_pad0: u32, special_pad1: u32,
     // area-weighted contact (src/gpu/adhesion.rs): `topo` sections (rule slots per type pair: CSR; each slot's rule), slots, then `surf` regions
+    // (the contact pass's closest distances, src/gpu/contact.rs; the rules' switch values and pulls)
     off_arule_start: u32, off_arule_list: u32, off_arules: u32, n_arules: u32,
-    off_aclosest: u32, off_aswitch: u32, off_apull: u32, adhesion_pad: u32,
+    off_closest: u32, off_aswitch: u32, off_apull: u32, adhesion_pad: u32,
     // protocols (shaders/common/protocol.wgsl): held-coordinate words present, ramped slots, the ramp table's first step, `protocol` offsets, driven indenters
     protocol_held: u32, n_ramp_slots: u32, ramp_first_lo: u32, off_movers: u32, off_ramp_slots: u32, off_ramp_table: u32, n_drives: u32, off_drives: u32,
 }

@@ -96,27 +96,24 @@ impl AdhesionPack {
         self.sections[2].len() as u32
     }
 
-    /// Entries of `surf` the adhesion passes use for `n` particles: each
-    /// particle's closest contact distance, then per particle and rule its
-    /// (s, s′, nearest face) and its pull.
+    /// Entries of `surf` the adhesion passes use for `n` particles: per
+    /// particle and rule its (s, s′, nearest face, s″) and its (pull,
+    /// Gauss–Newton weight).
     pub fn surf_entries(&self, n: u32) -> u64 {
-        if self.rules() == 0 {
-            0
-        } else {
-            n as u64 * (1 + 2 * self.rules() as u64)
-        }
+        n as u64 * 2 * self.rules() as u64
     }
 
     /// Appends the sections to `topo` and returns layout.wgsl's adhesion
-    /// fields, with the `surf` regions from entry `surf_base` on.
-    pub fn append(&self, topo: &mut Vec<u32>, surf_base: u64, n: u32) -> [u32; 8] {
+    /// fields, with the `surf` regions from entry `surf_base` on and the
+    /// contact pass's closest distances at `closest` ([`super::contact::ContactPack::closest_entry`]).
+    pub fn append(&self, topo: &mut Vec<u32>, surf_base: u64, n: u32, closest: u32) -> [u32; 8] {
         let mut fields = [0u32; 8];
         for (k, section) in self.sections.iter().enumerate() {
             fields[k] = topo.len() as u32;
             topo.extend(section);
         }
         let (base, rules) = (surf_base as u32, self.rules());
-        fields[3..7].copy_from_slice(&[rules, base, base + n, base + n + n * rules]);
+        fields[3..7].copy_from_slice(&[rules, closest, base, base + n * rules]);
         fields
     }
 }

@@ -324,7 +324,7 @@ impl GpuBackend {
     }
 
     /// Takes FIRE iterations in place of steps from now on (`minimize`,
-    /// src/gpu/fire.rs; the model must pass its `refusal`): each
+    /// src/gpu/fire.rs): each
     /// [`Self::run`] step is one iteration, and a run ends early when max |F|
     /// falls below `settings.ftol`. `dt`: the deck's timestep (Δt₀, masses γ·Δt₀).
     pub fn minimize_with_fire(&mut self, ctx: &GpuContext, model: &Model, settings: &FireSettings, dt: f64) -> Result<(), String> {
@@ -332,10 +332,11 @@ impl GpuBackend {
         Ok(())
     }
 
-    /// FIRE iterations taken so far (one small read-back; None without FIRE).
-    pub fn fire_iterations(&self) -> Option<u64> {
+    /// FIRE iterations taken so far and the moves the contact step clamp
+    /// shortened (one small read-back; None without FIRE).
+    pub fn fire_counts(&self) -> Option<(u64, u64)> {
         let fire = self.fire.as_ref()?;
-        Some(DeviceFire::iterations(&self.read(&fire.buffer, 16)))
+        Some(DeviceFire::counts(&self.read(&fire.buffer, DeviceFire::COUNT_BYTES)))
     }
 
     /// The last implicit step's iterations and relative residual (one small
@@ -454,7 +455,7 @@ impl GpuBackend {
         let nlist = NeighbourStorage::new(ctx, n as u32, params.nlist_cap, nlist_binding_limit)?;
         let force = zeros("force", 16 * n as u64, rw);
         let status = zeros("status", 4 * STATUS_WORDS as u64, rw);
-        let surf_bytes = 16 * (packed.surf_entries + contact.surf_entries() + adhesion.surf_entries(n as u32));
+        let surf_bytes = 16 * (packed.surf_entries + contact.surf_entries(n as u32) + adhesion.surf_entries(n as u32));
         check_binding(ctx, "the surface terms' face and body values", surf_bytes)?;
         let surf = zeros("surf", surf_bytes, rw);
         let args = zeros("dispatch_args", 4 * 12, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT);
@@ -1058,6 +1059,9 @@ impl GpuBackend {
                 self.dispatch(pass, &fire.partials, Over::Particles);
                 self.dispatch(pass, &fire.control, Over::Groups(1));
                 self.dispatch(pass, &fire.moves, Over::Particles);
+                if let Some(clamped) = &fire.clamped_moves {
+                    self.dispatch(pass, clamped, Over::Particles);
+                }
             } else if let Some(solver) = &self.implicit {
                 // The implicit step (src/gpu/implicit.rs) in place of `integrate`.
                 pass.set_bind_group(1, &solver.group, &[]);
@@ -1431,8 +1435,9 @@ fn pack_state(
     let bound = bonds.map(|b| b.bound.as_slice());
     let exclusions = Exclusions::from_pairs(model.len(), &model.excluded_pairs(bound));
     let mut packed = pack(model, &exclusions, settings.context.dt, settings.context.kt, bonds)?;
-    let fields = contact.append(&mut packed.topo, packed.surf_entries);
-    let adhesion_fields = adhesion.append(&mut packed.topo, packed.surf_entries + contact.surf_entries(), model.len() as u32);
+    let (fields, n) = (contact.append(&mut packed.topo, packed.surf_entries), model.len() as u32);
+    let adhesion_base = packed.surf_entries + contact.surf_entries(n);
+    let adhesion_fields = adhesion.append(&mut packed.topo, adhesion_base, n, contact.closest_entry(packed.surf_entries));
     Ok((packed, exclusions, fields, adhesion_fields))
 }
 

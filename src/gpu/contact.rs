@@ -189,13 +189,23 @@ impl ContactPack {
         EDGE_ALLOWANCE * self.longest_edge
     }
 
-    /// Entries of `surf` the contact kernels use (after the surface terms').
-    pub fn surf_entries(&self) -> u64 {
+    /// Entries of `surf` the contact kernels use for `n` particles (after
+    /// the surface terms'): the ring of step fractions, then each particle's
+    /// closest contact distance (at [`Self::closest_entry`]).
+    pub fn surf_entries(&self, n: u32) -> u64 {
         if self.faces() == 0 {
             0
         } else {
-            FRACTION_SLOTS as u64
+            FRACTION_SLOTS as u64 + n as u64
         }
+    }
+
+    /// The first `surf` entry of the particles' closest contact distances,
+    /// for the contact entries from `surf_base` on: written by the contact
+    /// pass, read by FIRE's step clamp (src/gpu/fire.rs) and, for its node
+    /// part, by the area-weighted terms' passes.
+    pub fn closest_entry(&self, surf_base: u64) -> u32 {
+        (surf_base + FRACTION_SLOTS as u64) as u32
     }
 
     /// Appends the sections to `topo` and returns layout.wgsl's contact

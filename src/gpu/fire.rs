@@ -9,7 +9,7 @@
 //! iterations) and zeroed when it turns negative (Δt halves, α back to 0.1),
 //! each move capped at dmax, until max |F| < ftol. `fixed` particles and
 //! held axes carry no force, as the CPU masks them. Each iteration is the
-//! neighbour check and force pass of a step followed by three kernels; the
+//! neighbour check and force pass of a step followed by three kernels (four with contact); the
 //! host runs the iterations as the steps of the backend's `run`
 //! (src/gpu/backend.rs), which stops at convergence (a halt bit the control
 //! kernel sets) and reads nothing back in between.
@@ -25,12 +25,17 @@
 //! tests/gpu_minimize.rs). The verdict and the reported max |F| and energy
 //! are the CPU's f64 evaluation at the positions the device reached.
 //!
-//! # Which models ([`refusal`])
+//! # Contact between bodies
 //!
-//! Not with node–face contact between bodies: the CPU scales every move by
-//! the contact step clamp, computed on the device for the overdamped step
-//! only. Protocols enter as their held axes alone (a minimisation takes no
-//! step, so nothing moves or ramps), as the CPU masks those forces.
+//! As on the CPU, every move is scaled by s = min(1, minᵢ Lᵢ/|Δxᵢ|), Lᵢ =
+//! 0.4 × particle i's closest contact distance at the evaluated positions
+//! (which the contact pass keeps, src/gpu/contact.rs), a line search that
+//! keeps every body outside every other; the velocities are kept. `fire_move`
+//! min-reduces s on the bits of the positive f32s (the order does not
+//! matter) and `fire_clamped_move` moves by s·Δx, counting the shortened
+//! moves for the report. Protocols enter as their held axes alone (a
+//! minimisation takes no step, so nothing moves or ramps), as the CPU masks
+//! those forces.
 
 use wgpu::util::DeviceExt;
 
@@ -40,14 +45,7 @@ use crate::integrate::fire::{FireSettings, ALPHA0, DT_MAX_FACTOR};
 use crate::system::Model;
 
 /// `fire` entries before the per-workgroup partial sums.
-const CONTROL_ENTRIES: usize = 3;
-
-/// Why FIRE cannot run on the device for this model (None: it can).
-pub fn refusal(model: &Model) -> Option<&'static str> {
-    model.has_contact_terms().then_some(
-        "contact between bodies scales FIRE's moves by the contact step clamp, which the device computes for the overdamped step only",
-    )
-}
+const CONTROL_ENTRIES: usize = 4;
 
 /// The device's FIRE: velocities, control words and partial sums, and the kernels.
 pub(super) struct DeviceFire {
@@ -55,6 +53,8 @@ pub(super) struct DeviceFire {
     pub(super) partials: wgpu::ComputePipeline,
     pub(super) control: wgpu::ComputePipeline,
     pub(super) moves: wgpu::ComputePipeline,
+    /// The clamped move after `moves`, with contact between bodies.
+    pub(super) clamped_moves: Option<wgpu::ComputePipeline>,
     /// `fire`: the control words, then the partials.
     pub(super) buffer: wgpu::Buffer,
 }
@@ -94,15 +94,20 @@ impl DeviceFire {
             partials: side.pipeline(ctx, "fire_partials"),
             control: side.pipeline(ctx, "fire_control"),
             moves: side.pipeline(ctx, "fire_move"),
+            clamped_moves: model.has_contact_terms().then(|| side.pipeline(ctx, "fire_clamped_move")),
             group: side.group,
             buffer,
         })
     }
 
-    /// The iterations taken, from the first control entry's bytes.
-    pub(super) fn iterations(bytes: &[u8]) -> u64 {
-        let entry: [f32; 4] = bytemuck::pod_read_unaligned(&bytes[..16]);
-        u64::from(entry[3].to_bits())
+    /// The bytes of the control entries that [`Self::counts`] reads.
+    pub(super) const COUNT_BYTES: u64 = 16 * CONTROL_ENTRIES as u64;
+
+    /// The iterations taken and the moves the contact step clamp shortened,
+    /// from the control entries' bytes.
+    pub(super) fn counts(bytes: &[u8]) -> (u64, u64) {
+        let entries: [[f32; 4]; CONTROL_ENTRIES] = bytemuck::pod_read_unaligned(&bytes[..Self::COUNT_BYTES as usize]);
+        (u64::from(entries[0][3].to_bits()), u64::from(entries[3][0].to_bits()))
     }
 }
 

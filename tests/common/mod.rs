@@ -328,3 +328,19 @@ pub fn assert_clamped_runs_agree(start: &cellmd::system::State, cpu: &Simulation
     assert!(gpu.min_contact_distance() > 0.0 && gpu.min_contact_distance() < 0.1);
     travelled
 }
+
+/// Two meshed cells (edge springs, k = 20 pN/µm) under [`CONTACT_SHELLS`] and
+/// [`CONTACT_BARRIER`], 0.1 µm apart, squeezed between plates at x = ±3.6 µm
+/// inside a square tube of half-width 2.3 µm (so they cannot slide past each
+/// other): a bounded energy with a minimum where the barrier is active.
+pub fn squeezed_cells(settings: &str) -> Case {
+    let top = two_cells_with_edges(2, 2.0, 0.1, Some("edge"));
+    let ff = format!("particle node drag 1\n{CONTACT_SHELLS}{CONTACT_BARRIER}bond edge harmonic k 20 r0 0.37\n");
+    let deck = format!(
+        "units cell\ntopology cells.top\nforcefield cells.ff\nbox x -10 10 f y -10 10 f z -10 10 f\ngroup both id 1:324\n\
+         external wy0 both wall ny 1 d -2.3 k 100\nexternal wy1 both wall ny -1 d -2.3 k 100\n\
+         external wz0 both wall nz 1 d -2.3 k 100\nexternal wz1 both wall nz -1 d -2.3 k 100\n\
+         external px0 both wall nx 1 d -3.6 k 1000\nexternal px1 both wall nx -1 d -3.6 k 1000\n{settings}"
+    );
+    Case::new(&[("cells.top", &top), ("cells.ff", &ff), ("deck.in", &deck)])
+}

@@ -304,37 +304,38 @@ impl Simulation {
         if device == DevicePreference::Cpu {
             return Ok(None);
         }
-        // Only what the forces or FIRE's moves need decides (not the integrator's or the constraints' refusals).
-        let custom = self.model.has_cpu_only_surface_terms().then_some(CUSTOM_SURFACE_TERMS);
-        if let Some(why) = crate::gpu::fire::refusal(&self.model).or(custom) {
-            self.say(&format!("minimize on the CPU: {why}"));
+        // Only what the forces need decides (not the integrator's or the constraints' refusals).
+        if self.model.has_cpu_only_surface_terms() {
+            self.say(&format!("minimize on the CPU: {CUSTOM_SURFACE_TERMS}"));
             return Ok(None);
         }
         let Some(context) = self.open_gpu(device)? else { return Ok(None) };
-        let settings_for_steps = self.step_settings();
-        // Held axes only: a minimisation takes no step, so nothing moves or ramps.
-        let full = self.protocols.for_device(&self.model);
-        let held = full.held.into_iter().map(|h| HeldCoordinates { mover: None, ..h }).collect();
-        let protocol = DeviceProtocol { held, ..Default::default() };
-        let (model, state, sim_box) = (&self.model, &self.state, &self.sim_box);
-        let mut gpu =
-            GpuBackend::with_protocol(&context, model, state, sim_box, &settings_for_steps, None, &protocol).map_err(RunError::Setup)?;
-        gpu.minimize_with_fire(&context, model, settings, self.dt).map_err(RunError::Setup)?;
-        let mut iterations = 0;
+        let mut gpu = self.fire_backend(&context, settings)?;
+        // The counts of the backends before this one (see `Reach` below).
+        let (mut iterations, mut clamped, mut before) = (0, 0, (0, 0));
         while iterations < settings.max_iterations {
             let segment = (settings.max_iterations - iterations).min(GPU_SYNC_STEPS);
             let outcome = gpu.run(self.state.step, segment);
-            iterations = gpu.fire_iterations().unwrap_or_default();
+            let (now, shortened) = gpu.fire_counts().unwrap_or_default();
+            (iterations, clamped) = (before.0 + now, before.1 + shortened);
             match outcome {
                 Ok(done) if done == segment => {}
                 Ok(_) => break,
+                Err(GpuHalt::Reach { .. }) => {
+                    // A face outgrew the contact search (src/gpu/contact.rs): FIRE
+                    // goes on from this state on a backend built with the faces'
+                    // reach now, from rest (v = 0, Δt₀, α₀), as a new `minimize` would.
+                    gpu.download(&mut self.state);
+                    before = (iterations, clamped);
+                    gpu = self.fire_backend(&context, settings)?;
+                }
                 Err(GpuHalt::Blowup { particle, .. }) => {
                     gpu.download(&mut self.state);
                     self.forces_current = false;
                     return Err(self.blowup(particle, "non-finite FIRE move on the GPU during minimisation".into()));
                 }
                 Err(GpuHalt::Capacity { message, .. }) => return Err(RunError::Setup(format!("device gpu: minimize: {message}"))),
-                // No contact search or `bind` runs in a device minimisation; should one halt it, say so rather than panic.
+                // No `bind` runs in a device minimisation; should one halt it, say so rather than panic.
                 Err(halt) => return Err(RunError::Setup(format!("device gpu: minimize stopped: {halt:?}"))),
             }
         }
@@ -345,7 +346,21 @@ impl Simulation {
         self.protocols.mask(&mut forces);
         let max_force = max_residual_force(&forces, &self.fire_masses());
         let energy = self.forces.total_energy();
-        Ok(Some(FireReport { converged: max_force < settings.ftol, iterations, energy, max_force, clamped: 0 }))
+        Ok(Some(FireReport { converged: max_force < settings.ftol, iterations, energy, max_force, clamped }))
+    }
+
+    /// A GPU backend at the current state that takes FIRE iterations, with
+    /// the protocols' held axes only (a minimisation takes no step, so
+    /// nothing moves or ramps).
+    fn fire_backend(&self, context: &GpuContext, settings: &FireSettings) -> Result<GpuBackend, RunError> {
+        let full = self.protocols.for_device(&self.model);
+        let held = full.held.into_iter().map(|h| HeldCoordinates { mover: None, ..h }).collect();
+        let protocol = DeviceProtocol { held, ..Default::default() };
+        let (model, state, sim_box) = (&self.model, &self.state, &self.sim_box);
+        let mut gpu =
+            GpuBackend::with_protocol(context, model, state, sim_box, &self.step_settings(), None, &protocol).map_err(RunError::Setup)?;
+        gpu.minimize_with_fire(context, model, settings, self.dt).map_err(RunError::Setup)?;
+        Ok(gpu)
     }
 
     /// Why the constraints cannot be projected on the device (src/gpu/shake.rs).
