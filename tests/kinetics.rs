@@ -109,12 +109,14 @@ fn lifetime_sweep(rule: &str, kt: f64, forces: &[f64], rate: impl Fn(f64) -> f64
     measured
 }
 
-/// Bell slip bonds: τ(F) = 1/(k0·exp(F·xβ/kT)) from 0 to 2 Fβ.
+/// Bell slip bonds: τ(F) = 1/(k0·exp(F·xβ/kT)) from 0 to 1.5 Fβ (a rate
+/// ratio of e³; to 2 Fβ, e⁴, the run to 20 lifetimes of the slowest force
+/// took 2.7 times as long: 38 s in release, for CI time).
 #[test]
 fn slip_lifetimes_follow_the_bell_law() {
     let (k0, x_beta, kt): (f64, f64, f64) = (1.0, 0.5, 1.0);
     let f_beta = kt / x_beta;
-    let forces: Vec<f64> = [0.0, 0.5, 1.0, 1.5, 2.0].iter().map(|a| a * f_beta).collect();
+    let forces: Vec<f64> = [0.0, 0.5, 1.0, 1.5].iter().map(|a| a * f_beta).collect();
     lifetime_sweep(&format!("slip k0 {k0} x_beta {x_beta}"), kt, &forces, |f| k0 * (f * x_beta / kt).exp(), 0.05, 19);
 }
 
@@ -250,7 +252,7 @@ fn binding_and_unbinding_reach_the_steady_state_fraction() {
 fn fibre_bundle_with_uniform_thresholds_peaks_at_a_quarter() {
     let n = 20_000;
     // Strain grows as the rest length shrinks at v0 between fixed ends 1 apart.
-    let (v0, dt) = (0.5, 1e-4);
+    let (v0, dt) = (0.5, 2e-4);
     let bond = format!("bond b spring k 1 r0 1 kinetics threshold strain 0.5 spread 2 kinetics motor v0 {v0} fs 1e12");
     let steps = (0.45 / (v0 * dt)) as u64; // r0 from 1 to 0.55: strain up to 0.82
     let c = case(
