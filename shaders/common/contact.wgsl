@@ -18,6 +18,20 @@ fn contact_closest(i: u32) -> u32 {
     return P.off_closest + i;
 }
 
+// The largest fraction s ≤ 1 of a move dx that particle i may take under the
+// contact step clamp of a move with no noise part (FIRE, the implicit step;
+// src/integrate/overdamped.rs, `clamp_fraction`): L_i/|dx| where |dx| exceeds
+// L_i = 0.4 × its closest contact distance, else 1 (also for particles of no
+// contact body).
+fn contact_move_fraction(i: u32, dx: vec3<f32>) -> f32 {
+    if contact_body(i) == NO_BODY {
+        return 1.0;
+    }
+    let limit = STEP_FRACTION * surf[contact_closest(i)].x;
+    let moved = length(dx);
+    return select(1.0, limit / moved, moved > limit);
+}
+
 fn contact_body(i: u32) -> u32 {
     return topo[P.off_cbody + i];
 }

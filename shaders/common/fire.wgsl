@@ -180,12 +180,9 @@ fn fire_move(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_ind
         fire_place(i, dx);
         return;
     }
-    if contact_body(i) != NO_BODY {
-        let limit = STEP_FRACTION * surf[contact_closest(i)].x;
-        let moved = length(dx);
-        if moved > limit {
-            atomicMin(&status[ST_FRACTION], bitcast<u32>(limit / moved));
-        }
+    let s = contact_move_fraction(i, dx);
+    if s < 1.0 {
+        atomicMin(&status[ST_FRACTION], bitcast<u32>(s));
     }
 }
 

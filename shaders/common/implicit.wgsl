@@ -649,16 +649,11 @@ fn implicit_blocks(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocati
     }
     diagonal += surface_diagonal(i);
     diagonal += pair_rows(i, VEC_X, vec3<f32>(0.0), true);
-    // The contact step clamp's limit L_i = 0.4·min(d̂, closest distance) in w
-    // (shaders/common/implicit_contact.wgsl; −1: not a contact body's node).
-    var limit = -1.0;
-    if CONTACT_TERMS && contact_body(i) != NO_BODY {
-        let contact = contact_rows(i, VEC_X, true);
-        diagonal += contact.v;
-        limit = STEP_FRACTION * contact.closest;
+    if CONTACT_TERMS {
+        diagonal += contact_rows(i, VEC_X, true);
     }
     // A held coordinate (`freeze`, `move`): the identity row.
-    imp[dinv] = vec4<f32>(select(vec3<f32>(1.0), 1.0 / diagonal, free_axes(i) != vec3<f32>(0.0)), limit);
+    imp[dinv] = vec4<f32>(select(vec3<f32>(1.0), 1.0 / diagonal, free_axes(i) != vec3<f32>(0.0)), 0.0);
 }
 
 fn imp_vec(section: u32, i: u32) -> vec3<f32> {
@@ -716,7 +711,7 @@ fn apply_row(i: u32, section: u32) -> vec3<f32> {
     }
     out += pair_rows(i, section, vi, false);
     if CONTACT_TERMS {
-        out += contact_rows(i, section, false).v;
+        out += contact_rows(i, section, false);
     }
     return select(vi, out, free_axes(i) != vec3<f32>(0.0));
 }

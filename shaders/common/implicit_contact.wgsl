@@ -10,13 +10,6 @@
 // d, w and n̂ again relative to the face's first corner, so the four
 // participants of a pair see the same bits and K̃ stays symmetric.
 
-// Particle i's contact rows applied to a vector (or their diagonal) and its
-// closest contact distance (at most d̂).
-struct ContactRows {
-    v: vec3<f32>,
-    closest: f32,
-}
-
 // max(Σ b″(d), 0) over the node–face rules of type pair `types`, in rule order.
 fn contact_stiffness(types: u32, d: f32) -> f32 {
     var c = 0.0;
@@ -57,11 +50,12 @@ fn contact_term(c: f32, g: f32, node: u32, face: u32, pair: ContactPair, section
     return c * g * dot(pair.n, imp_vec(section, node) - corners) * pair.n;
 }
 
-// Particle i's contact rows: as a node, over its pairs (`next_node_pair`)
+// Particle i's contact rows applied to the vector in `section` (or their
+// diagonal): as a node, over its pairs (`next_node_pair`)
 // and its area-weighted rules' nearest faces; as a corner, over its pairs
 // (`next_corner_pair`) — the force pass's walks, in its order.
-fn contact_rows(i: u32, section: u32, diagonal_only: bool) -> ContactRows {
-    var out = ContactRows(vec3<f32>(0.0), P.contact_dhat);
+fn contact_rows(i: u32, section: u32, diagonal_only: bool) -> vec3<f32> {
+    var out = vec3<f32>(0.0);
     let body = contact_body(i);
     if body == NO_BODY {
         return out;
@@ -69,25 +63,23 @@ fn contact_rows(i: u32, section: u32, diagonal_only: bool) -> ContactRows {
     var nodes = node_walk(i, body);
     while next_node_pair(&nodes) {
         let pair = contact_pair(i, nodes.face);
-        out.closest = min(out.closest, pair.d);
-        out.v += contact_term(contact_stiffness(nodes.types, pair.d), 1.0, i, nodes.face, pair, section, diagonal_only);
+        out += contact_term(contact_stiffness(nodes.types, pair.d), 1.0, i, nodes.face, pair, section, diagonal_only);
     }
     for (var j = 0u; j < P.n_arules; j++) {
         let c = max(surf[adhesion_pull(i, j)].y, 0.0);
         if c > 0.0 {
             let face = u32(surf[adhesion_switch(i, j)].z);
-            out.v += contact_term(c, 1.0, i, face, contact_pair(i, face), section, diagonal_only);
+            out += contact_term(c, 1.0, i, face, contact_pair(i, face), section, diagonal_only);
         }
     }
     var corners = corner_walk(i, body);
     while next_corner_pair(&corners) {
         let pair = contact_pair(corners.node, corners.face);
-        out.closest = min(out.closest, pair.d);
         var c = contact_stiffness(corners.types, pair.d);
         if P.n_arules > 0u {
             c += adhesion_stiffness(corners.node, corners.face, corners.types);
         }
-        out.v += contact_term(c, -pair.w[corners.role], corners.node, corners.face, pair, section, diagonal_only);
+        out += contact_term(c, -pair.w[corners.role], corners.node, corners.face, pair, section, diagonal_only);
     }
     return out;
 }
@@ -95,11 +87,11 @@ fn contact_rows(i: u32, section: u32, diagonal_only: bool) -> ContactRows {
 var<workgroup> workgroup_fraction: atomic<u32>;
 
 // The contact step clamp of the solved step (in the solve's one workgroup):
-// s = min(1, min_i L_i/|Δx_i|) over the limits L_i that `implicit_blocks`
-// left in the Jacobi entries' w (−1: no contact body), min-reduced through
-// the bits of positive f32s (the order does not matter), into ST_FRACTION —
-// replacing the explicit step's fraction the force pass left there.
-// `implicit_move` moves by s·Δx, and `advance` records s for the clock.
+// s = min(1, min_i L_i/|Δx_i|) (`contact_move_fraction`, from the closest
+// distances the contact pass kept), min-reduced through the bits of positive
+// f32s (the order does not matter), into ST_FRACTION — replacing the explicit
+// step's fraction the force pass left there. `implicit_move` moves by s·Δx,
+// and `advance` records s for the clock.
 fn clamp_step(local: u32) {
     if !CONTACT_TERMS {
         return;
@@ -109,11 +101,9 @@ fn clamp_step(local: u32) {
     }
     workgroupBarrier();
     for (var i = local; i < P.n; i += WORKGROUP) {
-        let limit = imp[P.n * VEC_DINV + i].w;
-        let dx = imp_vec(VEC_X, i);
-        let length2 = dot(dx, dx);
-        if limit >= 0.0 && length2 > limit * limit {
-            atomicMin(&workgroup_fraction, bitcast<u32>(limit / sqrt(length2)));
+        let s = contact_move_fraction(i, imp_vec(VEC_X, i));
+        if s < 1.0 {
+            atomicMin(&workgroup_fraction, bitcast<u32>(s));
         }
     }
     workgroupBarrier();

@@ -67,8 +67,9 @@
 //!   the corner's faces against its row) and computes each pair's d, w and n̂
 //!   again from its face's first corner, so the four participants see the
 //!   same bits and K̃ stays symmetric. **The step clamp** follows the
-//!   solve: `implicit_blocks` keeps each contact node's limit
-//!   L_i = 0.4·min(d̂, its closest distance) beside its Jacobi entry, the
+//!   solve: with each contact node's limit L_i = 0.4·min(d̂, its closest
+//!   distance), which the contact pass keeps (the FIRE moves' clamp reads
+//!   the same, `contact_move_fraction`), the
 //!   solve's workgroup min-reduces s = min(1, min_i L_i/|Δx_i|) on the bits
 //!   of positive f32s (order-independent) into the step's fraction,
 //!   replacing the explicit step's that the force pass left there, and
