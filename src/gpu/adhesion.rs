@@ -105,7 +105,8 @@ impl AdhesionPack {
 
     /// Appends the sections to `topo` and returns layout.wgsl's adhesion
     /// fields, with the `surf` regions from entry `surf_base` on and the
-    /// contact pass's closest distances at `closest` ([`super::contact::ContactPack::closest_entry`]).
+    /// contact pass's closest distances at `closest` (the contact pack's
+    /// `closest_entry`, in the pass this one runs around).
     pub fn append(&self, topo: &mut Vec<u32>, surf_base: u64, n: u32, closest: u32) -> [u32; 8] {
         let mut fields = [0u32; 8];
         for (k, section) in self.sections.iter().enumerate() {
