@@ -216,15 +216,45 @@ fn one_implicit_step_with_contact_matches_the_cpu() {
 /// of the distance travelled; measured 1.4e-5), and the cells stay apart.
 #[test]
 fn the_implicit_contact_clamp_runs_on_the_gpu_like_on_the_cpu() {
+    clamped_contact_runs_agree("integrator implicit");
+}
+
+/// The clamp test above with `integrator` the deck's integrator line.
+fn clamped_contact_runs_agree(integrator: &str) {
     let run = |device: DevicePreference| {
         let ff = format!("{CONTACT_SHELLS}{CONTACT_BARRIER}");
-        let case = contact_case(&ff, 0.1, 50.0, "integrator implicit\ntemperature 0\ntimestep 1e-2\nrun 10\n");
+        let case = contact_case(&ff, 0.1, 50.0, &format!("{integrator}\ntemperature 0\ntimestep 1e-2\nrun 10\n"));
         let options = RunOptions { output_dir: case.output_dir().to_path_buf(), device: Some(device), ..Default::default() };
         let start = Simulation::new(&case.plan(), RunOptions::default()).state;
         (start, Simulation::execute(case.plan(), options).unwrap_or_else(|e| panic!("{device:?}: {e}")))
     };
     let ((start, cpu), (_, gpu)) = (run(DevicePreference::Cpu), run(DevicePreference::Gpu));
     assert_clamped_runs_agree(&start, &cpu, &gpu, 1);
+}
+
+/// `gpu_workgroups all`: the split solve (src/gpu/implicit_split.rs), each
+/// phase of CG a dispatch over every workgroup, its sums per workgroup and
+/// then over workgroups. One step meets the bound of the one-workgroup
+/// solve on the filament (bonds, angles, externals), in more iterations
+/// than the first budget (32), so the step was taken again with a larger
+/// one; the clamp test's pressurised cells (turgor: the bodies' dots a pass
+/// of their own; the contact rows; the clamp's minimum over workgroups)
+/// are clamped at the same steps as on the CPU and follow it; and the same
+/// thermal run twice gives the same bits.
+#[test]
+fn the_split_solve_matches_the_cpu() {
+    let split = |case: common::Case| {
+        let deck = std::fs::read_to_string(case.path("deck.in")).unwrap();
+        std::fs::write(case.path("deck.in"), deck.replace("integrator implicit\n", "integrator implicit gpu_workgroups all\n")).unwrap();
+        case
+    };
+    let filament_step = one_step_matches(&split(filament(1, 0.0)));
+    // The filament's step outran the first budget: it was taken again with a larger one.
+    assert!(filament_step.last_solve.iterations > 32, "{} iterations", filament_step.last_solve.iterations);
+    clamped_contact_runs_agree("integrator implicit gpu_workgroups all");
+    let thermal = split(filament(30, 4.1e-3));
+    let (a, b) = (run(&thermal, DevicePreference::Gpu), run(&thermal, DevicePreference::Gpu));
+    assert_eq!(common::position_bits(&a), common::position_bits(&b));
 }
 
 /// Newton steps of a `solver cholesky` deck with volume elements:
@@ -350,7 +380,7 @@ fn bond_kinetics_with_the_implicit_step_match_the_cpu() {
     let apart = cpu.state.positions.iter().zip(&gpu.state.positions).map(|(x, y)| (*x - *y).length()).fold(0.0, f64::max);
     let bound = condition_bound(&plan, &start) * (F32_TOLERANCE + 8.0 * f32::EPSILON as f64) * travelled;
     println!("{broken} of 10 tethers broken; GPU − CPU {apart:.3e} µm after {travelled:.3e} (bound {bound:.3e})");
-    assert!(broken >= 2 && broken < 10, "{broken} tethers broken");
+    assert!((2..10).contains(&broken), "{broken} tethers broken");
     assert_eq!(cb.bound, gb.bound, "bound tethers");
     assert!(cb.age == gb.age, "tether ages");
     assert!(apart <= bound, "GPU − CPU {apart:e} > {bound:e}");
@@ -368,7 +398,8 @@ fn the_same_implicit_gpu_run_twice_gives_the_same_bits() {
     assert!(moved > 1e-3, "nothing moved: {moved:e}");
 }
 
-/// A law without a device stiffness block is refused with the reason.
+/// A law without a device stiffness block is refused with the reason; so is
+/// `gpu_workgroups all` with constrained bonds.
 #[test]
 fn implicit_decks_the_device_cannot_solve_are_refused_with_the_reason() {
     let case = filament(1, 0.0);
@@ -377,6 +408,14 @@ fn implicit_decks_the_device_cannot_solve_are_refused_with_the_reason() {
     std::fs::write(case.path("f.ff"), ff.replace("harmonic k 2000 r0 0.31", "fene K 30 R0 1.5 epsilon 0 sigma 1")).unwrap();
     let refused = Simulation::execute(case.plan(), options).err().map(|e| e.to_string()).unwrap_or_default();
     assert!(refused.contains("has no GPU stiffness block"), "{refused}");
+    // The projected solve of constrained bonds runs in one workgroup only.
+    let case = filament(1, 0.0);
+    let options = RunOptions { output_dir: case.output_dir().to_path_buf(), device: Some(DevicePreference::Gpu), ..Default::default() };
+    let deck = std::fs::read_to_string(case.path("deck.in")).unwrap();
+    std::fs::write(case.path("deck.in"), deck.replace("integrator implicit\n", "constrain rod\nintegrator implicit gpu_workgroups all\n"))
+        .unwrap();
+    let refused = Simulation::execute(case.plan(), options).err().map(|e| e.to_string()).unwrap_or_default();
+    assert!(refused.contains("`gpu_workgroups all` with `constrain`"), "{refused}");
 }
 
 /// `solver cholesky` on the device: `inputs/force_dipole.in` (8 quasi-static

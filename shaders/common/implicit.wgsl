@@ -17,7 +17,9 @@
 //   2. `implicit_blocks` (one per particle): the projected radial block of
 //      each of its bond ends and the Hessian of each of its externals, and
 //      the Jacobi diagonal from them and its angles' diagonal blocks.
-//   3. `implicit_solve` (ONE workgroup): the whole CG, every product K̃·v
+//   3. `implicit_solve` (ONE workgroup; or the split solve of
+//      shaders/common/implicit_split.wgsl over every workgroup, one
+//      dispatch per phase): the whole CG, every product K̃·v
 //      gathered per particle from its own terms in a fixed order, every dot
 //      product a fixed tree over the workgroup; the convergence test is
 //      taken on the device each iteration and nothing is read back. A body's
@@ -54,6 +56,7 @@ const IMP_V_TETRAS: u32 = 17u;      // … of the volume elements' blocks (36 pe
 const IMP_V_FACES: u32 = 18u;       // … of the faces' blocks (21 per face of the surface pack)
 const IMP_V_BODIES: u32 = 19u;      // … per packed body: (w_V, w_A, ∇V·v, ∇A·v)
 const IMP_V_NODES: u32 = 20u;       // … per curvature node: (w, β, g·v)
+const IMP_V_SPLIT: u32 = 21u;       // … of the split solve's scalars and partial sums (implicit_split.wgsl)
 
 // Per-particle vectors of `imp`: section s of particle i is imp[s·n + i].
 const VEC_X: u32 = 0u;    // Δx
@@ -371,54 +374,69 @@ fn edge_gradient_at(g: EdgeBending, r: u32) -> vec3<f32> {
 
 // For every packed body: (∇V·v, ∇A·v) of the vector in `section` beside its
 // weights (`store_body_weights`), each body's sums taken face by face in
-// order by one invocation; for every
-// curvature node k: g_k·v = ¼Σ_edges ∂(ℓθ)·v − β_k·⅓Σ_faces ∇A_t·v over its
-// edges and faces in order; then a barrier, so that `apply_row` can gather
-// them (`multiply` calls it before each product).
+// order by one invocation (`body_dot`); for every curvature node k: g_k·v
+// (`node_dot`); then a barrier, so that `apply_row` can gather them
+// (`multiply` calls it before each product; the split solve dispatches
+// `implicit_split_body_dots` instead).
 fn body_dots(local: u32, section: u32) {
     for (var k = local; k < P.n_body_nodes; k += WORKGROUP) {
-        var dm = 0.0;
-        let edges_end = topo[P.off_node_edge_offsets + k + 1u];
-        for (var q = topo[P.off_node_edge_offsets + k]; q < edges_end; q++) {
-            let e = topo[P.off_node_edges + q];
-            let g = edge_bending(e);
-            dm += dot(g.gi, imp_vec(section, edge_word(e, 0u))) + dot(g.gj, imp_vec(section, edge_word(e, 1u)))
-                + dot(g.ga, imp_vec(section, edge_word(e, 2u))) + dot(g.gb, imp_vec(section, edge_word(e, 3u)));
-        }
-        var da = 0.0;
-        let faces_end = topo[P.off_node_face_offsets + k + 1u];
-        for (var q = topo[P.off_node_face_offsets + k]; q < faces_end; q++) {
-            let f = topo[P.off_node_faces + q];
-            let g = face_geometry(f);
-            da += dot(g.ga0, imp_vec(section, face_word(f, 0u))) + dot(g.ga1, imp_vec(section, face_word(f, 1u)))
-                + dot(g.ga2, imp_vec(section, face_word(f, 2u)));
-        }
-        let at = imp_topo[IMP_V_NODES] + k;
-        imp[at].z = 0.25 * dm - imp[at].y * da / 3.0;
+        node_dot(k, section);
     }
     for (var b = local; b < P.n_bodies; b += WORKGROUP) {
-        var dots = vec2<f32>(0.0);
-        let faces_end = topo[P.off_body_faces + b + 1u];
-        for (var f = topo[P.off_body_faces + b]; f < faces_end; f++) {
-            let g = face_geometry(f);
-            let va = imp_vec(section, face_word(f, 0u));
-            let vb = imp_vec(section, face_word(f, 1u));
-            let vc = imp_vec(section, face_word(f, 2u));
-            dots += vec2<f32>(dot(g.gv, va + vb + vc), dot(g.ga0, va) + dot(g.ga1, vb) + dot(g.ga2, vc));
-        }
-        let at = imp_topo[IMP_V_BODIES] + b;
-        imp[at].z = dots.x;
-        imp[at].w = dots.y;
+        body_dot(b, section);
     }
     storageBarrier();
+}
+
+// Curvature node k's g_k·v = ¼Σ_edges ∂(ℓθ)·v − β_k·⅓Σ_faces ∇A_t·v over its
+// edges and faces in order, for the vector in `section`.
+fn node_dot(k: u32, section: u32) {
+    var dm = 0.0;
+    let edges_end = topo[P.off_node_edge_offsets + k + 1u];
+    for (var q = topo[P.off_node_edge_offsets + k]; q < edges_end; q++) {
+        let e = topo[P.off_node_edges + q];
+        let g = edge_bending(e);
+        dm += dot(g.gi, imp_vec(section, edge_word(e, 0u))) + dot(g.gj, imp_vec(section, edge_word(e, 1u)))
+            + dot(g.ga, imp_vec(section, edge_word(e, 2u))) + dot(g.gb, imp_vec(section, edge_word(e, 3u)));
+    }
+    var da = 0.0;
+    let faces_end = topo[P.off_node_face_offsets + k + 1u];
+    for (var q = topo[P.off_node_face_offsets + k]; q < faces_end; q++) {
+        let f = topo[P.off_node_faces + q];
+        let g = face_geometry(f);
+        da += dot(g.ga0, imp_vec(section, face_word(f, 0u))) + dot(g.ga1, imp_vec(section, face_word(f, 1u)))
+            + dot(g.ga2, imp_vec(section, face_word(f, 2u)));
+    }
+    let at = imp_topo[IMP_V_NODES] + k;
+    imp[at].z = 0.25 * dm - imp[at].y * da / 3.0;
+}
+
+// Packed body b's (∇V·v, ∇A·v) for the vector in `section`, face by face in order.
+fn body_dot(b: u32, section: u32) {
+    var dots = vec2<f32>(0.0);
+    let faces_end = topo[P.off_body_faces + b + 1u];
+    for (var f = topo[P.off_body_faces + b]; f < faces_end; f++) {
+        let g = face_geometry(f);
+        let va = imp_vec(section, face_word(f, 0u));
+        let vb = imp_vec(section, face_word(f, 1u));
+        let vc = imp_vec(section, face_word(f, 2u));
+        dots += vec2<f32>(dot(g.gv, va + vb + vc), dot(g.ga0, va) + dot(g.ga1, vb) + dot(g.ga2, vc));
+    }
+    let at = imp_topo[IMP_V_BODIES] + b;
+    imp[at].z = dots.x;
+    imp[at].w = dots.y;
 }
 
 // Every packed body's weights (w_V, w_A), fixed within a step: stored once
 // before the solve's first product (`body_dots` adds the dots beside them).
 fn store_body_weights(local: u32) {
     for (var b = local; b < P.n_bodies; b += WORKGROUP) {
-        imp[imp_topo[IMP_V_BODIES] + b] = vec4<f32>(body_weight_sum(b), 0.0, 0.0);
+        store_body_weight(b);
     }
+}
+
+fn store_body_weight(b: u32) {
+    imp[imp_topo[IMP_V_BODIES] + b] = vec4<f32>(body_weight_sum(b), 0.0, 0.0);
 }
 
 // Particle i's rows of its faces' blocks and of its bodies' rank-one terms

@@ -24,9 +24,10 @@ use wgpu::util::DeviceExt;
 
 use super::adhesion::AdhesionPack;
 use super::contact::{reach_message, ContactPack, CONTACT_ONLY, FRACTION_SLOTS};
-use super::context::{storage_entry, GpuContext};
+use super::context::{storage_entry, GpuContext, WORKGROUP};
 use super::fire::DeviceFire;
 use super::implicit::ImplicitSolver;
+use super::implicit_split::HALT_BUDGET;
 use super::kinetics::{KinKernels, KinLayout};
 use super::nlist::NeighbourStorage;
 use super::pack::{cell_grid, pack, FixedPoint, Packed, Params};
@@ -40,7 +41,6 @@ use crate::integrate::implicit::{ImplicitSettings, SolveReport};
 use crate::neighbor::Exclusions;
 use crate::system::{BondState, Model, SimBox, State};
 
-const WORKGROUP: u32 = 256;
 const STATUS_WORDS: usize = 11;
 const ST_HALTED: usize = 0;
 const ST_OVERFLOW_NEED: usize = 1;
@@ -946,9 +946,8 @@ impl GpuBackend {
         let integrate = match &self.implicit {
             // The implicit step in place of `integrate` (src/gpu/implicit.rs).
             Some(solver) => {
-                // In the step's order (`encode_step`): angles, elements, faces, then the per-particle passes.
-                let mut passes: Vec<_> = solver.term_passes(WORKGROUP).into_iter().map(|(k, groups)| (k, Over::Groups(groups))).collect();
-                passes.extend([(&solver.blocks, particles), (&solver.solve, Over::Groups(1)), (&solver.moves, particles)]);
+                // In the step's order (`encode_step`).
+                let passes: Vec<_> = solver.step_passes().into_iter().map(|(k, groups)| (k, Over::Groups(groups))).collect();
                 time(self, &passes, Some(&solver.group)) + time(self, &[(&k.commit, particles), (&k.advance, Over::Groups(1))], None)
             }
             None => time(self, &[(&k.integrate, particles), (&k.commit, particles), (&k.advance, Over::Groups(1))], None),
@@ -1065,12 +1064,9 @@ impl GpuBackend {
             } else if let Some(solver) = &self.implicit {
                 // The implicit step (src/gpu/implicit.rs) in place of `integrate`.
                 pass.set_bind_group(1, &solver.group, &[]);
-                for (kernel, groups) in solver.term_passes(WORKGROUP) {
+                for (kernel, groups) in solver.step_passes() {
                     self.dispatch(pass, kernel, Over::Groups(groups));
                 }
-                self.dispatch(pass, &solver.blocks, Over::Particles);
-                self.dispatch(pass, &solver.solve, Over::Groups(1));
-                self.dispatch(pass, &solver.moves, Over::Particles);
             } else {
                 self.dispatch(pass, &k.integrate, Over::Particles);
             }
@@ -1345,6 +1341,11 @@ impl GpuBackend {
             if let Some(message) = self.span_halt(&status) {
                 return Err(GpuHalt::Capacity { step: first_step + done, message });
             }
+            if let Some(split) = self.implicit.as_mut().and_then(ImplicitSolver::split_mut).filter(|_| status[ST_HALTED] & HALT_BUDGET != 0)
+            {
+                // The step that ran out of iterations moved nothing: take it again with a larger budget.
+                split.grow();
+            }
             if let Some(solver) = self.implicit.as_ref().filter(|_| status[ST_HALTED] & HALT_SOLVE != 0) {
                 let message = solver.failure(&self.implicit_report().unwrap_or_default());
                 return Err(GpuHalt::Capacity { step: first_step + done, message });
@@ -1362,7 +1363,20 @@ impl GpuBackend {
                 self.grow_if_overflowed(&status).map_err(|message| GpuHalt::Capacity { step: first_step + done, message })? || requested;
         }
         self.time += self.elapsed(done);
+        self.fit_split_budget();
         Ok(done)
+    }
+
+    /// After a run: the split solve's budget fitted to the most iterations a
+    /// step took, and that count cleared (one small read-back).
+    fn fit_split_budget(&mut self) {
+        let Some(solver) = self.implicit.as_ref().filter(|s| s.is_split()) else { return };
+        let bytes = self.read_at(&solver.buffer, solver.report_at, 16);
+        self.ctx.queue.write_buffer(&solver.buffer, solver.report_at + 8, &[0; 4]);
+        let most = ImplicitSolver::most_iterations(&bytes);
+        if most > 0 {
+            self.implicit.as_mut().and_then(ImplicitSolver::split_mut).expect("a split solve").fit(most);
+        }
     }
 }
 

@@ -42,7 +42,6 @@
 use crate::system::Model;
 
 const NONE: u32 = u32::MAX;
-const WORKGROUP: usize = 256;
 const RULE_WORDS: usize = 8;
 /// `bind` rules the device takes (`BIND_RULES` of bind.wgsl).
 const RULES: usize = 4;
@@ -158,7 +157,7 @@ pub(super) fn append(model: &Model, sizes: &BindSizes, pool_end: usize, words: &
     header[27] = words.len() as u32;
     words.resize(words.len() + n, 0);
     header[28] = words.len() as u32;
-    words.resize(words.len() + 2 * n.div_ceil(WORKGROUP), 0);
+    words.resize(words.len() + 2 * n.div_ceil(super::context::WORKGROUP as usize), 0);
     header[31] = max_gain(model);
 }
 

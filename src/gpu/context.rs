@@ -33,6 +33,9 @@ impl DevicePreference {
 /// Storage buffers bound by the kernels at once (see shaders/common/layout.wgsl).
 pub const STORAGE_BINDINGS: u32 = 13;
 
+/// Invocations per workgroup of every kernel (`WORKGROUP` in shaders/common/layout.wgsl).
+pub const WORKGROUP: u32 = 256;
+
 /// An open device and its queue (cheap to clone: handles are shared).
 #[derive(Clone)]
 pub struct GpuContext {

@@ -123,8 +123,8 @@
 //!
 //! # Determinism and the read-back
 //!
-//! The whole CG runs in ONE workgroup (`implicit_solve`): each product K̃·v
-//! is gathered per particle from its own bond ends, externals and angle
+//! The CG runs in ONE workgroup (`implicit_solve`) by default: each product
+//! K̃·v is gathered per particle from its own bond ends, externals and angle
 //! slots in a fixed order, and each dot product is a fixed pairwise tree
 //! over the workgroup, so the same run gives the same bits (no atomics on
 //! floats). One workgroup has workgroup barriers, so the convergence test
@@ -134,10 +134,18 @@
 //! and `solver_residual`. A solve that does not converge within
 //! `max_iterations` halts the run before that step is taken
 //! (the host reports the step, the residual and the iterations). The cost:
-//! one workgroup runs the solve on one compute unit. That suits filaments
-//! and networks of up to ~10⁴ particles; the 10⁵–10⁶-particle systems would
-//! need a multi-workgroup CG (one dispatch per phase with a device-side
-//! convergence flag), which is not written.
+//! one workgroup runs the solve on one compute unit, which suits filaments
+//! and networks of up to ~10⁴ particles.
+//!
+//! Larger systems take the **split solve** (src/gpu/implicit_split.rs,
+//! shaders/common/implicit_split.wgsl): the same CG with one dispatch per
+//! phase over every workgroup, its dot products summed per workgroup by a
+//! fixed tree and then over the workgroups in a fixed order (the same bits
+//! on every run, not the one-workgroup solve's), a budget of iterations
+//! encoded per step and a step that outruns it taken again with a larger
+//! one. `integrator implicit … gpu_workgroups one|all|auto` chooses; `auto`
+//! (the default) splits from [`SPLIT_SOLVE_FROM`] particles on, except with
+//! constrained bonds, whose projected solve runs in one workgroup only.
 //!
 //! # Precision
 //!
@@ -150,11 +158,12 @@
 
 use wgpu::util::DeviceExt;
 
-use super::context::GpuContext;
+use super::context::{GpuContext, WORKGROUP};
+use super::implicit_split::SplitSolve;
 use super::pack::push_csr;
 use super::shader;
 use super::side_group::SideGroup;
-use crate::integrate::implicit::{ImplicitSettings, SolveReport};
+use crate::integrate::implicit::{GpuWorkgroups, ImplicitSettings, SolveReport};
 use crate::interactions::{Law, SurfaceGpu, REGISTRY};
 use crate::system::Model;
 
@@ -163,7 +172,12 @@ use crate::system::Model;
 /// decks' systems, ~10³, leaves a margin of ten).
 pub const F32_TOLERANCE: f64 = 1e-6;
 
-const HEADER_WORDS: usize = 21;
+/// `gpu_workgroups auto` splits the solve over every workgroup from this many
+/// particles on (a round figure, not measured on hardware: below it one
+/// workgroup loops over ≤ 32 particles per invocation per product).
+pub const SPLIT_SOLVE_FROM: usize = 8192;
+
+const HEADER_WORDS: usize = 22;
 /// `imp` entries per particle (Δx, r, z, p, A·p, the Jacobi diagonal).
 const PARTICLE_VECTORS: usize = 6;
 /// `imp` entries of an angle's 9×9 block.
@@ -207,6 +221,21 @@ pub fn refusal(model: &Model) -> Option<&'static str> {
         );
     }
     None
+}
+
+/// Whether the solve is split over every workgroup (`gpu_workgroups`, `n`
+/// particles, constrained bonds or not).
+fn splits(choice: GpuWorkgroups, n: usize, constrained: bool) -> Result<bool, String> {
+    match choice {
+        GpuWorkgroups::One => Ok(false),
+        GpuWorkgroups::All if constrained => {
+            Err("`gpu_workgroups all` with `constrain`: the device's projected solve runs in one workgroup \
+                                                  (use `gpu_workgroups one` or `auto`)"
+                .into())
+        }
+        GpuWorkgroups::All => Ok(true),
+        GpuWorkgroups::Auto => Ok(n >= SPLIT_SOLVE_FROM && !constrained),
+    }
 }
 
 /// The WGSL function giving an interaction's stiffness, if its evaluator
@@ -286,19 +315,30 @@ pub fn stiffness_dispatch() -> String {
     radial + &three + &one + &tetra + &face + &weights + &node + &contact + &area
 }
 
+/// The conjugate gradients: in one workgroup (`implicit_solve` or, with
+/// constraints, `implicit_solve_constrained`), or split over every workgroup
+/// (src/gpu/implicit_split.rs).
+enum Solve {
+    One(wgpu::ComputePipeline),
+    Split(SplitSolve),
+}
+
 /// The device's implicit solver: its buffers, bind group (group 1) and kernels.
 pub(super) struct ImplicitSolver {
     pub(super) group: wgpu::BindGroup,
-    pub(super) angles: wgpu::ComputePipeline,
-    pub(super) tetras: wgpu::ComputePipeline,
-    pub(super) faces: wgpu::ComputePipeline,
-    pub(super) nodes: wgpu::ComputePipeline,
-    pub(super) blocks: wgpu::ComputePipeline,
-    pub(super) solve: wgpu::ComputePipeline,
-    pub(super) moves: wgpu::ComputePipeline,
+    angles: wgpu::ComputePipeline,
+    tetras: wgpu::ComputePipeline,
+    faces: wgpu::ComputePipeline,
+    nodes: wgpu::ComputePipeline,
+    blocks: wgpu::ComputePipeline,
+    solve: Solve,
+    moves: wgpu::ComputePipeline,
     /// The `imp` buffer and the byte offset of its report entry.
     pub(super) buffer: wgpu::Buffer,
     pub(super) report_at: u64,
+    particles: u32,
+    /// Curvature nodes and bodies of the surface terms (the split solve's body dots).
+    body_items: u32,
     angle_count: u32,
     tetra_count: u32,
     face_count: u32,
@@ -392,8 +432,12 @@ impl ImplicitSolver {
         header[15] = (HEADER_WORDS + words.len()) as u32;
         words.extend(&slots);
         header[16] = (report + 1) as u32;
+        // The split solve's scalars and one partial sum per workgroup
+        // (shaders/common/implicit_split.wgsl), after the constraints'.
+        let split_at = report + 1 + CONSTRAINT_VEC4 * constrained.len();
+        header[21] = split_at as u32;
         let topo: Vec<u32> = header.into_iter().chain(words).collect();
-        let entries = (report + 1 + CONSTRAINT_VEC4 * constrained.len()) as u64;
+        let entries = (split_at + 3 + n.div_ceil(WORKGROUP as usize)) as u64;
         let limit = ctx.limits.max_storage_buffer_binding_size.min(ctx.limits.max_buffer_size);
         if 16 * entries > limit || entries > u32::MAX as u64 {
             return Err(format!(
@@ -410,22 +454,30 @@ impl ImplicitSolver {
         let buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("imp"),
             size: 16 * entries,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         let side = SideGroup::new(ctx, main_layout, model, "the implicit step", &[(1, true, &imp_topo), (2, false, &buffer)])?;
+        let split = splits(implicit.gpu_workgroups, n, !constrained.is_empty())?;
+        // Only the solve kernels the model uses: llvmpipe compiles a kernel at its first dispatch.
+        let solve = if split {
+            Solve::Split(SplitSolve::new(&side, ctx, bodies > 0, !model.contact_rules.is_empty(), implicit.max_iterations))
+        } else {
+            Solve::One(side.pipeline(ctx, if constrained.is_empty() { "implicit_solve" } else { "implicit_solve_constrained" }))
+        };
         Ok(Self {
             angles: side.pipeline(ctx, "implicit_angles"),
             tetras: side.pipeline(ctx, "implicit_tetras"),
             faces: side.pipeline(ctx, "implicit_faces"),
             nodes: side.pipeline(ctx, "implicit_nodes"),
             blocks: side.pipeline(ctx, "implicit_blocks"),
-            // Only the solve kernel the model uses: llvmpipe compiles a kernel at its first dispatch.
-            solve: side.pipeline(ctx, if constrained.is_empty() { "implicit_solve" } else { "implicit_solve_constrained" }),
+            solve,
             moves: side.pipeline(ctx, "implicit_move"),
             group: side.group,
             buffer,
             report_at: 16 * report as u64,
+            particles: n as u32,
+            body_items: body_nodes.max(bodies) as u32,
             angle_count: model.angles.len() as u32,
             tetra_count: model.tetras.len() as u32,
             face_count: faces as u32,
@@ -437,14 +489,45 @@ impl ImplicitSolver {
         })
     }
 
-    /// The per-term block kernels that have terms, in the step's order
-    /// (angles, volume elements, faces, curvature nodes), with their workgroups.
-    pub(super) fn term_passes(&self, workgroup: u32) -> Vec<(&wgpu::ComputePipeline, u32)> {
-        [(&self.angles, self.angle_count), (&self.tetras, self.tetra_count), (&self.faces, self.face_count), (&self.nodes, self.node_count)]
-            .into_iter()
-            .filter(|&(_, count)| count > 0)
-            .map(|(kernel, count)| (kernel, count.div_ceil(workgroup)))
-            .collect()
+    /// The step's kernels in order with their workgroups: the per-term
+    /// block kernels that have terms (angles, volume elements, faces,
+    /// curvature nodes), the per-particle blocks, the solve and the move.
+    pub(super) fn step_passes(&self) -> Vec<(&wgpu::ComputePipeline, u32)> {
+        let particles = self.particles.div_ceil(WORKGROUP);
+        let terms = [
+            (&self.angles, self.angle_count),
+            (&self.tetras, self.tetra_count),
+            (&self.faces, self.face_count),
+            (&self.nodes, self.node_count),
+        ];
+        let mut passes: Vec<_> =
+            terms.into_iter().filter(|&(_, count)| count > 0).map(|(kernel, count)| (kernel, count.div_ceil(WORKGROUP))).collect();
+        passes.push((&self.blocks, particles));
+        match &self.solve {
+            Solve::One(kernel) => passes.push((kernel, 1)),
+            Solve::Split(split) => passes.extend(split.passes(particles, self.body_items.div_ceil(WORKGROUP))),
+        }
+        passes.push((&self.moves, particles));
+        passes
+    }
+
+    pub(super) fn is_split(&self) -> bool {
+        matches!(self.solve, Solve::Split(_))
+    }
+
+    /// The split solve, if the step runs it.
+    pub(super) fn split_mut(&mut self) -> Option<&mut SplitSolve> {
+        match &mut self.solve {
+            Solve::One(_) => None,
+            Solve::Split(split) => Some(split),
+        }
+    }
+
+    /// The most iterations a step's split solve took since the host last
+    /// cleared the report's third word, from the report's 16 bytes.
+    pub(super) fn most_iterations(bytes: &[u8]) -> usize {
+        let entry: [f32; 4] = bytemuck::pod_read_unaligned(&bytes[..16]);
+        entry[2].to_bits() as usize
     }
 
     /// The last solve's report, from the 16 bytes of its entry.
@@ -467,5 +550,18 @@ impl ImplicitSolver {
              (tolerance {:e}, max_iterations {})",
             report.relative_residual, report.iterations, self.tolerance, self.max_iterations
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn auto_splits_large_unconstrained_solves() {
+        let auto = |n, constrained| splits(GpuWorkgroups::Auto, n, constrained).unwrap();
+        assert!(!auto(SPLIT_SOLVE_FROM - 1, false) && auto(SPLIT_SOLVE_FROM, false) && !auto(10 * SPLIT_SOLVE_FROM, true));
+        assert!(!splits(GpuWorkgroups::One, 1 << 20, false).unwrap() && splits(GpuWorkgroups::All, 10, false).unwrap());
+        assert!(splits(GpuWorkgroups::All, 10, true).unwrap_err().contains("constrain"));
     }
 }

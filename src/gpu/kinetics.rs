@@ -62,7 +62,6 @@ const TYPE_WORDS: usize = 44;
 const EVENT_WORDS: usize = 8;
 const NONE: u32 = u32::MAX;
 const CURSOR: usize = 9;
-const WORKGROUP: usize = 256;
 
 /// The rule codes of kinetics.wgsl (`RULE_*`).
 fn rule_code(name: &str) -> Option<u32> {
@@ -190,7 +189,7 @@ impl KinLayout {
         let own = &packed.own_bonds;
         let bind = super::bind::BindSizes::of(model);
         let count = own.len() + bind.pool;
-        let blocks = count.div_ceil(WORKGROUP);
+        let blocks = count.div_ceil(super::context::WORKGROUP as usize);
         let capacity = 2 * count + 1024 + bind.candidates;
         let mut header = [0u32; HEADER_WORDS];
         let sizes = [BOND_WORDS * count, count, 2 * count, 3 * count, count, 2 * blocks, TYPE_WORDS * model.bond_types.len()];

@@ -26,7 +26,9 @@
 //!   coordinates and moving groups in the integrator, ramped parameters
 //!   written per step from a table.
 //! - [`implicit`]: `integrator implicit`: per-term stiffness blocks and
-//!   Jacobi-preconditioned conjugate gradients in one workgroup, matrix-free.
+//!   Jacobi-preconditioned conjugate gradients in one workgroup, matrix-free;
+//!   `implicit_split`: the same CG split over every workgroup (one dispatch
+//!   per phase, an iteration budget per step) for large systems.
 //! - [`shake`]: `constrain`: overdamped SHAKE after the explicit step, the
 //!   constraints coloured so that a colour's corrections run in parallel,
 //!   swept in one workgroup until converged.
@@ -85,6 +87,7 @@ pub mod context;
 pub mod custom;
 pub mod fire;
 pub mod implicit;
+mod implicit_split;
 pub mod kinetics;
 mod nlist;
 pub mod pack;

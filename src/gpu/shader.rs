@@ -47,7 +47,7 @@ mod embedded {
 pub use embedded::{COMMON_SHADERS, INTERACTION_SHADERS};
 
 /// The common files in the order they must appear (declarations first).
-const COMMON_ORDER: [&str; 18] = [
+const COMMON_ORDER: [&str; 19] = [
     "layout",
     "philox",
     "neighbor",
@@ -63,6 +63,7 @@ const COMMON_ORDER: [&str; 18] = [
     "protocol",
     "implicit",
     "implicit_contact",
+    "implicit_split",
     "implicit_constraints",
     "shake",
     "fire",

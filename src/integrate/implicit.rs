@@ -67,6 +67,18 @@ pub enum LinearSolver {
     Cholesky,
 }
 
+/// How the GPU backend spreads its conjugate gradients (src/gpu/implicit.rs):
+/// `gpu_workgroups one|all|auto`. The CPU ignores it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GpuWorkgroups {
+    /// One workgroup runs the whole solve (nothing read back per step).
+    One,
+    /// Every workgroup: one dispatch per phase (the split solve).
+    All,
+    /// `all` above [`crate::gpu::implicit::SPLIT_SOLVE_FROM`] particles without `constrain`, else `one`.
+    Auto,
+}
+
 /// Options of `integrator implicit`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ImplicitSettings {
@@ -74,11 +86,12 @@ pub struct ImplicitSettings {
     /// Relative residual |AΔx − b|/|b| at which CG stops.
     pub tolerance: f64,
     pub max_iterations: usize,
+    pub gpu_workgroups: GpuWorkgroups,
 }
 
 impl Default for ImplicitSettings {
     fn default() -> Self {
-        Self { solver: LinearSolver::Cg, tolerance: 1e-10, max_iterations: 1000 }
+        Self { solver: LinearSolver::Cg, tolerance: 1e-10, max_iterations: 1000, gpu_workgroups: GpuWorkgroups::Auto }
     }
 }
 

@@ -66,7 +66,7 @@ const COMMANDS: &[Command] = &[
     line("device", "device cpu|gpu|auto", Validator::device),
     line(
         "integrator",
-        "integrator overdamped|implicit [noise uniform|gaussian] [max_displacement D] [solver cg|cholesky] [tolerance T] [max_iterations N]",
+        "integrator overdamped|implicit [noise uniform|gaussian] [max_displacement D] [solver cg|cholesky] [tolerance T] [max_iterations N] [gpu_workgroups one|all|auto]",
         Validator::integrator,
     ),
     line("neighbor", "neighbor skin S [every N] [check yes|no]", Validator::neighbor),

@@ -7,7 +7,7 @@ use crate::deck::plan::{Action, NeighborSettings};
 use crate::gpu::DevicePreference;
 use crate::input::{parse_u64, InputError, Token};
 use crate::integrate::fire::{FireSettings, MinimizeStyle};
-use crate::integrate::implicit::{ImplicitSettings, LinearSolver};
+use crate::integrate::implicit::{GpuWorkgroups, ImplicitSettings, LinearSolver};
 use crate::integrate::overdamped::OverdampedSettings;
 use crate::integrate::Integrator;
 use crate::rng::Noise;
@@ -56,14 +56,17 @@ impl Validator {
     }
 
     pub(super) fn integrator(&mut self, s: &[Token], usage: &str) -> Result<(), InputError> {
-        expect_len(s, 1..=11, usage)?;
+        expect_len(s, 1..=13, usage)?;
         let implicit = match s[1].text.as_str() {
             "overdamped" => false,
             "implicit" => true,
             other => return Err(s[1].error(format!("found integrator `{other}`, expected `overdamped` or `implicit`"))),
         };
-        let keys: &[&str] =
-            if implicit { &["noise", "max_displacement", "solver", "tolerance", "max_iterations"] } else { &["noise", "max_displacement"] };
+        let keys: &[&str] = if implicit {
+            &["noise", "max_displacement", "solver", "tolerance", "max_iterations", "gpu_workgroups"]
+        } else {
+            &["noise", "max_displacement"]
+        };
         let opts = options(&s[2..], keys, usage)?;
         let mut settings = OverdampedSettings::default();
         if let Some(t) = opts.get("noise") {
@@ -91,6 +94,14 @@ impl Validator {
             }
             if let Some(t) = opts.get("max_iterations") {
                 solve.max_iterations = parse_u64(t, "an iteration count")?.max(1) as usize;
+            }
+            if let Some(t) = opts.get("gpu_workgroups") {
+                solve.gpu_workgroups = match t.text.as_str() {
+                    "one" => GpuWorkgroups::One,
+                    "all" => GpuWorkgroups::All,
+                    "auto" => GpuWorkgroups::Auto,
+                    other => return Err(t.error(format!("found gpu_workgroups `{other}`, expected `one`, `all` or `auto`"))),
+                };
             }
             choice = Integrator::Implicit(settings, solve);
         }
