@@ -559,8 +559,10 @@ fn thermal_implicit_runs_have_the_exact_statistics_on_both_devices() {
 /// `inputs/network_shear.in` on the device: its `plastic` crosslinks decided
 /// by the host from read-back positions, every step (damped at γ/dt = 1
 /// pN/µm, then quasi-static Newton steps at 1e-6) solved by the device's f32
-/// CG; the first two shear stages, 4 + 4 steps each (the whole deck takes
-/// ~1.7 s a step on llvmpipe). The crosslinks' rest lengths, reset by the
+/// CG; the first shear stage, 4 + 4 steps (the whole deck takes ~1.7 s a
+/// step on llvmpipe; two stages took 60 s of CI's test binary, one leaves
+/// 284 rest lengths reset and the worst residual at 0.75 of what f32
+/// resolves there). The crosslinks' rest lengths, reset by the
 /// first tiny step, agree within 1e-5 relative (as in tests/gpu.rs's
 /// kinetics test). The end state is an equilibrium of the CPU's f64 forces
 /// to what f32 resolves: a bond's force rounds its separation d to f32, an
@@ -570,7 +572,7 @@ fn thermal_implicit_runs_have_the_exact_statistics_on_both_devices() {
 /// 1.5e-4 µm after 1.4e-3 µm in three stages, where forces agree to 1e-3 pN).
 #[test]
 fn network_shear_stages_reach_the_cpu_equilibrium_on_the_gpu() {
-    let vars = [("stages".to_string(), "2".to_string()), ("relax_steps".to_string(), "4".to_string())];
+    let vars = [("stages".to_string(), "1".to_string()), ("relax_steps".to_string(), "4".to_string())];
     let plan = cellmd::deck::validate_file(std::path::Path::new("inputs/network_shear.in"), &vars).unwrap_or_else(|e| panic!("{e}"));
     let dir = tempfile::tempdir().unwrap();
     let run_on = |device| {
