@@ -339,6 +339,11 @@ impl GpuBackend {
         Some(DeviceFire::counts(&self.read(&fire.buffer, DeviceFire::COUNT_BYTES)))
     }
 
+    /// Whether the implicit step's CG is split over every workgroup (src/gpu/implicit_split.rs).
+    pub fn implicit_is_split(&self) -> bool {
+        self.implicit.as_ref().is_some_and(ImplicitSolver::is_split)
+    }
+
     /// The last implicit step's iterations and relative residual (one small
     /// read-back; None without the implicit step).
     pub fn implicit_report(&self) -> Option<SolveReport> {

@@ -78,6 +78,12 @@ impl GpuSteps {
                 ));
             }
             gpu.step_implicitly(context, model, &settings, implicit, &sim.constraints.pairs(model)).map_err(RunError::Setup)?;
+            if gpu.implicit_is_split() {
+                sim.say(&format!(
+                    "device gpu: integrator implicit: conjugate gradients split over every workgroup ({} particles; gpu_workgroups one keeps them in one)",
+                    model.len()
+                ));
+            }
         }
         if !sim.constraints.list.is_empty() {
             // The constraints' projection on the device (src/gpu/shake.rs): f32 lengths have a tolerance floor.
