@@ -49,7 +49,8 @@
 //! implicit step's stiffness dispatch, `implicit.rs` reads the evaluator
 //! files to tell which laws have a device stiffness block, and
 //! `side_group.rs`, which compiles the composed program for the implicit
-//! step's kernels, is one of `implicit.rs`'s imports.
+//! step's kernels, is one of `implicit.rs`'s imports, and one of
+//! `implicit_split.rs`'s, which takes the split solve's kernels from it.
 //!
 //! What runs where: each step — neighbour-list check and (when due) rebuild,
 //! forces, overdamped integration — runs on the GPU without reading anything

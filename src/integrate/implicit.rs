@@ -75,7 +75,7 @@ pub enum GpuWorkgroups {
     One,
     /// Every workgroup: one dispatch per phase (the split solve).
     All,
-    /// `all` above [`crate::gpu::implicit::SPLIT_SOLVE_FROM`] particles without `constrain`, else `one`.
+    /// `all` from 8 192 particles on (`SPLIT_SOLVE_FROM` in src/gpu/implicit.rs) without `constrain`, else `one`.
     Auto,
 }
 
