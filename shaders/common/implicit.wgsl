@@ -808,6 +808,43 @@ fn implicit_rhs(i: u32) -> vec3<f32> {
     return free_axes(i) * (force[i].xyz + kick * unit_noise(i));
 }
 
+// The preconditioned CG's per-particle steps, shared by the one-workgroup
+// solve (`implicit_solve`) and the split one (implicit_split.wgsl), so both
+// do the same arithmetic. Each returns particle i's share of the sums that
+// follow it.
+
+// The first residual: b (in VEC_R) − A·x₀ (in VEC_Q) into VEC_R, z = D⁻¹r
+// into VEC_Z and the first direction p = z into VEC_P; returns
+// (r·z, r·r, b·b).
+fn first_residual(i: u32) -> vec3<f32> {
+    let n = P.n;
+    let b = imp_vec(VEC_R, i);
+    let r = b - imp_vec(VEC_Q, i);
+    let z = imp[n * VEC_DINV + i].xyz * r;
+    imp[n * VEC_R + i] = vec4<f32>(r, 0.0);
+    imp[n * VEC_Z + i] = vec4<f32>(z, 0.0);
+    imp[n * VEC_P + i] = vec4<f32>(z, 0.0);
+    return vec3<f32>(dot(r, z), dot(r, r), dot(b, b));
+}
+
+// One iteration's update x += αp, r −= αq (q = A·p in VEC_Q), z = D⁻¹r;
+// returns (r·z, r·r, 0) of the new residual.
+fn cg_update(i: u32, alpha: f32) -> vec3<f32> {
+    let n = P.n;
+    let x = imp_vec(VEC_X, i) + alpha * imp_vec(VEC_P, i);
+    let r = imp_vec(VEC_R, i) - alpha * imp_vec(VEC_Q, i);
+    let z = imp[n * VEC_DINV + i].xyz * r;
+    imp[n * VEC_X + i] = vec4<f32>(x, 0.0);
+    imp[n * VEC_R + i] = vec4<f32>(r, 0.0);
+    imp[n * VEC_Z + i] = vec4<f32>(z, 0.0);
+    return vec3<f32>(dot(r, z), dot(r, r), 0.0);
+}
+
+// The next direction p = z + βp.
+fn cg_direction(i: u32, beta: f32) {
+    imp[P.n * VEC_P + i] = vec4<f32>(imp_vec(VEC_Z, i) + beta * imp_vec(VEC_P, i), 0.0);
+}
+
 @compute @workgroup_size(256)
 fn implicit_solve(@builtin(local_invocation_index) local: u32) {
     if !begin_solve(local) {
@@ -835,13 +872,7 @@ fn implicit_solve(@builtin(local_invocation_index) local: u32) {
         if section == VEC_X {
             var sums = vec3<f32>(0.0);
             for (var i = local; i < n; i += WORKGROUP) {
-                let b = imp_vec(VEC_R, i);
-                let r = b - imp_vec(VEC_Q, i);
-                let z = imp[n * VEC_DINV + i].xyz * r;
-                imp[n * VEC_R + i] = vec4<f32>(r, 0.0);
-                imp[n * VEC_Z + i] = vec4<f32>(z, 0.0);
-                imp[n * VEC_P + i] = vec4<f32>(z, 0.0);
-                sums += vec3<f32>(dot(r, z), dot(r, r), dot(b, b));
+                sums += first_residual(i);
             }
             let start = workgroup_sum(local, sums);
             rz = start.x;
@@ -856,20 +887,14 @@ fn implicit_solve(@builtin(local_invocation_index) local: u32) {
             let alpha = rz / curvature;
             var next = vec3<f32>(0.0);
             for (var i = local; i < n; i += WORKGROUP) {
-                let x = imp_vec(VEC_X, i) + alpha * imp_vec(VEC_P, i);
-                let r = imp_vec(VEC_R, i) - alpha * imp_vec(VEC_Q, i);
-                let z = imp[n * VEC_DINV + i].xyz * r;
-                imp[n * VEC_X + i] = vec4<f32>(x, 0.0);
-                imp[n * VEC_R + i] = vec4<f32>(r, 0.0);
-                imp[n * VEC_Z + i] = vec4<f32>(z, 0.0);
-                next += vec3<f32>(dot(r, z), dot(r, r), 0.0);
+                next += cg_update(i, alpha);
             }
             let after = workgroup_sum(local, next);
             let beta = after.x / rz;
             rz = after.x;
             residual = sqrt(after.y);
             for (var i = local; i < n; i += WORKGROUP) {
-                imp[n * VEC_P + i] = vec4<f32>(imp_vec(VEC_Z, i) + beta * imp_vec(VEC_P, i), 0.0);
+                cg_direction(i, beta);
             }
             iterations += 1u;
         }

@@ -134,13 +134,7 @@ fn implicit_split_residual(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_
     let i = linear_index(wg, local);
     var sums = vec3<f32>(0.0);
     if i < P.n {
-        let b = imp_vec(VEC_R, i);
-        let r = b - imp_vec(VEC_Q, i);
-        let z = imp[P.n * VEC_DINV + i].xyz * r;
-        imp[P.n * VEC_R + i] = vec4<f32>(r, 0.0);
-        imp[P.n * VEC_Z + i] = vec4<f32>(z, 0.0);
-        imp[P.n * VEC_P + i] = vec4<f32>(z, 0.0);
-        sums = vec3<f32>(dot(r, z), dot(r, r), dot(b, b));
+        sums = first_residual(i);
     }
     split_partial(wg, local, sums);
 }
@@ -198,13 +192,7 @@ fn implicit_split_update(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_in
     let alpha = imp[split_entry(SPLIT_SCALARS)].y;
     var sums = vec3<f32>(0.0);
     if i < P.n {
-        let x = imp_vec(VEC_X, i) + alpha * imp_vec(VEC_P, i);
-        let r = imp_vec(VEC_R, i) - alpha * imp_vec(VEC_Q, i);
-        let z = imp[P.n * VEC_DINV + i].xyz * r;
-        imp[P.n * VEC_X + i] = vec4<f32>(x, 0.0);
-        imp[P.n * VEC_R + i] = vec4<f32>(r, 0.0);
-        imp[P.n * VEC_Z + i] = vec4<f32>(z, 0.0);
-        sums = vec3<f32>(dot(r, z), dot(r, r), 0.0);
+        sums = cg_update(i, alpha);
     }
     split_partial(wg, local, sums);
 }
@@ -222,7 +210,7 @@ fn implicit_split_direction(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local
     let beta = after.x / copy.x;
     let i = linear_index(wg, local);
     if i < P.n {
-        imp[P.n * VEC_P + i] = vec4<f32>(imp_vec(VEC_Z, i) + beta * imp_vec(VEC_P, i), 0.0);
+        cg_direction(i, beta);
     }
     if i == 0u {
         let iterations = bitcast<u32>(copy.y) + 1u;
