@@ -214,7 +214,7 @@ def main():
                 ("generator", f"OpenMM {mm.__version__} (Reference platform, double precision) via reference/openmm_solids.py"),
                 ("date", args.date), ("case", case), ("deck", f"{name}/{case}.in"),
                 ("epsilon", "1e-10"), ("run_epsilon", "1e-9"),
-                ("epsilon_reason", "OpenMM differentiates the same f64 formulas symbolically (Lepton) and sums in another order; D_m^-1 is inverted by numpy here and by glam in cellmd: measured <= 3.4e-14 relative on every case (tests/golden.rs); 1e-10 leaves margin for other compilers and libm versions"),
+                ("epsilon_reason", "OpenMM differentiates the same f64 formulas symbolically (Lepton) and sums in another order; D_m^-1 is inverted by numpy here and by glam in cellmd: measured <= 3.4e-14 relative on every case (tests/suite/golden.rs); 1e-10 leaves margin for other compilers and libm versions"),
                 ("run_epsilon_reason", "after 100 overdamped Euler steps (OpenMM CustomIntegrator x <- x + dt*f, drag 1) round-off has accumulated over every step: measured <= 3.2e-13; 1e-9 leaves margin for its growth"),
             ]
             docs.append(document(header, [("init", init), ("run", last)]))

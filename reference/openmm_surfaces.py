@@ -513,7 +513,7 @@ def main():
                 ("generator", f"OpenMM {mm.__version__} (Reference platform, double precision) via reference/openmm_surfaces.py"),
                 ("date", args.date), ("case", case), ("deck", f"{name}/{case}.in"),
                 ("epsilon", "1e-10"), ("run_epsilon", "1e-9"),
-                ("epsilon_reason", "OpenMM differentiates the same f64 formulas symbolically (Lepton; CustomCVForce by the chain rule) and sums in another order: measured <= 1.1e-14 relative on every case (tests/golden.rs); 1e-10 leaves margin for other compilers and libm versions"),
+                ("epsilon_reason", "OpenMM differentiates the same f64 formulas symbolically (Lepton; CustomCVForce by the chain rule) and sums in another order: measured <= 1.1e-14 relative on every case (tests/suite/golden.rs); 1e-10 leaves margin for other compilers and libm versions"),
                 ("run_epsilon_reason", "after 100 overdamped Euler steps (OpenMM CustomIntegrator x <- x + dt*f/gamma) round-off has accumulated over every step (positions relative to the largest displacement, forces and energies to the largest value met): measured <= 1.1e-12; 1e-9 leaves margin for chaotic growth of round-off"),
             ]
             docs.append(document(header, [("init", init), ("run", last)]))

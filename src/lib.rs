@@ -6,7 +6,7 @@
 //! `interactions`, `kinetics`, `forcefield`, `topology`, `system`,
 //! `neighbor`, `backend`, `integrate`, `kinetics_engine`, `measure`,
 //! `output`, `gpu`, `deck`, `run`, `export`, `compare`, `build`, `cli`.
-//! `tests/architecture.rs` fails on any cycle among them.
+//! `tests/suite/architecture.rs` fails on any cycle among them.
 //!
 //! | module | role |
 //! |---|---|

@@ -79,7 +79,7 @@
 //! bending stiffness, buckles inwards under the struts. Vassaux & Milan fill
 //! the cell with packed cytosol particles and the nucleus with nucleoskeleton
 //! particles; here `--bodies` lets the force field give both shells a
-//! `turgor` term instead. In the level-2 cell of `tests/build.rs` (a strut on
+//! `turgor` term instead. In the level-2 cell of `tests/suite/build.rs` (a strut on
 //! every ray, 12 fixed adhesions) every cable stays taut and every strut
 //! compressed with turgor (100 Pa cytosol, 5 kPa nucleus); without it a
 //! manual run ended with 237 of the 480 cortex cables slack and the cortex
@@ -96,7 +96,7 @@
 //! cables', 5·T_a·(R′ − RN′/√5)/d′; each nucleus node balances C against its
 //! compressed edges, Q·k_n·(1 − RN′/RN), and the cables' outward pull
 //! 5·T_a·(R′/√5 − RN′)/d′ (d′ the cable length, T_c and T_a the `cable`
-//! tensions at R′ and d′). `tests/build.rs` solves these by Newton's method
+//! tensions at R′ and d′). `tests/suite/build.rs` solves these by Newton's method
 //! and checks the engine's relaxed structure against them.
 //!
 //! The summary prints the counts, the radial length L (r0 of the struts, and

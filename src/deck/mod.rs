@@ -14,7 +14,7 @@
 //! -o DIR`). See README.md for the command reference.
 //!
 //! File-level circles that remain (the folder as a whole imports no module
-//! that imports it back, `tests/architecture.rs`):
+//! that imports it back, `tests/suite/architecture.rs`):
 //! - `control.rs` ↔ `validate.rs`: control flow (`loop`, `if`) is a second
 //!   `impl Validator` that validates the commands of a block, and the
 //!   validator hands blocks to it;

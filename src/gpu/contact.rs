@@ -242,7 +242,7 @@ pub fn reach_message(edge: f64) -> String {
 mod tests {
     use super::*;
 
-    /// The kernels' constants are the host's (the step fraction's: tests/gpu.rs).
+    /// The kernels' constants are the host's (the step fraction's: tests/suite/gpu.rs).
     #[test]
     fn the_shader_constants_match() {
         let program = super::super::shader::compose();

@@ -22,7 +22,7 @@
 //! the path differs from the CPU's by rounding, and FIRE's branch on the
 //! sign of P can take the other turn where P is near 0: the two runs can
 //! take different numbers of iterations to the same minimum (measured in
-//! tests/gpu_minimize.rs). The verdict and the reported max |F| and energy
+//! tests/suite/gpu_minimize.rs). The verdict and the reported max |F| and energy
 //! are the CPU's f64 evaluation at the positions the device reached.
 //!
 //! # Contact between bodies

@@ -107,8 +107,8 @@
 //! steps (γ/dt = 1e-6 against stiffnesses of 10²–10⁵), and the device
 //! solves them by the same f32 CG, saying so in the log. From the Jacobi
 //! first guess CG reaches the Newton step (on the CPU to 1e-12 of the
-//! Cholesky step: tests/implicit.rs), so a stage relaxes to the same
-//! equilibrium within the f32 rounding of the forces (tests/gpu_implicit.rs,
+//! Cholesky step: tests/suite/implicit.rs), so a stage relaxes to the same
+//! equilibrium within the f32 rounding of the forces (tests/suite/gpu_implicit.rs,
 //! the force dipole).
 //!
 //! # Constrained bonds
@@ -154,7 +154,7 @@
 //! max(tolerance, [`F32_TOLERANCE`]) and says so in the log when it raises
 //! the deck's tolerance. The step then differs from the CPU's by about
 //! κ(A)·[`F32_TOLERANCE`] relative at most, in practice the f32 rounding of
-//! forces and blocks (measured in tests/gpu_implicit.rs).
+//! forces and blocks (measured in tests/suite/gpu_implicit.rs).
 
 use wgpu::util::DeviceExt;
 

@@ -16,7 +16,7 @@
 //!
 //! Its sums differ from the one-workgroup solve's in their order (per
 //! workgroup, then over workgroups), so its bits differ from it by f32
-//! rounding; both are matched to the CPU in tests/gpu_implicit.rs.
+//! rounding; both are matched to the CPU in tests/suite/gpu_implicit.rs.
 
 use super::context::GpuContext;
 use super::side_group::SideGroup;

@@ -78,7 +78,7 @@
 //! error terms of two-sum; integers cannot be rewritten that way.
 //! Separations are exact integer differences rounded once to f32. The
 //! remaining difference from the CPU is the f32 force and displacement
-//! rounding (relative ≈ 1e-7 per step), measured in `tests/gpu.rs`.
+//! rounding (relative ≈ 1e-7 per step), measured in `tests/suite/gpu.rs`.
 
 pub mod adhesion;
 pub mod backend;

@@ -21,7 +21,7 @@
 //! colours follow one another in a fixed order. Both converge to a point
 //! within the tolerance of the constraint manifold, but not to the same
 //! point: the two results differ by about the tolerance times the bond
-//! length (measured in tests/gpu_constraints.rs). The whole projection runs
+//! length (measured in tests/suite/gpu_constraints.rs). The whole projection runs
 //! in ONE workgroup (`shake_solve`, as the implicit solve), so the
 //! convergence test is taken on the device every sweep and nothing is read
 //! back per step; the host reads the tensions and the last projection's

@@ -38,7 +38,7 @@
 //! than holding them together. The column is the mean over the bodies of
 //! the type; units force/length (pN/µm = mN/m). For a pressurised shell of
 //! edge springs, Young–Laplace gives γ = ΔP·R/2 (checked in
-//! `tests/measure.rs`).
+//! `tests/suite/measure.rs`).
 
 use std::f64::consts::PI;
 

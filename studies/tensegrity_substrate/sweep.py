@@ -18,7 +18,7 @@ Vassaux & Milan 2017), with inputs/tensegrity_substrate.in.
    tension against 1/R.
 
 Writes OUT/calibration.csv, OUT/indentation.csv, OUT/curvature.csv and, with
-plot.py, the PNGs. Not part of CI (tests/tensegrity_substrate.rs runs a
+plot.py, the PNGs. Not part of CI (tests/suite/tensegrity_substrate.rs runs a
 reduced case).
 
     python3 studies/tensegrity_substrate/sweep.py --cellmd target/release/cellmd --out out/tensegrity_substrate [--level 2] [--device gpu] [--min-style newton] [--jobs 2]
