@@ -30,7 +30,7 @@ be stopped and resumed (or extended to more seeds). A run that cellmd stops
 (a blow-up) is reported with cellmd's message, and its realisation is left
 out of both columns, so the differences stay paired.
 
-    python3 studies/collagen/asymmetry.py --cellmd target/release/cellmd --out out/collagen_asym --seeds 5 --steps 1000
+    python3 studies/collagen/asymmetry.py --cellmd target/release/cellmd --out out/collagen_asym --seeds 5 --steps 1000 --workers 2
 """
 
 import argparse
@@ -38,6 +38,7 @@ import csv
 import json
 import math
 import sys
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -142,8 +143,11 @@ def main():
     p.add_argument("--fibre-length", default="200")
     p.add_argument("--node-spacing", default="10")
     p.add_argument("--temperature", type=float, default=0.0, help="K, the deck's T (kT = 1.380649e-5·T pN·µm; 72 429 K: kT = 1 pN·µm)")
+    p.add_argument("--workers", type=int, default=1, help="runs at a time (each cellmd run takes one thread)")
     a = p.parse_args()
-    runs = {(seed, fibres): run(a, seed, fibres) for seed in range(1, a.seeds + 1) for fibres in FIBRES}
+    points = [(seed, fibres) for seed in range(1, a.seeds + 1) for fibres in FIBRES]
+    with ThreadPoolExecutor(a.workers) as pool:
+        runs = dict(zip(points, pool.map(lambda point: run(a, *point), points)))
     seeds = [s for s in range(1, a.seeds + 1) if all(runs[(s, f)] is not None for f in FIBRES)]
     if len(seeds) < a.seeds:
         print(f"left out (a run stopped): seeds {sorted(set(range(1, a.seeds + 1)) - set(seeds))}")
