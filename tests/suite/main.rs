@@ -1,10 +1,11 @@
 //! cellmd's integration tests as one binary, a module per subject (the GPU
 //! ones are `gpu` and `gpu_*`); `common` holds the helpers they share.
 //!
-//! One binary, not one per file: the 46 binaries took 190 s of a 2-core
-//! build after the library (each compiled the helpers and the generic code
-//! it instantiates again, and linked alone), this one takes 50 s; and one
-//! pool of test threads packs the long tests with the short ones.
+//! One binary, not one per file: rebuilt after a change to the library
+//! (2 cores, `cargo build --timings`), the 46 binaries took 190 s, each
+//! compiling the helpers and the generic code it instantiates again and
+//! linking alone; this one takes 50 s. One pool of test threads also packs
+//! the long tests with the short ones.
 //! `cargo test --test suite gpu_implicit::` runs one module.
 
 mod common;
