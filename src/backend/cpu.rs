@@ -110,7 +110,7 @@ impl CpuBackend {
         let pair_rule_column = model.pair_rules.iter().map(|r| pair_interactions.binary_search(&registry_index(r)).unwrap()).collect();
         let mut backend = Self {
             neighbors: NeighborList::half(model.max_pair_cutoff(), skin),
-            exclusions: Exclusions::from_pairs(model.len(), &model.excluded_pairs(state.bonds.as_ref().map(|b| b.bound.as_slice()))),
+            exclusions: pair_exclusions(model, state.bonds.as_ref().map(|b| b.bound.as_slice())),
             special: SpecialPairs::new(model, state.bonds.as_ref().map(|b| b.bound.as_slice())),
             bonded: Bonded::new(model),
             surfaces: Surfaces::new(model),
@@ -165,7 +165,7 @@ impl CpuBackend {
             return Ok(());
         }
         let bound = state.bonds.as_ref().map(|b| b.bound.as_slice());
-        self.exclusions = Exclusions::from_pairs(model.len(), &model.excluded_pairs(bound));
+        self.exclusions = pair_exclusions(model, bound);
         self.special = SpecialPairs::new(model, bound);
         self.rebuild_neighbors(state, sim_box)
     }
@@ -450,6 +450,14 @@ impl ScatterTerms<'_> {
         }
         Some((energy, virial))
     }
+}
+
+/// What the pair list leaves out: the `special_bonds` pairs along the
+/// bound bonds (`bound` = None: all), and every pair of particle types that
+/// no pair rule acts between.
+fn pair_exclusions(model: &Model, bound: Option<&[bool]>) -> Exclusions {
+    let pairs = Exclusions::from_pairs(model.len(), &model.excluded_pairs(bound));
+    pairs.with_type_pairs(&model.types, model.type_names.len(), |a, b| model.pair_rules_between(a, b).is_empty())
 }
 
 /// One external's field on each of its members (index, energy and force),

@@ -61,6 +61,13 @@
 //! gathered independently in parallel (rayon), then sorted, so the result is
 //! identical for any thread count.
 //!
+//! * **Excluded type pairs** ([`Exclusions::with_type_pairs`]): each cell is
+//!   binned by particle type too, and a particle visits only the bins of the
+//!   types it may pair with, so pairs of types no rule acts between cost
+//!   nothing (not even a distance test). The cells are then capped at
+//!   `max(8·N/types, 27)`, so the bins stay about as many as the cells
+//!   without types.
+//!
 //! # Example
 //!
 //! ```

@@ -202,7 +202,13 @@ impl NeighborList {
             self.neighbors.clear();
             self.grid = [0; 3];
         } else {
-            let grid = CellGrid::new(range, sim_box, positions);
+            if exclusions.typed_particles().is_some_and(|typed| typed != n) {
+                return Err(format!(
+                    "neighbour list: the excluded type pairs were given for {} particles, not {n}",
+                    exclusions.typed_particles().unwrap_or(0)
+                ));
+            }
+            let grid = CellGrid::new(range, sim_box, positions, exclusions);
             let chunks = grid.gather(positions, sim_box, exclusions, range * range, self.half);
             let total: usize = chunks.iter().map(|(_, entries)| entries.len()).sum();
             if total > u32::MAX as usize {
@@ -239,18 +245,22 @@ struct CellGrid {
     lo: DVec3,
     lengths: DVec3,
     periodic: [bool; 3],
-    /// Flat cell index of each particle.
-    cell_of: Vec<u32>,
-    /// CSR over cells: particles of cell `c` are `members[start[c]..start[c + 1]]`, ascending.
+    /// Particle classes binned apart ([`Exclusions::classes`]).
+    classes: usize,
+    /// Bin of each particle: its flat cell index · classes + its class.
+    bin_of: Vec<u32>,
+    /// CSR over bins: particles of class k in cell `c` are
+    /// `members[start[b]..start[b + 1]]` with b = c·classes + k, ascending.
     start: Vec<u32>,
     members: Vec<u32>,
 }
 
 impl CellGrid {
-    fn new(range: f64, sim_box: &SimBox, positions: &[DVec3]) -> Self {
+    fn new(range: f64, sim_box: &SimBox, positions: &[DVec3], exclusions: &Exclusions) -> Self {
         let n = positions.len();
         let lengths = sim_box.lengths();
-        let cap = n.saturating_mul(8).max(27);
+        // Bins are cells × classes: cap their total as the cells' alone.
+        let cap = (n.saturating_mul(8) / exclusions.classes()).max(27);
         let mut counts = [1usize; 3];
         for a in 0..3 {
             let mut max_abs = sim_box.lo[a].abs().max(sim_box.hi[a].abs());
@@ -286,25 +296,28 @@ impl CellGrid {
             lo: sim_box.lo,
             lengths,
             periodic: sim_box.periodic,
-            cell_of: Vec::new(),
+            classes: exclusions.classes(),
+            bin_of: Vec::new(),
             start: Vec::new(),
             members: Vec::new(),
         };
-        grid.cell_of = positions.par_iter().with_min_len(4096).map(|x| grid.flat(grid.coords(*x))).collect();
-        // Stable counting sort: members of a cell come out in ascending particle order.
-        let n_cells = counts[0] * counts[1] * counts[2];
-        let mut start = vec![0u32; n_cells + 1];
-        for &c in &grid.cell_of {
-            start[c as usize + 1] += 1;
+        grid.bin_of = (positions.par_iter().enumerate().with_min_len(4096))
+            .map(|(i, x)| grid.flat(grid.coords(*x)) * grid.classes as u32 + exclusions.class_of(i))
+            .collect();
+        // Stable counting sort: members of a bin come out in ascending particle order.
+        let n_bins = counts[0] * counts[1] * counts[2] * grid.classes;
+        let mut start = vec![0u32; n_bins + 1];
+        for &b in &grid.bin_of {
+            start[b as usize + 1] += 1;
         }
-        for c in 0..n_cells {
-            start[c + 1] += start[c];
+        for b in 0..n_bins {
+            start[b + 1] += start[b];
         }
         let mut fill = start.clone();
         let mut members = vec![0u32; n];
-        for (i, &c) in grid.cell_of.iter().enumerate() {
-            members[fill[c as usize] as usize] = i as u32;
-            fill[c as usize] += 1;
+        for (i, &b) in grid.bin_of.iter().enumerate() {
+            members[fill[b as usize] as usize] = i as u32;
+            fill[b as usize] += 1;
         }
         grid.start = start;
         grid.members = members;
@@ -406,17 +419,21 @@ impl CellGrid {
         let (nx, kx) = self.axis_neighbours(0, c[0]);
         let (ny, ky) = self.axis_neighbours(1, c[1]);
         let (nz, kz) = self.axis_neighbours(2, c[2]);
+        let partner_classes = exclusions.partner_classes(exclusions.class_of(i));
         for &cz in &nz[..kz] {
             for &cy in &ny[..ky] {
                 for &cx in &nx[..kx] {
                     let cell = self.flat([cx, cy, cz]) as usize;
-                    for &j in &self.members[self.start[cell] as usize..self.start[cell + 1] as usize] {
-                        if j as usize == i || (half && (j as usize) < i) {
-                            continue;
-                        }
-                        let d = images.minimum_image(positions[j as usize] - xi);
-                        if d.length_squared() < range2 && !exclusions.is_excluded(i as u32, j) {
-                            out.push(j);
+                    for &class in partner_classes {
+                        let bin = cell * self.classes + class as usize;
+                        for &j in &self.members[self.start[bin] as usize..self.start[bin + 1] as usize] {
+                            if j as usize == i || (half && (j as usize) < i) {
+                                continue;
+                            }
+                            let d = images.minimum_image(positions[j as usize] - xi);
+                            if d.length_squared() < range2 && !exclusions.is_excluded(i as u32, j) {
+                                out.push(j);
+                            }
                         }
                     }
                 }
@@ -527,6 +544,27 @@ mod tests {
         let list = assert_matches_brute_force(&x, &b, 1.0, 0.25, &ex);
         for &(i, j) in &pairs {
             assert!(!list.neighbors(i as usize).contains(&j));
+        }
+    }
+
+    /// Three types of which only (0, 1) and (2, 2) interact, with pair
+    /// exclusions too: the list is the brute-force one with both left out.
+    #[test]
+    fn matches_brute_force_with_excluded_type_pairs() {
+        let mut rng = Rng(5);
+        let b = SimBox::new(DVec3::ZERO, DVec3::new(6.0, 6.0, 6.0), [true, true, false]);
+        let x = random_positions(&mut rng, 400, b.lo, b.hi);
+        let types: Vec<u32> = (0..400).map(|_| rng.below(3) as u32).collect();
+        let pairs: Vec<(u32, u32)> = (0..399).map(|i| (i, i + 1)).collect();
+        let ex = Exclusions::from_pairs(400, &pairs).with_type_pairs(&types, 3, |a, b| !matches!((a, b), (0, 1) | (2, 2)));
+        let list = assert_matches_brute_force(&x, &b, 1.0, 0.25, &ex);
+        let unfiltered = assert_matches_brute_force(&x, &b, 1.0, 0.25, &Exclusions::from_pairs(400, &pairs));
+        assert!(list.num_pairs() > 100 && 2 * list.num_pairs() < unfiltered.num_pairs(), "{} of {}", list.num_pairs(), unfiltered.num_pairs());
+        for i in 0..400 {
+            for &j in list.neighbors(i) {
+                let t = [types[i], types[j as usize]];
+                assert!(matches!(t, [0, 1] | [1, 0] | [2, 2]), "pair {i}-{j} of types {t:?}");
+            }
         }
     }
 
