@@ -90,16 +90,20 @@ pub struct FireReport {
     pub clamped: u64,
 }
 
-/// Minimises with FIRE. `evaluate` fills the forces at a state, and the
-/// per-particle step limits if the model has any (else leaves them empty),
-/// and returns the energy.
+/// Minimises with FIRE. `evaluate(state, f, limits, energy)` fills the
+/// forces at a state, and the per-particle step limits if the model has any
+/// (else leaves them empty), and returns the energy when `energy` is true
+/// (anything otherwise). FIRE's moves need only forces, so the energy is
+/// asked for once, at the state returned (its forces evaluated again: the
+/// same bits, an evaluation with energies giving the forces one without
+/// gives).
 pub fn fire_minimize<E>(
     state: &mut State,
     sim_box: &SimBox,
     mass: &[f64],
     ctx: &StepContext,
     settings: &FireSettings,
-    mut evaluate: impl FnMut(&State, &mut Vec<DVec3>, &mut Vec<f64>) -> Result<f64, E>,
+    mut evaluate: impl FnMut(&State, &mut Vec<DVec3>, &mut Vec<f64>, bool) -> Result<f64, E>,
 ) -> Result<FireReport, E> {
     let n = state.len();
     let mut v = vec![DVec3::ZERO; n];
@@ -110,10 +114,11 @@ pub fn fire_minimize<E>(
     let (mut iterations, mut clamped) = (0, 0);
     loop {
         limits.clear();
-        let energy = evaluate(state, &mut f, &mut limits)?;
+        evaluate(state, &mut f, &mut limits, false)?;
         zero_fixed_forces(&mut f, mass);
         let max_force = max_residual_force(&f, mass);
         if max_force < settings.ftol || iterations >= settings.max_iterations {
+            let energy = evaluate(state, &mut f, &mut limits, true)?;
             return Ok(FireReport { converged: max_force < settings.ftol, iterations, energy, max_force, clamped });
         }
         iterations += 1;
@@ -169,7 +174,7 @@ mod tests {
             &[1e-3, 1e-3],
             &timestep(1e-3),
             &FireSettings { ftol: 1e-8, ..Default::default() },
-            |s, f, _| {
+            |s, f, _, _| {
                 f.clear();
                 f.extend(s.positions.iter().map(|x| -k * *x));
                 Ok(s.positions.iter().map(|x| 0.5 * (k * *x).dot(*x)).sum())
@@ -188,7 +193,7 @@ mod tests {
         let mut state = State::new(vec![DVec3::new(3.0, 0.0, 0.0)]);
         let mut lowest = f64::INFINITY;
         let settings = FireSettings { ftol: 1e-12, max_iterations: 60, dmax: 0.5, ..Default::default() };
-        let report = fire_minimize::<()>(&mut state, &sim_box, &[1.0], &timestep(0.1), &settings, |s, f, limits| {
+        let report = fire_minimize::<()>(&mut state, &sim_box, &[1.0], &timestep(0.1), &settings, |s, f, limits, _| {
             lowest = lowest.min(s.positions[0].x);
             f.clear();
             f.push(DVec3::new(-1.0, 0.0, 0.0));
@@ -209,7 +214,7 @@ mod tests {
         let mut state = State::new(vec![DVec3::ZERO, DVec3::new(1.5, 0.2, 0.0)]);
         let (k, pull) = (4.0, DVec3::new(2.0, 0.0, 0.0));
         let settings = FireSettings { ftol: 1e-10, ..Default::default() };
-        let report = fire_minimize::<()>(&mut state, &sim_box, &[f64::INFINITY, 1e-2], &timestep(1e-2), &settings, |s, f, _| {
+        let report = fire_minimize::<()>(&mut state, &sim_box, &[f64::INFINITY, 1e-2], &timestep(1e-2), &settings, |s, f, _, _| {
             let d = s.positions[1] - s.positions[0];
             let spring = -k * (d.length() - 1.0) * d.normalize();
             f.clear();

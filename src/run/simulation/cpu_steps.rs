@@ -206,8 +206,8 @@ impl Simulation {
         let mut state = self.state.clone();
         let backend = self.cpu.get(&self.model, &self.state, &self.sim_box, self.neighbor.skin)?;
         let (model, sim_box, forces, protocols) = (&self.model, &self.sim_box, &mut self.forces, &self.protocols);
-        let report = fire_minimize(&mut state, sim_box, &mass, &ctx, settings, |s, f, limits| {
-            minimizer_forces(backend, model, sim_box, protocols, forces, s, f, limits)
+        let report = fire_minimize(&mut state, sim_box, &mass, &ctx, settings, |s, f, limits, energy| {
+            minimizer_forces(backend, model, sim_box, protocols, forces, s, f, limits, energy)
         })?;
         self.state = state;
         self.forces_current = true;
@@ -230,7 +230,7 @@ impl Simulation {
             &mass,
             &held,
             settings,
-            |s, f, limits| minimizer_forces(&mut backend.borrow_mut(), model, sim_box, protocols, forces, s, f, limits),
+            |s, f, limits| minimizer_forces(&mut backend.borrow_mut(), model, sim_box, protocols, forces, s, f, limits, true),
             |s| backend.borrow().stiffness(model, s, sim_box),
             |why| RunError::Setup(format!("minimize style newton: {why}")),
         )?;
@@ -244,7 +244,8 @@ impl Simulation {
 /// A minimiser's evaluation at state `s` on the CPU backend: the neighbour
 /// list and contacts brought up to date, the forces into `forces` and, with
 /// the protocols' held coordinates masked to 0, into `f`, the contact step
-/// limits into `limits`; returns the energy.
+/// limits into `limits`. With `energy`, energies and the virial too, and
+/// returns the energy; else NaN (the forces alone cost less).
 #[allow(clippy::too_many_arguments)]
 fn minimizer_forces(
     backend: &mut CpuBackend,
@@ -255,12 +256,17 @@ fn minimizer_forces(
     s: &State,
     f: &mut Vec<DVec3>,
     limits: &mut Vec<f64>,
+    energy: bool,
 ) -> Result<f64, RunError> {
     backend.update_neighbors(s, sim_box, true).map_err(RunError::Setup)?;
     backend.update_contacts(model, s, sim_box).map_err(RunError::Setup)?;
-    backend.compute(model, s, sim_box, forces);
+    if energy {
+        backend.compute(model, s, sim_box, forces);
+    } else {
+        backend.compute_forces(model, s, sim_box, forces);
+    }
     backend.contact_step_limits(s.len(), limits);
     f.clone_from(&forces.forces);
     protocols.mask(f);
-    Ok(forces.total_energy())
+    Ok(if energy { forces.total_energy() } else { f64::NAN })
 }
