@@ -45,7 +45,6 @@ use super::surface::Surfaces;
 use super::virial::add6;
 use crate::interactions::{Kind, RadialLaw, REGISTRY};
 use crate::neighbor::{Exclusions, NeighborList};
-use crate::system::BondState;
 use crate::system::{registry_index, External, Model, SimBox, State};
 
 /// Result of a force evaluation.
@@ -268,6 +267,7 @@ impl CpuBackend {
             self.pairs.update(model, &self.pair_rule_column);
         }
         self.bonded.resolve_laws(model);
+        self.bonded.gather_state(state.bonds.as_ref());
         self.surfaces.prepare(model, x, &images);
         self.contacts.prepare(model, x, &images);
         let bond_state = state.bonds.as_ref();
@@ -279,7 +279,7 @@ impl CpuBackend {
         let geometry = PairGeometry { x, types: &model.types, list: &self.neighbors, images };
         out.forces.resize(n, DVec3::ZERO);
         let scattered = has_pairs || !model.bonds.is_empty() || !model.angles.is_empty() || !model.tetras.is_empty();
-        let terms = ScatterTerms { pairs: has_pairs.then_some(pairs), geometry: &geometry, bonded, model, bond_state };
+        let terms = ScatterTerms { pairs: has_pairs.then_some(pairs), geometry: &geometry, bonded, model };
         let columns = self.pair_interactions.len();
         let pair_energy = match (scattered, energies) {
             (false, _) => None,
@@ -413,7 +413,6 @@ struct ScatterTerms<'a> {
     geometry: &'a PairGeometry<'a>,
     bonded: &'a Bonded,
     model: &'a Model,
-    bond_state: Option<&'a BondState>,
 }
 
 impl ScatterTerms<'_> {
@@ -429,7 +428,7 @@ impl ScatterTerms<'_> {
                 if let Some(pairs) = self.pairs {
                     pairs.row_forces::<ENERGY>(i, self.geometry, &mut near, energy, virial, |j, f| scatter.pair(i, j, f));
                 }
-                self.bonded.row_bonds(i, self.model, x, images, self.bond_state, |j, f| scatter.pair(i, j, f));
+                self.bonded.row_bonds(i, self.model, x, images, |j, f| scatter.pair(i, j, f));
                 self.bonded.row_angles(i, self.model, x, images, |p, f| scatter.add(p, f));
                 self.bonded.row_tetras(i, self.model, x, images, |p, f| scatter.add(p, f));
             }
