@@ -2,6 +2,7 @@
 
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use glam::DVec3;
 
@@ -31,13 +32,15 @@ pub(super) struct Validator {
     deck_dir: PathBuf,
     pub(super) vars: Variables,
     units: UnitSystem,
-    topology: Option<Topology>,
+    /// Shared, as the system below: a branch is validated on a copy of the
+    /// validator, which must not copy a 10⁵-term system each time.
+    topology: Option<Arc<Topology>>,
     forcefield: ForceField,
     forcefield_seen: bool,
     box_axes: Option<[BoxAxis; 3]>,
     special_bonds: SpecialBonds,
     /// The system as first built (the plan's starting point).
-    initial_model: Option<Model>,
+    initial_model: Option<Arc<Model>>,
     /// A working copy that `coeff` edits, so each edit is validated against
     /// the parameter values in force at that point of the deck.
     model: Option<Model>,
@@ -186,7 +189,7 @@ impl Validator {
             self.positions = topology.positions.clone();
             self.sim_box = Some(sim_box);
             self.groups.insert("all".into(), Group { name: "all".into(), members: (0..model.len() as u32).collect() });
-            self.initial_model = Some(model.clone());
+            self.initial_model = Some(Arc::new(model.clone()));
             self.model = Some(model);
         }
         Ok(self.model.as_mut().unwrap())
@@ -231,7 +234,7 @@ pub(super) fn validate_in(v: &mut Validator, file: &std::sync::Arc<SourceFile>) 
     v.warnings.extend(crate::system::custom_warnings(model, &externals, &v.positions, sim_box));
     Ok(Plan {
         deck_path: PathBuf::from(&file.path),
-        model: v.initial_model.take().expect("built above"),
+        model: Arc::unwrap_or_clone(v.initial_model.take().expect("built above")),
         sim_box: v.sim_box.expect("built with the model"),
         // Kept by the validator too: commands validated later (an `OpenDeck`) check
         // expressions at the initial positions.

@@ -1,6 +1,8 @@
 //! `topology FILE [offset auto|N]`, repeatable: the deck's system is the
 //! topologies in order, composed by [`Topology::append`]'s rule.
 
+use std::sync::Arc;
+
 use super::{expect_len, options, Validator};
 use crate::input::{parse_u64, InputError, SourceFile, Token};
 use crate::topology::parse_topology;
@@ -17,10 +19,10 @@ impl Validator {
         let parsed = parse_topology(&file)?;
         let mut top = match self.topology.take() {
             None if offset.unwrap_or(0) == 0 => {
-                self.topology = Some(parsed);
+                self.topology = Some(Arc::new(parsed));
                 return Ok(());
             }
-            previous => previous.unwrap_or_default(),
+            previous => previous.map(Arc::unwrap_or_clone).unwrap_or_default(),
         };
         top.append_at(parsed, offset).map_err(|c| {
             s[1].error(format!(
@@ -28,7 +30,7 @@ impl Validator {
                 c.id, s[1].text, c.offset, c.used
             ))
         })?;
-        self.topology = Some(top);
+        self.topology = Some(Arc::new(top));
         Ok(())
     }
 }
