@@ -62,7 +62,7 @@ pub(super) struct Bonded {
     /// type. The bond arrays are in the topology's order, which a row visits
     /// at scattered indices (a builder writes a shell's edges face by face);
     /// read there, their cache misses cost more than the laws: FIRE on the
-    /// level-5 tensegrity cell (23 803 particles, 128 093 bonds) took 26 s
+    /// level-5 tensegrity cell (23 803 particles, 128 091 bonds) took 26 s
     /// for 1 000 iterations with them, 20 s from the slots (one thread).
     slot_other: Vec<u32>,
     slot_type: Vec<u32>,
