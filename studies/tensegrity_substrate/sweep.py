@@ -28,6 +28,9 @@ style newton`, sparse Cholesky) instead of FIRE: at level 2 the whole
 protocol takes 523 iterations instead of FIRE's 35 488 (4.1 s against 10.0 s);
 at level 5 it is slower than FIRE (README, *Dynamics*).
 `--jobs N` runs the curvature points N at a time (each on one thread).
+The study resumes: a run whose `finished` file names the same variables is
+read, not run again, so a long sweep (level 5: up to ~40 CPU-minutes a run,
+nine runs) can be stopped and started again with the same command.
 """
 
 import argparse
@@ -72,7 +75,14 @@ def run(cellmd, top, out, curvature, volumes, device=None, **variables):
               "curvature": 0 if flat else float(curvature), "zc": -1000 if flat else bottom + float(curvature)}
     values.update(variables)
     out.mkdir(parents=True, exist_ok=True)
-    run_deck(cellmd, DECK, out, values, device)
+    # A finished run leaves `finished` holding its variables; a second call
+    # with the same ones reads its outputs instead of running it again.
+    finished = out / "finished"
+    said = "".join(f"{k}={values[k]}\n" for k in sorted(values)) + f"device={device}\n"
+    if not (finished.exists() and finished.read_text() == said):
+        finished.unlink(missing_ok=True)
+        run_deck(cellmd, DECK, out, values, device)
+        finished.write_text(said)
     phases = {}
     for phase in ["spread", "contract", "indentation"]:
         path = out / f"tensegrity_{phase}.thermo.csv"
