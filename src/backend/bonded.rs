@@ -75,7 +75,8 @@ pub(super) struct Bonded {
     /// Evaluator and force-only evaluator per bond type, re-resolved every evaluation.
     bond_laws: Vec<(RadialEval, RadialForce)>,
     /// Parameters per bond type, likewise, in a fixed-size array a bond with
-    /// its own rest length copies whole (no call to copy a slice).
+    /// its own rest length copies whole (no call to copy a slice); a custom
+    /// law with more parameters copies its own.
     bond_params: Vec<TypeParams>,
     /// Evaluator per angle type, likewise.
     angle_laws: Vec<ThreeBodyEval>,
@@ -115,8 +116,11 @@ impl Bonded {
         self.bond_params.clear();
         self.bond_params.extend(model.bond_types.iter().zip(&model.bond_kinetics).map(|(t, kinetics)| {
             let mut values = [0.0; MAX_BOND_PARAMS];
-            values[..t.params.len()].copy_from_slice(&t.params);
-            TypeParams { values, len: t.params.len(), rest_index: kinetics.rest_index }
+            let fits = t.params.len() <= MAX_BOND_PARAMS;
+            if fits {
+                values[..t.params.len()].copy_from_slice(&t.params);
+            }
+            TypeParams { values: fits.then_some(values), len: t.params.len(), rest_index: kinetics.rest_index }
         }));
         self.angle_laws.clear();
         self.angle_laws.extend(model.angle_types.iter().map(|t| t.law.0));
@@ -126,15 +130,25 @@ impl Bonded {
     /// length, if its type's law has one), and the stiffness scale to apply
     /// to the result; `None` when it is unbound.
     #[inline(always)]
-    fn with_state<R>(&self, t: usize, slot: SlotState, law: impl FnOnce(&[f64]) -> R) -> Option<(R, f64)> {
+    fn with_state<R>(&self, t: usize, model: &Model, slot: SlotState, law: impl FnOnce(&[f64]) -> R) -> Option<(R, f64)> {
         if !slot.bound {
             return None;
         }
-        let TypeParams { mut values, len, rest_index } = self.bond_params[t];
-        if let (Some(k), Some(rest)) = (rest_index, slot.rest) {
-            values[k] = rest;
-        }
-        Some((law(&values[..len]), slot.scale))
+        let params = &model.bond_types[t].params;
+        let out = match (&self.bond_params[t], slot.rest) {
+            (&TypeParams { values: Some(mut values), len, rest_index: Some(k) }, Some(rest)) => {
+                values[k] = rest;
+                law(&values[..len])
+            }
+            (&TypeParams { values: None, rest_index: Some(k), .. }, Some(rest)) => {
+                // A custom law with more parameters than the array holds.
+                let mut own = params.clone();
+                own[k] = rest;
+                law(&own)
+            }
+            _ => law(params),
+        };
+        Some((out, slot.scale))
     }
 
     /// Copies each bond's state into its slot (row order) for the rows'
@@ -146,7 +160,7 @@ impl Bonded {
             self.slot_state.clear();
             return;
         };
-        self.slot_state.resize(self.owned_bonds.len(), SlotState::of(s, 0));
+        self.slot_state.resize(self.owned_bonds.len(), SlotState { bound: false, rest: None, scale: 0.0 });
         (self.slot_state.par_iter_mut().zip(self.owned_bonds.par_iter()).with_min_len(4096))
             .for_each(|(slot, &b)| *slot = SlotState::of(s, b as usize));
     }
@@ -165,7 +179,7 @@ impl Bonded {
     ) -> Option<(R, f64)> {
         match state {
             None => Some((law(&model.bond_types[t].params), 1.0)),
-            Some(s) => self.with_state(t, SlotState::of(s, b), law),
+            Some(s) => self.with_state(t, model, SlotState::of(s, b), law),
         }
     }
 
@@ -196,7 +210,7 @@ impl Bonded {
             let law = |p: &[f64]| (self.bond_laws[t].1)(p, r2);
             let out = match self.slot_state.get(k) {
                 None => Some((law(&model.bond_types[t].params), 1.0)),
-                Some(&slot) => self.with_state(t, slot, law),
+                Some(&slot) => self.with_state(t, model, slot, law),
             };
             let f = match out {
                 Some((over_r, scale)) if over_r != 0.0 => d * (over_r * scale),
@@ -383,7 +397,8 @@ impl SlotState {
 /// A bond type's parameters ([`Bonded::resolve_laws`]).
 #[derive(Clone, Copy)]
 struct TypeParams {
-    values: [f64; MAX_BOND_PARAMS],
+    /// The values (None when a custom law has more than the array holds).
+    values: Option<[f64; MAX_BOND_PARAMS]>,
     len: usize,
     /// Which of them is the rest length a bond may have its own value of.
     rest_index: Option<usize>,
