@@ -12,7 +12,8 @@ Vassaux & Milan 2017), with inputs/tensegrity_substrate.in.
    indented by a rigid 2.5 µm sphere; the relaxed load against the travel
    since contact is the force-depth curve.
 3. Curvature sweep: the calibrated cell spread to F_sprd on substrates of
-   curvature radius ±75, ±150, ±500 µm and flat, then contracted; nucleus
+   curvature radius ±75, ±150, ±500 µm and flat (the check's own run),
+   then contracted; nucleus
    volumetric and vertical strain, summed stress-fibre tension (per fibre,
    the mean over its cables, summed over fibres) and mean cortex-cable
    tension against 1/R.
@@ -27,10 +28,11 @@ reduced case).
 style newton`, sparse Cholesky) instead of FIRE: at level 2 the whole
 protocol takes 523 iterations instead of FIRE's 35 488 (4.1 s against 10.0 s);
 at level 5 it is slower than FIRE (README, *Dynamics*).
-`--jobs N` runs the curvature points N at a time (each on one thread).
+`--jobs N` runs N points at a time (each on one thread); the check runs
+beside the curved points, and the flat point reuses it.
 The study resumes: a run whose `finished` file names the same variables is
 read, not run again, so a long sweep (level 5: up to ~40 CPU-minutes a run,
-nine runs) can be stopped and started again with the same command.
+eight runs) can be stopped and started again with the same command.
 """
 
 import argparse
@@ -66,12 +68,13 @@ def build(cellmd, level, curvature, path):
     return volumes[0], volumes[1], bottom
 
 
-def run(cellmd, top, out, curvature, volumes, device=None, **variables):
-    """Runs the deck on one topology (on `device`: cpu, gpu or auto; the
-    deck's own setting if None); returns the rows of its thermo files, by phase."""
+def run(cellmd, top, out, curvature, volumes, level, device=None, **variables):
+    """Runs the deck on one topology of `level` (the deck shortens its
+    explicit step on finer meshes) on `device` (cpu, gpu or auto; the deck's
+    own setting if None); returns the rows of its thermo files, by phase."""
     v_cell, v_nucleus, bottom = volumes
     flat = curvature == "flat"
-    values = {"topology": top, "v0_cell": v_cell, "v0_nucleus": v_nucleus, "c": 0 if flat else 1,
+    values = {"topology": top, "level": level, "v0_cell": v_cell, "v0_nucleus": v_nucleus, "c": 0 if flat else 1,
               "curvature": 0 if flat else float(curvature), "zc": -1000 if flat else bottom + float(curvature)}
     values.update(variables)
     out.mkdir(parents=True, exist_ok=True)
@@ -135,13 +138,27 @@ def main():
 
     top, volumes = tops["flat"]
     style = {"min_style": args.min_style}
-    raw = run(args.cellmd, top, out / "calibrate", "flat", volumes, args.device, scale=1, spread_area=AREA, steps=0, **style)
+    raw = run(args.cellmd, top, out / "calibrate", "flat", volumes, args.level, args.device, scale=1, spread_area=AREA, steps=0, **style)
     force = crossing(raw["spread"], "hullarea/cortex", AREA, "fabs/fa")
     scale = F_SPRD / force
     print(f"calibration: Σ|f| = {force:.1f} pN at {AREA} µm² with unit stiffnesses; scale {scale:.4f}", file=sys.stderr)
 
-    checked = run(args.cellmd, top, out / "indent", "flat", volumes, args.device, scale=scale, f_sprd=F_SPRD,
-                  indent_stages=args.indent_stages, **style)
+    def check():
+        return run(args.cellmd, top, out / "indent", "flat", volumes, args.level, args.device, scale=scale, f_sprd=F_SPRD,
+                   indent_stages=args.indent_stages, **style)
+
+    def point(curvature):
+        top, volumes = tops[curvature]
+        return run(args.cellmd, top, out / f"R_{curvature}", curvature, volumes, args.level, args.device, scale=scale, f_sprd=F_SPRD, **style)
+
+    # The check runs beside the curved points; the flat point is the check's
+    # own spreading and contraction (the deck is the same up to the indentation).
+    with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
+        checking = pool.submit(check)
+        curved = {c: pool.submit(point, c) for c in CURVATURES if c != "flat"}
+        checked = checking.result()
+        points = [checked if c == "flat" else curved[c].result() for c in CURVATURES]
+
     area = crossing(checked["spread"], "fabs/fa", F_SPRD, "hullarea/cortex")
     with open(out / "calibration.csv", "w", newline="") as f:
         w = csv.writer(f)
@@ -160,12 +177,6 @@ def main():
         for n, r in enumerate(r for r in rows if r["time"] >= t_contact):
             w.writerow([f"{n * indent_step:.3f}", f"{r['load/tip']:.6g}", f"{r['depth/tip']:.6g}"])
 
-    def point(curvature):
-        top, volumes = tops[curvature]
-        return run(args.cellmd, top, out / f"R_{curvature}", curvature, volumes, args.device, scale=scale, f_sprd=F_SPRD, **style)
-
-    with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
-        points = list(pool.map(point, CURVATURES))
     with open(out / "curvature.csv", "w", newline="") as f:
         w = None
         for curvature, phases in zip(CURVATURES, points):
