@@ -156,6 +156,14 @@ def main():
     with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
         checking = pool.submit(check)
         curved = {c: pool.submit(point, c) for c in CURVATURES if c != "flat"}
+        # A run that fails (a blow-up) stops the sweep: the runs not yet
+        # started are cancelled, the one still running is waited for.
+        runs = [checking, *curved.values()]
+        concurrent.futures.wait(runs, return_when=concurrent.futures.FIRST_EXCEPTION)
+        failed = [r.exception() for r in runs if r.done() and not r.cancelled() and r.exception()]
+        if failed:
+            pool.shutdown(cancel_futures=True)
+            raise failed[0]
         checked = checking.result()
         points = [checked if c == "flat" else curved[c].result() for c in CURVATURES]
 
