@@ -9,7 +9,7 @@ Vassaux & Milan 2017), with inputs/tensegrity_substrate.in.
    force is proportional to the common stiffness scale).
 2. Check and indent: the calibrated cell spread on the flat substrate to
    F_sprd = 47.15 nN (its footprint at F_sprd is reported), contracted, then
-   indented by a rigid 2.5 µm sphere; the relaxed load against the travel
+   indented by a rigid sphere of radius 5 µm; the relaxed load against the travel
    since contact is the force-depth curve.
 3. Curvature sweep: the calibrated cell spread to F_sprd on substrates of
    curvature radius ±75, ±150, ±500 µm and flat (the check's own run),
@@ -31,8 +31,9 @@ at level 5 it is slower than FIRE (README, *Dynamics*).
 `--jobs N` runs N points at a time (each on one thread); the check runs
 beside the curved points, and the flat point reuses it.
 The study resumes: a run whose `finished` file names the same variables is
-read, not run again, so a long sweep (level 5: up to ~40 CPU-minutes a run,
-eight runs) can be stopped and started again with the same command.
+read, not run again, so a long sweep (level 5: 40 min on 2 cores, the
+calibration 17 of them; README) can be stopped and started again with the
+same command.
 """
 
 import argparse
