@@ -12,11 +12,10 @@ Vassaux & Milan 2017), with inputs/tensegrity_substrate.in.
    indented by a rigid sphere of radius 5 µm; the relaxed load against the travel
    since contact is the force-depth curve.
 3. Curvature sweep: the calibrated cell spread to F_sprd on substrates of
-   curvature radius ±75, ±150, ±500 µm and flat (the check's own run),
-   then contracted; nucleus
-   volumetric and vertical strain, summed stress-fibre tension (per fibre,
-   the mean over its cables, summed over fibres) and mean cortex-cable
-   tension against 1/R.
+   curvature radius ±75, ±150, ±500 µm and flat (the check's own run), then
+   contracted; nucleus volumetric and vertical strain, summed stress-fibre
+   tension (per fibre, the mean over its cables, summed over fibres) and
+   summed cortex-cable tension against 1/R.
 
 Writes OUT/calibration.csv, OUT/indentation.csv, OUT/curvature.csv and, with
 plot.py, the PNGs. Not part of CI (tests/suite/tensegrity_substrate.rs runs a
@@ -176,8 +175,10 @@ def main():
     print(f"check: the calibrated cell reaches {F_SPRD} pN at a footprint of {area:.1f} µm²", file=sys.stderr)
 
     rows = checked["indentation"]
-    # The approach ends on the first row loaded to 1 pN; after it every
-    # (relaxed) row ends one stage of the deck's indent_step.
+    # Travel counts from the first relaxed row loaded to 1 pN (the
+    # approach's own relaxation may leave the tip free: at level 5 the cell
+    # draws back for two stages); after it every relaxed row ends one stage
+    # of the deck's indent_step.
     t_contact = next(r["time"] for r in rows if r["load/tip"] >= 1.0)
     indent_step = 0.2  # µm, the deck's default
     with open(out / "indentation.csv", "w", newline="") as f:
