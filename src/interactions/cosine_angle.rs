@@ -33,8 +33,15 @@ interaction!(
     Kind::Angle,
     "Cosine angle E = K[1 + cos θ] (LAMMPS angle_style cosine)",
     Law::ThreeBody(eval),
-    lammps = lammps
+    lammps = lammps,
+    fibre_bending = strength
 );
+
+/// The fibre-bending strength: K(1 + cos θ) = K(1 − t₁·t₂), since the
+/// vertex angle's cosine is −t₁·t₂ for the tangents along the chain.
+fn strength(p: &[f64]) -> f64 {
+    p[K]
+}
 
 #[cfg(test)]
 mod tests {

@@ -51,7 +51,7 @@ use crate::units::Dim;
 /// one-line summary, the module's `PARAMS` schema, its law, and optionally a
 /// `validate` function and a `lammps` translation ([`Interaction::lammps`]).
 macro_rules! interaction {
-    ($ty:ident, $name:literal, $kind:expr, $summary:literal, $law:expr $(, validate = $validate:path)? $(, lammps = $lammps:path)?) => {
+    ($ty:ident, $name:literal, $kind:expr, $summary:literal, $law:expr $(, validate = $validate:path)? $(, lammps = $lammps:path)? $(, fibre_bending = $bending:path)?) => {
         $crate::interactions::entry!($ty, $name, $kind.keyword(), $summary $(, validate = $validate)?);
 
         impl $crate::interactions::Interaction for $ty {
@@ -63,6 +63,9 @@ macro_rules! interaction {
             }
             $(fn lammps(&self, term: &$crate::interactions::lammps::LammpsTerm) -> $crate::interactions::lammps::Translation {
                 $lammps(term)
+            })?
+            $(fn fibre_bending(&self, params: &[f64]) -> Option<f64> {
+                Some($bending(params))
             })?
         }
     };
@@ -596,6 +599,13 @@ pub trait Interaction: Entry {
     /// How LAMMPS writes a term of this type (module [`lammps`]); `None`
     /// (the default) when it has no equivalent.
     fn lammps(&self, _term: &lammps::LammpsTerm) -> lammps::Translation {
+        None
+    }
+    /// For an angle law of the fibre-bending form E = s·(1 − t₁·t₂) (t₁, t₂
+    /// the unit tangents of the two arms, in chain order): s, so that the
+    /// fibre solver (`integrate::fibre`) can carry the joint in a fibre's
+    /// banded block; `None` (the default) for every other law.
+    fn fibre_bending(&self, _params: &[f64]) -> Option<f64> {
         None
     }
 }

@@ -15,7 +15,7 @@ static PARAMS: [ParamSpec; 2] = [
 ];
 
 fn eval(p: &[f64], [ri, rj, rk]: [DVec3; 3]) -> ThreeBody {
-    let strength = p[KAPPA] / p[L0];
+    let strength = strength(p);
     let a = rj - ri;
     let b = rk - rj;
     let (la, lb) = (a.length(), b.length());
@@ -42,8 +42,14 @@ interaction!(
     Kind::Angle,
     "Discrete worm-like-chain bending E = (κ/ℓ)(1 − t1·t2) (Cytosim)",
     Law::ThreeBody(eval),
-    lammps = lammps
+    lammps = lammps,
+    fibre_bending = strength
 );
+
+/// The fibre-bending strength s = κ/ℓ of E = s·(1 − t₁·t₂).
+fn strength(p: &[f64]) -> f64 {
+    p[KAPPA] / p[L0]
+}
 
 #[cfg(test)]
 mod tests {
