@@ -100,18 +100,25 @@ impl CpuBackend {
     /// K̃ at `state` (neighbour list, contact candidates and surface positions
     /// as at the last force evaluation).
     pub fn stiffness(&self, model: &Model, state: &State, sim_box: &SimBox) -> Stiffness {
+        self.stiffness_except(model, state, sim_box, &[], &[])
+    }
+
+    /// K̃ without the bonds and angles marked in `owned_bonds` and
+    /// `owned_angles` (those whose stiffness a fibre's banded block carries,
+    /// `integrate::fibre`; an empty slice owns none).
+    pub fn stiffness_except(&self, model: &Model, state: &State, sim_box: &SimBox, owned_bonds: &[bool], owned_angles: &[bool]) -> Stiffness {
         let x = &state.positions;
         let images: Images = sim_box.images();
-        let bond_state = state.bonds.as_ref();
         let mut blocks = Vec::new();
         for (b, &[i, j]) in model.bonds.iter().enumerate() {
-            let d = images.minimum_image(x[j as usize] - x[i as usize]);
-            let r = d.length();
-            if let Some(radial) = self.bonded().bond_radial(b, model.bond_type[b] as usize, r, model, bond_state) {
-                push_pair(&mut blocks, i, j, radial_block(&radial, d, r));
+            if owned_bonds.get(b).copied().unwrap_or(false) {
+                continue;
+            }
+            if let Some(block) = self.bond_block(b, model, state, &images) {
+                push_pair(&mut blocks, i, j, block);
             }
         }
-        for a in 0..model.angles.len() {
+        for a in (0..model.angles.len()).filter(|&a| !owned_angles.get(a).copied().unwrap_or(false)) {
             let (at, _) = eval_angle(model, a, x, &images);
             let term = &model.angle_types[model.angle_type[a] as usize];
             let AngleLaw(eval) = term.law;
@@ -154,6 +161,16 @@ impl CpuBackend {
         }
         let rank_one = self.surfaces().stiffness(model, &mut blocks);
         Stiffness { blocks, rank_one }
+    }
+}
+
+impl CpuBackend {
+    /// The projected radial block of bond `b` at `state` (`None` for an unbound bond).
+    pub fn bond_block(&self, b: usize, model: &Model, state: &State, images: &Images) -> Option<DMat3> {
+        let [i, j] = model.bonds[b];
+        let d = images.minimum_image(state.positions[j as usize] - state.positions[i as usize]);
+        let r = d.length();
+        self.bonded().bond_radial(b, model.bond_type[b] as usize, r, model, state.bonds.as_ref()).map(|radial| radial_block(&radial, d, r))
     }
 }
 

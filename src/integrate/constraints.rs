@@ -15,12 +15,20 @@
 //! `ctension/TYPE`). The force of the bond's own law still acts (it vanishes
 //! at r0 for harmonic-like laws).
 //!
+//! Constraints that form fibres — linear chains, the filaments of
+//! Cytosim — are not swept: each chain is solved exactly by the fibre
+//! solver ([`super::fibre`]), whose step keeps the lengths to first order
+//! and whose reshape restores them to the tolerance by Newton's method on
+//! one multiplier per segment. SHAKE handles the rest (branched or
+//! crosslinked constraint graphs).
+//!
 //! The GPU backend projects on the device with the same equation, the
 //! constraints swept colour by colour (src/gpu/shake.rs).
 
 use glam::DVec3;
 
 use super::context::StepContext;
+use super::fibre::{FibreInputs, Fibres};
 use crate::system::{Model, SimBox, State};
 
 /// One constrained bond.
@@ -31,7 +39,7 @@ pub struct Constraint {
 }
 
 /// The constrained bonds with their settings and last tensions.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Constraints {
     pub list: Vec<Constraint>,
     /// Largest |r − r0|/r0 accepted.
@@ -39,8 +47,22 @@ pub struct Constraints {
     pub max_iterations: usize,
     /// Tension of each constraint over the last step (force units).
     pub tension: Vec<f64>,
-    /// Sweeps the last projection took.
+    /// Sweeps (or, on fibres, Newton iterations) the last projection took.
     pub iterations: usize,
+    /// How chains of constraints are solved (`constrain … method`).
+    pub method: ConstraintMethod,
+    /// The chains among the constraints and their solver.
+    pub fibres: Fibres,
+}
+
+/// How constrained chains are solved (`constrain … method fibre|shake`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ConstraintMethod {
+    /// Fibre by fibre, with their bending implicit ([`super::fibre`]); SHAKE for the rest.
+    #[default]
+    Fibre,
+    /// Every constraint by SHAKE after the step (the GPU's projection).
+    Shake,
 }
 
 /// The message of a projection that failed at `step`: the constraint's
@@ -60,7 +82,36 @@ pub struct ConstraintFailure {
     pub relative_error: f64,
 }
 
+impl Default for Constraints {
+    fn default() -> Self {
+        Self { list: Vec::new(), tolerance: 1e-10, max_iterations: 1000, tension: Vec::new(), iterations: 0, method: ConstraintMethod::Fibre, fibres: Fibres::default() }
+    }
+}
+
 impl Constraints {
+    /// The fibre solver with the chains of the current list (found again
+    /// when the list changed); with `elastic`, also the elastic chains.
+    pub fn fibres(&mut self, model: &Model, elastic: bool) -> &mut Fibres {
+        self.fibres.prepare(model, self.list.iter().map(|c| c.bond), self.method == ConstraintMethod::Fibre, elastic);
+        &mut self.fibres
+    }
+
+    /// Moves `state` onto the constraint lengths at once (`constrain …
+    /// reshape yes`): the fibres' projection and SHAKE from the current
+    /// positions, each particle weighted by its mobility.
+    pub fn reshape_now(&mut self, model: &Model, state: &mut State, sim_box: &SimBox) -> Result<(), ConstraintFailure> {
+        let images = sim_box.images();
+        self.fibres.prepare(model, self.list.iter().map(|c| c.bond), self.method == ConstraintMethod::Fibre, false);
+        let list = &self.list;
+        let length = |k: usize| list[k].length;
+        let inputs = FibreInputs { model, positions: &state.positions, images: &images, constraint_length: &length, held: &[], bond_block: None };
+        self.fibres.load(&inputs);
+        let before = state.positions.clone();
+        let projected = self.project(model, &before, state, sim_box, &StepContext { dt: 1.0, ..Default::default() });
+        self.tension.clear();
+        projected
+    }
+
     /// The particles of each constrained bond, in list order.
     pub fn pairs(&self, model: &Model) -> Vec<[u32; 2]> {
         self.list.iter().map(|c| model.bonds[c.bond]).collect()
@@ -96,11 +147,15 @@ impl Constraints {
                 images.minimum_image(before[j as usize] - before[i as usize])
             })
             .collect();
+        self.iterations = 0;
+        let chained = &self.fibres.chains.chained_constraints;
+        let in_chain = |k: usize| chained.len() == self.list.len() && chained[k];
         let x = &mut state.positions;
         let mut worst = (0, 0.0);
-        for sweep in 0..self.max_iterations.max(1) {
+        let general = (0..self.list.len()).any(|k| !in_chain(k));
+        for sweep in 0..if general { self.max_iterations.max(1) } else { 0 } {
             worst = (0, 0.0);
-            for (k, c) in self.list.iter().enumerate() {
+            for (k, c) in self.list.iter().enumerate().filter(|(k, _)| !in_chain(*k)) {
                 let [i, j] = model.bonds[c.bond];
                 let (i, j) = (i as usize, j as usize);
                 let r = images.minimum_image(x[j] - x[i]);
@@ -124,6 +179,12 @@ impl Constraints {
             self.iterations = sweep + 1;
             if worst.1 <= self.tolerance {
                 break;
+            }
+        }
+        if !self.fibres.is_empty() {
+            match self.fibres.reshape(x, &images, dt, self.tolerance, self.max_iterations, &mut self.tension) {
+                Ok(iterations) => self.iterations = self.iterations.max(iterations),
+                Err((constraint, relative_error)) => return Err(ConstraintFailure { bond: self.list[constraint].bond, relative_error }),
             }
         }
         for (x, image) in x.iter_mut().zip(state.images.iter_mut()) {

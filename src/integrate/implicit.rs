@@ -44,15 +44,15 @@
 //! by s·dt. The contact barrier's Gauss–Newton blocks are in K̃, so the
 //! solve already slows the approach; the clamp is the guarantee.
 
-use faer::linalg::solvers::Solve;
 use faer::matrix_free::conjugate_gradient::{conjugate_gradient, conjugate_gradient_scratch, CgParams};
 use faer::matrix_free::InitialGuessStatus;
-use faer::sparse::{SparseColMat, Triplet};
-use faer::{dyn_stack::MemBuffer, dyn_stack::MemStack, Col, Mat, Par, Side};
+use faer::{dyn_stack::MemBuffer, dyn_stack::MemStack, Col, Mat, Par};
 use glam::DVec3;
 
 use super::context::StepContext;
+use super::fibre::Fibres;
 use super::overdamped::{clamp_fraction, Blowup};
+use super::projected_cg::projected_cg;
 use super::system_matrix::SystemMatrix;
 use crate::backend::Stiffness;
 use crate::rng::noise3;
@@ -115,7 +115,9 @@ pub enum ImplicitError {
 
 /// Moves `state` by one implicit step of the context's dt and kT; the
 /// caller ends the step ([`StepContext::advance`]). On an error `state` is
-/// unchanged.
+/// unchanged. `fibres`, assembled at `state` for this step, carry their
+/// own terms (which `stiffness` then leaves out) and precondition the solve;
+/// θ weighs the stiffness (`theta`).
 #[allow(clippy::too_many_arguments)]
 pub fn implicit_step(
     model: &Model,
@@ -125,7 +127,9 @@ pub fn implicit_step(
     sim_box: &SimBox,
     ctx: &StepContext,
     implicit: &ImplicitSettings,
+    theta: f64,
     constrained: &mut ConstrainedBonds,
+    fibres: Option<&mut Fibres>,
     limits: Option<&[f64]>,
     held: &[bool],
 ) -> Result<SolveReport, ImplicitError> {
@@ -134,8 +138,10 @@ pub fn implicit_step(
     let dim = 3 * n;
     let gamma = |i: usize| model.type_drag[model.types[i] as usize];
     let fixed = |i: usize| gamma(i).is_infinite();
-    let drag: Vec<f64> = (0..n).map(gamma).collect();
-    let matrix = SystemMatrix::new(&drag, held, dt, stiffness).map_err(ImplicitError::Solve)?;
+    let on_fibre = |i: usize| fibres.as_ref().is_some_and(|f| f.holds(i));
+    // A fibre's points carry their drag in the fibre's own block.
+    let drag: Vec<f64> = (0..n).map(|i| if on_fibre(i) && !fixed(i) { 0.0 } else { gamma(i) }).collect();
+    let matrix = SystemMatrix::new(&drag, held, dt, theta, stiffness).map_err(ImplicitError::Solve)?;
     let mut rhs = Col::<f64>::zeros(dim);
     for i in (0..n).filter(|&i| !fixed(i)) {
         let mut b = forces[i];
@@ -147,12 +153,13 @@ pub fn implicit_step(
         }
     }
     let (solution, report) = match implicit.solver {
-        _ if !constrained.pairs.is_empty() => {
+        _ if !constrained.pairs.is_empty() || fibres.is_some() => {
             let mobile: Vec<bool> = (0..n).map(|i| !fixed(i)).collect();
-            let solve = projected_cg(&matrix, &rhs, &mobile, constrained, &state.positions, sim_box, implicit)?;
+            let b: Vec<f64> = (0..dim).map(|k| rhs[k]).collect();
+            let solve = projected_cg(&matrix, &b, &mobile, held, constrained, fibres, &state.positions, sim_box, implicit)?;
             constrained.tension.clear();
             constrained.tension.extend(solve.lambda.iter().map(|l| -l));
-            (solve.x, solve.report)
+            (Mat::from_fn(dim, 1, |k, _| solve.x[k]), solve.report)
         }
         LinearSolver::Cholesky => {
             let x = matrix.solve_direct(&rhs).map_err(ImplicitError::Solve)?;
@@ -200,131 +207,6 @@ pub fn implicit_step(
 pub struct ConstrainedBonds {
     pub pairs: Vec<[u32; 2]>,
     pub tension: Vec<f64>,
-}
-
-struct ProjectedSolve {
-    x: Mat<f64>,
-    lambda: Vec<f64>,
-    report: SolveReport,
-}
-
-/// min ½ΔxᵀAΔx − bᵀΔx subject to JΔx = 0 (J: the constraint gradients
-/// û_ij at the current positions) by conjugate gradients with the projected
-/// Jacobi preconditioner P = D⁻¹ − D⁻¹Jᵀ(JD⁻¹Jᵀ)⁻¹JD⁻¹ (Gould, Hribar &
-/// Nocedal 2001): the iterates stay in the null space of J, and the answer
-/// is the step of the constrained linear system AΔx = b + Jᵀλ, JΔx = 0;
-/// λ = (JD⁻¹Jᵀ)⁻¹JD⁻¹(AΔx − b) are the constraint forces. JD⁻¹Jᵀ is
-/// factorised once per step by sparse Cholesky. Fixed particles have
-/// D⁻¹ = 0, so they never move; a bond with both ends fixed is skipped.
-fn projected_cg(
-    matrix: &SystemMatrix,
-    rhs: &Col<f64>,
-    mobile: &[bool],
-    constrained: &ConstrainedBonds,
-    positions: &[DVec3],
-    sim_box: &SimBox,
-    implicit: &ImplicitSettings,
-) -> Result<ProjectedSolve, ImplicitError> {
-    let dim = rhs.nrows();
-    let diagonal = matrix.diagonal();
-    let dinv: Vec<f64> = (0..dim).map(|k| if mobile[k / 3] { 1.0 / diagonal[k] } else { 0.0 }).collect();
-    let images = sim_box.images();
-    let rows: Vec<(usize, usize, DVec3)> = constrained
-        .pairs
-        .iter()
-        .map(|&[i, j]| (i as usize, j as usize, images.minimum_image(positions[j as usize] - positions[i as usize]).normalize_or_zero()))
-        .collect();
-    let active: Vec<bool> = rows.iter().map(|&(i, j, _)| mobile[i] || mobile[j]).collect();
-    let m = rows.len();
-    // S = J D⁻¹ Jᵀ; rows of inactive constraints are the identity.
-    let mut by_particle: std::collections::BTreeMap<usize, Vec<(usize, f64)>> = Default::default();
-    for (k, &(i, j, _)) in rows.iter().enumerate().filter(|(k, _)| active[*k]) {
-        by_particle.entry(i).or_default().push((k, -1.0));
-        by_particle.entry(j).or_default().push((k, 1.0));
-    }
-    let mut triplets = Vec::new();
-    for k in (0..m).filter(|&k| !active[k]) {
-        triplets.push(Triplet::new(k, k, 1.0));
-    }
-    for (&p, list) in &by_particle {
-        for &(k, sk) in list {
-            for &(l, sl) in list {
-                let dot: f64 = (0..3).map(|a| sk * rows[k].2[a] * dinv[3 * p + a] * sl * rows[l].2[a]).sum();
-                triplets.push(Triplet::new(k, l, dot));
-            }
-        }
-    }
-    let schur = SparseColMat::<usize, f64>::try_new_from_triplets(m, m, &triplets).map_err(|e| ImplicitError::Solve(format!("{e:?}")))?;
-    let schur = schur.sp_cholesky(Side::Lower).map_err(|e| ImplicitError::Solve(format!("constraint matrix JD⁻¹Jᵀ: {e:?}")))?;
-    // J·v and Jᵀ·μ.
-    let jv = |v: &Col<f64>| -> Col<f64> {
-        Col::from_fn(m, |k| {
-            let (i, j, u) = rows[k];
-            if !active[k] {
-                return 0.0;
-            }
-            (0..3).map(|a| u[a] * (v[3 * j + a] - v[3 * i + a])).sum()
-        })
-    };
-    let jt = |mu: &Col<f64>| -> Col<f64> {
-        let mut out = Col::<f64>::zeros(dim);
-        for (k, &(i, j, u)) in rows.iter().enumerate().filter(|(k, _)| active[*k]) {
-            for a in 0..3 {
-                out[3 * i + a] -= u[a] * mu[k];
-                out[3 * j + a] += u[a] * mu[k];
-            }
-        }
-        out
-    };
-    let dinv_times = |v: &Col<f64>| Col::from_fn(dim, |k| dinv[k] * v[k]);
-    // (JD⁻¹Jᵀ)⁻¹ J D⁻¹ v
-    let multipliers = |v: &Col<f64>| -> Col<f64> {
-        let mut mu = jv(&dinv_times(v));
-        schur.solve_in_place(mu.as_mat_mut());
-        mu
-    };
-    // The residual update of Gould, Hribar & Nocedal: r ← r − Jᵀ(JD⁻¹Jᵀ)⁻¹JD⁻¹r
-    // (a change of λ only) keeps r consistent with the null space, so the
-    // round-off of the projection does not stall the iteration; z = D⁻¹r is
-    // then the projected preconditioned residual.
-    let update = |r: &Col<f64>| -> Col<f64> { r - &jt(&multipliers(r)) };
-    let mut x = Col::<f64>::zeros(dim);
-    let mut r = update(rhs);
-    let mut z = dinv_times(&r);
-    let reference = z.norm_l2().max(f64::MIN_POSITIVE);
-    let mut p = z.clone();
-    let mut rz: f64 = r.transpose() * &z;
-    let mut iterations = 0;
-    let mut residual = z.norm_l2() / reference;
-    while residual > implicit.tolerance && iterations < implicit.max_iterations {
-        let ap = matrix.times(&p);
-        let curvature: f64 = p.transpose() * &ap;
-        if curvature <= 0.0 {
-            return Err(ImplicitError::Solve(format!("projected conjugate gradients: non-positive curvature {curvature:e}")));
-        }
-        let alpha = rz / curvature;
-        x += alpha * &p;
-        r -= alpha * &ap;
-        r = update(&r);
-        z = dinv_times(&r);
-        let rz_next: f64 = r.transpose() * &z;
-        p = &z + (rz_next / rz) * &p;
-        rz = rz_next;
-        iterations += 1;
-        residual = z.norm_l2() / reference;
-    }
-    if residual > implicit.tolerance {
-        return Err(ImplicitError::Solve(format!(
-            "projected conjugate gradients: relative residual {residual:e} after {iterations} iterations (tolerance {:e})",
-            implicit.tolerance
-        )));
-    }
-    let lambda = multipliers(&(matrix.times(&x) - rhs));
-    Ok(ProjectedSolve {
-        x: Mat::from_fn(dim, 1, |k, _| x[k]),
-        lambda: (0..m).map(|k| lambda[k]).collect(),
-        report: SolveReport { iterations, relative_residual: residual, step_fraction: 1.0 },
-    })
 }
 
 fn relative_residual(matrix: &SystemMatrix, x: &Mat<f64>, rhs: &Col<f64>) -> f64 {

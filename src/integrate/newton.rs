@@ -100,7 +100,7 @@ pub fn newton_minimize<E>(
         loop {
             iterations += 1;
             let drag: Vec<f64> = mass.iter().map(|m| if m.is_infinite() { f64::INFINITY } else { damping }).collect();
-            let matrix = SystemMatrix::new(&drag, held, 1.0, &k).map_err(&failed)?;
+            let matrix = SystemMatrix::new(&drag, held, 1.0, 1.0, &k).map_err(&failed)?;
             let solution = matrix.solve_direct(&rhs).map_err(&failed)?;
             let mut step: Vec<DVec3> =
                 (0..n).map(|i| DVec3::new(solution[(3 * i, 0)], solution[(3 * i + 1, 0)], solution[(3 * i + 2, 0)])).collect();

@@ -32,6 +32,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::context::StepContext;
+use super::fibre::FibreStep;
 use crate::rng::{noise3, Noise};
 use crate::system::{Model, SimBox, State};
 
@@ -42,11 +43,15 @@ pub struct OverdampedSettings {
     /// Largest displacement allowed in one step (length units) before the run
     /// is stopped as blown up.
     pub max_displacement: f64,
+    /// Weight θ of the stiffness in the implicit parts of a step (the
+    /// implicit step's K̃, an inextensible fibre's own terms on the explicit
+    /// one): 1 backward Euler, ½ the trapezoidal rule (`integrate::fibre`).
+    pub theta: f64,
 }
 
 impl Default for OverdampedSettings {
     fn default() -> Self {
-        Self { noise: Noise::Uniform, max_displacement: 1.0 }
+        Self { noise: Noise::Uniform, max_displacement: 1.0, theta: 1.0 }
     }
 }
 
@@ -76,7 +81,8 @@ pub fn clamp_fraction(moves: &[DVec3], limits: &[f64]) -> f64 {
 
 /// Moves `state` by one step of the context's dt and kT, shortened to s·dt
 /// when a particle would move farther than its entry of `limits` (see the
-/// module docs). Returns s (1 for a full step); the caller ends the step
+/// module docs). With `fibres`, the points of inextensible fibres take the
+/// fibre solver's semi-implicit step instead (`integrate::fibre`). Returns s (1 for a full step); the caller ends the step
 /// ([`StepContext::advance`]).
 ///
 /// `scratch` (the displacements) is reused between calls. On a blow-up
@@ -92,6 +98,7 @@ pub fn overdamped_step(
     ctx: &StepContext,
     limits: Option<&[f64]>,
     scratch: &mut Vec<DVec3>,
+    fibres: Option<FibreStep>,
 ) -> Result<f64, Blowup> {
     let StepContext { dt, kt, seed, noise, step, .. } = *ctx;
     let refused = |d: &DVec3| !d.is_finite() || d.length() > ctx.max_displacement;
@@ -132,6 +139,14 @@ pub fn overdamped_step(
             },
         )
         .reduce(|| false, |a, b| a | b);
+    let mut any_refused = any_refused;
+    if let Some(mut fibres) = fibres {
+        let images = sim_box.images();
+        if let Err(singular) = fibres.displace(model, &state.positions, &images, forces, ctx, fraction * dt, scratch) {
+            return Err(Blowup { particle: singular.particle as usize, displacement: f64::NAN });
+        }
+        any_refused = scratch.iter().any(refused);
+    }
     let scratch = &*scratch;
     if any_refused {
         let particle = scratch.iter().position(refused).expect("a refused displacement");

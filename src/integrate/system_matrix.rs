@@ -1,14 +1,16 @@
-//! The matrix A = γ/dt·I + K̃ of the linearly implicit step, sparse plus low
-//! rank.
+//! The matrix A = γ/dt·I + θ·K̃ of the linearly implicit step: diagonal,
+//! sparse and low rank.
 //!
 //! K̃ ([`Stiffness`]) is a list of 3×3 blocks and of Gauss–Newton rank-one
 //! terms w·g gᵀ: a body's volume (turgor) or total area (global area
 //! elasticity) couples all of its nodes, and as a dense block a 642-node
-//! cell would add 4·10⁵ blocks per term. So A = S + U·Uᵀ with S sparse
-//! (the diagonal and the blocks) and U one column √w·g per rank-one term:
+//! cell would add 4·10⁵ blocks per term. So A = S + U·Uᵀ with S = D + C,
+//! D the drag diagonal, C sparse (the blocks; none for a system of free
+//! fibres, whose blocks live in the fibre solver) and U one column √w·g
+//! per rank-one term:
 //!
-//! - **Products** A·v = S·v + Σ_k w_k·g_k (g_k·v) (conjugate gradients and the
-//!   projected CG of constrained bonds), and the Jacobi diagonal
+//! - **Products** A·v = D·v + C·v + Σ_k w_k·g_k (g_k·v) (conjugate gradients
+//!   and the projected CG of constrained bonds), and the Jacobi diagonal
 //!   S_ii + Σ_k w_k·g_k,i².
 //! - **Direct solve** by the Sherman–Morrison–Woodbury identity with the
 //!   sparse Cholesky factor of S: A⁻¹b = y − Z(I + UᵀZ)⁻¹Uᵀy, y = S⁻¹b,
@@ -28,51 +30,59 @@ use glam::{DMat3, DVec3};
 
 use crate::backend::Stiffness;
 
-/// A = S + Σ_k w_k·g_k g_kᵀ over 3n degrees of freedom.
+/// A = D + C + Σ_k w_k·g_k g_kᵀ over 3n degrees of freedom: D the diagonal
+/// γ/dt (1 on pinned coordinates), C the sparse couplings θ·K̃ (`None`
+/// when K̃ has no blocks: a system of free fibres and loose particles).
 #[derive(Debug)]
 pub struct SystemMatrix {
-    sparse: SparseColMat<usize, f64>,
+    drag: Vec<f64>,
+    couplings: Option<SparseColMat<usize, f64>>,
     /// Per rank-one term: w and the entries (particle, g) on mobile particles.
     rank_one: Vec<(f64, Vec<(usize, DVec3)>)>,
 }
 
 impl SystemMatrix {
-    /// Assembles γ_i/dt·I + K̃ (`drag[i]` infinite for a fixed particle;
+    /// Assembles γ_i/dt·I + θ·K̃ (`drag[i]` infinite for a fixed particle;
     /// `held[3i + a]` true for a held coordinate, or `held` empty).
-    pub fn new(drag: &[f64], held: &[bool], dt: f64, stiffness: &Stiffness) -> Result<Self, String> {
+    pub fn new(drag: &[f64], held: &[bool], dt: f64, theta: f64, stiffness: &Stiffness) -> Result<Self, String> {
         let n = drag.len();
         let dim = 3 * n;
         let fixed = |i: usize| drag[i].is_infinite();
         let pinned = |k: usize| fixed(k / 3) || held.get(k).copied().unwrap_or(false);
-        // The diagonal, then the blocks between mobile particles, merged per
-        // (i, j) in column order (a stable sort: duplicates add in term order)
-        // so the triplets arrive sorted, 9 per distinct block.
-        let diagonal = drag.iter().enumerate().map(|(i, gamma)| (i, i, DMat3::IDENTITY * if fixed(i) { 1.0 } else { gamma / dt }));
-        let couplings =
-            stiffness.blocks.iter().filter(|b| !fixed(b.i as usize) && !fixed(b.j as usize)).map(|b| (b.i as usize, b.j as usize, b.block));
-        let mut blocks: Vec<(usize, usize, DMat3)> = diagonal.chain(couplings).collect();
-        blocks.sort_by_key(|&(i, j, _)| (j, i));
-        let mut triplets = Vec::with_capacity(9 * blocks.len());
-        let mut k = 0;
-        while k < blocks.len() {
-            let (i, j, mut block) = blocks[k];
-            k += 1;
-            while k < blocks.len() && (blocks[k].0, blocks[k].1) == (i, j) {
-                block += blocks[k].2;
+        let diagonal: Vec<f64> = (0..dim).map(|k| if pinned(k) { 1.0 } else { drag[k / 3] / dt }).collect();
+        // The blocks between mobile particles, merged per (i, j) in column
+        // order (a stable sort: duplicates add in term order) so the
+        // triplets arrive sorted, 9 per distinct block.
+        let mut blocks: Vec<(usize, usize, DMat3)> = stiffness
+            .blocks
+            .iter()
+            .filter(|b| !fixed(b.i as usize) && !fixed(b.j as usize))
+            .map(|b| (b.i as usize, b.j as usize, theta * b.block))
+            .collect();
+        let couplings = if blocks.is_empty() {
+            None
+        } else {
+            blocks.sort_by_key(|&(i, j, _)| (j, i));
+            let mut triplets = Vec::with_capacity(9 * blocks.len());
+            let mut k = 0;
+            while k < blocks.len() {
+                let (i, j, mut block) = blocks[k];
                 k += 1;
-            }
-            for col in 0..3 {
-                for row in 0..3 {
-                    let (r, c) = (3 * i + row, 3 * j + col);
-                    if !pinned(r) && !pinned(c) {
-                        triplets.push(Triplet::new(r, c, block.col(col)[row]));
-                    } else if r == c {
-                        triplets.push(Triplet::new(r, c, 1.0));
+                while k < blocks.len() && (blocks[k].0, blocks[k].1) == (i, j) {
+                    block += blocks[k].2;
+                    k += 1;
+                }
+                for col in 0..3 {
+                    for row in 0..3 {
+                        let (r, c) = (3 * i + row, 3 * j + col);
+                        if !pinned(r) && !pinned(c) {
+                            triplets.push(Triplet::new(r, c, block.col(col)[row]));
+                        }
                     }
                 }
             }
-        }
-        let sparse = SparseColMat::<usize, f64>::try_new_from_triplets(dim, dim, &triplets).map_err(|e| format!("{e:?}"))?;
+            Some(SparseColMat::<usize, f64>::try_new_from_triplets(dim, dim, &triplets).map_err(|e| format!("{e:?}"))?)
+        };
         let rank_one = stiffness
             .rank_one
             .iter()
@@ -81,19 +91,19 @@ impl SystemMatrix {
                     let p = p as usize;
                     (p, DVec3::from_array(std::array::from_fn(|a| if pinned(3 * p + a) { 0.0 } else { g[a] })))
                 });
-                (r.weight, entries.collect())
+                (theta * r.weight, entries.collect())
             })
             .collect();
-        Ok(Self { sparse, rank_one })
+        Ok(Self { drag: diagonal, couplings, rank_one })
     }
 
     pub fn dim(&self) -> usize {
-        self.sparse.nrows()
+        self.drag.len()
     }
 
     /// The diagonal entries A_kk.
     pub fn diagonal(&self) -> Col<f64> {
-        let mut d = Col::from_fn(self.dim(), |k| self.sparse.get(k, k).copied().unwrap_or(0.0));
+        let mut d = Col::from_fn(self.dim(), |k| self.drag[k] + self.couplings.as_ref().and_then(|c| c.get(k, k).copied()).unwrap_or(0.0));
         for (w, entries) in &self.rank_one {
             for &(p, g) in entries {
                 for a in 0..3 {
@@ -106,9 +116,29 @@ impl SystemMatrix {
 
     /// A·v.
     pub fn times(&self, v: &Col<f64>) -> Col<f64> {
-        let mut out = &self.sparse * v;
-        self.add_rank_one(out.as_mat_mut(), v.as_mat());
+        let mut out = Col::zeros(self.dim());
+        self.apply_to(out.as_mat_mut(), v.as_mat());
         out
+    }
+
+    /// out = A·v on slices of length 3n.
+    pub fn times_slice(&self, v: &[f64], out: &mut [f64]) {
+        let rhs = faer::ColRef::from_slice(v);
+        let mut dst = faer::ColMut::from_slice_mut(out);
+        self.apply_to(dst.as_mut().as_mat_mut(), rhs.as_mat());
+    }
+
+    /// out = A·rhs, column by column.
+    fn apply_to(&self, mut out: MatMut<'_, f64>, rhs: MatRef<'_, f64>) {
+        for column in 0..rhs.ncols() {
+            for k in 0..self.dim() {
+                out[(k, column)] = self.drag[k] * rhs[(k, column)];
+            }
+        }
+        if let Some(c) = &self.couplings {
+            faer::sparse::linalg::matmul::sparse_dense_matmul(out.as_mut(), faer::Accum::Add, c.as_ref(), rhs, 1.0, Par::Seq);
+        }
+        self.add_rank_one(out, rhs);
     }
 
     /// out += Σ_k w_k·g_k (g_k·v) for each column v of `rhs`.
@@ -125,15 +155,25 @@ impl SystemMatrix {
         }
     }
 
-    /// A⁻¹·b by sparse Cholesky and Sherman–Morrison–Woodbury.
+    /// A⁻¹·b by sparse Cholesky of S = D + C and Sherman–Morrison–Woodbury.
     pub fn solve_direct(&self, b: &Col<f64>) -> Result<Mat<f64>, String> {
-        let llt = self.sparse.sp_cholesky(Side::Lower).map_err(|e| format!("sparse Cholesky: {e:?}"))?;
+        let dim = self.dim();
+        let mut triplets: Vec<Triplet<usize, usize, f64>> = (0..dim).map(|k| Triplet::new(k, k, self.drag[k])).collect();
+        if let Some(c) = &self.couplings {
+            for col in 0..dim {
+                for (row, value) in c.row_idx_of_col(col).zip(c.val_of_col(col)) {
+                    triplets.push(Triplet::new(row, col, *value));
+                }
+            }
+        }
+        let sparse = SparseColMat::<usize, f64>::try_new_from_triplets(dim, dim, &triplets).map_err(|e| format!("{e:?}"))?;
+        let llt = sparse.sp_cholesky(Side::Lower).map_err(|e| format!("sparse Cholesky: {e:?}"))?;
         let y = llt.solve(b.as_mat());
         let m = self.rank_one.len();
         if m == 0 {
             return Ok(y);
         }
-        let mut u = Mat::<f64>::zeros(self.dim(), m);
+        let mut u = Mat::<f64>::zeros(dim, m);
         for (k, (w, entries)) in self.rank_one.iter().enumerate() {
             for &(p, g) in entries {
                 for a in 0..3 {
@@ -149,8 +189,8 @@ impl SystemMatrix {
 }
 
 impl LinOp<f64> for SystemMatrix {
-    fn apply_scratch(&self, rhs_ncols: usize, par: Par) -> StackReq {
-        self.sparse.as_ref().apply_scratch(rhs_ncols, par)
+    fn apply_scratch(&self, _rhs_ncols: usize, _par: Par) -> StackReq {
+        StackReq::EMPTY
     }
 
     fn nrows(&self) -> usize {
@@ -161,9 +201,8 @@ impl LinOp<f64> for SystemMatrix {
         self.dim()
     }
 
-    fn apply(&self, mut out: MatMut<'_, f64>, rhs: MatRef<'_, f64>, par: Par, stack: &mut MemStack) {
-        self.sparse.as_ref().apply(out.as_mut(), rhs, par, stack);
-        self.add_rank_one(out, rhs);
+    fn apply(&self, out: MatMut<'_, f64>, rhs: MatRef<'_, f64>, _par: Par, _stack: &mut MemStack) {
+        self.apply_to(out, rhs);
     }
 
     fn conj_apply(&self, out: MatMut<'_, f64>, rhs: MatRef<'_, f64>, par: Par, stack: &mut MemStack) {
@@ -204,7 +243,7 @@ mod tests {
             ],
         };
         let dt = 0.1;
-        let a = SystemMatrix::new(&drag, held, dt, &stiffness).unwrap();
+        let a = SystemMatrix::new(&drag, held, dt, 1.0, &stiffness).unwrap();
         // The dense A: fixed particle 2 keeps the identity row and loses its couplings.
         let mut dense = Mat::<f64>::zeros(12, 12);
         for (i, gamma) in drag.iter().enumerate() {
@@ -234,6 +273,9 @@ mod tests {
         }
         let v = Col::from_fn(12, |k| (k as f64 * 0.7).sin());
         assert!((a.times(&v) - &dense * &v).norm_l2() < 1e-12 * v.norm_l2());
+        let (slice, mut out) = ((0..12).map(|k| v[k]).collect::<Vec<_>>(), vec![0.0; 12]);
+        a.times_slice(&slice, &mut out);
+        assert!((0..12).all(|k| (out[k] - a.times(&v)[k]).abs() < 1e-14));
         assert!((a.diagonal() - dense.diagonal().column_vector().to_owned()).norm_l2() < 1e-12);
         let x = a.solve_direct(&v).unwrap();
         assert!((&dense * &x - v.as_mat()).norm_l2() < 1e-10 * v.norm_l2());
