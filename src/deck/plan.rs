@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 use super::protocol::Protocol;
 use crate::forcefield::TermType;
+use crate::integrate::constraints::ConstraintMethod;
 use crate::integrate::fire::FireSettings;
 use crate::integrate::Integrator;
 use crate::output::DumpFormat;
@@ -246,6 +247,10 @@ pub enum Action {
         bond_type: usize,
         tolerance: f64,
         max_iterations: usize,
+        /// Move the particles onto the lengths at once (`reshape yes`).
+        reshape: bool,
+        /// Chains solved fibre by fibre, or every constraint by SHAKE (`method`).
+        method: ConstraintMethod,
     },
     /// Releases a constrained bond type (`unconstrain`).
     Unconstrain(usize),

@@ -49,7 +49,8 @@ use wgpu::util::DeviceExt;
 
 use super::context::GpuContext;
 use super::side_group::SideGroup;
-use crate::integrate::constraints::{failure_message, Constraints};
+use crate::integrate::constraints::{failure_message, ConstraintMethod, Constraints};
+use crate::integrate::fibre::chains::Chains;
 use crate::system::Model;
 
 /// The smallest |r − r0|/r0 the device's projection is asked for: ten times
@@ -59,9 +60,16 @@ pub const F32_TOLERANCE: f64 = 1e-6;
 const HEADER_WORDS: usize = 8;
 
 /// Why the constraints cannot be projected on the device (None: they can).
-pub fn refusal(model: &Model) -> Option<&'static str> {
+pub fn refusal(model: &Model, constraints: &Constraints) -> Option<&'static str> {
     if model.has_kinetics() {
         return Some("constrained bonds (`constrain`) with bond kinetics run on the CPU backend only");
+    }
+    let bonds: Vec<usize> = constraints.list.iter().map(|c| c.bond).collect();
+    if !Chains::find(model, &bonds, constraints.method == ConstraintMethod::Fibre, false, |_| None).is_empty() {
+        return Some(
+            "inextensible fibres (chains of constrained bonds) are solved fibre by fibre on the CPU backend only; \
+             `constrain … method shake` projects them on the GPU by SHAKE (explicit bending, small steps)",
+        );
     }
     None
 }

@@ -387,7 +387,7 @@ impl Simulation {
                 self.forces_current = false;
             }
             Action::Protocol(protocol) => self.protocols.apply(protocol),
-            Action::Constrain { bond_type, tolerance, max_iterations } => {
+            Action::Constrain { bond_type, tolerance, max_iterations, reshape, method } => {
                 self.constraints.list.retain(|c| self.model.bond_type[c.bond] as usize != *bond_type);
                 // Each bond at its rest length now (its own, or the type's `r0`; the deck checked it has one).
                 let bonds = (0..self.model.bonds.len()).filter(|&b| self.model.bond_type[b] as usize == *bond_type);
@@ -396,7 +396,11 @@ impl Simulation {
                 self.constraints.list.sort_by_key(|c| c.bond);
                 self.constraints.tolerance = *tolerance;
                 self.constraints.max_iterations = *max_iterations;
+                self.constraints.method = *method;
                 self.constraints.tension.clear();
+                if *reshape {
+                    self.reshape_to_constraints()?;
+                }
             }
             Action::Unconstrain(bond_type) => {
                 self.constraints.list.retain(|c| self.model.bond_type[c.bond] as usize != *bond_type);

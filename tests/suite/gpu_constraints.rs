@@ -68,7 +68,7 @@ fn worst_length_error(sim: &Simulation) -> f64 {
 fn constraint_tension_carries_the_axial_load_on_the_gpu() {
     let load = 0.5;
     let (dt, drag) = (1e-5, 0.01);
-    let case = chain(10, 1, dt, 50, (load, 0.0), "constrain rod tolerance 1e-10");
+    let case = chain(10, 1, dt, 50, (load, 0.0), "constrain rod method shake tolerance 1e-10");
     let gpu = run(&case, DevicePreference::Gpu).unwrap();
     let cpu_sweeps = run(&case, DevicePreference::Cpu).unwrap().constraints.iterations;
     let c = &gpu.constraints;
@@ -94,7 +94,7 @@ fn constraint_tension_carries_the_axial_load_on_the_gpu() {
 fn a_constrained_cantilever_bends_on_the_gpu_like_on_the_cpu() {
     let limit = 0.01 * 1e-3 / (8.0 * 0.01);
     // Bead 6 is held in y (`freeze`): the projection must not move it there.
-    let case = chain(10, 2, 0.4 * limit, 2_000, (0.0, 0.02), "constrain rod tolerance 1e-10\ngroup mid id 6\nfreeze mid y");
+    let case = chain(10, 2, 0.4 * limit, 2_000, (0.0, 0.02), "constrain rod method shake tolerance 1e-10\ngroup mid id 6\nfreeze mid y");
     let (cpu, gpu, path, apart, bound) = cantilever_on_both(&case);
     println!(
         "tip moved {path:.4e} µm; GPU − CPU {apart:.3e} µm (bound {bound:.2e}); worst |r − r0|/r0 GPU {:.2e}, CPU {:.2e}",
@@ -112,7 +112,7 @@ fn a_constrained_cantilever_bends_on_the_gpu_like_on_the_cpu() {
 /// before it.
 #[test]
 fn an_unmet_constraint_stops_the_gpu_run_like_the_cpu_run() {
-    let case = chain(10, 1, 1e-5, 5, (50.0, 20.0), "constrain rod tolerance 1e-8 max_iterations 1");
+    let case = chain(10, 1, 1e-5, 5, (50.0, 20.0), "constrain rod method shake tolerance 1e-8 max_iterations 1");
     let cpu = run(&case, DevicePreference::Cpu).err().expect("the CPU run fails");
     let gpu = run(&case, DevicePreference::Gpu).err().expect("the GPU run fails");
     println!("CPU: {cpu}\nGPU: {gpu}");
@@ -132,7 +132,7 @@ fn an_unmet_constraint_stops_the_gpu_run_like_the_cpu_run() {
 #[test]
 fn the_constrained_implicit_step_runs_on_the_gpu_like_on_the_cpu() {
     let limit = 0.01 * 1e-3 / (8.0 * 0.01);
-    let case = chain(10, 2, 100.0 * limit, 1_000, (0.0, 0.02), "constrain rod tolerance 1e-10\nintegrator implicit");
+    let case = chain(10, 2, 100.0 * limit, 1_000, (0.0, 0.02), "constrain rod method shake tolerance 1e-10\nintegrator implicit");
     let (cpu, gpu, path, apart, bound) = cantilever_on_both(&case);
     println!(
         "implicit cantilever: tip moved {path:.4e} µm; GPU − CPU {apart:.3e} µm (bound {bound:.2e}); worst |r − r0|/r0 GPU {:.2e}; \
@@ -146,7 +146,7 @@ fn the_constrained_implicit_step_runs_on_the_gpu_like_on_the_cpu() {
     assert!(worst_length_error(&gpu) <= device_length_bound());
 
     let load = 0.5;
-    let pulled = chain(10, 1, 1e-2, 50, (load, 0.0), "constrain rod tolerance 1e-10\nintegrator implicit");
+    let pulled = chain(10, 1, 1e-2, 50, (load, 0.0), "constrain rod method shake tolerance 1e-10\nintegrator implicit");
     let gpu = run(&pulled, DevicePreference::Gpu).unwrap();
     let worst = gpu.constraints.tension.iter().map(|t| (t / load - 1.0).abs()).fold(0.0, f64::max);
     println!("implicit pull: tensions {:?}, worst relative error {worst:.2e}", gpu.constraints.tension);
@@ -159,7 +159,7 @@ fn the_constrained_implicit_step_runs_on_the_gpu_like_on_the_cpu() {
 /// twice gives the same bits, tensions included.
 #[test]
 fn the_same_constrained_gpu_run_twice_gives_the_same_bits() {
-    let case = chain(10, 2, 5e-5, 200, (0.0, 0.02), "constrain rod");
+    let case = chain(10, 2, 5e-5, 200, (0.0, 0.02), "constrain rod method shake");
     let first = run(&case, DevicePreference::Gpu).unwrap();
     let second = run(&case, DevicePreference::Gpu).unwrap();
     assert_eq!(common::position_bits(&first), common::position_bits(&second));
@@ -172,7 +172,7 @@ fn the_same_constrained_gpu_run_twice_gives_the_same_bits() {
 /// constrained implicit deck in their own rows, each a positive share.
 #[test]
 fn profile_gpu_times_the_implicit_step_and_the_projection() {
-    let case = chain(10, 2, 1e-2, 10, (0.0, 0.02), "constrain rod\nintegrator implicit");
+    let case = chain(10, 2, 1e-2, 10, (0.0, 0.02), "constrain rod method shake\nintegrator implicit");
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_cellmd"))
         .current_dir(case.output_dir())
         .args(["profile-gpu", "deck.in", "--repetitions", "3"])
@@ -187,4 +187,18 @@ fn profile_gpu_times_the_implicit_step_and_the_projection() {
         let share: f64 = line.split_whitespace().last().unwrap().trim_end_matches('%').parse().unwrap();
         assert!(share > 0.0, "{line}");
     }
+}
+
+/// Chains of constraints under the default `method fibre` are solved fibre
+/// by fibre, which only the CPU does: `device gpu` refuses them with the
+/// reason and the way out, `device auto` runs them on the CPU.
+#[test]
+fn fibres_solved_fibre_by_fibre_are_refused_on_the_gpu_with_the_way_out() {
+    let case = chain(10, 2, 5e-5, 20, (0.0, 0.02), "constrain rod");
+    let refused = run(&case, DevicePreference::Gpu).err().expect("the GPU refuses");
+    println!("{refused}");
+    assert!(refused.contains("fibre by fibre on the CPU backend only") && refused.contains("method shake"), "{refused}");
+    let auto = run(&case, DevicePreference::Auto).unwrap();
+    let cpu = run(&case, DevicePreference::Cpu).unwrap();
+    assert_eq!(common::position_bits(&auto), common::position_bits(&cpu));
 }

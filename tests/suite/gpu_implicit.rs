@@ -412,7 +412,7 @@ fn implicit_decks_the_device_cannot_solve_are_refused_with_the_reason() {
     let case = filament(1, 0.0);
     let options = RunOptions { output_dir: case.output_dir().to_path_buf(), device: Some(DevicePreference::Gpu), ..Default::default() };
     let deck = std::fs::read_to_string(case.path("deck.in")).unwrap();
-    std::fs::write(case.path("deck.in"), deck.replace("integrator implicit\n", "constrain rod\nintegrator implicit gpu_workgroups all\n"))
+    std::fs::write(case.path("deck.in"), deck.replace("integrator implicit\n", "constrain rod method shake reshape yes\nintegrator implicit gpu_workgroups all\n"))
         .unwrap();
     let refused = Simulation::execute(case.plan(), options).err().map(|e| e.to_string()).unwrap_or_default();
     assert!(refused.contains("`gpu_workgroups all` with `constrain`"), "{refused}");

@@ -66,7 +66,7 @@ const COMMANDS: &[Command] = &[
     line("device", "device cpu|gpu|auto", Validator::device),
     line(
         "integrator",
-        "integrator overdamped|implicit [noise uniform|gaussian] [max_displacement D] [solver cg|cholesky] [tolerance T] [max_iterations N] [gpu_workgroups one|all|auto]",
+        "integrator overdamped|implicit [noise uniform|gaussian] [max_displacement D] [theta T] [solver cg|cholesky] [tolerance T] [max_iterations N] [gpu_workgroups one|all|auto]",
         Validator::integrator,
     ),
     line("neighbor", "neighbor skin S [every N] [check yes|no]", Validator::neighbor),
@@ -98,7 +98,7 @@ const COMMANDS: &[Command] = &[
     line("indent", "indent NAME velocity VX VY VZ [until LOAD] | indent NAME stop", |v, s, usage| {
         v.protocol(s, usage, Validator::indent)
     }),
-    line("constrain", "constrain BONDTYPE [tolerance T] [max_iterations N]", Validator::constrain),
+    line("constrain", "constrain BONDTYPE [tolerance T] [max_iterations N] [method fibre|shake] [reshape yes|no]", Validator::constrain),
     line("unconstrain", "unconstrain BONDTYPE", Validator::constrain),
     line("minimize", "minimize [ftol F] [maxiter N] [dmax D] [style fire|newton]", Validator::minimize),
     line("run", "run N", Validator::run),

@@ -3,14 +3,20 @@
 
 use glam::DVec3;
 
-use super::{expect_len, options, positive, NamedExpr, Validator};
+use super::{expect_len, options, positive, yes_no, NamedExpr, Validator};
 use crate::deck::expression::DeckExpr;
+use crate::integrate::constraints::ConstraintMethod;
 use crate::deck::plan::{Action, Group};
 use crate::expr::{ExprError, Ref};
 use crate::forcefield::{param_value, parse_params, typed, TermType};
 use crate::input::{parse_f64, parse_u64, InputError, Token};
 use crate::interactions::{param_index, Kind};
 use crate::system::{position_or_time, External};
+
+
+/// The largest relative distance from its rest length a constrained bond may
+/// start at without `reshape yes` (the first step's projection removes smaller ones).
+const MAX_CONSTRAINT_DEFECT: f64 = 0.01;
 
 impl Validator {
     pub(super) fn group(&mut self, s: &[Token], usage: &str) -> Result<(), InputError> {
@@ -115,9 +121,12 @@ impl Validator {
 
     pub(super) fn constrain(&mut self, s: &[Token], usage: &str) -> Result<(), InputError> {
         let kw = &s[0];
-        expect_len(s, 1..=5, usage)?;
-        let opts =
-            if kw.text == "constrain" { options(&s[2..], &["tolerance", "max_iterations"], usage)? } else { options(&s[2..], &[], usage)? };
+        expect_len(s, 1..=10, usage)?;
+        let opts = if kw.text == "constrain" {
+            options(&s[2..], &["tolerance", "max_iterations", "reshape", "method"], usage)?
+        } else {
+            options(&s[2..], &[], usage)?
+        };
         let model = self.model(kw)?;
         let bond_type = model
             .bond_types
@@ -125,24 +134,58 @@ impl Validator {
             .position(|t| t.label.text == s[1].text)
             .ok_or_else(|| s[1].error(format!("found bond type `{}`, expected one defined in the force field", s[1].text)))?;
         let term = &model.bond_types[bond_type];
-        if param_index(term.interaction, "r0").is_none() {
+        let Some(r0) = param_index(term.interaction, "r0") else {
             return Err(s[1].error(format!(
                 "bond type `{}` uses `{}`, which has no rest length r0; expected a bond type whose law has one",
                 s[1].text,
                 term.interaction.name()
             )));
-        }
+        };
         if !model.bond_kinetics[bond_type].rules.is_empty() {
             return Err(s[1].error(format!("bond type `{}` has kinetics; expected a bond type whose bonds never change", s[1].text)));
         }
         if kw.text == "unconstrain" {
             self.actions.push(Action::Unconstrain(bond_type));
-        } else {
-            let tolerance = opts.get("tolerance").map(|t| positive(t, "a relative length tolerance")).transpose()?.unwrap_or(1e-10);
-            let max_iterations =
-                opts.get("max_iterations").map(|t| parse_u64(t, "a sweep count")).transpose()?.unwrap_or(1000).max(1) as usize;
-            self.actions.push(Action::Constrain { bond_type, tolerance, max_iterations });
+            return Ok(());
         }
+        let tolerance = opts.get("tolerance").map(|t| positive(t, "a relative length tolerance")).transpose()?.unwrap_or(1e-10);
+        let max_iterations = opts.get("max_iterations").map(|t| parse_u64(t, "a sweep count")).transpose()?.unwrap_or(1000).max(1) as usize;
+        let method = match opts.get("method") {
+            None => ConstraintMethod::Fibre,
+            Some(t) => match t.text.as_str() {
+                "fibre" => ConstraintMethod::Fibre,
+                "shake" => ConstraintMethod::Shake,
+                other => return Err(t.error(format!("found method `{other}`, expected `fibre` or `shake`"))),
+            },
+        };
+        let reshape = opts.get("reshape").map(|t| yes_no(t)).transpose()?.unwrap_or(false);
+        if !reshape {
+            let model = self.model.as_ref().expect("built above");
+            let type_r0 = model.bond_types[bond_type].params[r0];
+            let images = self.sim_box.as_ref().expect("built with the model").images();
+            let worst = (0..model.topology_bonds)
+                .filter(|&b| model.bond_type[b] as usize == bond_type)
+                .map(|b| {
+                    let [i, j] = model.bonds[b];
+                    let length = images.minimum_image(self.positions[j as usize] - self.positions[i as usize]).length();
+                    let rest = model.bond_rest[b].unwrap_or(type_r0);
+                    (b, length, rest, ((length - rest) / rest).abs())
+                })
+                .fold(None, |worst: Option<(usize, f64, f64, f64)>, c| if worst.is_none_or(|w| c.3 > w.3) { Some(c) } else { worst });
+            if let Some((b, length, rest, error)) = worst.filter(|w| !(w.3 <= MAX_CONSTRAINT_DEFECT)) {
+                let [i, j] = model.bonds[b].map(|p| model.ids[p as usize]);
+                return Err(s[1].error(format!(
+                    "bond {i}-{j} of type `{}` is {length:e} long at the topology's positions, {:.3} % off its rest length {rest:e}; \
+                     expected every constrained bond within {} % of its rest length, or `constrain {} reshape yes` to move the particles \
+                     onto their lengths first",
+                    s[1].text,
+                    100.0 * error,
+                    100.0 * MAX_CONSTRAINT_DEFECT,
+                    s[1].text
+                )));
+            }
+        }
+        self.actions.push(Action::Constrain { bond_type, tolerance, max_iterations, reshape, method });
         Ok(())
     }
 

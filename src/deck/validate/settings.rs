@@ -5,7 +5,7 @@
 use super::{expect_len, non_negative, options, positive, yes_no, Validator};
 use crate::deck::plan::{Action, NeighborSettings};
 use crate::gpu::DevicePreference;
-use crate::input::{parse_u64, InputError, Token};
+use crate::input::{parse_f64, parse_u64, InputError, Token};
 use crate::integrate::fire::{FireSettings, MinimizeStyle};
 use crate::integrate::implicit::{GpuWorkgroups, ImplicitSettings, LinearSolver};
 use crate::integrate::overdamped::OverdampedSettings;
@@ -56,16 +56,16 @@ impl Validator {
     }
 
     pub(super) fn integrator(&mut self, s: &[Token], usage: &str) -> Result<(), InputError> {
-        expect_len(s, 1..=13, usage)?;
+        expect_len(s, 1..=15, usage)?;
         let implicit = match s[1].text.as_str() {
             "overdamped" => false,
             "implicit" => true,
             other => return Err(s[1].error(format!("found integrator `{other}`, expected `overdamped` or `implicit`"))),
         };
         let keys: &[&str] = if implicit {
-            &["noise", "max_displacement", "solver", "tolerance", "max_iterations", "gpu_workgroups"]
+            &["noise", "max_displacement", "theta", "solver", "tolerance", "max_iterations", "gpu_workgroups"]
         } else {
-            &["noise", "max_displacement"]
+            &["noise", "max_displacement", "theta"]
         };
         let opts = options(&s[2..], keys, usage)?;
         let mut settings = OverdampedSettings::default();
@@ -78,6 +78,15 @@ impl Validator {
         }
         if let Some(t) = opts.get("max_displacement") {
             settings.max_displacement = positive(t, "a maximum displacement per step")?;
+        }
+        if let Some(t) = opts.get("theta") {
+            let theta = parse_f64(t, "the implicit weight θ")?;
+            if !(0.5..=1.0).contains(&theta) {
+                return Err(t.error(format!(
+                    "found theta {theta}, expected a number in [0.5, 1] (1: backward Euler; 0.5: the trapezoidal rule; below 0.5 stiff modes grow)"
+                )));
+            }
+            settings.theta = theta;
         }
         let mut choice = Integrator::Overdamped(settings);
         if implicit {

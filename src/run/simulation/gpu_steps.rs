@@ -371,7 +371,7 @@ impl Simulation {
 
     /// Why the constraints cannot be projected on the device (src/gpu/shake.rs).
     fn constraint_refusal(&self) -> Option<&'static str> {
-        (!self.constraints.list.is_empty()).then(|| crate::gpu::shake::refusal(&self.model)).flatten()
+        (!self.constraints.list.is_empty()).then(|| crate::gpu::shake::refusal(&self.model, &self.constraints)).flatten()
     }
 
     /// Why the implicit step cannot run on the device (src/gpu/implicit.rs).
