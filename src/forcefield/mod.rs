@@ -5,6 +5,7 @@
 //! include common.ff                          # path relative to this file
 //! particle actin  drag 0.05                  # γ in pN·s/µm, optional radius (µm)
 //! particle bead   radius 0.05 viscosity 1e-3 # Stokes drag γ = 6πηa (η in Pa·s)
+//! particle point  viscosity 1 fibre 5 points 51  # a fibre's drag shared by its points (Cytosim's)
 //! particle anchor fixed                      # never moves (a substrate site)
 //! bond  actin_segment  harmonic  k 400 r0 0.1
 //! angle actin_bend     wlc_bending kappa 0.07 l0 0.1

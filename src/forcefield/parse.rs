@@ -94,11 +94,43 @@ fn check_unique<'a>(name: &Token, existing: impl Iterator<Item = &'a Token>, wha
     Ok(())
 }
 
+/// The keys of a `particle` line (besides `fixed`).
+const FIELDS: [&str; 7] = ["drag", "radius", "viscosity", "fibre", "points", "hydrodynamic_radius", "hydrodynamic_cutoff"];
+
+/// The drag of each of the N points of a fibre of length L in a fluid of
+/// viscosity η (`particle NAME viscosity η fibre L points N
+/// [hydrodynamic_radius r] [hydrodynamic_cutoff c]`), as Cytosim computes it
+/// (Nédélec & Foethke 2007), the cylinder's averaged translational friction
+/// of Tirado & García de la Torre (1979) shared equally by the points, never
+/// below the Stokes drag of a sphere of the fibre's radius (which a fibre
+/// shorter than its diameter takes):
+///
+/// γ = πη·max(3L / (ln(min(L, c)/2r) + 0.312), 6r) / N,
+///
+/// r = 0.0125 µm and c = 10 µm by default (Cytosim's), in the file's length
+/// units. `radius` stays the points' contact radius.
+fn fibre_point_drag(eta: f64, at: &Token, fields: &HashMap<&str, (f64, &Token)>) -> Result<f64, InputError> {
+    let length = fields["fibre"].0;
+    let Some(&(points, points_key)) = fields.get("points") else {
+        return Err(at.error("a fibre's drag is shared by its points; expected `points N` (the fibre's number of points)"));
+    };
+    if points.fract() != 0.0 || points < 2.0 {
+        return Err(points_key.error(format!("found points {points}, expected a whole number ≥ 2")));
+    }
+    let radius = fields.get("hydrodynamic_radius").map_or(0.0125, |f| f.0);
+    let cutoff = fields.get("hydrodynamic_cutoff").map_or(10.0, |f| f.0);
+    let log = (length.min(cutoff) / (2.0 * radius)).ln() + 0.312;
+    // A fibre shorter than its diameter (log ≤ 0) takes the sphere's drag, as in Cytosim.
+    let cylinder = if log > 0.0 { 3.0 * length / log } else { 0.0 };
+    Ok(std::f64::consts::PI * eta * cylinder.max(6.0 * radius) / points)
+}
+
 fn particle(s: &Statement) -> Result<ParticleType, InputError> {
     let t = &s.tokens;
     let Some(name) = t.get(1) else {
         return Err(t[0].error(
-            "expected `particle NAME drag G [radius A]`, `particle NAME radius A viscosity ETA` or `particle NAME fixed [radius A]`",
+            "expected `particle NAME drag G [radius A]`, `particle NAME radius A viscosity ETA`, \
+             `particle NAME viscosity ETA fibre L points N [hydrodynamic_radius R]` or `particle NAME fixed [radius A]`",
         ));
     };
     let fixed = t[2..].iter().find(|x| x.text == "fixed");
@@ -106,8 +138,8 @@ fn particle(s: &Statement) -> Result<ParticleType, InputError> {
     let values: Vec<&Token> = t[2..].iter().filter(|x| x.text != "fixed").collect();
     for pair in values.chunks(2) {
         let key = pair[0];
-        if !["drag", "radius", "viscosity"].contains(&key.text.as_str()) {
-            return Err(key.error(format!("found `{}`, expected `drag`, `radius`, `viscosity` or `fixed`", key.text)));
+        if !FIELDS.contains(&key.text.as_str()) {
+            return Err(key.error(format!("found `{}`, expected one of {} or `fixed`", key.text, FIELDS.map(|f| format!("`{f}`")).join(", "))));
         }
         let Some(value) = pair.get(1) else {
             return Err(key.error(format!("`{}` has no value; expected `{} VALUE`", key.text, key.text)));
@@ -121,6 +153,12 @@ fn particle(s: &Statement) -> Result<ParticleType, InputError> {
         }
     }
     let radius = fields.get("radius").map_or(0.0, |f| f.0);
+    let fibre_keys = ["fibre", "points", "hydrodynamic_radius", "hydrodynamic_cutoff"];
+    if let Some((_, extra)) = fibre_keys.iter().find_map(|f| fields.get(f)) {
+        if !fields.contains_key("fibre") || !fields.contains_key("viscosity") {
+            return Err(extra.error(format!("`{}` belongs to a fibre's drag; expected `viscosity ETA fibre L points N` with it", extra.text)));
+        }
+    }
     let drag = match (fixed, fields.get("drag"), fields.get("viscosity")) {
         (Some(_), Some((_, key)), _) | (Some(_), _, Some((_, key))) => {
             return Err(key.error("a `fixed` particle does not move; expected no `drag` or `viscosity`"))
@@ -128,6 +166,7 @@ fn particle(s: &Statement) -> Result<ParticleType, InputError> {
         (Some(_), None, None) => f64::INFINITY,
         (None, Some(_), Some((_, key))) => return Err(key.error("give either `drag` or `radius` + `viscosity`, not both")),
         (None, Some((g, _)), None) => *g,
+        (None, None, Some((eta, key))) if fields.contains_key("fibre") => fibre_point_drag(*eta, key, &fields)?,
         (None, None, Some((eta, key))) => {
             if radius <= 0.0 {
                 return Err(key.error("`viscosity` needs `radius` > 0 for the Stokes drag 6πηa"));
@@ -286,6 +325,27 @@ mod tests {
             .and_then(|_| check_pair_types(&ff))
             .map(|_| ff)
             .map_err(|e| e.to_string().replace(&format!("{}/", dir.path().display()), ""))
+    }
+
+    /// Cytosim's drag of a 5 µm fibre of 51 points in a 1 Pa·s fluid:
+    /// 3π·5/(ln(5/0.025) + 0.312) = 47.1239/5.61033 = 8.39951 pN·s/µm in all, shared by the points.
+    #[test]
+    fn a_fibre_points_drag_is_cytosims_fibre_drag_shared_by_its_points() {
+        let ff = load(&[("main.ff", "particle a viscosity 1 fibre 5 points 51
+particle b viscosity 1 fibre 0.01 points 2 hydrodynamic_radius 0.0125
+")]).unwrap();
+        let total = 3.0 * std::f64::consts::PI * 5.0 / ((5.0f64 / 0.025).ln() + 0.312);
+        assert!((total - 8.39951).abs() < 1e-5, "{total}");
+        assert!((ff.particle_types[0].drag - total / 51.0).abs() < 1e-15);
+        // Shorter than its diameter: the sphere's 6πηr.
+        assert!((ff.particle_types[1].drag - 6.0 * std::f64::consts::PI * 0.0125 / 2.0).abs() < 1e-15);
+        for (text, message) in [
+            ("particle a drag 1 fibre 5 points 51", "m.ff:1:19: `fibre` belongs to a fibre's drag; expected `viscosity ETA fibre L points N` with it"),
+            ("particle a viscosity 1 fibre 5", "m.ff:1:12: a fibre's drag is shared by its points; expected `points N` (the fibre's number of points)"),
+            ("particle a viscosity 1 fibre 5 points 2.5", "m.ff:1:32: found points 2.5, expected a whole number ≥ 2"),
+        ] {
+            assert_eq!(load(&[("m.ff", text)]).unwrap_err(), message);
+        }
     }
 
     #[test]
