@@ -6,7 +6,7 @@
 use cellmd::backend::{CpuBackend, Forces};
 use cellmd::deck::Plan;
 use cellmd::system::State;
-use crate::common::Case;
+use crate::common::{self, Case};
 use faer::{Mat, Side};
 use glam::DVec3;
 
@@ -170,45 +170,11 @@ fn euler_buckling_load_converges_to_pi2_kappa_over_l2() {
 fn thermal_filaments_keep_the_worm_like_chain_statistics() {
     let (chains, segments, kappa, k_bond) = (1000, 4, 4.0f64, 200.0);
     let a = kappa; // κ/(ℓ·kT) with ℓ = kT = 1
-    let mut seed = 0x2545F4914F6CDD1Du64;
-    let mut uniform = || {
-        seed ^= seed << 13;
-        seed ^= seed >> 7;
-        seed ^= seed << 17;
-        ((seed >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    };
-    let mut top = String::from("[ particles ]\n");
-    let mut bonds = String::from("[ bonds ]\n");
-    let mut angles = String::from("[ angles ]\n");
-    let mut id = 0;
-    for c in 0..chains {
-        let mut x = DVec3::new((c % 10) as f64 * 10.0, ((c / 10) % 10) as f64 * 10.0, (c / 100) as f64 * 10.0);
-        let mut t = DVec3::X;
-        for s in 0..=segments {
-            id += 1;
-            top += &format!("{id} bead {} {} {}\n", x.x, x.y, x.z);
-            if s > 0 {
-                bonds += &format!("rod {} {id}\n", id - 1);
-            }
-            if s > 1 {
-                angles += &format!("bend {} {} {id}\n", id - 2, id - 1);
-            }
-            // The next bond: cos θ to the previous one from exp(a·cos θ), azimuth uniform.
-            if s > 0 {
-                let u = uniform();
-                let cos = 1.0 + (u + (1.0 - u) * (-2.0 * a).exp()).ln() / a;
-                let cos = cos.clamp(-1.0, 1.0);
-                let phi = std::f64::consts::TAU * uniform();
-                let (e1, e2) = t.any_orthonormal_pair();
-                t = (cos * t + (1.0 - cos * cos).sqrt() * (phi.cos() * e1 + phi.sin() * e2)).normalize();
-            }
-            x += t;
-        }
-    }
+    let top = common::worm_like_chains(chains, segments, a, 0x2545F4914F6CDD1D);
     let ff = format!("particle bead drag 1\nbond rod harmonic k {k_bond} r0 1\nangle bend wlc_bending kappa {kappa} l0 1\n");
     let deck = "units lj\ntopology t.top\nforcefield f.ff\nbox x -10 110 f y -10 110 f z -10 110 f\n\
                 temperature 1\nseed 11\ntimestep 0.0005\nrun 8000\n";
-    let case = Case::new(&[("t.top", &(top + &bonds + &angles)), ("f.ff", &ff), ("deck.in", deck)]);
+    let case = Case::new(&[("t.top", &top), ("f.ff", &ff), ("deck.in", deck)]);
     let options = cellmd::run::RunOptions { output_dir: case.output_dir().to_path_buf(), ..Default::default() };
     let sim = cellmd::run::Simulation::execute(case.plan(), options).unwrap();
     let x = &sim.state.positions;

@@ -43,6 +43,7 @@ mod gpu_minimize;
 mod hertz;
 mod implicit;
 mod import_lammps;
+mod inextensible_fibres;
 mod inputs;
 mod kinetics;
 mod measure;

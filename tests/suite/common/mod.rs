@@ -344,3 +344,41 @@ pub fn squeezed_cells(settings: &str) -> Case {
     );
     Case::new(&[("cells.top", &top), ("cells.ff", &ff), ("deck.in", &deck)])
 }
+
+/// `chains` discrete worm-like chains of `segments` unit segments drawn from
+/// their exact equilibrium ensemble (each joint's cos θ from exp(a·cos θ),
+/// a = κ/(ℓ·kT), azimuth uniform; a = 0: freely jointed), started on a
+/// 10-spaced grid, as topology sections: particles `bead`, bonds `rod`,
+/// angles `bend` (none when `a` = 0).
+pub fn worm_like_chains(chains: usize, segments: usize, a: f64, seed: u64) -> String {
+    use glam::DVec3;
+    let mut uniform = uniform(seed);
+    let mut top = String::from("[ particles ]\n");
+    let mut bonds = String::from("[ bonds ]\n");
+    let mut angles = String::from("[ angles ]\n");
+    let mut id = 0;
+    for c in 0..chains {
+        let mut x = DVec3::new((c % 10) as f64 * 10.0, ((c / 10) % 10) as f64 * 10.0, (c / 100) as f64 * 10.0);
+        let mut t = DVec3::X;
+        for s in 0..=segments {
+            id += 1;
+            top += &format!("{id} bead {} {} {}\n", x.x, x.y, x.z);
+            if s > 0 {
+                bonds += &format!("rod {} {id}\n", id - 1);
+            }
+            if s > 1 && a > 0.0 {
+                angles += &format!("bend {} {} {id}\n", id - 2, id - 1);
+            }
+            if s > 0 {
+                let u = uniform();
+                let cos = if a > 0.0 { 1.0 + (u + (1.0 - u) * (-2.0 * a).exp()).ln() / a } else { 2.0 * u - 1.0 };
+                let cos = cos.clamp(-1.0, 1.0);
+                let phi = std::f64::consts::TAU * uniform();
+                let (e1, e2) = t.any_orthonormal_pair();
+                t = (cos * t + (1.0 - cos * cos).sqrt() * (phi.cos() * e1 + phi.sin() * e2)).normalize();
+            }
+            x += t;
+        }
+    }
+    top + &bonds + &angles
+}

@@ -1,0 +1,113 @@
+//! Thermal inextensible fibres (`constrain` on a chain's segments, solved
+//! fibre by fibre: src/integrate/fibre/) against the exact discrete
+//! worm-like chain, at steps far beyond the explicit limit of stiff
+//! springs.
+//!
+//! Chains of unit segments with the bending E = s·Σ(1 − t_i·t_{i+1})
+//! (`wlc_bending`, s = κ/ℓ; a = s/kT) have independent joints with the
+//! density ∝ exp(a·cos θ) — on the flexible measure, the stiff-spring
+//! limit the constrained step samples — so ⟨cos θ⟩ = L(a) = coth a − 1/a, ⟨cos²θ⟩ = 1 − 2L(a)/a,
+//! the tangents correlate as L(a)^k at lag k, and ⟨R²⟩ = N + 2Σ_{k≥1}(N −
+//! k)·L(a)^k. The chains start from that ensemble, so a biased dynamics
+//! shows as a drift of these averages, read at the run's end over every
+//! joint (joints independent: the standard errors are the exact ones).
+
+use crate::common::{self, Case};
+use cellmd::run::{RunOptions, Simulation};
+use glam::DVec3;
+
+/// `chains` chains of `segments` unit segments at a = κ/(ℓ·kT) (lj units,
+/// drag 1, kT = 1), constrained, run `steps` of `dt` by `integrator`.
+fn run(chains: usize, segments: usize, a: f64, integrator: &str, dt: f64, steps: u64) -> Simulation {
+    let top = common::worm_like_chains(chains, segments, a, 0x9E3779B97F4A7C15);
+    let bend = if a > 0.0 { format!("angle bend wlc_bending kappa {a} l0 1\n") } else { String::new() };
+    let ff = format!("particle bead drag 1\nbond rod harmonic k 100 r0 1\n{bend}");
+    let deck = format!(
+        "units lj\ntopology t.top\nforcefield f.ff\nbox x -10 110 f y -10 110 f z -10 {} f\ntemperature 1\nseed 7\n\
+         constrain rod\n{integrator}\ntimestep {dt}\nrun {steps}\n",
+        10.0 * (chains / 100 + 1) as f64
+    );
+    let case = Case::new(&[("t.top", &top), ("f.ff", &ff), ("deck.in", &deck)]);
+    Simulation::execute(case.plan(), RunOptions { output_dir: case.output_dir().to_path_buf(), ..Default::default() }).unwrap()
+}
+
+/// Per chain of `segments` segments: the unit tangents.
+fn tangents(sim: &Simulation, chains: usize, segments: usize) -> Vec<Vec<DVec3>> {
+    let x = &sim.state.positions;
+    (0..chains).map(|c| (0..segments).map(|s| x[c * (segments + 1) + s + 1] - x[c * (segments + 1) + s]).collect()).collect()
+}
+
+/// Mean and standard error of the values.
+fn mean_and_error(values: &[f64]) -> (f64, f64) {
+    let n = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / n;
+    let variance = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    (mean, (variance / n).sqrt())
+}
+
+fn langevin(a: f64) -> f64 {
+    if a == 0.0 {
+        0.0
+    } else {
+        1.0 / a.tanh() - 1.0 / a
+    }
+}
+
+fn worst_length_error(t: &[Vec<DVec3>]) -> f64 {
+    t.iter().flatten().map(|v| (v.length() - 1.0).abs()).fold(0.0, f64::max)
+}
+
+/// Semi-flexible chains (a = 3, Lp = 3ℓ) at θ = ½ and a step of 0.01
+/// joint relaxation times (γℓ²/kT = 1), 2500 steps (25 of them): the joint
+/// averages, the tangent correlations at lags 1–4 and ⟨R²⟩ against the exact
+/// chain within 2 standard errors; lengths held to 1e-9.
+#[test]
+#[ignore = "open goal: measured ⟨t_i·t_i+1⟩ = 0.7240 ± 0.0038 against 0.6716 (chains too straight, the step's bias)"]
+fn thermal_inextensible_fibres_keep_the_exact_worm_like_chain_statistics() {
+    let (chains, segments, a) = (800, 8, 3.0);
+    let sim = run(chains, segments, a, "integrator overdamped theta 0.5", 0.01, 2500);
+    let t = tangents(&sim, chains, segments);
+    assert!(worst_length_error(&t) < 1e-9, "a segment is off its length by {:e}", worst_length_error(&t));
+    let unit: Vec<Vec<DVec3>> = t.iter().map(|c| c.iter().map(|v| v.normalize()).collect()).collect();
+    let exact = langevin(a);
+    for k in 1..=4 {
+        let values: Vec<f64> = unit.iter().flat_map(|c| (0..segments - k).map(move |i| c[i].dot(c[i + k]))).collect();
+        let (mean, error) = mean_and_error(&values);
+        let expected = exact.powi(k as i32);
+        println!("lag {k}: ⟨t_i·t_i+k⟩ = {mean:.4} ± {error:.4} (exact {expected:.4})");
+        assert!((mean - expected).abs() < 2.0 * error, "lag {k}: {mean} ± {error} vs {expected}");
+    }
+    let squares: Vec<f64> = unit.iter().flat_map(|c| c.windows(2).map(|w| w[0].dot(w[1]).powi(2))).collect();
+    let (mean, error) = mean_and_error(&squares);
+    let expected = 1.0 - 2.0 * exact / a;
+    println!("⟨cos²θ⟩ = {mean:.4} ± {error:.4} (exact {expected:.4})");
+    assert!((mean - expected).abs() < 2.0 * error, "⟨cos²θ⟩ {mean} ± {error} vs {expected}");
+    let r2: Vec<f64> = t.iter().map(|c| c.iter().sum::<DVec3>().length_squared()).collect();
+    let (mean, error) = mean_and_error(&r2);
+    let n = segments as f64;
+    let expected = n + 2.0 * (1..segments).map(|k| (n - k as f64) * exact.powi(k as i32)).sum::<f64>();
+    println!("⟨R²⟩ = {mean:.3} ± {error:.3} (exact {expected:.3})");
+    assert!((mean - expected).abs() < 2.0 * error, "⟨R²⟩ {mean} ± {error} vs {expected}");
+}
+
+/// Freely jointed chains (no bending) keep uniform joints, ⟨cos θ⟩ = 0 and
+/// ⟨cos²θ⟩ = 1/3, within 2 standard errors: the flexible measure. The rigid
+/// measure ∝ √det G would lower ⟨cos²θ⟩ (for three beads to 0.322); the
+/// same chains with the Fixman force −∇(kT/2)·ln det G added (an earlier
+/// version of the solver) gave 0.3492 ± 0.0030, 5 standard errors high.
+/// Measured now: ⟨cos²θ⟩ = 0.3332 ± 0.0030, but ⟨cos θ⟩ = 0.0330 ± 0.0058.
+#[test]
+#[ignore = "open goal: measured ⟨cos θ⟩ = 0.0330 ± 0.0058 (5.7 standard errors; the step straightens chains)"]
+fn freely_jointed_fibres_keep_uniform_joints() {
+    let (chains, segments) = (2000, 6);
+    let sim = run(chains, segments, 0.0, "integrator overdamped", 0.01, 300);
+    let t = tangents(&sim, chains, segments);
+    assert!(worst_length_error(&t) < 1e-9, "a segment is off its length by {:e}", worst_length_error(&t));
+    let cosines: Vec<f64> = t.iter().flat_map(|c| c.windows(2).map(|w| w[0].normalize().dot(w[1].normalize()))).collect();
+    let (mean, error) = mean_and_error(&cosines);
+    let squares: Vec<f64> = cosines.iter().map(|c| c * c).collect();
+    let (mean2, error2) = mean_and_error(&squares);
+    println!("⟨cos θ⟩ = {mean:.4} ± {error:.4} (0); ⟨cos²θ⟩ = {mean2:.4} ± {error2:.4} (1/3)");
+    assert!(mean.abs() < 2.0 * error, "⟨cos θ⟩ = {mean} ± {error}");
+    assert!((mean2 - 1.0 / 3.0).abs() < 2.0 * error2, "⟨cos²θ⟩ = {mean2} ± {error2}");
+}
