@@ -44,7 +44,7 @@ def run_cellmd(binary, deck, threads):
     work = os.path.dirname(deck)
     code, text, errors, wall, cpu = timed([binary, "run", os.path.basename(deck), "--quiet", "--threads", str(threads), "-o", "."], work)
     if code != 0:
-        lines = [line for line in (errors + text).splitlines() if line.strip()]
+        lines = [line.strip() for line in errors.splitlines() if line.strip()] or [line.strip() for line in text.splitlines() if line.strip()]
         raise EngineError(f"cellmd exit {code}: " + (lines[-1] if lines else "(no message)"))
     loop = float(re.findall(r"loop time ([0-9.e+-]+) s", text)[-1])
     return {"loop": loop, "wall": wall, "cpu": cpu}

@@ -58,26 +58,29 @@ def run_system(system, args, binary, table, results):
 
 
 def print_timing(table, threads):
-    print(f"\n| system | engine | dt (s) | steps | loop time (s) | per step (ms) | per point-step (µs) | process CPU (s) | wall (s) | loop / Cytosim pc=0 | loop / Cytosim pc=1 |")
+    """One row per run; the ratios are cellmd over Cytosim (pc=0 / pc=1) at
+    the same dt (an explicit run: Cytosim's smallest dt), for the same
+    simulated time, on the engines' loop times and on the processes' CPU."""
+    print("\n| system | engine | dt (s) | steps | loop time (s) | per step (ms) | per point-step (µs) | process CPU (s) | wall (s) | loop ratio pc=0 / pc=1 | CPU ratio pc=0 / pc=1 |")
     print("|---|---|---|---|---|---|---|---|---|---|---|")
     cyto = {}
     for system, label, dt, timing, _ in table:
         if timing and label.startswith("Cytosim"):
-            cyto[(system.name, dt, label[-1])] = timing["loop"]
+            cyto[(system.name, dt, label[-1])] = timing
     for system, label, dt, timing, error in table:
-        name = system.label.split(":")[0]
+        name = system.label.split(" ")[0]
         if timing is None:
             print(f"| {name} | {label} | {dt if dt is not None else '—'} | — | — | — | — | — | — | — | {error} |")
             continue
         steps = system.steps(dt)
-        per_step = timing["loop"] / steps
         point_steps = steps * system.points * len(system.fibres)
-        ratios = []
+        ratios = {"loop": [], "cpu": []}
         for pc in "01":
             ref = cyto.get((system.name, dt, pc)) or cyto.get((system.name, min(system.dts), pc))
-            ratios.append(f"{timing['loop'] / ref:.3g}" if ref and not label.startswith("Cytosim") else "—")
+            for key in ratios:
+                ratios[key].append(f"{timing[key] / ref[key]:.3g}" if ref and not label.startswith("Cytosim") else "—")
         engine = label if label.startswith("Cytosim") else f"{label} ({threads} thread{'s' if threads > 1 else ''})"
-        print(f"| {name} | {engine} | {dt:g} | {steps} | {timing['loop']:.4g} | {per_step * 1e3:.4g} | {timing['loop'] / point_steps * 1e6:.4g} | {timing['cpu']:.4g} | {timing['wall']:.4g} | {ratios[0]} | {ratios[1]} |")
+        print(f"| {name} | {engine} | {dt:g} | {steps} | {timing['loop']:.4g} | {timing['loop'] / steps * 1e3:.4g} | {timing['loop'] / point_steps * 1e6:.4g} | {timing['cpu']:.4g} | {timing['wall']:.4g} | {' / '.join(ratios['loop'])} | {' / '.join(ratios['cpu'])} |")
 
 
 def print_checks(rows):

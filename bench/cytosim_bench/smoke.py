@@ -92,6 +92,20 @@ def check_config(system, dt, pc, text):
     close([float(run[0][0]) * dt, float(run[1]["nb_frames"])], [system.time, round(system.time / system.frame)], "run steps × dt, frames")
 
 
+def check_checker_catches(system):
+    """The config check must fail on a config whose last fibre is moved by 1 nm."""
+    dt = system.dts[0]
+    text = writers.cytosim_config(system, dt, 1)
+    head, _, last = text.rpartition("new fiber filament { length = ")
+    x = last.split("position = ")[1].split()[0]
+    moved = head + "new fiber filament { length = " + last.replace(f"position = {x}", f"position = {float(x) + 1e-3!r}", 1)
+    try:
+        check_config(system, dt, 1, moved)
+    except Mismatch:
+        return
+    raise Mismatch("the config check passed a config with a fibre moved by 1 nm")
+
+
 def synthetic_report(system):
     out = ["% frame   0", "% start   0", "% id pos_x pos_y pos_z"]
     for f in range(len(system.fibres)):
@@ -124,6 +138,7 @@ def run(args, binary):
             for dt in system.dts:
                 for pc in (0, 1):
                     check_config(system, dt, pc, writers.cytosim_config(system, dt, pc))
+            check_checker_catches(system)
             check_report_reader(system, work)
             results = []
             for variant, scheme, dt in harness.cellmd_runs(system, variants):

@@ -168,7 +168,7 @@ def cellmd_deck(system: System, variant, dt, tolerance=1e-6):
         "topology system.top",
         "forcefield system.ff",
         box(system),
-        f"integrator {integrator}",
+        f"integrator {integrator}" + (f" solver {system.implicit_solver}" if integrator == "implicit" and not constrained and system.implicit_solver != "cg" else ""),
         f"temperature {fmt(system.temperature())}   # kT = {system.kT} pN·µm",
         f"timestep {fmt(dt)}",
         f"seed {system.seed}",

@@ -25,6 +25,7 @@ mod contact;
 mod contractile_lattice;
 mod crashers;
 mod custom;
+mod cytosim_bench;
 mod deck_features;
 mod deck_language;
 mod doublet;
