@@ -71,8 +71,8 @@ def free_observables(system, frames):
     energy (all fibres) and the tangent correlations, each (mean, SE)."""
     c = system.rigidity / system.segmentation
     r2, energy_by_frame = [], []
-    late = [fr for fr in frames if fr[0] >= 0.5 * system.time - 1e-9]
     per_fibre_energy = [[] for _ in frames[0][1]]
+    per_fibre_r2 = [[] for _ in frames[0][1]]
     per_fibre_tcorr = {lag: [[] for _ in frames[0][1]] for lag in TCORR_LAGS}
     for t, fibres in frames:
         values = [dot(sub(f[-1], f[0]), sub(f[-1], f[0])) for f in fibres]
@@ -84,6 +84,7 @@ def free_observables(system, frames):
             energies.append(e)
             if t >= 0.5 * system.time - 1e-9:
                 per_fibre_energy[k].append(e)
+                per_fibre_r2[k].append(values[k])
                 for lag in TCORR_LAGS:
                     per_fibre_tcorr[lag][k].append(sum(dot(ts[i], ts[i + lag]) for i in range(len(ts) - lag)) / (len(ts) - lag))
         energy_by_frame.append((t, sum(energies)))
@@ -92,11 +93,11 @@ def free_observables(system, frames):
     return {
         "r2": r2,
         "r2_end": r2[-1][1],
-        "r2_late": mean_se([sum(dot(sub(f[-1], f[0]), sub(f[-1], f[0])) for _, fs in late for f in [fs[k]]) / len(late) for k in range(nf)]),
+        "r2_late": mean_se([sum(v) / len(v) for v in per_fibre_r2]),
         "energy": (energy[0] * nf, energy[1] * nf),
         "energy_frames": energy_by_frame,
         "tcorr": {lag: mean_se([sum(v) / len(v) for v in per_fibre_tcorr[lag]]) for lag in TCORR_LAGS},
-        "late_times": [t for t, _ in late],
+        "late_times": [t for t, _ in frames if t >= 0.5 * system.time - 1e-9],
     }
 
 

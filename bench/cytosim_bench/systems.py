@@ -127,30 +127,27 @@ def free_fibres():
 
 BUCKLING_LOADS = (0.8, 1.2, 1.5, 2.0, 3.0)  # multiples of the Euler load π²κ/(4L²)
 
+# The microtubule-like fibres of (b) and (c): 5 µm in 20 segments, κ = 20 pN·µm²,
+# in a 0.01 Pa·s medium (a cantilever's slowest mode relaxes in ≈ 0.1 s).
+MICROTUBULE = dict(length=5.0, segmentation=0.25, rigidity=20.0, viscosity=0.01, kT=4.2e-3, dts=(1e-3, 1e-2), spring_k=1e5)
+
 
 def buckling():
     """(b) Microtubule-like cantilevers (κ = 20 pN·µm², L = 5 µm, 20 segments)
     clamped at their minus end (first segment held) and pushed at the tip
     along −x by P = 0.8 … 3 × π²κ/(4L²); one fibre per load."""
-    kappa, length = 20.0, 5.0
-    euler = math.pi**2 * kappa / (4 * length**2)
+    euler = math.pi**2 * MICROTUBULE["rigidity"] / (4 * MICROTUBULE["length"] ** 2)
     fibres = [((0.0, 10.0 * i, 0.0), (1.0, 0.0, 0.0)) for i in range(len(BUCKLING_LOADS))]
-    n = 20
+    tip = round(MICROTUBULE["length"] / MICROTUBULE["segmentation"])
     return System(
         name="buckling",
         label="(b) clamped fibres under compression",
-        length=length,
-        segmentation=length / n,
-        rigidity=kappa,
-        viscosity=0.01,
-        kT=4.2e-3,
+        **MICROTUBULE,
         time=10.0,
         frame=0.25,
-        dts=(1e-3, 1e-2),
         fibres=fibres,
         clamps=[(f, p) for f in range(len(fibres)) for p in (0, 1)],
-        loads=[(f, n, (-m * euler, 0.0, 0.0)) for f, m in enumerate(BUCKLING_LOADS)],
-        spring_k=1e5,
+        loads=[(f, tip, (-m * euler, 0.0, 0.0)) for f, m in enumerate(BUCKLING_LOADS)],
         implicit_solver="cholesky",
         explicit_note="explicit bending limit γℓ³/(8κ) = 3.9e-7 s: 2.6e7 steps",
     )
@@ -161,25 +158,19 @@ def bundle():
     fibres (5 µm, 20 segments) joined by zero-length crosslinks at every
     other point; fibre 1 clamped at its minus end, fibre 2 pulled sideways
     (+y) at its tip by 0.3 pN, so the load reaches the clamp through the links."""
-    n = 20
+    n = round(MICROTUBULE["length"] / MICROTUBULE["segmentation"])
     fibres = [((0.0, 0.0, 0.0), (1.0, 0.0, 0.0)), ((0.0, 0.0, 0.0), (1.0, 0.0, 0.0))]
     return System(
         name="bundle",
         label="(c) crosslinked bundle under a side load",
-        length=5.0,
-        segmentation=5.0 / n,
-        rigidity=20.0,
-        viscosity=0.01,
-        kT=4.2e-3,
+        **MICROTUBULE,
         time=20.0,
         frame=0.1,
-        dts=(1e-3, 1e-2),
         fibres=fibres,
         clamps=[(0, 0), (0, 1)],
         loads=[(1, n, (0.0, 0.3, 0.0))],
         links=[(0, p, 1, p) for p in range(2, n + 1, 2)],
         link_stiffness=100.0,
-        spring_k=1e5,
         explicit_note="explicit bending limit γℓ³/(8κ) = 3.9e-7 s: 5e7 steps",
     )
 
