@@ -88,6 +88,9 @@ def check_config(system, dt, pc, text):
         raise Mismatch(f"{len(couples)} couples, {len(system.links)} links described")
     for values, (a, i, b, j) in zip(couples, system.links):
         close(numbers(values["attach1"]) + numbers(values["attach2"]), [a + 1, i * system.segmentation, b + 1, j * system.segmentation], "crosslink")
+    for verb, words, values in commands:
+        if verb == "new" and words[0] != "space" and values.get("placement") != "anywhere":
+            raise Mismatch(f"`new {' '.join(words)}` without `placement = anywhere`: Cytosim drops an object it cannot place inside its space")
     run = [(w, v) for verb, w, v in commands if verb == "run"][0]
     close([float(run[0][0]) * dt, float(run[1]["nb_frames"])], [system.time, round(system.time / system.frame)], "run steps × dt, frames")
 

@@ -12,7 +12,9 @@ The two models are the same physics term by term:
 | a constant force F on a point | a `fixed` single of stiffness \\|F\\|/D anchored D = `load_distance` away along F (the force varies by the point's travel over D, ≤ 1e-3) | `external … constant_force` |
 | a crosslink between two points | `couple` (zero rest length, Hookean) attached at both abscissae | bond `link`, `harmonic … r0 0` |
 
-Cytosim numbers its fibres from 1 in creation order; an attachment at
+Every `new` says `placement = anywhere`: by default Cytosim places an object
+only inside its space and silently creates none when it cannot (a load's
+anchor lies far outside). Cytosim numbers its fibres from 1 in creation order; an attachment at
 abscissa s = i·ℓ lies on point i (hands interpolate between points, and
 at a point the interpolation is that point).
 """
@@ -85,22 +87,22 @@ def cytosim_config(system: System, dt, precondition):
     ]
     for start, direction in system.fibres:
         centre = [s + 0.5 * system.length * d for s, d in zip(start, direction)]
-        out.append(f"new fiber filament {{ length = {fmt(system.length)}; position = {vec(centre)}; direction = {vec(direction)} }}")
+        out.append(f"new fiber filament {{ length = {fmt(system.length)}; position = {vec(centre)}; direction = {vec(direction)}; placement = anywhere }}")
     if system.clamps or system.loads or system.links:
         out += ["", "set hand holder", "{", "    binding = 0, 0", "    unbinding = 0, inf", "}"]
     if system.clamps:
         out += ["", "set single clamp", "{", "    hand = holder", f"    stiffness = {fmt(system.clamp_stiffness)}", "    activity = fixed", "}"]
         for fibre, point in system.clamps:
-            out.append(f"new single clamp {{ position = {vec(system.point(fibre, point))}; attach = {fibre + 1}, {fmt(point * system.segmentation)} }}")
+            out.append(f"new single clamp {{ position = {vec(system.point(fibre, point))}; attach = {fibre + 1}, {fmt(point * system.segmentation)}; placement = anywhere }}")
     for n, (fibre, point, force) in enumerate(system.loads):
         magnitude = sum(f * f for f in force) ** 0.5
         anchor = [x + system.load_distance * f / magnitude for x, f in zip(system.point(fibre, point), force)]
         out += ["", f"set single load{n}", "{", "    hand = holder", f"    stiffness = {fmt(magnitude / system.load_distance)}", "    activity = fixed", "}"]
-        out.append(f"new single load{n} {{ position = {vec(anchor)}; attach = {fibre + 1}, {fmt(point * system.segmentation)} }}")
+        out.append(f"new single load{n} {{ position = {vec(anchor)}; attach = {fibre + 1}, {fmt(point * system.segmentation)}; placement = anywhere }}")
     if system.links:
         out += ["", "set couple link", "{", "    hand1 = holder", "    hand2 = holder", f"    stiffness = {fmt(system.link_stiffness)}", "}"]
         for a, i, b, j in system.links:
-            out.append(f"new couple link {{ attach1 = {a + 1}, {fmt(i * system.segmentation)}; attach2 = {b + 1}, {fmt(j * system.segmentation)} }}")
+            out.append(f"new couple link {{ attach1 = {a + 1}, {fmt(i * system.segmentation)}; attach2 = {b + 1}, {fmt(j * system.segmentation)}; placement = anywhere }}")
     out += ["", f"run {system.steps(dt)} simul *", "{", f"    nb_frames = {frames}", "}", ""]
     return "\n".join(out)
 
