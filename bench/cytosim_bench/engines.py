@@ -78,7 +78,7 @@ def cellmd_frames(work, points):
 # --------------------------------------------------------------------- Cytosim
 
 
-def run_cytosim(sim, config, steps):
+def run_cytosim(sim, config):
     work = os.path.dirname(config)
     for stale in ("objects.cmo", "properties.cmo", "messages.cmo"):
         if os.path.exists(os.path.join(work, stale)):
@@ -90,17 +90,19 @@ def run_cytosim(sim, config, steps):
     if code != 0 or "error" in (errors + messages).lower():
         lines = [line for line in (errors + messages + text).splitlines() if line.strip()]
         raise EngineError(f"Cytosim exit {code}: " + " | ".join(lines[-3:]))
-    # F<frame> <simulated time>s CPU <CPU since last frame>s <CPU total>s
-    rows = [(int(m.group(1)), float(m.group(2)), float(m.group(3))) for m in re.finditer(r"^F(\d+)\s+([0-9.e+-]+)s\s+CPU\s+[0-9.e+-]+s\s+([0-9.e+-]+)s", messages + text, re.M)]
+    return {"loop": cytosim_loop_time(messages + text), "wall": wall, "cpu": cpu}
+
+
+def cytosim_loop_time(messages):
+    """Cytosim's loop time for its whole run from the frame lines of
+    messages.cmo: `F<frame> <simulated time>s CPU <CPU since last frame>s
+    <CPU total>s`; the CPU from the first frame to the last, scaled to the
+    run's simulated time (the first frame's line also counts the start-up)."""
+    rows = [(float(m.group(1)), float(m.group(2))) for m in re.finditer(r"^F\d+\s+([0-9.e+-]+)s\s+CPU\s+([0-9.e+-]+)s", messages, re.M)]
     if len(rows) < 2:
         raise EngineError("Cytosim wrote fewer than two frame lines (F… CPU …) to messages.cmo: cannot time its loop")
-    (_, t0, c0), (_, t1, c1) = rows[0], rows[-1]
-    # The total column is printed with no decimals: use the per-frame sums instead.
-    per_frame = [float(m.group(1)) for m in re.finditer(r"^F\d+\s+[0-9.e+-]+s\s+CPU\s+([0-9.e+-]+)s", messages + text, re.M)]
-    loop_cpu = sum(per_frame[1:])
-    total_time = rows[-1][1]
-    loop = loop_cpu * total_time / (t1 - t0)
-    return {"loop": loop, "wall": wall, "cpu": cpu}
+    loop_cpu = sum(cpu for _, cpu in rows[1:])
+    return loop_cpu * rows[-1][0] / (rows[-1][0] - rows[0][0])
 
 
 def cytosim_frames(report, work, points):

@@ -33,7 +33,7 @@ def run_system(system, args, binary, table, results):
                 where = os.path.join(work, f"cytosim-dt{dt:g}-pc{pc}")
                 config = writers.write_cytosim(system, dt, pc, where)
                 try:
-                    timing = engines.run_cytosim(args.sim, config, system.steps(dt))
+                    timing = engines.run_cytosim(args.sim, config)
                     frames = engines.cytosim_frames(args.report, where, system.points)
                     results.append((label, "implicit", dt, observe(system, frames)))
                     table.append((system, label, dt, timing, None))
