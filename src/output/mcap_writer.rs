@@ -46,7 +46,9 @@
 //! yield them all before they report the missing footer; indexed readers
 //! (`make_reader`, which starts from the footer) need the file finished
 //! (or rewritten by `mcap recover`). Bond events between frames go into the
-//! next frame's chunk.
+//! next frame's chunk, or into a chunk of their own once the oldest of them
+//! has waited [`BATCH_INTERVAL`] (1 s; checked every step), so a kill loses
+//! at most the last second of them.
 //!
 //! # Compression
 //!
@@ -70,12 +72,13 @@
 use std::collections::BTreeMap;
 use std::fs::File;
 use std::io;
+use std::time::Instant;
 
 use foxglove::Encode;
 use mcap::records::MessageHeader;
 
 use super::mcap_messages::{self as proto, descriptor_set, JsonForm};
-use super::records::RecordFile;
+use super::records::{RecordFile, BATCH_INTERVAL};
 use super::scene::{Scene, SCENE_UPDATE_SCHEMA};
 use super::{check_frame, check_topology, invalid_input, units_keyword, Encoding, FrameView, TopologyView, TrajectoryWriter};
 
@@ -199,6 +202,8 @@ struct Sink {
     writer: mcap::Writer<RecordFile>,
     sequence: BTreeMap<u16, u32>,
     buffer: Vec<u8>,
+    /// When the oldest message not yet in a written chunk was published.
+    unwritten_since: Option<Instant>,
 }
 
 impl Sink {
@@ -212,7 +217,14 @@ impl Sink {
         let sequence = self.sequence.entry(channel_id).or_insert(0);
         *sequence += 1;
         let header = MessageHeader { channel_id, sequence: *sequence, log_time: ns, publish_time: ns };
+        self.unwritten_since.get_or_insert_with(Instant::now);
         self.writer.write_to_known_channel(&header, &self.buffer).map_err(mcap_err)
+    }
+
+    /// Ends the chunk and writes it whole (see the module docs).
+    fn end_chunk(&mut self) -> io::Result<()> {
+        self.unwritten_since = None;
+        self.writer.flush().map_err(mcap_err)
     }
 }
 
@@ -269,10 +281,11 @@ impl McapWriter {
             }
         };
         let [channel_topology, channel_frame, channel_bond_state, channel_events, channel_scene] = channels;
+        let mut sink = Sink { writer, sequence: BTreeMap::new(), buffer: Vec::new(), unwritten_since: None };
         // The header and a first chunk with the schemas and channels.
-        writer.flush().map_err(mcap_err)?;
+        sink.end_chunk()?;
         Ok(Self {
-            sink: Sink { writer, sequence: BTreeMap::new(), buffer: Vec::new() },
+            sink,
             channel_topology,
             channel_frame,
             channel_bond_state,
@@ -365,7 +378,7 @@ impl TrajectoryWriter for McapWriter {
             self.write_scene(ns, frame)?;
         }
         // The frame ends its chunk, which goes to the file whole.
-        self.sink.writer.flush().map_err(mcap_err)
+        self.sink.end_chunk()
     }
 
     fn write_bond_events(&mut self, events: &[crate::kinetics_engine::Event], bound: &[bool]) -> io::Result<()> {
@@ -376,6 +389,13 @@ impl TrajectoryWriter for McapWriter {
             self.write_bond_state(first.step, first.time, bound)?;
         }
         Ok(())
+    }
+
+    fn flush_due(&mut self) -> io::Result<()> {
+        match self.sink.unwritten_since {
+            Some(since) if since.elapsed() >= BATCH_INTERVAL => self.sink.end_chunk(),
+            _ => Ok(()),
+        }
     }
 
     fn finish(mut self: Box<Self>) -> io::Result<()> {
@@ -584,6 +604,32 @@ mod tests {
         assert_eq!(frame_box["id"], "box");
         assert_eq!(frame_box["lines"][0]["points"].as_array().unwrap().len(), 24);
         assert_eq!(frame_box["triangles"], serde_json::json!([]));
+    }
+
+    /// A message between frames is in a whole chunk on disk once it has
+    /// waited the batch interval, and a streaming reader recovers it from
+    /// the unfinished file (as after a kill).
+    #[test]
+    fn messages_between_frames_are_written_within_the_batch_interval() {
+        let s = Sample::new(2);
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.mcap");
+        let mut w = McapWriter::new(File::create(&path).unwrap(), &s.topology(), Encoding::Protobuf).unwrap();
+        w.write_frame(&s.frame(0)).unwrap();
+        let after_frame = std::fs::metadata(&path).unwrap().len();
+        w.write_bond_state(50, 0.05, &[true, false]).unwrap();
+        w.flush_due().unwrap();
+        assert_eq!(std::fs::metadata(&path).unwrap().len(), after_frame, "a message waits up to the interval");
+        std::thread::sleep(BATCH_INTERVAL);
+        w.flush_due().unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        assert!(bytes.len() as u64 > after_frame);
+        let stream = mcap::MessageStream::new_with_options(&bytes, mcap::read::Options::IgnoreEndMagic.into()).unwrap();
+        let topics: Vec<String> = stream.map_while(Result::ok).map(|m| m.channel.topic.clone()).collect();
+        assert_eq!(topics.last().map(String::as_str), Some(TOPIC_BOND_STATE), "{topics:?}");
+        let len = bytes.len();
+        w.flush_due().unwrap();
+        assert_eq!(std::fs::read(&path).unwrap().len(), len, "nothing new, nothing written");
     }
 
     #[test]

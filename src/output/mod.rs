@@ -39,8 +39,8 @@
 //! symbolic link (file or subdirectory) is followed. Streams are written in
 //! whole records through [`records`]: each trajectory frame (an MCAP chunk,
 //! an XYZ/LAMMPS/DCD frame, the bond rows of a frame) and each thermo row is
-//! written with one write as soon as it is complete; the event log's rows
-//! are batched for at most 1 s. After a SIGKILL every output therefore ends
+//! written with one write as soon as it is complete; the event log's rows,
+//! and an MCAP's bond events between frames, are batched for at most 1 s. After a SIGKILL every output therefore ends
 //! at its last complete record (an MCAP lacks only its summary and footer;
 //! streaming readers recover every message before the cut). A failed write
 //! (`ENOSPC`) is cut back to the last whole record and stops the run with
@@ -176,6 +176,12 @@ pub trait TrajectoryWriter: Send {
     /// Records the bond events of one step and the bound flags after them.
     /// Formats without a channel for them ignore this.
     fn write_bond_events(&mut self, _events: &[crate::kinetics_engine::Event], _bound: &[bool]) -> io::Result<()> {
+        Ok(())
+    }
+    /// Writes the whole records that have waited in memory for
+    /// [`records::BATCH_INTERVAL`] (an MCAP's bond events between frames);
+    /// called once per step, between records.
+    fn flush_due(&mut self) -> io::Result<()> {
         Ok(())
     }
     /// The quantities the writer reads from [`FrameView::measures`].

@@ -21,7 +21,8 @@ use std::io::{self, Seek, SeekFrom, Write};
 use std::time::{Duration, Instant};
 
 /// How long complete records may wait in memory when a writer batches them
-/// ([`RecordFile::commit_batched`]): the event log's rows.
+/// ([`RecordFile::commit_batched`]): the event log's rows, and an MCAP's
+/// messages between frames.
 pub const BATCH_INTERVAL: Duration = Duration::from_secs(1);
 /// How many bytes may wait in memory before a batch is written regardless.
 pub const BATCH_BYTES: usize = 1 << 16;

@@ -149,6 +149,9 @@ impl Simulation {
                 return Err(self.output_error(&path, e));
             }
         }
+        if let Some((path, e)) = self.dumps.iter_mut().find_map(|d| d.writer.flush_due().err().map(|e| (d.path.clone(), e))) {
+            return Err(self.output_error(&path, e));
+        }
         for i in 0..self.dumps.len() {
             if step.is_multiple_of(self.dumps[i].spec.every) && self.dumps[i].last_step != Some(step) {
                 self.write_dump(i)?;
