@@ -358,6 +358,13 @@ where
                 Ok(plan) => plan,
                 Err(e) => return report(e),
             };
+            // A restart that does not fit its deck is bad input: refused before any output exists.
+            if let (Some(data), Some(path)) = (&restart, &resume) {
+                if let Err(e) = Simulation::check_restart(&plan, data, path) {
+                    eprintln!("error: {e}");
+                    return ExitCode::from(1);
+                }
+            }
             if let Err(e) = std::fs::create_dir_all(&output_dir) {
                 eprintln!("error: cannot create output directory {}: {e}", output_dir.display());
                 return ExitCode::from(OUTPUT_ERROR_STATUS);

@@ -31,9 +31,9 @@
 //! `NSAVC = 1` and `DELTA = 0`.
 
 use std::fs::File;
-use std::io::{self, BufWriter, Seek, SeekFrom, Write};
-use std::path::Path;
+use std::io::{self, Write};
 
+use super::records::RecordFile;
 use super::{check_frame, check_topology, units_keyword, FrameView, TopologyView, TrajectoryWriter};
 
 /// Byte offset of the control words (after the record marker and `CORD`).
@@ -43,7 +43,7 @@ const CHARMM_VERSION: i32 = 24;
 
 /// Writes DCD frames to a file.
 pub struct DcdWriter {
-    out: BufWriter<File>,
+    out: RecordFile,
     /// Internal indices sorted by user id.
     order: Vec<usize>,
     frames: i32,
@@ -56,8 +56,8 @@ pub struct DcdWriter {
 }
 
 impl DcdWriter {
-    /// Creates (or truncates) `path` and writes the header.
-    pub fn create(path: &Path, topology: &TopologyView) -> io::Result<Self> {
+    /// Writes the header to `file` (empty, as opened for output).
+    pub fn new(file: File, topology: &TopologyView) -> io::Result<Self> {
         check_topology(topology)?;
         let n = i32::try_from(topology.ids.len())
             .ok()
@@ -66,7 +66,7 @@ impl DcdWriter {
         let mut order: Vec<usize> = (0..topology.ids.len()).collect();
         order.sort_by_key(|&i| topology.ids[i]);
         let mut w = Self {
-            out: BufWriter::new(File::create(path)?),
+            out: RecordFile::new(file),
             order,
             frames: 0,
             first: None,
@@ -83,6 +83,7 @@ impl DcdWriter {
         }
         record(&mut w.out, &title)?;
         record(&mut w.out, &n.to_le_bytes())?;
+        w.out.commit()?;
         Ok(w)
     }
 
@@ -139,19 +140,14 @@ impl TrajectoryWriter for DcdWriter {
             self.coords.extend(self.order.iter().flat_map(|&i| (frame.positions[i][a] as f32).to_le_bytes()));
             record(&mut self.out, &self.coords)?;
         }
-        // Keep the header's counts true for the frames on disk.
+        // The frame goes to the file whole, then the header counts it.
+        self.out.commit()?;
         let control: Vec<u8> = self.control().iter().flat_map(|c| c.to_le_bytes()).collect();
-        self.out.flush()?;
-        let file = self.out.get_mut();
-        file.seek(SeekFrom::Start(CONTROL_OFFSET))?;
-        file.write_all(&control)?;
-        file.seek(SeekFrom::End(0))?;
-        Ok(())
+        self.out.overwrite(CONTROL_OFFSET, &control)
     }
 
     fn finish(mut self: Box<Self>) -> io::Result<()> {
-        self.out.flush()?;
-        self.out.get_ref().sync_data()
+        self.out.finish()
     }
 }
 
@@ -183,7 +179,7 @@ mod tests {
         let s = Sample::new(3);
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("t.dcd");
-        let mut w: Box<dyn TrajectoryWriter> = Box::new(DcdWriter::create(&path, &s.topology()).unwrap());
+        let mut w: Box<dyn TrajectoryWriter> = Box::new(DcdWriter::new(File::create(&path).unwrap(), &s.topology()).unwrap());
         for f in 0..3 {
             w.write_frame(&s.frame(f)).unwrap();
         }
@@ -221,7 +217,7 @@ mod tests {
         let s = Sample::new(1);
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("t.dcd");
-        let mut w = DcdWriter::create(&path, &s.topology()).unwrap();
+        let mut w = DcdWriter::new(File::create(&path).unwrap(), &s.topology()).unwrap();
         w.write_frame(&s.frame(0)).unwrap();
         let bytes = std::fs::read(&path).unwrap();
         let control = words(&records(&bytes)[0][4..]);

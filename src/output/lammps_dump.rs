@@ -37,9 +37,9 @@
 //!   and XYZ outputs carry it.
 
 use std::fs::File;
-use std::io::{self, BufWriter, Write};
-use std::path::Path;
+use std::io::{self, Write};
 
+use super::records::RecordFile;
 use super::{check_frame, check_topology, invalid_input, token, FrameView, Needs, Real, TopologyView, TrajectoryWriter};
 
 /// A per-atom column of a LAMMPS dump (`dump … lammps FILE columns ...`).
@@ -131,7 +131,7 @@ impl AtomColumn {
 
 /// Writes LAMMPS text dump frames to a file.
 pub struct LammpsDumpWriter {
-    out: BufWriter<File>,
+    out: RecordFile,
     ids: Vec<u64>,
     types: Vec<u32>,
     /// Type-name token per type.
@@ -144,13 +144,8 @@ pub struct LammpsDumpWriter {
 }
 
 impl LammpsDumpWriter {
-    /// Creates (or truncates) `path`, with the default columns.
-    pub fn create(path: &Path, topology: &TopologyView) -> io::Result<Self> {
-        Self::with_columns(path, topology, &[])
-    }
-
-    /// Creates (or truncates) `path` writing `columns` (empty: the defaults).
-    pub fn with_columns(path: &Path, topology: &TopologyView, columns: &[AtomColumn]) -> io::Result<Self> {
+    /// Writes frames of `columns` (empty: the defaults) to `file` (empty, as opened for output).
+    pub fn new(file: File, topology: &TopologyView, columns: &[AtomColumn]) -> io::Result<Self> {
         check_topology(topology)?;
         let mut order: Vec<usize> = (0..topology.ids.len()).collect();
         order.sort_by_key(|&i| topology.ids[i]);
@@ -160,7 +155,7 @@ impl LammpsDumpWriter {
             Needs { forces: a.forces || n.forces, virial: a.virial || n.virial, bonds: a.bonds || n.bonds }
         });
         Ok(Self {
-            out: BufWriter::new(File::create(path)?),
+            out: RecordFile::new(file),
             ids: topology.ids.to_vec(),
             types: topology.types.to_vec(),
             type_names: topology.type_names.iter().map(|n| token(n)).collect(),
@@ -217,7 +212,8 @@ impl TrajectoryWriter for LammpsDumpWriter {
             }
             writeln!(out, "{line}")?;
         }
-        Ok(())
+        // The frame goes to the file whole.
+        out.commit()
     }
 
     fn needs(&self) -> Needs {
@@ -225,8 +221,7 @@ impl TrajectoryWriter for LammpsDumpWriter {
     }
 
     fn finish(mut self: Box<Self>) -> io::Result<()> {
-        self.out.flush()?;
-        self.out.get_ref().sync_data()
+        self.out.finish()
     }
 }
 
@@ -240,7 +235,7 @@ mod tests {
         let s = Sample::new(2);
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("t.lammpstrj");
-        let mut w: Box<dyn TrajectoryWriter> = Box::new(LammpsDumpWriter::create(&path, &s.topology()).unwrap());
+        let mut w: Box<dyn TrajectoryWriter> = Box::new(LammpsDumpWriter::new(File::create(&path).unwrap(), &s.topology(), &[]).unwrap());
         w.write_frame(&s.frame(0)).unwrap();
         w.write_frame(&s.frame(1)).unwrap();
         w.finish().unwrap();
@@ -286,7 +281,7 @@ mod tests {
         let path = dir.path().join("s.lammpstrj");
         let names = "id xu fx wxy sxx syy szz sxy vonmises";
         let columns: Vec<AtomColumn> = names.split(' ').map(|n| AtomColumn::from_name(n).unwrap()).collect();
-        let mut w = LammpsDumpWriter::with_columns(&path, &s.topology(), &columns).unwrap();
+        let mut w = LammpsDumpWriter::new(File::create(&path).unwrap(), &s.topology(), &columns).unwrap();
         assert_eq!(w.needs(), Needs { forces: true, virial: true, bonds: false });
         // Without the measures the frame is refused, not written with zeros.
         assert!(w.write_frame(&s.frame(0)).is_err());

@@ -32,11 +32,29 @@
 //! bonds the state is no longer written (it would not match the topology):
 //! `/cellmd/events` carries every change.
 //!
+//! # Chunks: what survives a kill
+//!
+//! Each frame ends its chunk: the chunk is assembled in memory, compressed,
+//! and written to the file with its message indexes in one write when the
+//! frame is complete (see [`records`](super::records)), so after a SIGKILL
+//! or a full disk the file is the header and whole chunks, and only the
+//! summary and footer, which a clean end writes, are missing. Readers that
+//! stream the file recover every message of every frame written before:
+//! Python's `mcap.reader.NonSeekingReader(f).iter_messages(log_time_order=False)`
+//! (or `mcap.stream_reader.StreamReader(f).records`) and Rust's
+//! `mcap::MessageStream::new_with_options(bytes, Options::IgnoreEndMagic.into())`
+//! yield them all before they report the missing footer; indexed readers
+//! (`make_reader`, which starts from the footer) need the file finished
+//! (or rewritten by `mcap recover`). Bond events between frames go into the
+//! next frame's chunk, or into a chunk of their own once the oldest of them
+//! has waited [`BATCH_INTERVAL`] (1 s; checked every step), so a kill loses
+//! at most the last second of them.
+//!
 //! # Compression
 //!
-//! Chunks are compressed with zstd (default level, the MCAP default chunk
-//! size of 768 KiB, single-threaded so the bytes do not depend on the
-//! machine). The quickstart shortened to 9 frames of 1500 particles
+//! Chunks are compressed with zstd (default level, single-threaded so the
+//! bytes do not depend on the machine); a frame larger than the MCAP default
+//! chunk size of 768 KiB spans several chunks. The quickstart shortened to 9 frames of 1500 particles
 //! (`--var steps=2000`) writes 0.73 MB for 2.98 MB of messages; its frames
 //! take 365 kB in protobuf and 874 kB as JSON, and with `encoding json`
 //! 7.25 MB of messages compress to 0.75 MB. Every MCAP reader (the `mcap`
@@ -53,13 +71,14 @@
 
 use std::collections::BTreeMap;
 use std::fs::File;
-use std::io::{self, BufWriter, Write};
-use std::path::Path;
+use std::io;
+use std::time::Instant;
 
 use foxglove::Encode;
 use mcap::records::MessageHeader;
 
 use super::mcap_messages::{self as proto, descriptor_set, JsonForm};
+use super::records::{RecordFile, BATCH_INTERVAL};
 use super::scene::{Scene, SCENE_UPDATE_SCHEMA};
 use super::{check_frame, check_topology, invalid_input, units_keyword, Encoding, FrameView, TopologyView, TrajectoryWriter};
 
@@ -180,9 +199,11 @@ pub struct McapWriter {
 
 /// The MCAP writer with per-channel sequence numbers and a reused buffer.
 struct Sink {
-    writer: mcap::Writer<BufWriter<File>>,
+    writer: mcap::Writer<RecordFile>,
     sequence: BTreeMap<u16, u32>,
     buffer: Vec<u8>,
+    /// When the oldest message not yet in a written chunk was published.
+    unwritten_since: Option<Instant>,
 }
 
 impl Sink {
@@ -196,27 +217,31 @@ impl Sink {
         let sequence = self.sequence.entry(channel_id).or_insert(0);
         *sequence += 1;
         let header = MessageHeader { channel_id, sequence: *sequence, log_time: ns, publish_time: ns };
+        self.unwritten_since.get_or_insert_with(Instant::now);
         self.writer.write_to_known_channel(&header, &self.buffer).map_err(mcap_err)
+    }
+
+    /// Ends the chunk and writes it whole (see the module docs).
+    fn end_chunk(&mut self) -> io::Result<()> {
+        self.unwritten_since = None;
+        self.writer.flush().map_err(mcap_err)
     }
 }
 
 impl McapWriter {
-    /// Creates (or truncates) `path` with protobuf channels.
-    pub fn create(path: &Path, topology: &TopologyView) -> io::Result<Self> {
-        Self::create_with(path, topology, Encoding::Protobuf)
-    }
-
-    /// Creates (or truncates) `path` and registers the schemas and channels
-    /// in `encoding`.
-    pub fn create_with(path: &Path, topology: &TopologyView, encoding: Encoding) -> io::Result<Self> {
+    /// Writes to `file` (empty, as opened for output) and registers the
+    /// schemas and channels in `encoding`.
+    pub fn new(file: File, topology: &TopologyView, encoding: Encoding) -> io::Result<Self> {
         check_topology(topology)?;
         let options = mcap::WriteOptions::new()
             .compression(Some(mcap::Compression::Zstd))
             // One thread: the bytes then never depend on the machine's core count.
             .compression_threads(0)
+            // Chunks assembled in memory and written whole (see the module docs).
+            .disable_seeking(true)
             .profile("")
             .library(format!("cellmd {}", env!("CARGO_PKG_VERSION")));
-        let mut writer = options.create(BufWriter::new(File::create(path)?)).map_err(mcap_err)?;
+        let mut writer = options.create(RecordFile::new(file)).map_err(mcap_err)?;
         let no_metadata = BTreeMap::new();
         let mut channel =
             |schema_name: &str, schema_encoding: &str, schema: &[u8], topic: &str, message_encoding: &str| -> io::Result<u16> {
@@ -256,8 +281,11 @@ impl McapWriter {
             }
         };
         let [channel_topology, channel_frame, channel_bond_state, channel_events, channel_scene] = channels;
+        let mut sink = Sink { writer, sequence: BTreeMap::new(), buffer: Vec::new(), unwritten_since: None };
+        // The header and a first chunk with the schemas and channels.
+        sink.end_chunk()?;
         Ok(Self {
-            sink: Sink { writer, sequence: BTreeMap::new(), buffer: Vec::new() },
+            sink,
             channel_topology,
             channel_frame,
             channel_bond_state,
@@ -349,7 +377,8 @@ impl TrajectoryWriter for McapWriter {
         if self.scene_enabled {
             self.write_scene(ns, frame)?;
         }
-        Ok(())
+        // The frame ends its chunk, which goes to the file whole.
+        self.sink.end_chunk()
     }
 
     fn write_bond_events(&mut self, events: &[crate::kinetics_engine::Event], bound: &[bool]) -> io::Result<()> {
@@ -362,11 +391,16 @@ impl TrajectoryWriter for McapWriter {
         Ok(())
     }
 
+    fn flush_due(&mut self) -> io::Result<()> {
+        match self.sink.unwritten_since {
+            Some(since) if since.elapsed() >= BATCH_INTERVAL => self.sink.end_chunk(),
+            _ => Ok(()),
+        }
+    }
+
     fn finish(mut self: Box<Self>) -> io::Result<()> {
         self.sink.writer.finish().map_err(mcap_err)?;
-        let mut out = self.sink.writer.into_inner();
-        out.flush()?;
-        out.get_ref().sync_data()
+        self.sink.writer.into_inner().finish()
     }
 }
 
@@ -387,9 +421,10 @@ mod tests {
     use super::super::test_support::Sample;
     use super::*;
     use serde_json::Value;
+    use std::path::Path;
 
     fn write_sample(path: &Path, s: &Sample, times: &[f64], encoding: Encoding) {
-        let mut w = McapWriter::create_with(path, &s.topology(), encoding).unwrap();
+        let mut w = McapWriter::new(File::create(path).unwrap(), &s.topology(), encoding).unwrap();
         for (f, &t) in times.iter().enumerate() {
             let mut frame = s.frame(f);
             frame.time = t;
@@ -571,12 +606,38 @@ mod tests {
         assert_eq!(frame_box["triangles"], serde_json::json!([]));
     }
 
+    /// A message between frames is in a whole chunk on disk once it has
+    /// waited the batch interval, and a streaming reader recovers it from
+    /// the unfinished file (as after a kill).
+    #[test]
+    fn messages_between_frames_are_written_within_the_batch_interval() {
+        let s = Sample::new(2);
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.mcap");
+        let mut w = McapWriter::new(File::create(&path).unwrap(), &s.topology(), Encoding::Protobuf).unwrap();
+        w.write_frame(&s.frame(0)).unwrap();
+        let after_frame = std::fs::metadata(&path).unwrap().len();
+        w.write_bond_state(50, 0.05, &[true, false]).unwrap();
+        w.flush_due().unwrap();
+        assert_eq!(std::fs::metadata(&path).unwrap().len(), after_frame, "a message waits up to the interval");
+        std::thread::sleep(BATCH_INTERVAL);
+        w.flush_due().unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        assert!(bytes.len() as u64 > after_frame);
+        let stream = mcap::MessageStream::new_with_options(&bytes, mcap::read::Options::IgnoreEndMagic.into()).unwrap();
+        let topics: Vec<String> = stream.map_while(Result::ok).map(|m| m.channel.topic.clone()).collect();
+        assert_eq!(topics.last().map(String::as_str), Some(TOPIC_BOND_STATE), "{topics:?}");
+        let len = bytes.len();
+        w.flush_due().unwrap();
+        assert_eq!(std::fs::read(&path).unwrap().len(), len, "nothing new, nothing written");
+    }
+
     #[test]
     fn later_bond_states_and_scene_toggle() {
         let s = Sample::new(2);
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("t.mcap");
-        let mut w = McapWriter::create(&path, &s.topology()).unwrap();
+        let mut w = McapWriter::new(File::create(&path).unwrap(), &s.topology(), Encoding::Protobuf).unwrap();
         w.write_frame(&s.frame(0)).unwrap();
         w.write_bond_state(50, 0.05, &[true, false]).unwrap();
         assert!(w.write_bond_state(50, 0.05, &[true]).is_err());

@@ -32,24 +32,39 @@
 //! * Text formats print f64 in Rust's shortest round-trip form (`{}`, or
 //!   `{:e}` outside `1e-5 ≤ |x| < 1e16`), so a value read back is bit-identical
 //!   to the one written.
+//!
+//! # What survives a kill or a full disk
+//!
+//! Files are opened through [`files`]: inside the output directory no
+//! symbolic link (file or subdirectory) is followed. Streams are written in
+//! whole records through [`records`]: each trajectory frame (an MCAP chunk,
+//! an XYZ/LAMMPS/DCD frame, the bond rows of a frame) and each thermo row is
+//! written with one write as soon as it is complete; the event log's rows,
+//! and an MCAP's bond events between frames, are batched for at most 1 s. After a SIGKILL every output therefore ends
+//! at its last complete record (an MCAP lacks only its summary and footer;
+//! streaming readers recover every message before the cut). A failed write
+//! (`ENOSPC`) is cut back to the last whole record and stops the run with
+//! `OUTPUT_ERROR_STATUS`. Restarts and the lifetime table are written
+//! atomically (a synced `NAME.tmp` renamed over `NAME`).
 
 use std::fmt;
+use std::fs::File;
 use std::io;
-use std::path::Path;
 
 use glam::DVec3;
 
 use crate::system::SimBox;
 use crate::units::UnitSystem;
 
-pub mod atomic;
 pub mod bond_csv;
 pub mod dcd;
 pub mod event_log;
+pub mod files;
 pub mod lammps_dump;
 pub mod lifetimes;
 pub mod mcap_messages;
 pub mod mcap_writer;
+pub mod records;
 pub mod restart;
 pub mod run_log;
 pub mod scene;
@@ -163,6 +178,12 @@ pub trait TrajectoryWriter: Send {
     fn write_bond_events(&mut self, _events: &[crate::kinetics_engine::Event], _bound: &[bool]) -> io::Result<()> {
         Ok(())
     }
+    /// Writes the whole records that have waited in memory for
+    /// [`records::BATCH_INTERVAL`] (an MCAP's bond events between frames);
+    /// called once per step, between records.
+    fn flush_due(&mut self) -> io::Result<()> {
+        Ok(())
+    }
     /// The quantities the writer reads from [`FrameView::measures`].
     fn needs(&self) -> Needs {
         Needs::default()
@@ -245,16 +266,12 @@ pub struct WriterOptions {
     pub encoding: Encoding,
 }
 
-/// Opens a writer of `format` at `path` (created or truncated), with default options.
-pub fn open_writer(format: DumpFormat, path: &Path, topology: &TopologyView) -> io::Result<Box<dyn TrajectoryWriter>> {
-    open_writer_with(format, path, topology, &WriterOptions::default())
-}
-
-/// [`open_writer`] with options: LAMMPS dumps take `columns`, MCAP files an
-/// `encoding`; a non-default option for another format is an error.
-pub fn open_writer_with(
+/// A writer of `format` into `file` (empty, as [`files::create`] opens it),
+/// with options: LAMMPS dumps take `columns`, MCAP files an `encoding`; a
+/// non-default option for another format is an error.
+pub fn open_writer(
     format: DumpFormat,
-    path: &Path,
+    file: File,
     topology: &TopologyView,
     options: &WriterOptions,
 ) -> io::Result<Box<dyn TrajectoryWriter>> {
@@ -265,11 +282,11 @@ pub fn open_writer_with(
         return Err(invalid_input(format!("only `mcap` dumps take an encoding, not `{}`", format.keyword())));
     }
     Ok(match format {
-        DumpFormat::Mcap => Box::new(McapWriter::create_with(path, topology, options.encoding)?),
-        DumpFormat::Xyz => Box::new(XyzWriter::create(path, topology)?),
-        DumpFormat::Lammps => Box::new(LammpsDumpWriter::with_columns(path, topology, &options.columns)?),
-        DumpFormat::Bonds => Box::new(BondCsvWriter::create(path, topology)?),
-        DumpFormat::Dcd => Box::new(DcdWriter::create(path, topology)?),
+        DumpFormat::Mcap => Box::new(McapWriter::new(file, topology, options.encoding)?),
+        DumpFormat::Xyz => Box::new(XyzWriter::new(file, topology)?),
+        DumpFormat::Lammps => Box::new(LammpsDumpWriter::new(file, topology, &options.columns)?),
+        DumpFormat::Bonds => Box::new(BondCsvWriter::new(file, topology)?),
+        DumpFormat::Dcd => Box::new(DcdWriter::new(file, topology)?),
     })
 }
 
@@ -499,13 +516,13 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         for format in [DumpFormat::Mcap, DumpFormat::Xyz, DumpFormat::Lammps, DumpFormat::Dcd] {
             let path = dir.path().join(format!("traj.{}", format.extension()));
-            let mut w = open_writer(format, &path, &s.topology()).unwrap();
+            let mut w = open_writer(format, File::create(&path).unwrap(), &s.topology(), &WriterOptions::default()).unwrap();
             w.write_frame(&s.frame(0)).unwrap();
             w.write_frame(&s.frame(1)).unwrap();
             w.finish().unwrap();
             assert!(std::fs::metadata(&path).unwrap().len() > 0);
         }
         let json = WriterOptions { encoding: Encoding::Json, ..Default::default() };
-        assert!(open_writer_with(DumpFormat::Xyz, &dir.path().join("x.xyz"), &s.topology(), &json).is_err());
+        assert!(open_writer(DumpFormat::Xyz, File::create(dir.path().join("x.xyz")).unwrap(), &s.topology(), &json).is_err());
     }
 }

@@ -27,14 +27,14 @@
 //! them); use the LAMMPS dump or MCAP output when unwrapped paths matter.
 
 use std::fs::File;
-use std::io::{self, BufWriter, Write};
-use std::path::Path;
+use std::io::{self, Write};
 
+use super::records::RecordFile;
 use super::{check_frame, check_topology, element_symbol, token, units_keyword, FrameView, Real, TopologyView, TrajectoryWriter};
 
 /// Writes extended XYZ frames to a file.
 pub struct XyzWriter {
-    out: BufWriter<File>,
+    out: RecordFile,
     ids: Vec<u64>,
     /// Element symbol of each particle's type.
     species: Vec<&'static str>,
@@ -44,12 +44,12 @@ pub struct XyzWriter {
 }
 
 impl XyzWriter {
-    /// Creates (or truncates) `path`.
-    pub fn create(path: &Path, topology: &TopologyView) -> io::Result<Self> {
+    /// Writes frames to `file` (empty, as opened for output).
+    pub fn new(file: File, topology: &TopologyView) -> io::Result<Self> {
         check_topology(topology)?;
         let names: Vec<String> = topology.type_names.iter().map(|n| token(n)).collect();
         Ok(Self {
-            out: BufWriter::new(File::create(path)?),
+            out: RecordFile::new(file),
             ids: topology.ids.to_vec(),
             species: topology.types.iter().map(|&t| element_symbol(t as usize)).collect(),
             type_names: topology.types.iter().map(|&t| names[t as usize].clone()).collect(),
@@ -86,12 +86,12 @@ impl TrajectoryWriter for XyzWriter {
         for (i, x) in frame.positions.iter().enumerate() {
             writeln!(out, "{} {} {} {} {} {}", self.species[i], Real(x.x), Real(x.y), Real(x.z), self.type_names[i], self.ids[i])?;
         }
-        Ok(())
+        // The frame goes to the file whole.
+        out.commit()
     }
 
     fn finish(mut self: Box<Self>) -> io::Result<()> {
-        self.out.flush()?;
-        self.out.get_ref().sync_data()
+        self.out.finish()
     }
 }
 
@@ -105,7 +105,7 @@ mod tests {
         let s = Sample::new(2);
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("t.xyz");
-        let mut w: Box<dyn TrajectoryWriter> = Box::new(XyzWriter::create(&path, &s.topology()).unwrap());
+        let mut w: Box<dyn TrajectoryWriter> = Box::new(XyzWriter::new(File::create(&path).unwrap(), &s.topology()).unwrap());
         w.write_frame(&s.frame(0)).unwrap();
         w.write_frame(&s.frame(1)).unwrap();
         w.finish().unwrap();
@@ -142,7 +142,7 @@ mod tests {
     fn wrong_particle_count_is_an_error() {
         let s = Sample::new(1);
         let dir = tempfile::tempdir().unwrap();
-        let mut w = XyzWriter::create(&dir.path().join("t.xyz"), &s.topology()).unwrap();
+        let mut w = XyzWriter::new(File::create(dir.path().join("t.xyz")).unwrap(), &s.topology()).unwrap();
         let mut f = s.frame(0);
         f.positions = &s.frames[0][..3];
         assert_eq!(w.write_frame(&f).unwrap_err().kind(), io::ErrorKind::InvalidInput);

@@ -34,7 +34,7 @@
 //! | `load/NAME`, `depth/NAME` | an indenter external's load \|Σ F\| on its group (its reaction) and its deepest penetration δ = (3E/K)^{1/3} | pN, µm |
 
 use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::Write;
 use std::path::PathBuf;
 
 use super::protocol::indenter_load;
@@ -42,6 +42,7 @@ use crate::backend::Forces;
 use crate::deck::{GroupQuantity, ThermoColumn};
 use crate::interactions::REGISTRY;
 use crate::measure::{clustering, filaments, fracture, planes};
+use crate::output::records::RecordFile;
 use crate::units::{Dim, UnitSystem};
 use glam::DVec2;
 
@@ -302,7 +303,7 @@ pub struct Thermo {
     pub(crate) labels: Vec<String>,
     pub units: UnitSystem,
     /// The CSV file and its path (for error messages).
-    file: Option<(BufWriter<File>, PathBuf)>,
+    file: Option<(RecordFile, PathBuf)>,
     file_header_written: bool,
     /// Whether rows are kept in `log` (the Python API's `thermo()`).
     pub(crate) record: bool,
@@ -348,7 +349,7 @@ impl Thermo {
 
     pub fn set_file(&mut self, file: File, path: PathBuf) -> Result<(), FileError> {
         self.close()?;
-        self.file = Some((BufWriter::new(file), path));
+        self.file = Some((RecordFile::new(file), path));
         self.file_header_written = false;
         Ok(())
     }
@@ -400,7 +401,8 @@ impl Thermo {
                     .map(|(c, v)| if is_integer(c) { format!("{}", *v as u64) } else { format!("{v:e}") })
                     .collect();
                 writeln!(file, "{}", fields.join(","))?;
-                file.flush()
+                // The row goes to the file whole.
+                file.commit()
             };
             write().map_err(|e| (path.clone(), e))?;
         }
@@ -409,7 +411,7 @@ impl Thermo {
 
     pub fn close(&mut self) -> Result<(), FileError> {
         if let Some((mut file, path)) = self.file.take() {
-            file.flush().map_err(|e| (path, e))?;
+            file.finish().map_err(|e| (path, e))?;
         }
         Ok(())
     }

@@ -23,6 +23,7 @@ mod compose;
 mod constraints;
 mod contact;
 mod contractile_lattice;
+mod crash_safety;
 mod crashers;
 mod custom;
 mod cytosim_bench;

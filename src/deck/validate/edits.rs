@@ -70,6 +70,7 @@ impl Validator {
         if members.is_empty() {
             return Err(s[1].error(format!("group `{name}` is empty; expected a selection that matches particles")));
         }
+        self.spend_bytes(&s[0], 4 * members.len() as u64)?;
         self.groups.insert(name.clone(), Group { name, members });
         Ok(())
     }
