@@ -99,8 +99,10 @@ enum Command {
         probes: bool,
     },
     /// Translate a LAMMPS data file (and the input script that reads it) into
-    /// DIR/system.top, system.ff and system.in, listing what it could not translate.
+    /// DIR/system.top, system.ff and system.in, listing what it could not
+    /// translate. An input script alone names its data file by `read_data`.
     ImportLammps {
+        /// The data file, or the input script (whose `read_data` names the data file).
         data: PathBuf,
         input: Option<PathBuf>,
         #[arg(short, long, value_name = "DIR")]
@@ -295,7 +297,7 @@ where
             Ok(imported) => {
                 out!("wrote {0}/system.top, {0}/system.ff and {0}/system.in", output.display());
                 for note in &imported.notes {
-                    out!("not translated: {note}");
+                    out!("note: {note}");
                 }
                 ExitCode::SUCCESS
             }

@@ -128,7 +128,7 @@ pub fn is_thermal(plan: &Plan) -> bool {
 
 /// The deck up to its first `run` or `minimize`: what a comparison at
 /// step 0 needs, so that neither engine runs a trajectory it cannot compare.
-fn up_to_first_run(plan: &Plan) -> Plan {
+pub fn up_to_first_run(plan: &Plan) -> Plan {
     let mut plan = plan.clone();
     let first = plan.actions.iter().position(|a| matches!(a, Action::Run(_) | Action::Minimize(_))).unwrap_or(plan.actions.len());
     plan.actions.truncate(first);

@@ -11,7 +11,6 @@
 //! which `scripts/test-all` creates before the tests run). Where it is absent
 //! the reader checks print why and pass without reading.
 
-
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::process::Command;
@@ -216,7 +215,9 @@ fn ovito_reads_the_xyz_with_type_names_and_the_lammps_dump() {
     for ((from_xyz, from_dump), want) in xyz.iter().zip(ovito_dump).zip(&dump) {
         let names = names_by_id(want);
         let by_id: BTreeMap<u64, [f64; 3]> = want.column("id").iter().map(|id| id.parse().unwrap()).zip(want.positions()).collect();
-        for (from, names) in [(from_xyz, names.clone()), (from_dump, names.iter().map(|(&id, &n)| (id, if n == "a" { "H" } else { "He" })).collect())] {
+        for (from, names) in
+            [(from_xyz, names.clone()), (from_dump, names.iter().map(|(&id, &n)| (id, if n == "a" { "H" } else { "He" })).collect())]
+        {
             let types: Vec<String> = serde_json::from_value(from["types"].clone()).unwrap();
             let positions: Vec<[f64; 3]> = serde_json::from_value(from["positions"].clone()).unwrap();
             let ids: Vec<u64> = serde_json::from_value(from["ids"].clone()).unwrap();
