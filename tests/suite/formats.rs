@@ -199,7 +199,8 @@ fn ase_reads_the_lammps_dump() {
 }
 
 /// OVITO names the XYZ's particle types after the type names (`a`, `b`,
-/// not H/He) and the dump's after their elements; positions bit for bit.
+/// not H/He) and the dump's after their elements; positions to the last
+/// bit but one (OVITO's parser rounds some 17-digit numbers one ulp off).
 #[test]
 fn ovito_reads_the_xyz_with_type_names_and_the_lammps_dump() {
     let Some(python) = reference_python().filter(has_ovito) else {
@@ -224,7 +225,10 @@ fn ovito_reads_the_xyz_with_type_names_and_the_lammps_dump() {
             assert_eq!(ids.len(), by_id.len());
             for ((id, t), x) in ids.iter().zip(&types).zip(&positions) {
                 assert_eq!(t, names[id], "id {id}");
-                assert_eq!(x.map(f64::to_bits), by_id[id].map(f64::to_bits), "id {id}");
+                // OVITO's number parser is not correctly rounded: it reads the
+                // `1.4036974322645301` written by cellmd as 1.40369743226453, one ulp below.
+                let ulps = (0..3).map(|a| x[a].to_bits().abs_diff(by_id[id][a].to_bits())).max().unwrap();
+                assert!(ulps <= 1, "id {id}: OVITO read {x:?}, the file holds {:?}", by_id[id]);
             }
         }
     }
