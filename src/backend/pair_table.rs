@@ -166,16 +166,7 @@ impl PairTable {
                 if r2 >= self.skip2[pair] {
                     return;
                 }
-                let mut over_r = 0.0;
-                for kernel in self.kernels_of(pair) {
-                    over_r += (kernel.force)(self.params_of(kernel), r2);
-                    if ENERGY {
-                        let r = r2.sqrt();
-                        if r < kernel.cutoff {
-                            energy[kernel.column as usize] += (kernel.eval)(self.params_of(kernel), r).energy;
-                        }
-                    }
-                }
+                let over_r = self.pair_force::<ENERGY>(pair, r2, energy);
                 if over_r != 0.0 {
                     let f = d * over_r;
                     if ENERGY {
@@ -196,16 +187,7 @@ impl PairTable {
             };
             for &k in near.kept(kept) {
                 let (j, (d, r2)) = (batch[k as usize] as usize, near.separation(k as usize));
-                let mut over_r = 0.0;
-                for kernel in self.kernels_of(row + types[j] as usize) {
-                    over_r += (kernel.force)(self.params_of(kernel), r2);
-                    if ENERGY {
-                        let r = r2.sqrt();
-                        if r < kernel.cutoff {
-                            energy[kernel.column as usize] += (kernel.eval)(self.params_of(kernel), r).energy;
-                        }
-                    }
-                }
+                let over_r = self.pair_force::<ENERGY>(row + types[j] as usize, r2, energy);
                 if over_r != 0.0 {
                     let f = d * over_r;
                     if ENERGY {
@@ -216,6 +198,24 @@ impl PairTable {
                 }
             }
         }
+    }
+
+    /// (dE/dr)/r of type pair `pair` at r², summed over its kernels in
+    /// force-field order; with `ENERGY`, each kernel's energy within its
+    /// cutoff added to its column of `energy`.
+    #[inline(always)]
+    fn pair_force<const ENERGY: bool>(&self, pair: usize, r2: f64, energy: &mut [f64]) -> f64 {
+        let mut over_r = 0.0;
+        for kernel in self.kernels_of(pair) {
+            over_r += (kernel.force)(self.params_of(kernel), r2);
+            if ENERGY {
+                let r = r2.sqrt();
+                if r < kernel.cutoff {
+                    energy[kernel.column as usize] += (kernel.eval)(self.params_of(kernel), r).energy;
+                }
+            }
+        }
+        over_r
     }
 
     #[inline(always)]

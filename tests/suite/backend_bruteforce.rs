@@ -5,8 +5,31 @@ use crate::common::{random_case, Case};
 use cellmd::backend::{CpuBackend, Forces};
 use cellmd::deck::validate_file;
 use cellmd::interactions::{lookup, Law, REGISTRY};
-use cellmd::system::State;
+use cellmd::system::{Model, State};
 use glam::DVec3;
+
+/// Adds the pair terms of particles i and j at separation d = x_j − x_i
+/// (one image of the pair): the forces in full, the energy (per
+/// interaction) and the virial r_ij ⊗ f_ij times `weight`.
+fn add_pair_terms(model: &Model, (i, j): (usize, usize), d: DVec3, weight: f64, out: &mut Forces) {
+    let r = d.length();
+    for &rule in model.pair_rules_between(model.types[i], model.types[j]) {
+        let term = &model.pair_rules[rule as usize];
+        let Law::Radial { eval, range, .. } = term.interaction.law() else { unreachable!() };
+        if r < range(&term.params) {
+            let e = eval(&term.params, r);
+            let f_i = e.de_dr * d / r;
+            out.forces[i] += f_i;
+            out.forces[j] -= f_i;
+            let column = REGISTRY.iter().position(|k| k.name() == term.interaction.name()).unwrap();
+            out.energy_by_interaction[column] += weight * e.energy;
+            let w = [-d.x * f_i.x, -d.y * f_i.y, -d.z * f_i.z, -d.x * f_i.y, -d.x * f_i.z, -d.y * f_i.z];
+            for c in 0..6 {
+                out.virial[c] += weight * w[c];
+            }
+        }
+    }
+}
 
 fn brute_force(case: &Case) -> (Forces, Vec<DVec3>) {
     let plan = validate_file(&case.path("deck.in"), &[]).unwrap();
@@ -18,10 +41,16 @@ fn brute_force(case: &Case) -> (Forces, Vec<DVec3>) {
     }
     let x = &state.positions;
     let n = model.len();
-    let mut forces = vec![DVec3::ZERO; n];
-    let mut energy = vec![0.0; REGISTRY.len()];
-    let mut virial = [0.0; 6];
+    let mut out = Forces { forces: vec![DVec3::ZERO; n], energy_by_interaction: vec![0.0; REGISTRY.len()], virial: [0.0; 6] };
     let excluded = model.excluded_pairs(None);
+    for i in 0..n {
+        for j in i + 1..n {
+            if !excluded.contains(&(i as u32, j as u32)) {
+                add_pair_terms(model, (i, j), sim_box.minimum_image(x[j] - x[i]), 1.0, &mut out);
+            }
+        }
+    }
+    let Forces { mut forces, energy_by_interaction: mut energy, mut virial } = out;
     let mut add_virial = |r: DVec3, f: DVec3| {
         let w = [r.x * f.x, r.y * f.y, r.z * f.z, r.x * f.y, r.x * f.z, r.y * f.z];
         for k in 0..6 {
@@ -29,27 +58,6 @@ fn brute_force(case: &Case) -> (Forces, Vec<DVec3>) {
         }
     };
     let reg = |name: &str| REGISTRY.iter().position(|i| i.name() == name).unwrap();
-    for i in 0..n {
-        for j in i + 1..n {
-            if excluded.contains(&(i as u32, j as u32)) {
-                continue;
-            }
-            let d = sim_box.minimum_image(x[j] - x[i]);
-            let r = d.length();
-            for &rule in model.pair_rules_between(model.types[i], model.types[j]) {
-                let term = &model.pair_rules[rule as usize];
-                let Law::Radial { eval, range, .. } = term.interaction.law() else { unreachable!() };
-                if r < range(&term.params) {
-                    let out = eval(&term.params, r);
-                    let f_i = out.de_dr * d / r;
-                    forces[i] += f_i;
-                    forces[j] -= f_i;
-                    energy[reg(term.interaction.name())] += out.energy;
-                    add_virial(-d, f_i);
-                }
-            }
-        }
-    }
     let harmonic = lookup("harmonic").unwrap();
     for (b, &[i, j]) in model.bonds.iter().enumerate() {
         let term = &model.bond_types[model.bond_type[b] as usize];
@@ -172,7 +180,7 @@ fn small_periodic_box_matches_brute_force_over_images() {
     let state = State::new(plan.positions.clone());
     let x = &state.positions;
     let excluded = model.excluded_pairs(None);
-    let (mut forces, mut energy, mut virial) = (vec![DVec3::ZERO; n], 0.0, [0.0; 6]);
+    let mut want = Forces { forces: vec![DVec3::ZERO; n], energy_by_interaction: vec![0.0; REGISTRY.len()], virial: [0.0; 6] };
     let k = 4;
     for i in 0..n {
         for j in i..n {
@@ -185,29 +193,15 @@ fn small_periodic_box_matches_brute_force_over_images() {
                         if (i == j || is_excluded) && s == DVec3::ZERO {
                             continue;
                         }
-                        let d = d0 + s * lengths;
-                        let r = d.length();
                         let weight = if i == j { 0.5 } else { 1.0 };
-                        for &rule in model.pair_rules_between(model.types[i], model.types[j]) {
-                            let term = &model.pair_rules[rule as usize];
-                            let Law::Radial { eval, range, .. } = term.interaction.law() else { unreachable!() };
-                            if r < range(&term.params) {
-                                let out = eval(&term.params, r);
-                                let f_i = out.de_dr * d / r;
-                                forces[i] += f_i;
-                                forces[j] -= f_i;
-                                energy += weight * out.energy;
-                                let w = [-d.x * f_i.x, -d.y * f_i.y, -d.z * f_i.z, -d.x * f_i.y, -d.x * f_i.z, -d.y * f_i.z];
-                                for c in 0..6 {
-                                    virial[c] += weight * w[c];
-                                }
-                            }
-                        }
+                        add_pair_terms(model, (i, j), d0 + s * lengths, weight, &mut want);
                     }
                 }
             }
         }
     }
+    let Forces { forces, energy_by_interaction, virial } = want;
+    let energy: f64 = energy_by_interaction.iter().sum();
     let mut backend = CpuBackend::new(model, &state, &plan.sim_box, 0.4).unwrap();
     let mut got = Forces::default();
     backend.compute(model, &state, &plan.sim_box, &mut got);
