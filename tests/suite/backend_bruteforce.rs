@@ -24,8 +24,8 @@ fn add_pair_terms(model: &Model, (i, j): (usize, usize), d: DVec3, weight: f64, 
             let column = REGISTRY.iter().position(|k| k.name() == term.interaction.name()).unwrap();
             out.energy_by_interaction[column] += weight * e.energy;
             let w = [-d.x * f_i.x, -d.y * f_i.y, -d.z * f_i.z, -d.x * f_i.y, -d.x * f_i.z, -d.y * f_i.z];
-            for c in 0..6 {
-                out.virial[c] += weight * w[c];
+            for (v, w) in out.virial.iter_mut().zip(w) {
+                *v += weight * w;
             }
         }
     }
@@ -222,13 +222,13 @@ fn small_periodic_box_matches_brute_force_over_images() {
     };
     let bonds = bonds_only("");
     let scale = forces.iter().map(|f| f.length()).fold(0.0, f64::max);
-    for i in 0..n {
+    for (i, want) in forces.iter().enumerate() {
         let ours = got.forces[i] - bonds.forces[i];
-        assert!((ours - forces[i]).length() <= 1e-12 * scale, "particle {i}: {ours} vs {}", forces[i]);
+        assert!((ours - *want).length() <= 1e-12 * scale, "particle {i}: {ours} vs {want}");
     }
     let vscale = virial.iter().map(|v| v.abs()).fold(0.0, f64::max);
-    for c in 0..6 {
+    for (c, want) in virial.iter().enumerate() {
         let ours = got.virial[c] - bonds.virial[c];
-        assert!((ours - virial[c]).abs() <= 1e-12 * vscale, "virial {c}: {ours} vs {}", virial[c]);
+        assert!((ours - want).abs() <= 1e-12 * vscale, "virial {c}: {ours} vs {want}");
     }
 }
