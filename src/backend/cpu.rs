@@ -108,7 +108,7 @@ impl CpuBackend {
         pair_interactions.dedup();
         let pair_rule_column = model.pair_rules.iter().map(|r| pair_interactions.binary_search(&registry_index(r)).unwrap()).collect();
         let mut backend = Self {
-            neighbors: NeighborList::half(model.max_pair_cutoff(), skin),
+            neighbors: NeighborList::half(model.max_pair_cutoff(), skin).with_periodic_images(),
             exclusions: pair_exclusions(model, state.bonds.as_ref().map(|b| b.bound.as_slice())),
             special: SpecialPairs::new(model, state.bonds.as_ref().map(|b| b.bound.as_slice())),
             bonded: Bonded::new(model),

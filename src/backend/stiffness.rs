@@ -131,8 +131,12 @@ impl CpuBackend {
         }
         if let Some(list) = self.neighbor_list() {
             for i in 0..model.len() {
-                for &j in list.neighbors(i) {
-                    let d = images.minimum_image(x[j as usize] - x[i]);
+                // Every image of each partner (a small periodic box has several); a
+                // particle's own images are at a fixed distance: no stiffness.
+                list.for_each_separation(i, x, &images, |j, d| {
+                    if j as usize == i {
+                        return;
+                    }
                     let r = d.length();
                     for &rule in model.pair_rules_between(model.types[i], model.types[j as usize]) {
                         let term = &model.pair_rules[rule as usize];
@@ -141,7 +145,7 @@ impl CpuBackend {
                             push_pair(&mut blocks, i as u32, j, radial_block(&eval(&term.params, r), d, r));
                         }
                     }
-                }
+                });
             }
         }
         self.special_pairs().for_each(model, x, &images, |i, j, d, r, radial, _| push_pair(&mut blocks, i, j, radial_block(&radial, d, r)));

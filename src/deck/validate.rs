@@ -20,6 +20,7 @@ use crate::units::UnitSystem;
 mod commands;
 mod compose;
 mod edits;
+mod foreign;
 mod output_names;
 mod outputs;
 mod protocols;

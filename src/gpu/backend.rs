@@ -38,7 +38,7 @@ use crate::integrate::constraints::Constraints;
 use crate::integrate::context::StepContext;
 use crate::integrate::fire::FireSettings;
 use crate::integrate::implicit::{ImplicitSettings, SolveReport};
-use crate::neighbor::Exclusions;
+use crate::neighbor::{Exclusions, ImageShifts};
 use crate::system::{BondState, Model, SimBox, State};
 
 const STATUS_WORDS: usize = 11;
@@ -364,6 +364,13 @@ impl GpuBackend {
             return Err(
                 "the GPU backend has no kernels for custom surface terms of bodies (`custom` body lines) yet; use `device cpu`".into()
             );
+        }
+        if model.max_pair_cutoff() > 0.0 && ImageShifts::new(sim_box, model.max_pair_cutoff() + settings.skin).is_some() {
+            return Err(format!(
+                "the GPU backend has no kernels yet for pairs through several periodic images (a periodic box edge shorter \
+                 than 2·(pair cutoff + skin) = {}); use `device cpu`",
+                2.0 * (model.max_pair_cutoff() + settings.skin)
+            ));
         }
         let n = model.len();
         if n == 0 {

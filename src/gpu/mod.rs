@@ -60,7 +60,9 @@
 //!
 //! Not on the GPU (refused by [`GpuBackend::new`], and by `device gpu`
 //! before a run; `device auto` falls back to the CPU): custom surface terms
-//! of bodies, which have no kernel yet; the implicit
+//! of bodies, which have no kernel yet; pairs through several periodic
+//! images (a periodic edge shorter than 2·(pair cutoff + skin), walked by
+//! the CPU's list, `neighbor::ImageShifts`); the implicit
 //! step of the models [`implicit::refusal`] names; constraints where
 //! [`shake::refusal`] names why. Bond kinetics
 //! are decided on the device for the rules [`kinetics`] ports, else on the

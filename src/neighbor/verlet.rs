@@ -3,7 +3,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::Exclusions;
+use super::{Exclusions, ImageShifts};
 use crate::system::{Images, SimBox};
 
 const AXES: [char; 3] = ['x', 'y', 'z'];
@@ -24,6 +24,14 @@ pub struct NeighborList {
     reference_box: Option<SimBox>,
     builds: u64,
     grid: [usize; 3],
+    /// Whether a box with periodic edges shorter than 2·(cutoff + skin) is
+    /// allowed (its images walked, [`ImageShifts`]); otherwise it is an error.
+    periodic_images: bool,
+    /// The image shifts of the last build's box, when it has short edges.
+    shifts: Option<ImageShifts>,
+    /// With `shifts`: per entry, whether the pair is excluded at its
+    /// minimum image (its other images interact).
+    skip_minimum: Vec<bool>,
 }
 
 impl NeighborList {
@@ -41,6 +49,49 @@ impl NeighborList {
             reference_box: None,
             builds: 0,
             grid: [0; 3],
+            periodic_images: false,
+            shifts: None,
+            skip_minimum: Vec::new(),
+        }
+    }
+
+    /// Allows periodic edges shorter than 2·(cutoff + skin): rows then hold
+    /// every partner with some image in range, a particle itself when one of
+    /// its own images is, and excluded pairs whose other images are in range;
+    /// [`Self::for_each_separation`] walks the images (module
+    /// `neighbor::images`). For the pair forces; searches that want one
+    /// image per pair (contacts, bond formation) keep the error.
+    pub fn with_periodic_images(self) -> Self {
+        Self { periodic_images: true, ..self }
+    }
+
+    /// The image shifts of the last build, when its box had a periodic edge
+    /// shorter than 2·(cutoff + skin) (only with [`Self::with_periodic_images`]).
+    pub fn image_shifts(&self) -> Option<&ImageShifts> {
+        self.shifts.as_ref()
+    }
+
+    /// Calls `visit(j, d)` for every partner j of row i and every image of it
+    /// within the list range, d = x_j + s·L − x_i: in the usual box one per
+    /// partner, its minimum image, in row order; with image shifts, each
+    /// partner's images in [`ImageShifts::for_each`] order (a particle's own
+    /// images as j = i, once per ± pair in a half list). Consumers test their
+    /// own cutoffs on |d|.
+    #[inline]
+    pub fn for_each_separation(&self, i: usize, x: &[DVec3], images: &Images, mut visit: impl FnMut(u32, DVec3)) {
+        let row = self.offsets[i] as usize..self.offsets[i + 1] as usize;
+        let Some(shifts) = &self.shifts else {
+            for &j in &self.neighbors[row] {
+                visit(j, images.minimum_image(x[j as usize] - x[i]));
+            }
+            return;
+        };
+        let range2 = self.range() * self.range();
+        for k in row {
+            let j = self.neighbors[k];
+            let own = j as usize == i;
+            let d0 = if own { DVec3::ZERO } else { images.minimum_image(x[j as usize] - x[i]) };
+            shifts.for_each(d0, range2, self.skip_minimum[k], own, self.half, |d| visit(j, d));
         }
     }
 
@@ -116,14 +167,17 @@ impl NeighborList {
         &self.neighbors[self.offsets[i] as usize..self.offsets[i + 1] as usize]
     }
 
-    /// Every partner of particle `i`, ascending, from either kind of list
-    /// (a half list is searched row by row: for diagnostics, not loops).
+    /// Every other particle listed as a partner of `i`, ascending, from
+    /// either kind of list (a half list is searched row by row: for
+    /// diagnostics, not loops); `i` itself, listed for its own images in a
+    /// small periodic box, is left out.
     pub fn partners(&self, i: usize) -> Vec<u32> {
+        let others = self.neighbors(i).iter().copied().filter(|&j| j as usize != i);
         if !self.half {
-            return self.neighbors(i).to_vec();
+            return others.collect();
         }
         let below = (0..i).filter(|&k| self.neighbors(k).binary_search(&(i as u32)).is_ok());
-        below.map(|k| k as u32).chain(self.neighbors(i).iter().copied()).collect()
+        below.map(|k| k as u32).chain(others).collect()
     }
 
     /// True when the list must be rebuilt before computing forces at `positions`:
@@ -156,8 +210,8 @@ impl NeighborList {
     ///
     /// Errors (with the list left unchanged) on a negative or non-finite
     /// cutoff/skin, an inverted or non-finite box, a periodic edge shorter
-    /// than `2·(cutoff + skin)`, a non-finite position, or more than `u32::MAX`
-    /// particles or pairs.
+    /// than `2·(cutoff + skin)` (unless [`Self::with_periodic_images`]), a
+    /// non-finite position, or more than `u32::MAX` particles or pairs.
     pub fn build(&mut self, positions: &[DVec3], sim_box: &SimBox, exclusions: &Exclusions) -> Result<(), String> {
         let range = self.range();
         if !(self.cutoff.is_finite() && self.cutoff >= 0.0) {
@@ -180,7 +234,7 @@ impl NeighborList {
                     AXES[a], sim_box.lo[a], sim_box.hi[a]
                 ));
             }
-            if sim_box.periodic[a] && (l <= 0.0 || l < 2.0 * range) {
+            if sim_box.periodic[a] && (l <= 0.0 || (l < 2.0 * range && !self.periodic_images)) {
                 return Err(format!(
                     "neighbour list: the periodic box edge along {} is {l}, shorter than \
                      2·(cutoff + skin) = 2·({} + {}) = {}; the minimum image would be ambiguous \
@@ -196,11 +250,15 @@ impl NeighborList {
             return Err(format!("neighbour list: particle {i} has a non-finite position {}", positions[i]));
         }
 
+        let shifts = if self.periodic_images && range > 0.0 { ImageShifts::new(sim_box, range) } else { None };
+        self.skip_minimum.clear();
         if range == 0.0 || n == 0 {
             self.offsets.clear();
             self.offsets.resize(n + 1, 0);
             self.neighbors.clear();
             self.grid = [0; 3];
+        } else if let Some(shifts) = &shifts {
+            self.build_with_images(positions, sim_box, exclusions, shifts);
         } else {
             if exclusions.typed_particles().is_some_and(|typed| typed != n) {
                 return Err(format!(
@@ -229,11 +287,53 @@ impl NeighborList {
             }
             self.grid = grid.counts;
         }
+        self.shifts = shifts;
         self.reference.clear();
         self.reference.extend_from_slice(positions);
         self.reference_box = Some(*sim_box);
         self.builds += 1;
         Ok(())
+    }
+
+    /// The rows of a box with short periodic edges: every j (j ≥ i in a half
+    /// list, i itself included) with some image within the range, excluded
+    /// pairs flagged and kept only when an image beyond the minimum is in
+    /// range. A plain O(N²) search: such boxes hold few particles per
+    /// cutoff volume's worth of box (each pair is walked over its images anyway).
+    fn build_with_images(&mut self, positions: &[DVec3], sim_box: &SimBox, exclusions: &Exclusions, shifts: &ImageShifts) {
+        let n = positions.len();
+        let range2 = self.range() * self.range();
+        let images = sim_box.images();
+        let rows: Vec<Vec<(u32, bool)>> = (0..n)
+            .into_par_iter()
+            .with_min_len(64)
+            .map(|i| {
+                let first = if self.half { i } else { 0 };
+                let mut row = Vec::new();
+                for j in first..n {
+                    let (ju, own) = (j as u32, j == i);
+                    if exclusions.excludes_types_of(i as u32, ju) {
+                        continue;
+                    }
+                    let d0 = if own { DVec3::ZERO } else { images.minimum_image(positions[j] - positions[i]) };
+                    let excluded = !own && exclusions.is_excluded(i as u32, ju);
+                    let minimum_in_range = !own && !excluded && d0.length_squared() < range2;
+                    if minimum_in_range || shifts.any_beyond_minimum(d0, range2) {
+                        row.push((ju, excluded));
+                    }
+                }
+                row
+            })
+            .collect();
+        self.offsets.clear();
+        self.offsets.push(0);
+        self.neighbors.clear();
+        for row in &rows {
+            self.neighbors.extend(row.iter().map(|e| e.0));
+            self.skip_minimum.extend(row.iter().map(|e| e.1));
+            self.offsets.push(self.neighbors.len() as u32);
+        }
+        self.grid = [1; 3];
     }
 }
 
@@ -559,7 +659,12 @@ mod tests {
         let ex = Exclusions::from_pairs(400, &pairs).with_type_pairs(&types, 3, |a, b| !matches!((a, b), (0, 1) | (2, 2)));
         let list = assert_matches_brute_force(&x, &b, 1.0, 0.25, &ex);
         let unfiltered = assert_matches_brute_force(&x, &b, 1.0, 0.25, &Exclusions::from_pairs(400, &pairs));
-        assert!(list.num_pairs() > 100 && 2 * list.num_pairs() < unfiltered.num_pairs(), "{} of {}", list.num_pairs(), unfiltered.num_pairs());
+        assert!(
+            list.num_pairs() > 100 && 2 * list.num_pairs() < unfiltered.num_pairs(),
+            "{} of {}",
+            list.num_pairs(),
+            unfiltered.num_pairs()
+        );
         for i in 0..400 {
             for &j in list.neighbors(i) {
                 let t = [types[i], types[j as usize]];

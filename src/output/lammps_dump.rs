@@ -14,7 +14,7 @@
 //! 0 10
 //! -5 5
 //! ITEM: ATOMS id type element x y z ix iy iz
-//! 3 1 cortex 3 7.25 -1.5 0 0 0
+//! 3 1 H 3 7.25 -1.5 0 0 0
 //! ...
 //! ```
 //!
@@ -22,9 +22,18 @@
 //!   (`p` periodic, `f` fixed).
 //! * Atom lines are sorted by user id; `type` is the 1-based type number
 //!   (type index + 1, the order of the force field's type names) and
-//!   `element` its name (whitespace replaced by `_`) — the column OVITO and
-//!   VMD take particle type names from (LAMMPS writes it with
-//!   `dump_modify element`); positions are the stored (wrapped) ones with
+//!   `element` the chemical symbol standing for the type: type index `t` is
+//!   the element of atomic number `t + 1` (H, He, Li, …, as
+//!   [`element_symbol`](super::element_symbol) and the extended XYZ's `Z`
+//!   column). LAMMPS' `dump_modify element` column holds chemical elements,
+//!   and readers take it so: ASE (`ase.io.read(…, format="lammps-dump-text")`)
+//!   maps it to atomic numbers and fails on any other name, OVITO and VMD
+//!   name the particle types after it. Type names have no column in a dump
+//!   that every reader accepts (OVITO refuses a text column it does not
+//!   know); the extended XYZ (`species`, `type_name`) and the MCAP carry
+//!   them, and the mapping is fixed by the force field's type order (the
+//!   first `particle` line is `1`/H, the second `2`/He, …). Positions are
+//!   the stored (wrapped) ones with
 //!   image flags `ix iy iz`, so the unwrapped position is `x + ix·Lx`. Reals
 //!   use shortest round-trip form.
 //! * `dump … lammps FILE columns C...` selects the atom columns instead
@@ -40,14 +49,14 @@ use std::fs::File;
 use std::io::{self, Write};
 
 use super::records::RecordFile;
-use super::{check_frame, check_topology, invalid_input, token, FrameView, Needs, Real, TopologyView, TrajectoryWriter};
+use super::{check_frame, check_topology, element_symbol, invalid_input, FrameView, Needs, Real, TopologyView, TrajectoryWriter};
 
 /// A per-atom column of a LAMMPS dump (`dump … lammps FILE columns ...`).
 ///
 /// | name | meaning | unit (`cell`) |
 /// |---|---|---|
 /// | `id`, `type` | user id, 1-based type number | – |
-/// | `element` | type name (OVITO and VMD read it as the particle type) | – |
+/// | `element` | the chemical symbol whose atomic number is the type number (H for type 1, He for 2, …; ASE, OVITO and VMD read it as the particle type) | – |
 /// | `x y z` | stored (wrapped) position | µm |
 /// | `ix iy iz` | image flags | – |
 /// | `xu yu zu` | unwrapped position x + ix·Lx | µm |
@@ -134,8 +143,6 @@ pub struct LammpsDumpWriter {
     out: RecordFile,
     ids: Vec<u64>,
     types: Vec<u32>,
-    /// Type-name token per type.
-    type_names: Vec<String>,
     /// Internal indices sorted by user id.
     order: Vec<usize>,
     columns: Vec<AtomColumn>,
@@ -158,7 +165,6 @@ impl LammpsDumpWriter {
             out: RecordFile::new(file),
             ids: topology.ids.to_vec(),
             types: topology.types.to_vec(),
-            type_names: topology.type_names.iter().map(|n| token(n)).collect(),
             order,
             columns,
             needs,
@@ -200,7 +206,7 @@ impl TrajectoryWriter for LammpsDumpWriter {
                 let _ = match *c {
                     AtomColumn::Id => write!(line, "{}", self.ids[i]),
                     AtomColumn::Type => write!(line, "{}", self.types[i] + 1),
-                    AtomColumn::Element => line.write_str(&self.type_names[self.types[i] as usize]),
+                    AtomColumn::Element => line.write_str(element_symbol(self.types[i] as usize)),
                     AtomColumn::X(a) => write!(line, "{}", Real(frame.positions[i][a])),
                     AtomColumn::Image(a) => write!(line, "{}", frame.image(i)[a]),
                     AtomColumn::Unwrapped(a) => write!(line, "{}", Real(b.unwrap(frame.positions[i], frame.image(i))[a])),
@@ -262,7 +268,7 @@ mod tests {
                 last_id = id;
                 let i = s.ids.iter().position(|&x| x == id).unwrap();
                 assert_eq!(cols[1].parse::<u32>().unwrap(), s.types[i] + 1);
-                assert_eq!(cols[2], ["cortex", "adhesion_site"][s.types[i] as usize]);
+                assert_eq!(cols[2], ["H", "He"][s.types[i] as usize]);
                 for a in 0..3 {
                     let x: f64 = cols[3 + a].parse().unwrap();
                     assert_eq!(x.to_bits(), s.frames[f][i][a].to_bits(), "{line}");
@@ -270,8 +276,8 @@ mod tests {
                 }
             }
         }
-        assert_eq!(lines[9], "3 1 cortex 3 7.25 -1.5 0 0 0");
-        assert_eq!(lines[10], "7 2 adhesion_site 9.95 5 2.5 -1 2 0");
+        assert_eq!(lines[9], "3 1 H 3 7.25 -1.5 0 0 0");
+        assert_eq!(lines[10], "7 2 He 9.95 5 2.5 -1 2 0");
     }
 
     #[test]

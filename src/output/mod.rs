@@ -8,8 +8,8 @@
 //! | format | keyword | module | contents |
 //! |---|---|---|---|
 //! | MCAP (Foxglove), zstd chunks | `mcap` | [`mcap_writer`], [`scene`] | topology, frames, bond state, a protobuf (or JSON) 3D scene |
-//! | extended XYZ (OVITO, ASE) | `xyz` | [`xyz`] | element symbol, position, type name, id; box and pbc per frame |
-//! | LAMMPS text dump | `lammps` | [`lammps_dump`] | id, type, element (type name), position, image flags, sorted by id; or the columns the deck names (forces, per-particle stress, von Mises) |
+//! | extended XYZ (OVITO, ASE) | `xyz` | [`xyz`] | type name (species), position, atomic number Z standing for the type, type name, id; box and pbc per frame |
+//! | LAMMPS text dump | `lammps` | [`lammps_dump`] | id, type, element (chemical symbol standing for the type), position, image flags, sorted by id; or the columns the deck names (forces, per-particle stress, von Mises) |
 //! | DCD (CHARMM/NAMD binary; MDAnalysis, MDTraj, VMD) | `dcd` | [`dcd`] | f32 positions sorted by id, box lengths per frame |
 //! | per-bond tension (CSV) | `bonds` | [`bond_csv`] | per frame and bond: ids, type, length, tension dE/dr, midpoint |
 //! | restart (JSON) | — | [`restart`] | step, time, box, ids, positions, images, bond state, counters, the deck's inputs |
@@ -22,9 +22,11 @@
 //!   internal indices and are written as user ids.
 //! * `types[i]` indexes `type_names` (and `type_radius`); LAMMPS dumps write
 //!   the 1-based number `types[i] + 1`. Where a reader expects a chemical
-//!   element (ASE's extended XYZ species), type `t` is written as the element
-//!   of atomic number `t + 1` ([`element_symbol`]: H, He, Li, …) and the type
-//!   name goes in a column of its own.
+//!   element (the LAMMPS dump's `element` column, the extended XYZ's `Z`,
+//!   which ASE reads), type `t` is written as the element of atomic number
+//!   `t + 1` ([`element_symbol`], [`atomic_number`]: H, He, Li, …) and the
+//!   type name goes where readers take names from (the extended XYZ's
+//!   `species`, which OVITO names its types after, and `type_name`).
 //! * Positions are the stored ones (wrapped into the box on periodic axes);
 //!   the image counters give the unwrapped position `x + image·L`.
 //! * `images` may be empty (e.g. a minimiser that does not track images): it
@@ -377,6 +379,11 @@ pub fn element_symbol(t: usize) -> &'static str {
     ELEMENTS[t % ELEMENTS.len()]
 }
 
+/// The atomic number of [`element_symbol`]`(t)`: `t + 1`, wrapping after 118.
+pub fn atomic_number(t: usize) -> usize {
+    t % ELEMENTS.len() + 1
+}
+
 /// A type name usable as one whitespace-free token (whitespace becomes `_`).
 pub(crate) fn token(name: &str) -> String {
     if name.is_empty() {
@@ -473,6 +480,7 @@ mod tests {
         assert_eq!(Encoding::from_keyword("json"), Some(Encoding::Json));
         assert_eq!(Encoding::from_keyword("cbor"), None);
         assert_eq!((element_symbol(0), element_symbol(1), element_symbol(117), element_symbol(118)), ("H", "He", "Og", "H"));
+        assert_eq!((atomic_number(0), atomic_number(117), atomic_number(118)), (1, 118, 1));
     }
 
     #[test]
