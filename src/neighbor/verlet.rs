@@ -559,7 +559,12 @@ mod tests {
         let ex = Exclusions::from_pairs(400, &pairs).with_type_pairs(&types, 3, |a, b| !matches!((a, b), (0, 1) | (2, 2)));
         let list = assert_matches_brute_force(&x, &b, 1.0, 0.25, &ex);
         let unfiltered = assert_matches_brute_force(&x, &b, 1.0, 0.25, &Exclusions::from_pairs(400, &pairs));
-        assert!(list.num_pairs() > 100 && 2 * list.num_pairs() < unfiltered.num_pairs(), "{} of {}", list.num_pairs(), unfiltered.num_pairs());
+        assert!(
+            list.num_pairs() > 100 && 2 * list.num_pairs() < unfiltered.num_pairs(),
+            "{} of {}",
+            list.num_pairs(),
+            unfiltered.num_pairs()
+        );
         for i in 0..400 {
             for &j in list.neighbors(i) {
                 let t = [types[i], types[j as usize]];

@@ -1,12 +1,11 @@
 //! The CPU backend (neighbour list, images, exclusions, gather) against a
 //! brute-force O(N²) evaluation written independently here.
 
-
+use crate::common::{random_case, Case};
 use cellmd::backend::{CpuBackend, Forces};
 use cellmd::deck::validate_file;
 use cellmd::interactions::{lookup, Law, REGISTRY};
 use cellmd::system::State;
-use crate::common::{random_case, Case};
 use glam::DVec3;
 
 fn brute_force(case: &Case) -> (Forces, Vec<DVec3>) {

@@ -1,10 +1,9 @@
 //! A run that blows up stops with the step, the particle and the interaction
 //! responsible, writes the last good frame, and leaves complete output files.
 
-
+use crate::common::Case;
 use cellmd::deck::validate_file;
 use cellmd::run::{RunError, RunOptions, Simulation};
-use crate::common::Case;
 
 fn run_to_error(case: &Case) -> RunError {
     let plan = validate_file(&case.path("deck.in"), &[]).unwrap();

@@ -9,7 +9,6 @@
 //! which `scripts/test-all` creates before the tests run). Where it is absent
 //! the reader checks print why and pass without reading.
 
-
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::process::Command;

@@ -4,6 +4,9 @@
 
 use crate::common;
 
+use crate::common::{
+    assert_clamped_runs_agree, contact_case, random_case, CONTACT_ADHESION, CONTACT_BARRIER, CONTACT_GPU_EPSILON, CONTACT_SHELLS,
+};
 use cellmd::backend::{CpuBackend, Forces};
 use cellmd::deck::{Action, Plan};
 use cellmd::gpu::backend::StepSettings;
@@ -15,9 +18,6 @@ use cellmd::integrate::Integrator;
 use cellmd::rng::Noise;
 use cellmd::run::{RunOptions, Simulation};
 use cellmd::system::State;
-use crate::common::{
-    assert_clamped_runs_agree, contact_case, random_case, CONTACT_ADHESION, CONTACT_BARRIER, CONTACT_GPU_EPSILON, CONTACT_SHELLS,
-};
 use glam::DVec3;
 
 fn context() -> GpuContext {

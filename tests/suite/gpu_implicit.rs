@@ -3,12 +3,12 @@
 
 use crate::common;
 
+use crate::common::{assert_clamped_runs_agree, contact_case, CONTACT_ADHESION, CONTACT_BARRIER, CONTACT_SHELLS};
 use cellmd::backend::{CpuBackend, Forces};
 use cellmd::gpu::implicit::F32_TOLERANCE;
 use cellmd::gpu::DevicePreference;
 use cellmd::run::{RunOptions, Simulation};
 use cellmd::system::State;
-use crate::common::{assert_clamped_runs_agree, contact_case, CONTACT_ADHESION, CONTACT_BARRIER, CONTACT_SHELLS};
 use glam::DVec3;
 
 /// A bent 12-bead filament (stiff harmonic bonds, wlc_bending angles),
