@@ -28,7 +28,7 @@
 //!   force) or its positive part written out (an indenter's 2K(R − r)·ûûᵀ,
 //!   without the negative transverse −K(R − r)²/r the CPU's projection drops).
 //! - **Volume elements**: the element's exact 12×12 Hessian
-//!   V_0·Σ_AB g_c[A]·g_d[B]·∂²W/∂F_αA∂F_βB (g_k the rows of D_m⁻¹, g_0 their
+//!   V_0·Σ_AB g_c\[A\]·g_d\[B\]·∂²W/∂F_αA∂F_βB (g_k the rows of D_m⁻¹, g_0 their
 //!   negative sum), with ∂²W/∂F∂F from the law's `NAME_tetra_hessian`,
 //!   projected like the angles' (kernel `implicit_tetras`; the CPU takes it
 //!   by central differences of the element's forces); each product gathers a

@@ -6,7 +6,7 @@
 //! - [`custom`]: evaluators generated from a model's `custom` expressions.
 //! - [`pack`]: the model flattened into the buffers the kernels read.
 //! - [`backend`]: buffers, pipelines and the GPU-resident step loop.
-//! - [`nlist`]: the neighbour list's buffer, bound in chunks of particles
+//! - `nlist`: the neighbour list's buffer, bound in chunks of particles
 //!   where it exceeds the adapter's largest storage binding.
 //! - [`surface`]: surface (body) terms: face, body, edge and node passes,
 //!   deterministic (no float atomics).
@@ -18,7 +18,7 @@
 //!   compacted in bond order and drained by the host at synchronisations.
 //! - [`bind`]: `bind` formation on the device: candidates from the GPU
 //!   neighbour list, accepted in the CPU's order into a preallocated pool.
-//! - [`special`]: pairs of bonded neighbours with a fractional
+//! - `special`: pairs of bonded neighbours with a fractional
 //!   `special_bonds` weight, each particle's own list.
 //! - [`tetra`]: volume elements (`[ tetrahedra ]`): one pass per element
 //!   into corner slots, gathered per particle.

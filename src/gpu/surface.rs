@@ -50,7 +50,7 @@ const EDGE_WORDS: usize = 8;
 /// The surface sections of the GPU topology.
 #[derive(Default)]
 pub struct SurfacePack {
-    /// Face records ([`FACE_WORDS`]); faces of a body contiguous.
+    /// Face records (`FACE_WORDS`); faces of a body contiguous.
     pub faces: Vec<u32>,
     /// Body b's faces are `body_faces[b]..body_faces[b + 1]`.
     pub body_faces: Vec<u32>,
@@ -61,7 +61,7 @@ pub struct SurfacePack {
     /// Particle i's `surf` entries are `node_slots[node_slot_offsets[i]..node_slot_offsets[i + 1]]`.
     pub node_slot_offsets: Vec<u32>,
     pub node_slots: Vec<u32>,
-    /// Edge records ([`EDGE_WORDS`]) of the bodies with a curvature law.
+    /// Edge records (`EDGE_WORDS`) of the bodies with a curvature law.
     pub edges: Vec<u32>,
     /// The packed body of each body node.
     pub node_body: Vec<u32>,

@@ -27,7 +27,7 @@ pub struct InputError {
     pub line: u32,
     pub col: u32,
     pub message: String,
-    snippet: Option<Snippet>,
+    snippet: Option<Box<Snippet>>,
 }
 
 /// The clipped line an error shows, with the span it underlines (byte
@@ -108,14 +108,14 @@ impl InputError {
             line: token.line,
             col: token.col,
             message: clip_quotes(message.into()),
-            snippet: Some(Snippet::new(&token.file, token.offset, token.text_len.max(1), token.line)),
+            snippet: Some(Box::new(Snippet::new(&token.file, token.offset, token.text_len.max(1), token.line))),
         }
     }
 
     /// An error at a position of a file (used by the lexer).
     pub fn at_offset(file: &SourceFile, offset: usize, message: impl Into<String>) -> Self {
         let (line, col) = file.line_col(offset);
-        let snippet = Some(Snippet::new(file, offset, 1, line));
+        let snippet = Some(Box::new(Snippet::new(file, offset, 1, line)));
         Self { path: file.path.clone(), line, col, message: clip_quotes(message.into()), snippet }
     }
 
@@ -135,7 +135,7 @@ impl std::error::Error for InputError {}
 
 impl Diagnostic for InputError {
     fn source_code(&self) -> Option<&dyn SourceCode> {
-        self.snippet.as_ref().map(|s| s as &dyn SourceCode)
+        self.snippet.as_deref().map(|s| s as &dyn SourceCode)
     }
 
     fn labels(&self) -> Option<Box<dyn Iterator<Item = LabeledSpan> + '_>> {

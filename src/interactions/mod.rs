@@ -13,7 +13,7 @@
 //! NAME` prints [`documentation`] of either.
 //!
 //! Parameters reach an evaluator as a slice in schema order, already checked
-//! against the schema and by [`Interaction::validate`].
+//! against the schema and by [`Entry::validate`].
 //!
 //! Many-body terms of closed surfaces (cell shells) use [`Law::Surface`]: the
 //! evaluator sees one body's whole mesh ([`SurfaceMesh`]) with image-consistent
@@ -309,7 +309,7 @@ pub enum Law {
     /// (x_j − x_i)·force: what the step loop calls. It is the same
     /// derivative as `eval`'s without the energy and d²E/dr², so it skips
     /// their work (`soft` takes a sine, no cosine), and it takes r² so a law
-    /// that needs no r skips the square root (`wca`, `lj`). [`radial_force!`]
+    /// that needs no r skips the square root (`wca`, `lj`). `radial_force!`
     /// derives it from `eval`: inlined, the unused energy terms are dropped.
     Radial { eval: fn(&[f64], f64) -> Radial, force: fn(&[f64], f64) -> f64, range: fn(&[f64]) -> f64 },
     /// E(r_i, r_j, r_k) for angles; positions are made image-consistent

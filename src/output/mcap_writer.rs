@@ -530,7 +530,7 @@ mod tests {
                 }
             }
             let images: Vec<i64> = frame["images"].as_array().unwrap().iter().map(|v| v.as_i64().unwrap()).collect();
-            assert_eq!(images, s.images.iter().flatten().map(|&v| v as i64).collect::<Vec<_>>());
+            assert_eq!(images, s.images.iter().flatten().copied().collect::<Vec<_>>());
         }
 
         let (stamp, scene) = &scenes[0];
