@@ -342,7 +342,8 @@ pub enum Law {
     /// (s ≡ 0 for d ≥ `range`): a face counts in proportion to how fully all
     /// three corners touch. The CPU backend finds the nearest faces (with the
     /// node–face candidates of [`Law::Contact`]) and adds both the area and
-    /// the distance gradients. No GPU kernel yet.
+    /// the distance gradients; the GPU backend's area-weighted contact passes
+    /// do the same on the device (src/gpu/adhesion.rs).
     ContactArea { switch: fn(&[f64], f64) -> Radial, density: fn(&[f64]) -> f64, range: fn(&[f64]) -> f64 },
     /// E(x_0 … x_3) of one linear tetrahedron with rest shape `TetraRest`;
     /// positions are image-consistent (around x_0). On the GPU its
