@@ -276,7 +276,8 @@ pub fn point_triangle(p: DVec3, [a, b, c]: [DVec3; 3]) -> PointTriangle {
 }
 
 /// Barycentric weights of the point of triangle (a, b, c) closest to p,
-/// by Voronoi region: three vertices, three edges, then the interior.
+/// by Voronoi region: three vertices, three edges, then the interior. The
+/// GPU's f32 twin, line by line, is `closest_weights` in `src/mesh.wgsl`.
 fn closest_weights(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> [f64; 3] {
     let (ab, ac, ap) = (b - a, c - a, p - a);
     let (d1, d2) = (ab.dot(ap), ac.dot(ap));

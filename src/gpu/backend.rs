@@ -27,10 +27,11 @@ use super::contact::{reach_message, ContactPack, CONTACT_ONLY, FRACTION_SLOTS};
 use super::context::{storage_entry, GpuContext, WORKGROUP};
 use super::fire::DeviceFire;
 use super::implicit::ImplicitSolver;
-use super::implicit_split::HALT_BUDGET;
 use super::kinetics::{KinKernels, KinLayout};
 use super::nlist::NeighbourStorage;
 use super::pack::{cell_grid, pack, FixedPoint, Packed, Params};
+use super::prelude::implicit_split::HALT_BUDGET;
+use super::prelude::status::*;
 use super::protocol::{DeviceProtocol, PackedTerms, ProtocolPack, RAMP_ROWS};
 use super::shader;
 use super::shake::{DeviceShake, ShakeReport};
@@ -41,32 +42,6 @@ use crate::integrate::implicit::{ImplicitSettings, SolveReport};
 use crate::neighbor::Exclusions;
 use crate::system::{BondState, Model, SimBox, State};
 
-const STATUS_WORDS: usize = 11;
-const ST_HALTED: usize = 0;
-const ST_OVERFLOW_NEED: usize = 1;
-const ST_BUILDS: usize = 3;
-const ST_STEPS_DONE: usize = 4;
-const ST_BLOWUP_PARTICLE: usize = 5;
-const ST_FORCE_REBUILD: usize = 6;
-const ST_SPAN_BODY: usize = 7;
-const HALT_OVERFLOW: u32 = 1;
-const HALT_BLOWUP: u32 = 2;
-const HALT_SPAN: u32 = 4;
-const HALT_EVENTS: u32 = 16;
-/// This step's fraction of dt (f32 bits; the contact step clamp, src/gpu/contact.rs).
-const ST_FRACTION: usize = 8;
-/// The fractions of dt of this call's steps, summed (f32 bits; `sim_time` in integrate.wgsl).
-const ST_ELAPSED: usize = 9;
-/// A face edge outgrew the contact search (src/gpu/contact.rs).
-const HALT_REACH: u32 = 8;
-/// The implicit step's solve did not converge (src/gpu/implicit.rs).
-const HALT_SOLVE: u32 = 32;
-/// A step's `bind` formation was left to the host (src/gpu/bind.rs).
-const HALT_FORMATION: u32 = 64;
-/// A constraint projection did not converge (src/gpu/shake.rs).
-const HALT_CONSTRAINT: u32 = 128;
-/// FIRE converged: max |F| < ftol (src/gpu/fire.rs).
-const HALT_CONVERGED: u32 = 256;
 /// Steps per command buffer.
 const STEPS_PER_SUBMIT: u64 = 64;
 
@@ -753,8 +728,8 @@ impl GpuBackend {
 
     fn reset_status(&self, force_rebuild: bool) {
         let mut status = [0u32; STATUS_WORDS];
-        status[ST_BLOWUP_PARTICLE] = u32::MAX;
-        status[ST_SPAN_BODY] = u32::MAX;
+        status[ST_BLOWUP_PARTICLE] = NO_PARTICLE;
+        status[ST_SPAN_BODY] = NO_PARTICLE;
         status[ST_FORCE_REBUILD] = force_rebuild as u32;
         status[ST_FRACTION] = 1f32.to_bits();
         status[ST_ELAPSED] = 0f32.to_bits();
@@ -1458,44 +1433,4 @@ fn pack_state(
     let adhesion_base = packed.surf_entries + contact.surf_entries(n);
     let adhesion_fields = adhesion.append(&mut packed.topo, adhesion_base, n, contact.closest_entry(packed.surf_entries));
     Ok((packed, exclusions, fields, adhesion_fields))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The status words and halt bits the host reads are the kernels' (each
-    /// kernel file declares the bits it raises).
-    #[test]
-    fn the_status_constants_match_the_kernels() {
-        let program = shader::compose();
-        let words = [
-            ("ST_HALTED", ST_HALTED),
-            ("ST_OVERFLOW_NEED", ST_OVERFLOW_NEED),
-            ("ST_BUILDS", ST_BUILDS),
-            ("ST_STEPS_DONE", ST_STEPS_DONE),
-            ("ST_BLOWUP_PARTICLE", ST_BLOWUP_PARTICLE),
-            ("ST_FORCE_REBUILD", ST_FORCE_REBUILD),
-            ("ST_SPAN_BODY", ST_SPAN_BODY),
-            ("ST_FRACTION", ST_FRACTION),
-            ("ST_ELAPSED", ST_ELAPSED),
-        ];
-        for (name, value) in words {
-            assert!(program.contains(&format!("const {name}: u32 = {value}u;")), "{name}");
-        }
-        let bits = [
-            ("HALT_OVERFLOW", HALT_OVERFLOW),
-            ("HALT_BLOWUP", HALT_BLOWUP),
-            ("HALT_SPAN", HALT_SPAN),
-            ("HALT_REACH", HALT_REACH),
-            ("HALT_EVENTS", HALT_EVENTS),
-            ("HALT_SOLVE", HALT_SOLVE),
-            ("HALT_FORMATION", HALT_FORMATION),
-            ("HALT_CONSTRAINT", HALT_CONSTRAINT),
-            ("HALT_CONVERGED", HALT_CONVERGED),
-        ];
-        for (name, value) in bits {
-            assert!(program.contains(&format!("const {name}: u32 = {value}u;")), "{name}");
-        }
-    }
 }

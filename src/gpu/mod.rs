@@ -1,8 +1,12 @@
 //! The GPU backend (wgpu, Vulkan; WGSL kernels in `shaders/`).
 //!
 //! - [`context`]: adapter choice (`device gpu|auto`), limits for ≥ 10⁶ particles.
-//! - [`shader`]: the program composed from `shaders/common/` and one
-//!   evaluator file per interaction type, validated by naga.
+//! - [`shader`]: the program composed from `shaders/common/`, one
+//!   evaluator file per interaction type and per kinetic rule with a device
+//!   form (`src/kinetics/NAME.wgsl`), validated by naga.
+//! - `prelude`: the constants the host and the kernels share (buffer layouts,
+//!   halt bits, record sizes, physics constants), written once
+//!   in Rust and generated into the program.
 //! - [`custom`]: evaluators generated from a model's `custom` expressions.
 //! - [`pack`]: the model flattened into the buffers the kernels read.
 //! - [`backend`]: buffers, pipelines and the GPU-resident step loop.
@@ -92,6 +96,7 @@ mod implicit_split;
 pub mod kinetics;
 mod nlist;
 pub mod pack;
+mod prelude;
 pub mod protocol;
 pub mod shader;
 pub mod shake;

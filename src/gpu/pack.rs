@@ -35,8 +35,7 @@ use crate::neighbor::Exclusions;
 use crate::system::BondState;
 use crate::system::{Model, SimBox};
 
-/// Parameter slots per term on the GPU.
-pub const PARAM_SLOTS: usize = 8;
+pub use super::prelude::pack::PARAM_SLOTS;
 
 /// The uniform block (must match `Params` in layout.wgsl).
 #[repr(C)]
