@@ -54,6 +54,7 @@
 
 use super::backend::GpuBackend;
 use super::pack::Packed;
+pub use super::prelude::kinetics::RULES_PER_TYPE;
 use super::prelude::kinetics::*;
 use super::shader::rule_code;
 use crate::kinetics_engine::EventKind;
