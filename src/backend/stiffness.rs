@@ -19,7 +19,7 @@
 //! - **Surface terms of bodies** ([`crate::hessian::SurfaceHessian`], each
 //!   term's `hessian` in its interaction file): local stencils projected like
 //!   the angles, and Gauss–Newton rank-one terms w·g gᵀ kept as vectors
-//!   ([`RankOneTerm`]; the implicit step applies them matrix-free):
+//!   ([`RankOneTerm`](super::RankOneTerm); the implicit step applies them matrix-free):
 //!   - `surface_tension`: γ·∇²A_t per face (analytic, exact before
 //!     projection); `area_conservation`: per face
 //!     (k_l/a0)·∇A_t∇A_tᵀ + τ_t·∇²A_t with τ_t = dE/dA_t, and the global

@@ -35,7 +35,7 @@ pub struct InputError {
     pub line: u32,
     pub col: u32,
     pub message: String,
-    snippet: Option<Snippet>,
+    snippet: Option<Box<Snippet>>,
 }
 
 /// The clipped line an error shows, with the span it underlines (byte
@@ -144,7 +144,7 @@ impl InputError {
         let file = &token.file;
         let (message, snippet) = match file.unrecognised {
             Some((first, line_end)) if token.offset == first => (without_content(message.into(), &file.text[first..line_end]), None),
-            _ => (message.into(), Some(Snippet::new(file, token.offset, token.text_len.max(1), token.line))),
+            _ => (message.into(), Some(Box::new(Snippet::new(file, token.offset, token.text_len.max(1), token.line)))),
         };
         Self { path: file.path.clone(), line: token.line, col: token.col, message: printable_message(clip_quotes(message)), snippet }
     }
@@ -152,7 +152,7 @@ impl InputError {
     /// An error at a position of a file (used by the lexer).
     pub fn at_offset(file: &SourceFile, offset: usize, message: impl Into<String>) -> Self {
         let (line, col) = file.line_col(offset);
-        let snippet = (!unrecognised(file, offset)).then(|| Snippet::new(file, offset, 1, line));
+        let snippet = (!unrecognised(file, offset)).then(|| Box::new(Snippet::new(file, offset, 1, line)));
         Self { path: file.path.clone(), line, col, message: printable_message(clip_quotes(message.into())), snippet }
     }
 
@@ -172,7 +172,7 @@ impl std::error::Error for InputError {}
 
 impl Diagnostic for InputError {
     fn source_code(&self) -> Option<&dyn SourceCode> {
-        self.snippet.as_ref().map(|s| s as &dyn SourceCode)
+        self.snippet.as_deref().map(|s| s as &dyn SourceCode)
     }
 
     fn labels(&self) -> Option<Box<dyn Iterator<Item = LabeledSpan> + '_>> {

@@ -317,7 +317,7 @@ impl Simulation {
     }
 
     /// Applies one action (jumps only make sense within their plan: see
-    /// [`Self::perform`]).
+    /// `perform`).
     pub fn apply(&mut self, action: &Action) -> Result<(), RunError> {
         match action {
             Action::Branch { .. } | Action::Skip(_) => {

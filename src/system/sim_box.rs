@@ -73,7 +73,7 @@ impl SimBox {
     /// counter: one box length is added or subtracted (the usual case, as a
     /// step crosses at most one box), more by floor arithmetic, never by a loop
     /// (1e300 in a 10 µm box, or 1 in a 1e-12 one, never ended). A coordinate
-    /// that cannot be wrapped — not finite, or [`MAX_IMAGE`] box lengths or
+    /// that cannot be wrapped — not finite, or `MAX_IMAGE` box lengths or
     /// more away — is left as it is, for [`Self::misplaced_axis`] to report.
     #[inline]
     pub fn wrap(&self, x: &mut DVec3, image: &mut [i64; 3]) {

@@ -249,10 +249,10 @@ fn ase_reads_the_extended_xyz_with_elements_and_type_names() {
         assert_eq!(frame["step"].as_u64().unwrap(), want.step);
         assert_eq!(frame["pbc"], serde_json::json!([true, true, true]));
         let cell: Vec<Vec<f64>> = serde_json::from_value(frame["cell"].clone()).unwrap();
-        for a in 0..3 {
-            for b in 0..3 {
-                let edge = want.bounds[a][1] - want.bounds[a][0];
-                assert_eq!(cell[a][b], if a == b { edge } else { 0.0 });
+        for (a, row) in cell.iter().enumerate() {
+            let edge = want.bounds[a][1] - want.bounds[a][0];
+            for (b, &value) in row.iter().enumerate() {
+                assert_eq!(value, if a == b { edge } else { 0.0 });
             }
         }
         // ASE keeps the file's (internal) order; the dump is sorted by id.

@@ -11,9 +11,9 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
+use crate::common::{assert_complete_csv, seeded_fraction, state_bits, Case};
 use cellmd::output::read_state;
 use cellmd::run::{OUTPUT_ERROR_STATUS, STOPPED_STATUS};
-use crate::common::{assert_complete_csv, seeded_fraction, state_bits, Case};
 
 fn cellmd() -> Command {
     Command::new(env!("CARGO_BIN_EXE_cellmd"))

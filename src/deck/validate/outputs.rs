@@ -12,9 +12,6 @@ use crate::interactions::REGISTRY;
 use crate::kinetics_engine::EventKind;
 use crate::output::{read_state, AtomColumn, DumpFormat, Encoding, WriterOptions};
 
-/// Whether a thermo column prefix names a group measurement: (force (`fx`,
-/// `fy`, `fz`) or mean unwrapped position (`xu`, `yu`, `zu`), axis).
-
 impl Validator {
     pub(super) fn thermo(&mut self, s: &[Token], usage: &str) -> Result<(), InputError> {
         expect_len(s, 1..=usize::MAX, usage)?;
