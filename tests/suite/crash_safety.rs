@@ -61,7 +61,8 @@ fn xyz_frames(path: &Path) -> usize {
     for frame in lines.chunks(PARTICLES + 2) {
         assert_eq!(frame[0], PARTICLES.to_string());
         assert!(frame[1].starts_with("Lattice="));
-        assert!(frame[2..].iter().all(|l| l.split(' ').count() == 6), "a partial line in {}", path.display());
+        // The columns of Properties=: species, pos (3), Z, type_name, id.
+        assert!(frame[2..].iter().all(|l| l.split(' ').count() == 7), "a partial line in {}", path.display());
     }
     lines.len() / (PARTICLES + 2)
 }
