@@ -336,13 +336,11 @@ struct PairCoeff {
     text: String,
 }
 
+/// Pair laws `(i, j, law)` with i ≤ j, and notes for the pairs that have none.
+pub type PairLaws = (Vec<(usize, usize, String)>, Vec<String>);
+
 /// The pair laws: `(i, j, law)` with i ≤ j, and notes for what has none.
-pub fn pairs(
-    style: &Style,
-    modify: &PairModify,
-    lines: &[(Source, Line)],
-    n: usize,
-) -> Result<(Vec<(usize, usize, String)>, Vec<String>), String> {
+pub fn pairs(style: &Style, modify: &PairModify, lines: &[(Source, Line)], n: usize) -> Result<PairLaws, String> {
     // (i, j) → assigned sub-styles (one, or several under overlay).
     let mut set: BTreeMap<(usize, usize), Vec<PairCoeff>> = BTreeMap::new();
     for (source, line) in lines {
