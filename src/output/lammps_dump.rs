@@ -24,7 +24,7 @@
 //!   (type index + 1, the order of the force field's type names) and
 //!   `element` the chemical symbol standing for the type: type index `t` is
 //!   the element of atomic number `t + 1` (H, He, Li, …, as
-//!   [`element_symbol`](super::element_symbol) and the extended XYZ's `Z`
+//!   [`super::element_symbol`] and the extended XYZ's `Z`
 //!   column). LAMMPS' `dump_modify element` column holds chemical elements,
 //!   and readers take it so: ASE (`ase.io.read(…, format="lammps-dump-text")`)
 //!   maps it to atomic numbers and fails on any other name, OVITO and VMD

@@ -24,7 +24,7 @@
 //! # Type names and elements: how readers see them
 //!
 //! Type index `t` stands for the element of atomic number `Z = t + 1`
-//! (wrapping after 118; [`element_symbol`]: H, He, Li, …), the same mapping
+//! (wrapping after 118; [`element_symbol`](super::element_symbol): H, He, Li, …), the same mapping
 //! as the LAMMPS dump's `element` column. OVITO names its particle types
 //! after `species`, so it shows the type names (`cortex`, `adhesion_site`);
 //! ASE builds its atoms from `Z` when a file has it (`species` is then not

@@ -5,7 +5,7 @@
 //! `system.in` with its `file:line`, and printed.
 //!
 //! What is read:
-//! - the data file ([`data`]): box, `Masses`, `Atoms` (styles `atomic`,
+//! - the data file (`data.rs`): box, `Masses`, `Atoms` (styles `atomic`,
 //!   `bond`, `angle`, `molecular`, `charge`, `full`, from the script's
 //!   `atom_style` or the `Atoms # STYLE` comment; image flags unwrap the
 //!   positions), `Bonds`, `Angles`, and the `Pair`/`Bond`/`Angle Coeffs`
@@ -13,8 +13,8 @@
 //!   type N is named by its `Masses` comment (`1 1.0 # actin`) or `tN`; bond
 //!   and angle types are `bondN` and `angleN`. A box that is not finite, or
 //!   with hi ≤ lo, and coordinates that are not finite are errors.
-//! - the script ([`script`]): units, boundaries, `special_bonds`, the styles
-//!   and their coefficients with wildcards and mixing ([`coeffs`], which
+//! - the script (`script.rs`): units, boundaries, `special_bonds`, the styles
+//!   and their coefficients with wildcards and mixing (`coeffs.rs`, which
 //!   also lists every translation), the dynamics, `timestep`, `thermo`,
 //!   `run`, `neighbor`/`neigh_modify` and `print`, in the script's order.
 //!
