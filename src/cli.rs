@@ -8,7 +8,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use crate::compare::{cellmd_probes, golden, run_lammps, Agreement, Lmp, Tolerance};
+use crate::compare::{golden, Lmp, Tolerance};
 use crate::deck::{validate_file_with, Plan, ValidateOptions};
 use crate::export::{self, ExportOptions};
 use crate::gpu::{DevicePreference, GpuBackend, GpuContext};
@@ -99,8 +99,10 @@ enum Command {
         probes: bool,
     },
     /// Translate a LAMMPS data file (and the input script that reads it) into
-    /// DIR/system.top, system.ff and system.in, listing what it could not translate.
+    /// DIR/system.top, system.ff and system.in, listing what it could not
+    /// translate. An input script alone names its data file by `read_data`.
     ImportLammps {
+        /// The data file, or the input script (whose `read_data` names the data file).
         data: PathBuf,
         input: Option<PathBuf>,
         #[arg(short, long, value_name = "DIR")]
@@ -295,7 +297,7 @@ where
             Ok(imported) => {
                 out!("wrote {0}/system.top, {0}/system.ff and {0}/system.in", output.display());
                 for note in &imported.notes {
-                    out!("not translated: {note}");
+                    out!("note: {note}");
                 }
                 ExitCode::SUCCESS
             }
@@ -358,6 +360,13 @@ where
                 Ok(plan) => plan,
                 Err(e) => return report(e),
             };
+            // A restart that does not fit its deck is bad input: refused before any output exists.
+            if let (Some(data), Some(path)) = (&restart, &resume) {
+                if let Err(e) = Simulation::check_restart(&plan, data, path) {
+                    eprintln!("error: {e}");
+                    return ExitCode::from(1);
+                }
+            }
             if let Err(e) = std::fs::create_dir_all(&output_dir) {
                 eprintln!("error: cannot create output directory {}: {e}", output_dir.display());
                 return ExitCode::from(OUTPUT_ERROR_STATUS);
@@ -517,18 +526,14 @@ fn compare(
     };
     let scratch = tempfile::tempdir().map_err(|e| e.to_string())?;
     let dir = workdir.unwrap_or_else(|| scratch.path().to_path_buf());
-    let (reference, version) = run_lammps(plan, &lmp, &dir)?;
-    let ours = cellmd_probes(plan)?;
-    let agreement = Agreement::new(&ours, &reference)?;
-    let table =
-        format!("cellmd {} vs {version} on {}\n{}", env!("CARGO_PKG_VERSION"), plan.deck_path.display(), agreement.table("LAMMPS", tol));
+    let comparison = crate::compare::compare_deck(plan, &lmp, &dir)?;
     if let Some(path) = write_golden {
-        let mut entries = vec![("generator", format!("{version} via cellmd export-lammps"))];
+        let mut entries = vec![("generator", format!("{} via cellmd export-lammps", comparison.version))];
         entries.extend(header.iter().map(|(k, v)| (k.as_str(), v.clone())));
-        let doc = golden::document_of(&entries, &reference);
+        let doc = golden::document_of(&entries, &comparison.reference);
         std::fs::write(&path, golden::write(&[doc])).map_err(|e| format!("{}: {e}", path.display()))?;
     }
-    Ok((table, agreement.agrees(tol)))
+    Ok((comparison.table(plan, tol), comparison.agreement.agrees(tol)))
 }
 
 /// Validates a deck and prints its warnings on stderr.

@@ -12,10 +12,10 @@
 //!
 //! - Face area A_t = ½|(x_b − x_a) × (x_c − x_a)| with gradient
 //!   ∂A_t/∂x_a = ½ (x_b − x_c) × n̂ (cyclic in a, b, c). Its Hessian, with
-//!   n = (x_b − x_a) × (x_c − x_a), P = I − n̂n̂ᵀ, [v]ₓ the cross-product
+//!   n = (x_b − x_a) × (x_c − x_a), P = I − n̂n̂ᵀ, \[v\]ₓ the cross-product
 //!   matrix and e_a = x_b − x_c (cyclic): ∂²A_t/∂x_k∂x_l =
-//!   −[e_k]ₓ P [e_l]ₓ/(2|n|) + ½M_kl, where M_kk = 0, M_ab = M_bc = M_ca =
-//!   −[n̂]ₓ and M_ba = M_cb = M_ac = [n̂]ₓ (the second-order part of n̂·n).
+//!   −\[e_k\]ₓ P \[e_l\]ₓ/(2|n|) + ½M_kl, where M_kk = 0, M_ab = M_bc = M_ca =
+//!   −\[n̂\]ₓ and M_ba = M_cb = M_ac = \[n̂\]ₓ (the second-order part of n̂·n).
 //!   Indefinite: a face shrinks to second order when two corners slide
 //!   apart across each other.
 //! - Enclosed volume by the divergence theorem,
@@ -205,13 +205,13 @@ pub fn triangle_area_gradient([a, b, c]: [DVec3; 3]) -> (f64, [DVec3; 3]) {
     (0.5 * twice, [0.5 * (b - c).cross(unit), 0.5 * (c - a).cross(unit), 0.5 * (a - b).cross(unit)])
 }
 
-/// The cross-product matrix [v]ₓ: [v]ₓ·u = v × u.
+/// The cross-product matrix \[v\]ₓ: \[v\]ₓ·u = v × u.
 #[inline]
 pub fn cross_matrix(v: DVec3) -> DMat3 {
     DMat3::from_cols(DVec3::new(0.0, v.z, -v.y), DVec3::new(-v.z, 0.0, v.x), DVec3::new(v.y, -v.x, 0.0))
 }
 
-/// The Hessian ∂²A/∂x_k∂x_l of a triangle's area, as 3×3 blocks [k][l]
+/// The Hessian ∂²A/∂x_k∂x_l of a triangle's area, as 3×3 blocks `[k][l]`
 /// (see the module docs).
 pub fn triangle_area_hessian([a, b, c]: [DVec3; 3]) -> [[DMat3; 3]; 3] {
     let n = (b - a).cross(c - a);
@@ -276,7 +276,8 @@ pub fn point_triangle(p: DVec3, [a, b, c]: [DVec3; 3]) -> PointTriangle {
 }
 
 /// Barycentric weights of the point of triangle (a, b, c) closest to p,
-/// by Voronoi region: three vertices, three edges, then the interior.
+/// by Voronoi region: three vertices, three edges, then the interior. The
+/// GPU's f32 twin, line by line, is `closest_weights` in `src/mesh.wgsl`.
 fn closest_weights(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> [f64; 3] {
     let (ab, ac, ap) = (b - a, c - a, p - a);
     let (d1, d2) = (ab.dot(ap), ac.dot(ap));

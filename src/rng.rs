@@ -64,7 +64,7 @@ pub const STREAM_NOISE: u32 = 0;
 pub const STREAM_NOISE_GAUSSIAN: u32 = 1;
 
 /// √12: scales a zero-mean uniform on `(−½, ½)` to unit variance.
-const SQRT_12: f64 = 3.464_101_615_137_754_5;
+pub const SQRT_12: f64 = 3.464_101_615_137_754_5;
 
 #[inline(always)]
 fn mulhilo(a: u32, b: u32) -> (u32, u32) {

@@ -26,30 +26,9 @@
 // Bonds of a bind rule's type that existed when the backend was built are
 // kinetic bonds in the particles' bond rows (terms from P.kin_first_term);
 // bonds formed since live in the pool and are gathered through the slots.
-
-const HALT_FORMATION: u32 = 64u;
-const FORMATION_SALT: u32 = 0x62696E64u; // ASCII "bind", as src/kinetics_engine/formation.rs
-const EVENT_FORM: u32 = 3u;
-
-// Header words of `kin` (after kinetics.wgsl's).
-const KIN_SLOT_OF: u32 = 16u;    // offset of each particle's slot base (KIN_NONE: takes no part)
-const KIN_SLOTS: u32 = 17u;      // offset of the slots (pool records, KIN_NONE: free)
-const KIN_SLOT_WIDTH: u32 = 18u; // slots per particle (0: no `bind` on the device)
-const KIN_RULES: u32 = 19u;      // offset of the rule records (KIN_RULE_WORDS each)
-const KIN_RULE_COUNT: u32 = 20u;
-const KIN_BODY: u32 = 21u;       // offset of each particle's body (KIN_NONE: none)
-const KIN_POOL_NEXT: u32 = 22u;  // next free pool record
-const KIN_POOL_END: u32 = 23u;   // end of the pool (= kinetic records)
-const KIN_NEXT_BOND: u32 = 24u;  // the model bond index of the next new bond
-const KIN_CAND: u32 = 25u;       // offset of the candidates (i, j, rule)
-const KIN_CAND_CAP: u32 = 26u;   // candidates the list holds
-const KIN_CAND_N: u32 = 27u;     // offset of the per-particle candidate counts
-const KIN_CAND_BLOCK: u32 = 28u; // offset of the per-block counts, then bases
-const KIN_CAND_TOTAL: u32 = 29u; // this step's candidates
-const KIN_DEFER: u32 = 30u;      // 1: this step's formation is left to the host
-const KIN_MAX_GAIN: u32 = 31u;   // Σ max_bonds over the rules: most new bonds of one particle in a step
-
-const KIN_RULE_WORDS: u32 = 8u; // type a, type b, bond type, max_bonds, between bodies, capture, k_on, rest (f32 bits)
+//
+// The header words of `kin` from KIN_SLOT_OF on, KIN_RULE_WORDS, BIND_RULES
+// and FORMATION_SALT are the prelude's (src/gpu/prelude.rs).
 
 fn bind_on() -> bool {
     return P.kin_bonds > 0u && kin_word(KIN_SLOT_WIDTH) > 0u;
@@ -148,7 +127,6 @@ fn formed_bond_forces(i: u32) -> vec4<f32> {
 
 // What the candidate search reads of the rules and of particle i, loaded
 // once per particle (the rules from `kin`, at most BIND_RULES of them).
-const BIND_RULES: u32 = 4u;
 
 struct BindSearch {
     rules: u32,

@@ -4,12 +4,9 @@
 // `forces`; `contact_law` dispatches on the registry index of the rule's
 // interaction type to `NAME_contact` (shaders/interactions/NAME.wgsl).
 
-const NO_BODY: u32 = 0xffffffffu;
-const CONTACT_RULE_WORDS: u32 = 9u;
-// The step clamp: a particle moves at most this fraction of its closest contact distance.
-const STEP_FRACTION: f32 = 0.4;
-// Entries of the ring of step fractions in `surf` (FRACTION_SLOTS in src/gpu/contact.rs).
-const FRACTION_SLOTS: u32 = 1024u;
+// STEP_FRACTION (the step clamp: a particle moves at most this fraction of its
+// closest contact distance), FRACTION_SLOTS (the ring of step fractions in
+// `surf`), CONTACT_RULE_WORDS and NO_BODY are the prelude's (src/gpu/prelude.rs).
 
 // Where particle i's closest contact distance lives in `surf` (x): written by
 // the contact pass (its node part first, with area-weighted rules), read by
@@ -66,50 +63,6 @@ fn contact_radial(types: u32, d: f32) -> Radial {
         out.de_dr += b.de_dr;
     }
     return out;
-}
-
-// Barycentric weights of the point of triangle (a, b, c) closest to p, by
-// Voronoi region (src/mesh.rs, `closest_weights`).
-fn closest_weights(p: vec3<f32>, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> vec3<f32> {
-    let ab = b - a;
-    let ac = c - a;
-    let ap = p - a;
-    let d1 = dot(ab, ap);
-    let d2 = dot(ac, ap);
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return vec3<f32>(1.0, 0.0, 0.0);
-    }
-    let bp = p - b;
-    let d3 = dot(ab, bp);
-    let d4 = dot(ac, bp);
-    if d3 >= 0.0 && d4 <= d3 {
-        return vec3<f32>(0.0, 1.0, 0.0);
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        let v = d1 / (d1 - d3);
-        return vec3<f32>(1.0 - v, v, 0.0);
-    }
-    let cp = p - c;
-    let d5 = dot(ab, cp);
-    let d6 = dot(ac, cp);
-    if d6 >= 0.0 && d5 <= d6 {
-        return vec3<f32>(0.0, 0.0, 1.0);
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        let w = d2 / (d2 - d6);
-        return vec3<f32>(1.0 - w, 0.0, w);
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0 {
-        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        return vec3<f32>(0.0, 1.0 - w, w);
-    }
-    let denom = 1.0 / (va + vb + vc);
-    let v = vb * denom;
-    let w = vc * denom;
-    return vec3<f32>(1.0 - v - w, v, w);
 }
 
 // Node k against face f: the distance d, the weights w of the closest

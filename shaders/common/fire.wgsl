@@ -25,22 +25,9 @@
 @group(1) @binding(5) var<storage, read_write> fire_v: array<vec4<f32>>;
 @group(1) @binding(6) var<storage, read_write> fire: array<vec4<f32>>;
 
-// Entries of `fire` (src/gpu/fire.rs writes the first three).
-const FIRE_STATE: u32 = 0u;    // (Δt, α, positive steps (bits), iterations (bits))
-const FIRE_MIXING: u32 = 1u;   // (1 − α or 0, α|v|/|F| or 0, Δt₀, Δt_max)
-const FIRE_LIMITS: u32 = 2u;   // (ftol, dmax, max |F| of the last evaluation, blocks (bits))
-const FIRE_CLAMPED: u32 = 3u;  // (moves the contact step clamp shortened (bits), 0, 0, 0)
-const FIRE_PARTIALS: u32 = 4u; // one per workgroup of `fire_partials`: (P, Σ|v|², Σ|F|², max |F|)
-
-// Converged (status word ST_HALTED): max |F| < ftol.
-const HALT_CONVERGED: u32 = 256u;
-
-// FIRE's parameters, the CPU's (src/integrate/fire.rs; a test compares them).
-const FIRE_N_MIN: u32 = 5u;
-const FIRE_F_INC: f32 = 1.1;
-const FIRE_F_DEC: f32 = 0.5;
-const FIRE_ALPHA0: f32 = 0.1;
-const FIRE_F_ALPHA: f32 = 0.99;
+// Entries of `fire` (FIRE_STATE, FIRE_MIXING, FIRE_LIMITS, FIRE_CLAMPED, then
+// FIRE_PARTIALS …) and FIRE's parameters (FIRE_N_MIN, FIRE_F_INC, …, the
+// CPU's) are the prelude's (src/gpu/prelude.rs); src/gpu/fire.rs writes the first three.
 
 var<workgroup> fire_tree: array<vec4<f32>, 256>;
 var<workgroup> fire_flag: u32;

@@ -39,24 +39,8 @@
 @group(1) @binding(1) var<storage, read> imp_topo: array<u32>;
 @group(1) @binding(2) var<storage, read_write> imp: array<vec4<f32>>;
 
-// Header words of `imp_topo` (src/gpu/implicit.rs writes them).
-const IMP_ANGLES: u32 = 0u;         // number of angles
-const IMP_OFF_ANGLES: u32 = 1u;     // angle records (i, j, k, term)
-const IMP_OFF_SLOT_START: u32 = 2u; // per particle (n + 1): start of its angle slots
-const IMP_OFF_SLOTS: u32 = 3u;      // angle slots (angle, role)
-const IMP_MAX_ITER: u32 = 4u;       // CG iteration cap
-const IMP_TOLERANCE: u32 = 5u;      // relative residual |r|/|b| (f32 bits)
-const IMP_OFF_DRAG: u32 = 6u;       // per type γ/dt (f32 bits; 0 for a fixed type)
-const IMP_OFF_KICK: u32 = 7u;       // per type √(2kT·γ/dt) (f32 bits)
-const IMP_V_BONDS: u32 = 8u;        // `imp` entry of the bond-end blocks (2 per end)
-const IMP_V_EXTERNALS: u32 = 9u;    // … of the external blocks (2 per external entry)
-const IMP_V_ANGLES: u32 = 10u;      // … of the angle blocks (21 per angle)
-const IMP_V_REPORT: u32 = 11u;      // … of the last solve's report
-const IMP_V_TETRAS: u32 = 17u;      // … of the volume elements' blocks (36 per element)
-const IMP_V_FACES: u32 = 18u;       // … of the faces' blocks (21 per face of the surface pack)
-const IMP_V_BODIES: u32 = 19u;      // … per packed body: (w_V, w_A, ∇V·v, ∇A·v)
-const IMP_V_NODES: u32 = 20u;       // … per curvature node: (w, β, g·v)
-const IMP_V_SPLIT: u32 = 21u;       // … of the split solve's scalars and partial sums (implicit_split.wgsl)
+// The header words of `imp_topo` (IMP_*, src/gpu/implicit.rs writes them) and
+// the block sizes ANGLE_VEC4, TETRA_VEC4 and FACE_VEC4 are the prelude's (src/gpu/prelude.rs).
 
 // Per-particle vectors of `imp`: section s of particle i is imp[s·n + i].
 const VEC_X: u32 = 0u;    // Δx
@@ -65,14 +49,8 @@ const VEC_Z: u32 = 2u;    // preconditioned residual
 const VEC_P: u32 = 3u;    // search direction
 const VEC_Q: u32 = 4u;    // A·p
 const VEC_DINV: u32 = 5u; // inverse Jacobi diagonal
-const ANGLE_VEC4: u32 = 21u;
-const TETRA_VEC4: u32 = 36u;
-const FACE_VEC4: u32 = 21u;
 // Row stride of the matrices `project_psd` works on.
 const PSD_STRIDE: u32 = 12u;
-
-// The solve did not converge (status word ST_HALTED).
-const HALT_SOLVE: u32 = 32u;
 
 fn identity3() -> mat3x3<f32> {
     return mat3x3<f32>(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(0.0, 0.0, 1.0));

@@ -11,14 +11,8 @@
 // (shaders/common/shake.wgsl) then removes the second-order drift of the
 // lengths, as on the CPU.
 
-// Header words of `imp_topo` for the constraints (src/gpu/implicit.rs).
-const IMP_CONSTRAINTS: u32 = 12u;     // constrained bonds
-const IMP_OFF_CONSTRAINTS: u32 = 13u; // their (i, j)
-const IMP_OFF_CSLOT_START: u32 = 14u; // per particle (n + 1): start of its constraint slots
-const IMP_OFF_CSLOTS: u32 = 15u;      // slots: constraint index, bit 31 set where the particle is its j
-const IMP_V_CONSTRAINTS: u32 = 16u;   // `imp` entry of the constraints' vectors (CONSTRAINT_VEC4 each)
-const CONSTRAINT_VEC4: u32 = 3u;
-const J_END: u32 = 0x80000000u;
+// The constraints' header words of `imp_topo` (IMP_CONSTRAINTS …
+// IMP_V_CONSTRAINTS), CONSTRAINT_VEC4 and J_END are the prelude's (src/gpu/prelude.rs).
 // Scalars of a constraint's second entry.
 const C_MU: u32 = 0u;
 const C_R: u32 = 1u;

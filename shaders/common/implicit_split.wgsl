@@ -25,14 +25,9 @@
 // integer atomicMin on the bits, order-free) and `implicit_move`.
 // Once converged, every later kernel of the budget returns at once.
 
-// Entries of the split solve from imp_topo[IMP_V_SPLIT] on.
-const SPLIT_SCALARS: u32 = 0u;  // (r·z, α, threshold = tolerance·|b|, |b|)
-const SPLIT_STATE: u32 = 1u;    // (iterations (bits), done (bits), |r|, the section the products multiply (bits))
-const SPLIT_COPY: u32 = 2u;     // `implicit_split_alpha`'s copy for `implicit_split_direction`: (r·z, iterations (bits), done (bits), 0)
-const SPLIT_PARTIALS: u32 = 3u; // one per workgroup of a particle kernel
-
-// The budget ran out before the solve converged (status word ST_HALTED).
-const HALT_BUDGET: u32 = 512u;
+// The entries of the split solve from imp_topo[IMP_V_SPLIT] on (SPLIT_SCALARS,
+// SPLIT_STATE, SPLIT_COPY, then SPLIT_PARTIALS …) and HALT_BUDGET are the
+// prelude's (src/gpu/prelude.rs).
 
 var<workgroup> split_flag: u32;
 

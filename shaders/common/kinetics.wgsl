@@ -15,40 +15,20 @@
 //                dependence).
 // Before every step `kin_room` halts the run (HALT_EVENTS) when the event
 // buffer could not take one more step's events; the host drains it and goes on.
+//
+// The header words of `kin` (KIN_BONDS …), its record sizes, the event kinds,
+// the Philox streams and COARSE_RATE_DT are the prelude's (src/gpu/prelude.rs).
+// Each rule is decided by its device form (FORM_RATE, FORM_BEYOND,
+// FORM_ON_RATE): the generated `rule_form`, `unbind_law`, `threshold_law` and
+// `rebind_law` dispatch on the rule's code to its evaluator beside the rule
+// (src/kinetics/NAME.wgsl, src/gpu/shader.rs).
 
-const HALT_EVENTS: u32 = 16u;
-
-// Header words of `kin`.
-const KIN_BONDS: u32 = 0u;   // offset of the bond records (KIN_BOND_WORDS each)
-const KIN_BOUND: u32 = 1u;   // offset of the bound flags (1 each)
-const KIN_AGE: u32 = 2u;     // offset of the ages (f64 bits: high, low)
-const KIN_MEASURE: u32 = 3u; // offset of tension, length, k·dt (f32 bits)
-const KIN_FLAG: u32 = 4u;    // offset of this step's event kinds (1 each)
-const KIN_BLOCK: u32 = 5u;   // offset of the per-block event counts, then bases
-const KIN_TYPE: u32 = 6u;    // offset of the bond-type records (KIN_TYPE_WORDS each)
-const KIN_EXCL: u32 = 7u;    // offset of the exclusion tags (kinetic bond, or none)
-const KIN_EVENTS: u32 = 8u;  // offset of the events (KIN_EVENT_WORDS each)
-const KIN_CURSOR: u32 = 9u;  // events written since the host last drained
-const KIN_DT_HI: u32 = 10u;  // dt as f64 bits
-const KIN_DT_LO: u32 = 11u;
-const KIN_DT: u32 = 12u;     // dt, kT as f32 bits
-const KIN_KT: u32 = 13u;
-
-const KIN_BOND_WORDS: u32 = 6u;  // i, j, bond type, bond index, term, rest length (f32 bits)
-const KIN_TYPE_WORDS: u32 = 44u; // rules, warned, warned bond, step lo, step hi, k·dt, 2 spare, 4 × (rule, 8 params)
-const KIN_EVENT_WORDS: u32 = 8u; // step lo, step hi, bond index, kind, tension, length, age hi, age lo
-const KIN_NONE: u32 = 0xFFFFFFFFu;
-
-const RULE_SLIP: u32 = 1u;
-const RULE_CATCH_SLIP: u32 = 2u;
-const RULE_CADHERIN: u32 = 3u;
-const RULE_THRESHOLD: u32 = 4u;
-const RULE_REBIND: u32 = 5u;
-const EVENT_BREAK: u32 = 1u;
-const EVENT_REBIND: u32 = 2u;
-const STREAM_KINETICS: u32 = 2u;
-const STREAM_QUENCHED: u32 = 3u;
-const COARSE_RATE_DT: f32 = 0.1;
+// A threshold rule's verdict at a bond: beyond its threshold, and its break
+// rate there (0: at once).
+struct Beyond {
+    over: bool,
+    rate: f32,
+}
 
 fn kin_word(k: u32) -> u32 {
     return atomicLoad(&kin[k]);
@@ -122,22 +102,9 @@ fn draws_below(x: u32, p: f32) -> bool {
     return p >= 1.0 || f32(x) + 0.5 < p * 4294967296.0;
 }
 
-// The off-rate of an `Unbind` rule at tension f (src/kinetics/*.rs).
-fn unbind_rate(code: u32, p: u32, f: f32, kt: f32) -> f32 {
-    let q = array<f32, 8>(kin_f32(p), kin_f32(p + 1u), kin_f32(p + 2u), kin_f32(p + 3u), kin_f32(p + 4u), kin_f32(p + 5u), kin_f32(p + 6u), kin_f32(p + 7u));
-    if code == RULE_SLIP {
-        return q[0] * exp(abs(f) * q[1] / kt);
-    }
-    let g = max(f, 0.0);
-    if code == RULE_CATCH_SLIP {
-        return q[0] * exp(-g * q[1] / kt) + q[2] * exp(g * q[3] / kt);
-    }
-    // cadherin: the closed-form effective rate of its three-state generator.
-    let k1 = q[0] * exp(g * q[1] / kt);
-    let ks = q[2] * exp(g * q[3] / kt);
-    let kr = q[4] * exp(-g * q[5] / kt);
-    let k2 = q[6] * exp(g * q[7] / kt);
-    return (k1 * (kr + k2) + ks * k2) / (kr + k2 + ks);
+// The eight parameters of the rule record at word p (f32 bits).
+fn kin_rule_params(p: u32) -> array<f32, 8> {
+    return array<f32, 8>(kin_f32(p), kin_f32(p + 1u), kin_f32(p + 2u), kin_f32(p + 3u), kin_f32(p + 4u), kin_f32(p + 5u), kin_f32(p + 6u), kin_f32(p + 7u));
 }
 
 // f64 addition a + b of two finite non-negative numbers given as (high, low)
@@ -311,8 +278,13 @@ fn kin_decide_bond(k: u32) -> u32 {
     let age_at = kin_word(KIN_AGE) + 2u * k;
     if kin_word(bound_at) == 0u {
         for (var r = 0u; r < rules; r++) {
-            let p = trec + 8u + 9u * r;
-            if kin_word(p) == RULE_REBIND && len < kin_f32(p + 2u) && draws_below(x, one_minus_exp(kin_f32(p + 1u) * dt)) {
+            let p = trec + KIN_TYPE_RULES + KIN_RULE_STRIDE * r;
+            let code = kin_word(p);
+            if rule_form(code) != FORM_ON_RATE {
+                continue;
+            }
+            let on = rebind_law(code, kin_rule_params(p + 1u));
+            if len < on.y && draws_below(x, one_minus_exp(on.x * dt)) {
                 atomicStore(&kin[bound_at], 1u);
                 atomicStore(&kin[age_at], 0u);
                 atomicStore(&kin[age_at + 1u], 0u);
@@ -326,22 +298,21 @@ fn kin_decide_bond(k: u32) -> u32 {
     var rate = 0.0;
     var immediate = false;
     for (var r = 0u; r < rules; r++) {
-        let p = trec + 8u + 9u * r;
+        let p = trec + KIN_TYPE_RULES + KIN_RULE_STRIDE * r;
         let code = kin_word(p);
-        if code == RULE_THRESHOLD {
+        let form = rule_form(code);
+        if form == FORM_BEYOND {
             let u = (f32(philox4x32_10(vec4<u32>(bond, STREAM_QUENCHED, KIN_NONE, KIN_NONE), seed).x) + 0.5) * 2.3283064365386963e-10;
-            let factor = 1.0 + kin_f32(p + 3u) * (u - 0.5);
-            let over_strain = kin_f32(p + 1u) > 0.0 && abs(strain) > kin_f32(p + 1u) * factor;
-            let over_force = kin_f32(p + 2u) > 0.0 && force > kin_f32(p + 2u) * factor;
-            if over_strain || over_force {
-                if kin_f32(p + 4u) > 0.0 {
-                    rate += kin_f32(p + 4u);
+            let beyond = threshold_law(code, kin_rule_params(p + 1u), force, strain, u);
+            if beyond.over {
+                if beyond.rate > 0.0 {
+                    rate += beyond.rate;
                 } else {
                     immediate = true;
                 }
             }
-        } else if code != RULE_REBIND {
-            rate += unbind_rate(code, p + 1u, force, kt);
+        } else if form == FORM_RATE {
+            rate += unbind_law(code, kin_rule_params(p + 1u), force, kt);
         }
     }
     let rate_dt = rate * dt;

@@ -106,26 +106,9 @@ fn nlist_row(i: u32) -> u32 {
     return (i - chunk.first) * (1u + P.nlist_cap);
 }
 
-// Words of `status` (read back by the host at every synchronisation).
-const ST_HALTED: u32 = 0u;        // bit 0: neighbour list overflow, bit 1: blow-up
-const ST_OVERFLOW_NEED: u32 = 1u; // largest neighbour count met (when it overflowed)
-const ST_MAX_DISP2: u32 = 2u;     // bits of the largest squared displacement since the last build
-const ST_BUILDS: u32 = 3u;        // neighbour-list builds so far
-const ST_STEPS_DONE: u32 = 4u;    // steps completed in this call
-const ST_BLOWUP_PARTICLE: u32 = 5u; // lowest particle index whose step was refused (NO_PARTICLE: none)
-const ST_FORCE_REBUILD: u32 = 6u; // host request: rebuild before the next step
-const ST_SPAN_BODY: u32 = 7u;     // lowest packed body wider than half the periodic box
-const HALT_OVERFLOW: u32 = 1u;
-const HALT_BLOWUP: u32 = 2u;
-const HALT_SPAN: u32 = 4u;
-const ST_FRACTION: u32 = 8u;      // bits of this step's fraction s of dt (contact step clamp; 1.0 without)
-const HALT_REACH: u32 = 8u;       // a face edge outgrew the contact search (src/gpu/contact.rs)
-const ST_ELAPSED: u32 = 9u;       // bits of the fractions of dt the steps of this call took, summed (f32; `sim_time`)
-const ST_LIST_AFTER_STEP: u32 = 10u; // 1 while the list is checked after `commit` (bind.wgsl): an overflow there defers, not halts
-const NO_PARTICLE: u32 = 0xffffffffu; // ST_BLOWUP_PARTICLE while no step was refused
-const CONTACT_ONLY: u32 = 0x80000000u; // neighbour-list entry kept for the contact search only
-
-const WORKGROUP: u32 = 256u;
+// The words of `status` (ST_*, read back by the host at every
+// synchronisation), the halt bits (HALT_*), NO_PARTICLE, CONTACT_ONLY and
+// WORKGROUP are the prelude's (src/gpu/prelude.rs).
 
 // Linear invocation index of a 2-D dispatch (dispatches wider than 65 535
 // workgroups are split along y).

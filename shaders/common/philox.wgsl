@@ -2,12 +2,8 @@
 // CPU's src/integrate/rng.rs: counter = [id, stream, step_lo, step_hi],
 // key = [seed_lo, seed_hi]. WGSL has no 64-bit integers, so the 32×32 → 64
 // products are assembled from 16-bit halves; the words are bit-identical to
-// the CPU's.
-
-const PHILOX_M0: u32 = 0xD2511F53u;
-const PHILOX_M1: u32 = 0xCD9E8D57u;
-const PHILOX_W0: u32 = 0x9E3779B9u;
-const PHILOX_W1: u32 = 0xBB67AE85u;
+// the CPU's. PHILOX_M0, PHILOX_M1, PHILOX_W0, PHILOX_W1, the noise streams
+// and SQRT_12 are the prelude's (src/gpu/prelude.rs, from src/rng.rs).
 
 // (high, low) words of a · b.
 fn mulhilo(a: u32, b: u32) -> vec2<u32> {
@@ -42,9 +38,9 @@ fn philox4x32_10(counter: vec4<u32>, key: vec2<u32>) -> vec4<u32> {
 // `noise uniform` on the CPU: the top 24 bits of each word, so that the f32
 // value is exact (the CPU uses all 32 bits in f64; the two differ by < 2⁻²⁴·√12).
 fn noise3(seed: vec2<u32>, step: vec2<u32>, id: u32) -> vec3<f32> {
-    let w = philox4x32_10(vec4<u32>(id, 0u, step.x, step.y), seed);
+    let w = philox4x32_10(vec4<u32>(id, STREAM_NOISE, step.x, step.y), seed);
     let u = (vec3<f32>(vec3<u32>(w.x, w.y, w.z) >> vec3<u32>(8u)) + 0.5) * (1.0 / 16777216.0) - 0.5;
-    return u * 3.4641016151377544;
+    return u * SQRT_12;
 }
 
 // A uniform on (0, 1) from the top 24 bits of a word (never 0 or 1).
@@ -56,8 +52,8 @@ fn open_unit(word: u32) -> f32 {
 // gaussian` on the CPU (same words; f32 and WGSL's ln/sin/cos, so the same
 // distribution but not the same bits).
 fn gaussian3(seed: vec2<u32>, step: vec2<u32>, id: u32) -> vec3<f32> {
-    let a = philox4x32_10(vec4<u32>(id, 0u, step.x, step.y), seed);
-    let b = philox4x32_10(vec4<u32>(id, 1u, step.x, step.y), seed);
+    let a = philox4x32_10(vec4<u32>(id, STREAM_NOISE, step.x, step.y), seed);
+    let b = philox4x32_10(vec4<u32>(id, STREAM_NOISE_GAUSSIAN, step.x, step.y), seed);
     let r = sqrt(-2.0 * log(open_unit(a.x)));
     let angle = 6.283185307179586 * open_unit(a.z);
     let r2 = sqrt(-2.0 * log(open_unit(b.x)));

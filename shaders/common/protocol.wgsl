@@ -80,7 +80,7 @@ var<workgroup> drive_load: array<vec3<f32>, 256>;
 @compute @workgroup_size(256)
 fn protocol_drive_check(@builtin(local_invocation_index) local: u32) {
     for (var d = 0u; d < P.n_drives; d++) {
-        let base = P.off_drives + 16u * d;
+        let base = P.off_drives + DRIVE_WORDS * d;
         let term = protocol[base];
         let kind = topo[P.off_term_kind + term];
         let p = term_params(term);
@@ -111,7 +111,7 @@ fn protocol_drive_advance() {
         return;
     }
     for (var d = 0u; d < P.n_drives; d++) {
-        let base = P.off_drives + 16u * d;
+        let base = P.off_drives + DRIVE_WORDS * d;
         if protocol[base + 3u] == 0u {
             let a = protocol[base + 4u] + 1u;
             protocol[base + 4u] = a;

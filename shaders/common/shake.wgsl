@@ -27,18 +27,7 @@
 @group(1) @binding(3) var<storage, read> shake_topo: array<u32>;
 @group(1) @binding(4) var<storage, read_write> shake_out: array<f32>;
 
-// Header words of `shake_topo` (src/gpu/shake.rs writes them).
-const SH_COUNT: u32 = 0u;          // constraints
-const SH_COLORS: u32 = 1u;         // colours
-const SH_OFF_COLOR_START: u32 = 2u; // per colour (colours + 1): first record
-const SH_OFF_RECORDS: u32 = 3u;    // records (i, j, r0 bits, index in the deck's list), by colour
-const SH_MAX_SWEEPS: u32 = 4u;     // sweep cap
-const SH_TOLERANCE: u32 = 5u;      // largest |r − r0|/r0 accepted (f32 bits)
-const SH_OFF_PARTICLES: u32 = 6u;  // the constrained particles
-const SH_PARTICLES: u32 = 7u;      // … their number
-
-// A projection did not converge (status word ST_HALTED).
-const HALT_CONSTRAINT: u32 = 128u;
+// The header words of `shake_topo` (SH_*, src/gpu/shake.rs writes them) are the prelude's (src/gpu/prelude.rs).
 
 var<workgroup> shake_flag: u32;
 var<workgroup> shake_limits: vec2<u32>;

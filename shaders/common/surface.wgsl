@@ -9,10 +9,8 @@
 
 var<workgroup> partial: array<vec2<f32>, 256>;
 
-// Words of a face record and of an edge record in `topo`.
-const FACE_WORDS: u32 = 8u;
-const EDGE_WORDS: u32 = 8u;
-const NO_NODE: u32 = 0xffffffffu;
+// FACE_WORDS and EDGE_WORDS (the words of a face record and of an edge record
+// in `topo`) and NO_NODE are the prelude's (src/gpu/prelude.rs).
 
 // Word k of face f: corners 0–2 (particles), 3 its body, 4–6 the corners' body nodes.
 fn face_word(f: u32, k: u32) -> u32 {

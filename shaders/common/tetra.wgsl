@@ -7,10 +7,9 @@
 // type to `NAME_tetra` (shaders/interactions/NAME.wgsl); it is generated
 // from the registry when the shader is composed.
 
-// Words of an element record in `topo`: corners 0–3 (particles), 4 its term.
-const TETRA_WORDS: u32 = 5u;
-// Floats of an element's rest shape in `fparams`: D_m⁻¹ by columns, then V_0.
-const TETRA_REST_FLOATS: u32 = 10u;
+// TETRA_WORDS (the words of an element record in `topo`: corners 0–3
+// (particles), 4 its term) and TETRA_REST_FLOATS (an element's rest shape in
+// `fparams`: D_m⁻¹ by columns, then V_0) are the prelude's (src/gpu/prelude.rs).
 
 // A strain-energy density W at F and its first Piola stress P = ∂W/∂F.
 struct TetraDensity {

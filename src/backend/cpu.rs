@@ -6,11 +6,11 @@
 //!
 //! - **Pairs**: a half neighbour list (each pair once, rows sorted by
 //!   index), the pair rules resolved per type pair
-//!   ([`PairTable`](super::pair_table)), each pair's force added to both
+//!   (`PairTable`, `pair_table.rs`), each pair's force added to both
 //!   particles by Newton's third law in the ordered scatter/gather of
-//!   [`newton`](super::newton) (first pass, and the start of the second).
+//!   `newton` (first pass, and the start of the second).
 //! - **Bonds, angles and volume elements**: each once, in the row of its lowest-index
-//!   particle, in the same scatter as the pairs (see [`bonded`](super::bonded)).
+//!   particle, in the same scatter as the pairs (see `bonded`).
 //! - The second pass gathers, per particle, the spills of the scatter, then
 //!   the slots of surface and contact terms.
 //! - **Externals**: per member particle, on the unwrapped position.
@@ -108,7 +108,7 @@ impl CpuBackend {
         pair_interactions.dedup();
         let pair_rule_column = model.pair_rules.iter().map(|r| pair_interactions.binary_search(&registry_index(r)).unwrap()).collect();
         let mut backend = Self {
-            neighbors: NeighborList::half(model.max_pair_cutoff(), skin),
+            neighbors: NeighborList::half(model.max_pair_cutoff(), skin).with_periodic_images(),
             exclusions: pair_exclusions(model, state.bonds.as_ref().map(|b| b.bound.as_slice())),
             special: SpecialPairs::new(model, state.bonds.as_ref().map(|b| b.bound.as_slice())),
             bonded: Bonded::new(model),

@@ -101,8 +101,24 @@ impl PairTable {
     #[inline(always)]
     pub(super) fn for_each_term(&self, i: usize, g: &PairGeometry, mut visit: impl FnMut(usize, DVec3, f64, Radial, u32)) {
         let PairGeometry { x, types, list, images } = g;
-        let xi = x[i];
         let row = types[i] as usize * self.n_types;
+        if list.image_shifts().is_some() {
+            // A box with short periodic edges: every image of every partner (i's own as j = i).
+            list.for_each_separation(i, x, images, |j, d| {
+                let pair = row + types[j as usize] as usize;
+                let r2 = d.length_squared();
+                if r2 < self.skip2[pair] {
+                    let r = r2.sqrt();
+                    for k in self.kernels_of(pair) {
+                        if r < k.cutoff {
+                            visit(k.column as usize, d, r, (k.eval)(self.params_of(k), r), j);
+                        }
+                    }
+                }
+            });
+            return;
+        }
+        let xi = x[i];
         for &j in list.neighbors(i) {
             let pair = row + types[j as usize] as usize;
             let d = images.minimum_image(x[j as usize] - xi);
@@ -140,6 +156,29 @@ impl PairTable {
         let PairGeometry { x, types, list, images } = g;
         let xi = x[i];
         let row = types[i] as usize * self.n_types;
+        if list.image_shifts().is_some() {
+            // A box with short periodic edges: every image of every partner,
+            // one at a time. A particle's own images add energy and virial;
+            // their forces cancel in ± pairs, so none is applied.
+            list.for_each_separation(i, x, images, |j, d| {
+                let pair = row + types[j as usize] as usize;
+                let r2 = d.length_squared();
+                if r2 >= self.skip2[pair] {
+                    return;
+                }
+                let over_r = self.pair_force::<ENERGY>(pair, r2, energy);
+                if over_r != 0.0 {
+                    let f = d * over_r;
+                    if ENERGY {
+                        add6(virial, outer(-d, f));
+                    }
+                    if j as usize != i {
+                        visit(j as usize, f);
+                    }
+                }
+            });
+            return;
+        }
         for batch in list.neighbors(i).chunks(BATCH) {
             // One particle type (the common case): one reach, no type look-up.
             let kept = match self.skip2[..] {
@@ -148,16 +187,7 @@ impl PairTable {
             };
             for &k in near.kept(kept) {
                 let (j, (d, r2)) = (batch[k as usize] as usize, near.separation(k as usize));
-                let mut over_r = 0.0;
-                for kernel in self.kernels_of(row + types[j] as usize) {
-                    over_r += (kernel.force)(self.params_of(kernel), r2);
-                    if ENERGY {
-                        let r = r2.sqrt();
-                        if r < kernel.cutoff {
-                            energy[kernel.column as usize] += (kernel.eval)(self.params_of(kernel), r).energy;
-                        }
-                    }
-                }
+                let over_r = self.pair_force::<ENERGY>(row + types[j] as usize, r2, energy);
                 if over_r != 0.0 {
                     let f = d * over_r;
                     if ENERGY {
@@ -168,6 +198,24 @@ impl PairTable {
                 }
             }
         }
+    }
+
+    /// (dE/dr)/r of type pair `pair` at r², summed over its kernels in
+    /// force-field order; with `ENERGY`, each kernel's energy within its
+    /// cutoff added to its column of `energy`.
+    #[inline(always)]
+    fn pair_force<const ENERGY: bool>(&self, pair: usize, r2: f64, energy: &mut [f64]) -> f64 {
+        let mut over_r = 0.0;
+        for kernel in self.kernels_of(pair) {
+            over_r += (kernel.force)(self.params_of(kernel), r2);
+            if ENERGY {
+                let r = r2.sqrt();
+                if r < kernel.cutoff {
+                    energy[kernel.column as usize] += (kernel.eval)(self.params_of(kernel), r).energy;
+                }
+            }
+        }
+        over_r
     }
 
     #[inline(always)]

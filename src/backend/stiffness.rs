@@ -19,7 +19,7 @@
 //! - **Surface terms of bodies** ([`crate::hessian::SurfaceHessian`], each
 //!   term's `hessian` in its interaction file): local stencils projected like
 //!   the angles, and Gauss–Newton rank-one terms w·g gᵀ kept as vectors
-//!   ([`RankOneTerm`]; the implicit step applies them matrix-free):
+//!   ([`RankOneTerm`](super::RankOneTerm); the implicit step applies them matrix-free):
 //!   - `surface_tension`: γ·∇²A_t per face (analytic, exact before
 //!     projection); `area_conservation`: per face
 //!     (k_l/a0)·∇A_t∇A_tᵀ + τ_t·∇²A_t with τ_t = dE/dA_t, and the global
@@ -106,7 +106,14 @@ impl CpuBackend {
     /// K̃ without the bonds and angles marked in `owned_bonds` and
     /// `owned_angles` (those whose stiffness a fibre's banded block carries,
     /// `integrate::fibre`; an empty slice owns none).
-    pub fn stiffness_except(&self, model: &Model, state: &State, sim_box: &SimBox, owned_bonds: &[bool], owned_angles: &[bool]) -> Stiffness {
+    pub fn stiffness_except(
+        &self,
+        model: &Model,
+        state: &State,
+        sim_box: &SimBox,
+        owned_bonds: &[bool],
+        owned_angles: &[bool],
+    ) -> Stiffness {
         let x = &state.positions;
         let images: Images = sim_box.images();
         let mut blocks = Vec::new();
@@ -138,8 +145,12 @@ impl CpuBackend {
         }
         if let Some(list) = self.neighbor_list() {
             for i in 0..model.len() {
-                for &j in list.neighbors(i) {
-                    let d = images.minimum_image(x[j as usize] - x[i]);
+                // Every image of each partner (a small periodic box has several); a
+                // particle's own images are at a fixed distance: no stiffness.
+                list.for_each_separation(i, x, &images, |j, d| {
+                    if j as usize == i {
+                        return;
+                    }
                     let r = d.length();
                     for &rule in model.pair_rules_between(model.types[i], model.types[j as usize]) {
                         let term = &model.pair_rules[rule as usize];
@@ -148,7 +159,7 @@ impl CpuBackend {
                             push_pair(&mut blocks, i as u32, j, radial_block(&eval(&term.params, r), d, r));
                         }
                     }
-                }
+                });
             }
         }
         self.special_pairs().for_each(model, x, &images, |i, j, d, r, radial, _| push_pair(&mut blocks, i, j, radial_block(&radial, d, r)));

@@ -8,7 +8,7 @@ use glam::{DMat3, DVec3};
 
 use crate::hessian::block;
 
-/// A Gauss–Newton term w·g gᵀ of K̃ (w ≥ 0): g[k] on particle `particles[k]`.
+/// A Gauss–Newton term w·g gᵀ of K̃ (w ≥ 0): `g[k]` on particle `particles[k]`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RankOneTerm {
     pub weight: f64,

@@ -29,7 +29,7 @@ pub struct AsterArgs {
     /// Angle type of centre–first–second bead (radial clamp); none if not given.
     #[arg(long)]
     pub anchor_angle_type: Option<String>,
-    /// Also write a fixed (non-periodic) cubic [ box ] of this half-width around the centre.
+    /// Also write a fixed (non-periodic) cubic `[ box ]` of this half-width around the centre.
     #[arg(allow_negative_numbers = true, long = "box", value_name = "HALF_WIDTH")]
     pub box_half_width: Option<f64>,
     #[command(flatten)]

@@ -115,7 +115,7 @@ pub fn ball(args: &BallArgs) -> Result<Built, String> {
     let radius = positive("--radius", args.radius)?;
     let centre = vec3("--centre", &args.centre)?;
     let n = args.cells as usize;
-    if n < 2 || n % 2 != 0 || n > 256 {
+    if n < 2 || !n.is_multiple_of(2) || n > 256 {
         return Err(format!("expected --cells an even number in [2, 256], found {n}"));
     }
     let spacing = args.spacing.map(|h| positive("--spacing", h)).transpose()?;

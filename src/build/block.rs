@@ -96,9 +96,9 @@ pub fn block(args: &BlockArgs) -> Result<Built, String> {
     let mut count = 0;
     for i in low..side {
         for j in low..side {
-            for k in 0..=n {
+            for (k, depth) in down.iter().enumerate().take(n + 1) {
                 let v = index(i, j, k);
-                x[v] = centre + DVec3::new(offset(i), offset(j), -down[k]);
+                x[v] = centre + DVec3::new(offset(i), offset(j), -depth);
                 let held: String = [(i, 'x'), (j, 'y')].iter().filter(|&&(c, _)| args.quarter && c == n).map(|&(_, a)| a).collect();
                 let type_name = match (k == n, held.is_empty()) {
                     (true, _) => format!("{t}_base"),

@@ -37,7 +37,7 @@ pub struct BranchedArgs {
     /// Half-width of the cube holding the mothers' centres [default: the mother length].
     #[arg(allow_negative_numbers = true, long)]
     pub extent: Option<f64>,
-    /// Also write a fixed (non-periodic) cubic [ box ] of this half-width around the centre.
+    /// Also write a fixed (non-periodic) cubic `[ box ]` of this half-width around the centre.
     #[arg(allow_negative_numbers = true, long = "box", value_name = "HALF_WIDTH")]
     pub box_half_width: Option<f64>,
     #[command(flatten)]

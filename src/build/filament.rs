@@ -18,7 +18,7 @@ pub struct FilamentArgs {
     /// Draw the direction uniformly on the sphere from --seed.
     #[arg(long)]
     pub random_direction: bool,
-    /// Also write a fixed (non-periodic) cubic [ box ] of this half-width around the filament's midpoint.
+    /// Also write a fixed (non-periodic) cubic `[ box ]` of this half-width around the filament's midpoint.
     #[arg(allow_negative_numbers = true, long = "box", value_name = "HALF_WIDTH")]
     pub box_half_width: Option<f64>,
     #[command(flatten)]

@@ -32,7 +32,7 @@ pub struct FilopodiumArgs {
     /// Crosslinker bond types and the fraction of crosslinks each takes, `NAME:FRACTION,…`.
     #[arg(long, default_value = "fascin")]
     pub crosslinker_types: CrosslinkerTypes,
-    /// Also write a fixed (non-periodic) cubic [ box ] of this half-width around the bundle's midpoint.
+    /// Also write a fixed (non-periodic) cubic `[ box ]` of this half-width around the bundle's midpoint.
     #[arg(allow_negative_numbers = true, long = "box", value_name = "HALF_WIDTH")]
     pub box_half_width: Option<f64>,
     #[command(flatten)]

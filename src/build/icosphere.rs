@@ -144,7 +144,7 @@ pub struct IcosphereArgs {
     /// Id of the first node; the others follow.
     #[arg(long, default_value_t = 1)]
     pub first_id: u64,
-    /// Also write a fixed (non-periodic) cubic [ box ] of this half-width around the centre.
+    /// Also write a fixed (non-periodic) cubic `[ box ]` of this half-width around the centre.
     #[arg(allow_negative_numbers = true, long = "box", value_name = "HALF_WIDTH")]
     pub box_half_width: Option<f64>,
     /// Write each bond's length as built as its own rest length r0 (`type i j r0`), so the shell starts force-free.

@@ -137,7 +137,7 @@ pub struct SheetArgs {
     /// Bond type between neighbouring cells (cell–cell junctions).
     #[arg(long, default_value = "junction")]
     pub junction_bond_type: String,
-    /// Also write a fixed (non-periodic) cubic [ box ] of this half-width around the centre.
+    /// Also write a fixed (non-periodic) cubic `[ box ]` of this half-width around the centre.
     #[arg(allow_negative_numbers = true, long = "box", value_name = "HALF_WIDTH")]
     pub box_half_width: Option<f64>,
     #[command(flatten)]

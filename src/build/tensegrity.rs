@@ -163,7 +163,7 @@ pub struct TensegrityArgs {
     // `--substrate flat|R` and its options: a rigid substrate under the cell.
     #[command(flatten)]
     pub substrate: SubstrateOptions,
-    /// Also write a fixed (non-periodic) cubic [ box ] of this half-width around the centre.
+    /// Also write a fixed (non-periodic) cubic `[ box ]` of this half-width around the centre.
     #[arg(allow_negative_numbers = true, long = "box", value_name = "HALF_WIDTH")]
     pub box_half_width: Option<f64>,
     #[command(flatten)]

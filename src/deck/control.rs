@@ -25,6 +25,18 @@
 //! `undump`, `external`, `unexternal`, `variable`), so every later command is
 //! valid whichever branch ran. A `break` inside such an `if` ends the
 //! innermost loop during the run; elsewhere it ends the unrolling.
+//!
+//! # Limits
+//!
+//! Unrolling is bounded for the whole deck, so `check` always ends quickly
+//! and in bounded memory, whatever the deck: blocks nest at most
+//! [`MAX_NESTING`] deep; all loops together run at most [`MAX_ITERATIONS`]
+//! iterations (nested loops multiply: every iteration of an inner loop
+//! counts, each time); at most [`MAX_STATEMENTS`] commands are validated
+//! (after unrolling, both branches of every `if` included); and those
+//! commands after `${…}` substitution, with the member lists of the groups
+//! they define, hold at most [`MAX_UNROLLED_BYTES`]. Each limit fails with
+//! `file:line:col` at the command that crossed it.
 
 use super::expression::{Condition, DeckExpr};
 use super::plan::Action;
@@ -32,8 +44,14 @@ use super::validate::Validator;
 use crate::expr::Ref;
 use crate::input::{InputError, Statement, Token};
 
-/// The most iterations one `loop` may unroll to.
-const MAX_ITERATIONS: i64 = 100_000;
+/// The most `loop`/`if` blocks nested inside each other.
+pub const MAX_NESTING: usize = 100;
+/// The most loop iterations a deck may unroll to, all loops together.
+pub const MAX_ITERATIONS: u64 = 100_000;
+/// The most commands a deck may validate, loops unrolled.
+pub const MAX_STATEMENTS: u64 = 1_000_000;
+/// The most bytes the unrolled commands and their groups' members may hold: 256 MiB.
+pub const MAX_UNROLLED_BYTES: u64 = 256 << 20;
 
 /// Commands refused inside an `if` decided during the run.
 const DECLARING: [&str; 6] = ["group", "dump", "undump", "external", "unexternal", "variable"];
@@ -56,30 +74,43 @@ pub(super) enum Flow {
 /// Nests the statements of a deck into blocks.
 pub(super) fn blocks(statements: Vec<Statement>) -> Result<Vec<Node>, InputError> {
     let mut iter = statements.into_iter();
-    let (nodes, end) = block(&mut iter, None)?;
+    let (nodes, end) = block(&mut iter, None, 0)?;
     match end {
         None => Ok(nodes),
         Some(s) => Err(s.keyword().error(format!("found `{}` without an opening `loop` or `if`", s.keyword().text))),
     }
 }
 
-/// Reads nodes up to a closing word (`endloop`, `else`, `endif`), which is returned.
-fn block(iter: &mut impl Iterator<Item = Statement>, opened_by: Option<&Token>) -> Result<(Vec<Node>, Option<Statement>), InputError> {
+/// Reads nodes up to a closing word (`endloop`, `else`, `endif`), which is
+/// returned; `depth` blocks enclose them.
+fn block(
+    iter: &mut impl Iterator<Item = Statement>,
+    opened_by: Option<&Token>,
+    depth: usize,
+) -> Result<(Vec<Node>, Option<Statement>), InputError> {
     let mut nodes = Vec::new();
     while let Some(s) = iter.next() {
-        match s.keyword().text.as_str() {
+        let kw = s.keyword();
+        if matches!(kw.text.as_str(), "loop" | "if") && depth == MAX_NESTING {
+            return Err(kw.error(format!(
+                "found `{}` at nesting depth {}, expected at most {MAX_NESTING} `loop`/`if` blocks nested in each other",
+                kw.text,
+                depth + 1
+            )));
+        }
+        match kw.text.as_str() {
             "endloop" | "else" | "endif" => return Ok((nodes, Some(s))),
             "loop" => {
-                let (body, end) = block(iter, Some(s.keyword()))?;
+                let (body, end) = block(iter, Some(s.keyword()), depth + 1)?;
                 closed_by(&s, end.as_ref(), "endloop")?;
                 nodes.push(Node::Loop { head: s, body });
             }
             "if" => {
-                let (then, end) = block(iter, Some(s.keyword()))?;
+                let (then, end) = block(iter, Some(s.keyword()), depth + 1)?;
                 let end = end.expect("an unclosed block is an error");
                 let otherwise = if end.keyword().text == "else" {
                     only_word(&end)?;
-                    let (otherwise, end) = block(iter, Some(s.keyword()))?;
+                    let (otherwise, end) = block(iter, Some(s.keyword()), depth + 1)?;
                     closed_by(&s, end.as_ref(), "endif")?;
                     otherwise
                 } else {
@@ -148,6 +179,13 @@ impl Validator {
 
     fn statement(&mut self, statement: &Statement) -> Result<Flow, InputError> {
         let kw = statement.keyword();
+        self.control.budget.statements += 1;
+        if self.control.budget.statements > MAX_STATEMENTS {
+            return Err(kw.error(format!(
+                "found more than {MAX_STATEMENTS} commands to validate (loops unrolled, both branches of every `if`), expected at most \
+                 {MAX_STATEMENTS} in all"
+            )));
+        }
         if self.control.runtime_branch && DECLARING.contains(&kw.text.as_str()) {
             return Err(kw.error(format!(
                 "found `{}` inside an `if` decided during the run (its condition reads thermo); expected commands that declare or \
@@ -174,6 +212,7 @@ impl Validator {
             return Ok(Flow::Next);
         }
         let tokens = self.vars.substitute_all(&statement.tokens)?;
+        self.spend_bytes(kw, tokens.iter().map(|t| t.text.len() as u64 + 1).sum())?;
         self.command(&tokens)?;
         self.last = Some(kw.clone());
         Ok(Flow::Next)
@@ -194,7 +233,7 @@ impl Validator {
         if last < first {
             return Err(s[3].error(format!("found the empty range {first} … {last}, expected LAST >= FIRST")));
         }
-        if last - first + 1 > MAX_ITERATIONS {
+        if (last - first) as u64 >= MAX_ITERATIONS {
             return Err(s[3].error(format!("found {} iterations, expected at most {MAX_ITERATIONS}", last - first + 1)));
         }
         let outer_breaks = std::mem::take(&mut self.control.breaks);
@@ -202,6 +241,13 @@ impl Validator {
         self.control.loop_depth += 1;
         let previous = self.vars.set_loop(name, first.to_string());
         for i in first..=last {
+            self.control.budget.iterations += 1;
+            if self.control.budget.iterations > MAX_ITERATIONS {
+                return Err(s[3].error(format!(
+                    "found more than {MAX_ITERATIONS} loop iterations in this deck (every iteration of every loop counts, so nested loops \
+                     multiply), expected at most {MAX_ITERATIONS} in all"
+                )));
+            }
             self.vars.set_loop(name, i.to_string());
             let flow = self.block(body).map_err(|mut e| {
                 e.message.push_str(&format!(" (in the iteration {name} = {i} of the loop at line {})", head.keyword().line));
@@ -243,7 +289,9 @@ impl Validator {
         if !condition.reads_thermo() {
             let taken = condition.eval(&self.vars)? != 0.0;
             let (run, skipped) = if taken { (then, otherwise) } else { (otherwise, then) };
-            self.shadow().block(skipped)?;
+            let mut shadow = self.shadow();
+            shadow.block(skipped)?;
+            self.control.budget = shadow.control.budget;
             return self.block(run);
         }
         self.model(kw)?;
@@ -254,6 +302,9 @@ impl Validator {
             shadow.control.runtime_branch = true;
             shadow.control.runtime_in_loop = self.control.loop_depth > 0;
             shadow.block(nodes)?;
+            self.control.budget = shadow.control.budget;
+            // Either arm may run: the files it writes are taken.
+            self.take_output_names(&shadow);
             *arm = (shadow.actions, shadow.control.breaks);
         }
         let [(then_actions, then_breaks), (else_actions, else_breaks)] = arms;
@@ -292,9 +343,34 @@ impl Validator {
     }
 }
 
+/// What the deck has spent of its limits so far (see the module docs).
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Budget {
+    pub iterations: u64,
+    pub statements: u64,
+    pub bytes: u64,
+}
+
+impl Validator {
+    /// Charges `bytes` held by the plan or the validator (substituted
+    /// commands, group members) to the deck's budget.
+    pub(super) fn spend_bytes(&mut self, at: &Token, bytes: u64) -> Result<(), InputError> {
+        self.control.budget.bytes += bytes;
+        if self.control.budget.bytes > MAX_UNROLLED_BYTES {
+            return Err(at.error(format!(
+                "found more than {MAX_UNROLLED_BYTES} bytes in the unrolled deck's commands and the members of its groups, expected at \
+                 most 256 MiB in all"
+            )));
+        }
+        Ok(())
+    }
+}
+
 /// Control-flow state of the validator.
 #[derive(Clone, Debug, Default)]
 pub(super) struct ControlState {
+    /// Limits spent so far (carried back from the copies that validate branches).
+    pub budget: Budget,
     /// Loops around the command being validated.
     pub loop_depth: usize,
     /// Inside an `if` decided during the run (of any enclosing loop).

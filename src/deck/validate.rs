@@ -20,6 +20,8 @@ use crate::units::UnitSystem;
 mod commands;
 mod compose;
 mod edits;
+mod foreign;
+mod output_names;
 mod outputs;
 mod protocols;
 mod settings;
@@ -48,6 +50,8 @@ pub(super) struct Validator {
     sim_box: Option<SimBox>,
     groups: HashMap<String, Group>,
     dumps: HashMap<String, PathBuf>,
+    /// Every output file named so far, by kind (one file, one writer).
+    output_names: output_names::OutputNames,
     externals: HashSet<String>,
     states_written: HashSet<PathBuf>,
     timestep_set: bool,
@@ -155,6 +159,18 @@ impl Validator {
         Ok(path)
     }
 
+    /// [`Self::output_file`], claimed for a writer of `kind` (see `output_names`).
+    fn output_of(&mut self, token: &Token, kind: output_names::OutputKind) -> Result<PathBuf, InputError> {
+        let path = self.output_file(token)?;
+        self.output_names.claim(token, &path, kind)?;
+        Ok(path)
+    }
+
+    /// The output names `other` (a copy that validated a branch) claimed.
+    pub(super) fn take_output_names(&mut self, other: &Validator) {
+        self.output_names = other.output_names.clone();
+    }
+
     /// The group a token names (`all` or one a `group` command defined before).
     fn group_named(&self, token: &Token) -> Result<&Group, InputError> {
         self.groups.get(&token.text).ok_or_else(|| {
@@ -222,6 +238,7 @@ pub fn validate_with(
 
 /// Validates a deck with a fresh `v`, which then holds the deck's context.
 pub(super) fn validate_in(v: &mut Validator, file: &std::sync::Arc<SourceFile>) -> Result<Plan, InputError> {
+    v.output_names.reserve_for_deck(&file.path);
     let last = v.statements(file)?;
     let Some(last) = last else {
         return Err(InputError::in_file(&file.path, "the deck is empty; expected at least `topology`, `forcefield`, `timestep` and `run`"));
@@ -262,6 +279,7 @@ impl Validator {
             sim_box: None,
             groups: HashMap::new(),
             dumps: HashMap::new(),
+            output_names: Default::default(),
             externals: HashSet::new(),
             states_written: HashSet::new(),
             timestep_set: false,

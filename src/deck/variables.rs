@@ -3,7 +3,7 @@
 //! line (`--var NAME=VALUE`) take precedence over the deck's definitions.
 //!
 //! Memory is bounded: a value, and the substituted words of one statement
-//! together, hold at most [`MAX_VARIABLE_BYTES`], and all values together at
+//! together, hold at most `MAX_VARIABLE_BYTES`, and all values together at
 //! most [`MAX_VARIABLES_BYTES`] (28 string variables that each doubled the
 //! last took 3.1 GB before these caps).
 //!
@@ -104,7 +104,7 @@ impl Variables {
     }
 
     /// Substitutes every token of a statement; the substituted ones may hold
-    /// [`MAX_VARIABLE_BYTES`] together.
+    /// `MAX_VARIABLE_BYTES` together.
     pub fn substitute_all(&self, tokens: &[Token]) -> Result<Vec<Token>, InputError> {
         let mut grown = 0;
         tokens

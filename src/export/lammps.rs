@@ -41,18 +41,17 @@
 //! choice is mutual, one new bond per particle and rule per step), except
 //! that LAMMPS never bonds a pair already bonded by another bond type.
 
-use std::collections::BTreeMap;
-use std::fmt::Write;
-
 use super::bond_types::LammpsBondTypes;
+use super::data_file::{bonded_extent, data_file};
 use super::formula;
-use super::styles::{self, ExternalStyle, PairStyled, Styled};
+use super::hybrid::{Hybrid, Pairs};
+use super::kinetic_fixes::{bond_break_length, extra_per_atom, kinetic_fixes, KineticFixes};
+use super::styles::{self, ExternalStyle};
 use crate::deck::{Action, CoeffTarget, Plan};
 use crate::expr::{Expr, UnaryOp};
 use crate::forcefield::{TermType, Typed};
 use crate::integrate::Integrator;
 use crate::interactions::lammps::num;
-use crate::kinetics::{deterministic_strain, Effect};
 use crate::rng::Noise;
 use crate::system::{External, Model};
 use crate::units::UnitSystem;
@@ -86,101 +85,6 @@ fn ident(prefix: &str, name: &str) -> String {
     format!("{prefix}{clean}")
 }
 
-/// Sub-styles in order of first use, and the sub-style of each type.
-struct Hybrid {
-    styles: Vec<&'static str>,
-    /// The cellmd interactions each sub-style stands for (energy keys).
-    interactions: Vec<Vec<&'static str>>,
-    per_type: Vec<Styled>,
-}
-
-impl Hybrid {
-    fn new(types: &[TermType], map: fn(&TermType) -> Result<Styled, String>) -> Result<Self, String> {
-        let mut h = Hybrid { styles: Vec::new(), interactions: Vec::new(), per_type: Vec::new() };
-        for t in types {
-            let s = map(t)?;
-            let k = h.styles.iter().position(|&x| x == s.style).unwrap_or_else(|| {
-                h.styles.push(s.style);
-                h.interactions.push(Vec::new());
-                h.styles.len() - 1
-            });
-            if !h.interactions[k].contains(&t.interaction.name()) {
-                h.interactions[k].push(t.interaction.name());
-            }
-            h.per_type.push(s);
-        }
-        Ok(h)
-    }
-}
-
-/// One `pair_style hybrid/overlay` instance: a style serving one cellmd interaction.
-struct PairInstance {
-    interaction: &'static str,
-    style: &'static str,
-    shift: bool,
-    /// `lj/cut 2` when the style appears more than once, else `lj/cut`.
-    reference: String,
-}
-
-struct Pairs {
-    instances: Vec<PairInstance>,
-    /// For each pair rule: its instance and converted coefficients.
-    per_rule: Vec<(usize, PairStyled)>,
-    max_cutoff: f64,
-}
-
-impl Pairs {
-    fn new(model: &Model) -> Result<Self, String> {
-        let mut instances: Vec<PairInstance> = Vec::new();
-        let mut per_rule = Vec::new();
-        // The n-th rule of an interaction on one type pair uses that interaction's n-th instance.
-        let mut seen: BTreeMap<(u32, u32, &'static str), usize> = BTreeMap::new();
-        for (rule, term) in model.pair_rules.iter().enumerate() {
-            let styled = styles::pair(term)?;
-            let (a, b) = model.pair_rule_types[rule];
-            let nth = seen.entry((a.min(b), a.max(b), term.interaction.name())).or_default();
-            let mut found = None;
-            let mut count = 0;
-            for (k, inst) in instances.iter().enumerate() {
-                if inst.interaction == term.interaction.name() {
-                    if count == *nth {
-                        found = Some(k);
-                    }
-                    count += 1;
-                }
-            }
-            let k = found.unwrap_or_else(|| {
-                instances.push(PairInstance {
-                    interaction: term.interaction.name(),
-                    style: styled.style,
-                    shift: styled.shift,
-                    reference: String::new(),
-                });
-                instances.len() - 1
-            });
-            *nth += 1;
-            per_rule.push((k, styled));
-        }
-        let names: Vec<&str> = instances.iter().map(|i| i.style).collect();
-        let mut index: BTreeMap<&str, usize> = BTreeMap::new();
-        for inst in &mut instances {
-            let n = index.entry(inst.style).or_default();
-            *n += 1;
-            inst.reference =
-                if names.iter().filter(|&&s| s == inst.style).count() > 1 { format!("{} {n}", inst.style) } else { inst.style.to_string() };
-        }
-        let max_cutoff = per_rule.iter().map(|(_, s)| s.cutoff).fold(0.0, f64::max);
-        Ok(Pairs { instances, per_rule, max_cutoff })
-    }
-
-    fn coeff_line(&self, model: &Model, rule: usize, term: &TermType) -> Result<String, String> {
-        let (a, b) = model.pair_rule_types[rule];
-        let (k, _) = &self.per_rule[rule];
-        let styled = styles::pair(term)?;
-        Ok(format!("pair_coeff {} {} {} {}", a.min(b) + 1, a.max(b) + 1, self.instances[*k].reference, styled.coeffs))
-    }
-}
-
 /// Ids as LAMMPS `group ... id` arguments, consecutive runs as `a:b`.
 fn id_ranges(ids: &mut [u64]) -> String {
     ids.sort_unstable();
@@ -195,164 +99,6 @@ fn id_ranges(ids: &mut [u64]) -> String {
         k += 1;
     }
     out.join(" ")
-}
-
-/// Writes the data file.
-fn data_file(plan: &Plan, bond_types: &LammpsBondTypes, title: &str) -> String {
-    let m = &plan.model;
-    let b = &plan.sim_box;
-    let mut s = format!("{title}\n\n{} atoms\n{} bonds\n{} angles\n", m.len(), m.bonds.len(), m.angles.len());
-    let _ = writeln!(
-        s,
-        "{} atom types\n{} bond types\n{} angle types\n",
-        m.type_names.len(),
-        bond_types.count().max(1),
-        m.angle_types.len().max(1)
-    );
-    for (a, (lo, hi)) in ["x", "y", "z"].iter().zip(b.lo.to_array().iter().zip(b.hi.to_array())) {
-        let _ = writeln!(s, "{} {} {a}lo {a}hi", num(*lo), num(hi));
-    }
-    s += "\nMasses\n\n";
-    for (t, name) in m.type_names.iter().enumerate() {
-        let _ = writeln!(s, "{} 1.0  # {name}", t + 1);
-    }
-    s += "\nAtoms # angle\n\n";
-    for (i, x) in plan.positions.iter().enumerate() {
-        let (mut x, mut image) = (*x, [0; 3]);
-        b.wrap(&mut x, &mut image);
-        let _ =
-            writeln!(s, "{} 1 {} {} {} {} {} {} {}", m.ids[i], m.types[i] + 1, num(x.x), num(x.y), num(x.z), image[0], image[1], image[2]);
-    }
-    if !m.bonds.is_empty() {
-        s += "\nBonds\n\n";
-        for (k, &[i, j]) in m.bonds.iter().enumerate() {
-            let _ = writeln!(s, "{} {} {} {}", k + 1, bond_types.of_bond(k) + 1, m.ids[i as usize], m.ids[j as usize]);
-        }
-    }
-    if !m.angles.is_empty() {
-        s += "\nAngles\n\n";
-        for (k, (&[i, j, l], t)) in m.angles.iter().zip(&m.angle_type).enumerate() {
-            let _ = writeln!(s, "{} {} {} {} {}", k + 1, t + 1, m.ids[i as usize], m.ids[j as usize], m.ids[l as usize]);
-        }
-    }
-    s
-}
-
-/// Largest distance between particles of one bond or angle (minimum image), so
-/// LAMMPS' ghost cutoff reaches every bonded partner.
-fn bonded_extent(plan: &Plan) -> f64 {
-    let x = &plan.positions;
-    let d = |i: u32, j: u32| plan.sim_box.minimum_image(x[j as usize] - x[i as usize]).length();
-    let bonds = plan.model.bonds.iter().map(|&[i, j]| d(i, j));
-    let angles = plan.model.angles.iter().map(|&[i, j, k]| d(i, j) + d(j, k));
-    bonds.chain(angles).fold(0.0, f64::max)
-}
-
-/// The LAMMPS fixes that stand for a deck's bond kinetics.
-#[derive(Clone, Debug, Default)]
-struct KineticFixes {
-    /// LAMMPS bond types (from 0) broken by `fix bond/break`.
-    breaks: Vec<usize>,
-    /// Bind rules done by `fix bond/create`.
-    creates: Vec<usize>,
-}
-
-impl KineticFixes {
-    /// The largest capture radius of the exported bind rules (0: none).
-    fn capture(&self, model: &Model) -> f64 {
-        self.creates.iter().map(|&k| model.bind_rules[k].capture).fold(0.0, f64::max)
-    }
-}
-
-/// The `fix bond/break` length Rmax = r0·(1 + S) of LAMMPS bond type `l`
-/// (at its own r0), whose cellmd type's only rule is a deterministic strain
-/// threshold; any other kinetics is refused.
-fn bond_break_length(model: &Model, bond_types: &LammpsBondTypes, l: usize) -> Result<f64, String> {
-    let t = bond_types.cellmd_type(l);
-    let kinetics = &model.bond_kinetics[t];
-    let label = &model.bond_types[t].label.text;
-    let names: Vec<&str> = kinetics.rules.iter().map(|r| r.rule.name()).collect();
-    match kinetics.rules.as_slice() {
-        [r] if matches!(r.rule.effect(), Effect::Threshold(_)) => {
-            let strain = deterministic_strain(&r.params).ok_or_else(|| {
-                format!("bond type `{label}`: only a `threshold` with a `strain` alone (no `force`, `spread` or `rate`) maps to LAMMPS `fix bond/break`; export the deck without it")
-            })?;
-            let r0 = kinetics.rest_index.map(|k| bond_types.term(model, l).params[k]).ok_or_else(|| {
-                format!("bond type `{label}`: its law `{}` has no `r0`, so its strain threshold has no LAMMPS length", model.bond_types[t].interaction.name())
-            })?;
-            Ok(r0 * (1.0 + strain))
-        }
-        _ => Err(format!(
-            "bond type `{label}` has kinetic rules ({}): LAMMPS has no force-dependent bond kinetics; it expresses only a strain `threshold` (fix bond/break) and certain `bind ... partner nearest` (fix bond/create); export the deck without them",
-            names.join(", ")
-        )),
-    }
-}
-
-/// The fixes for a deck's kinetics, or why LAMMPS cannot express them.
-fn kinetic_fixes(plan: &Plan, bond_types: &LammpsBondTypes) -> Result<KineticFixes, String> {
-    let m = &plan.model;
-    let mut fixes = KineticFixes::default();
-    for l in 0..bond_types.count() {
-        if !m.bond_kinetics[bond_types.cellmd_type(l)].rules.is_empty() {
-            bond_break_length(m, bond_types, l)?;
-            fixes.breaks.push(l);
-        }
-    }
-    let steps: Vec<f64> = plan.actions.iter().filter_map(|a| if let Action::Timestep(dt) = a { Some(*dt) } else { None }).collect();
-    for (k, r) in m.bind_rules.iter().enumerate() {
-        let bond = &m.bond_types[r.bond_type as usize].label.text;
-        let name = format!("`bind {} {} {bond}`", m.type_names[r.type_a as usize], m.type_names[r.type_b as usize]);
-        if !r.nearest {
-            return Err(format!(
-                "{name} has `partner random`: LAMMPS `fix bond/create` binds mutual-nearest partners only (`partner nearest`)"
-            ));
-        }
-        if r.between_bodies {
-            return Err(format!(
-                "{name} has `between bodies`: LAMMPS `fix bond/create` cannot restrict binding to particles of different bodies"
-            ));
-        }
-        if let Some(dt) = steps.iter().find(|&&dt| -(-r.k_on * dt).exp_m1() < 1.0) {
-            return Err(format!(
-                "{name}: binding is not certain within a step (k_on·dt = {:e}); LAMMPS `fix bond/create` binds every eligible pair at once: export it with k_on·dt ≥ 40",
-                r.k_on * dt
-            ));
-        }
-        if !m.bond_kinetics[r.bond_type as usize].rules.is_empty() {
-            return Err(format!(
-                "{name}: bond type `{bond}` also has kinetic rules; LAMMPS `fix bond/create` does not count bonds that other fixes break"
-            ));
-        }
-        if m.bind_rules.iter().filter(|o| o.bond_type == r.bond_type).count() > 1 {
-            return Err(format!(
-                "{name}: several `bind` lines form `{bond}`; each LAMMPS `fix bond/create` counts only the bonds it made itself"
-            ));
-        }
-        let sb = m.special_bonds;
-        if sb.weights[1] == 0.0 || sb.weights[2] == 0.0 {
-            return Err(format!(
-                "{name}: `special_bonds` excludes 1-3 or 1-4 neighbours, which LAMMPS leaves out of `fix bond/create`'s neighbour list while cellmd binds them"
-            ));
-        }
-        fixes.creates.push(k);
-    }
-    Ok(fixes)
-}
-
-/// `read_data` room for the bonds `fix bond/create` adds: per atom, the
-/// new bonds, and the special list of 1-2, 1-3 and 1-4 neighbours they can
-/// make (m + m(m − 1) + m(m − 1)² for m bonds per atom).
-fn extra_per_atom(model: &Model, fixes: &KineticFixes) -> (usize, usize) {
-    let new: usize = fixes.creates.iter().map(|&k| model.bind_rules[k].max_bonds as usize).sum();
-    let mut count = vec![0usize; model.len()];
-    for &[i, j] in &model.bonds {
-        count[i as usize] += 1;
-        count[j as usize] += 1;
-    }
-    let m = count.iter().copied().max().unwrap_or(0) + new;
-    let fan = m.saturating_sub(1);
-    (new, m + m * fan + m * fan * fan)
 }
 
 /// State of the script being written.

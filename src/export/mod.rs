@@ -11,8 +11,11 @@
 //! back as a topology, force field and deck (`cellmd import-lammps`).
 
 pub mod bond_types;
+mod data_file;
 pub mod formula;
+mod hybrid;
 pub mod import_lammps;
+mod kinetic_fixes;
 pub mod lammps;
 pub mod styles;
 

@@ -50,15 +50,15 @@ pub(crate) fn binary(op: BinaryOp, lhs: Expr, rhs: Expr, span: Span) -> Expr {
         }
     }
     match (op, a, b) {
-        (Add, Some(z), _) if z == 0.0 => rhs,
-        (Add | Sub, _, Some(z)) if z == 0.0 => lhs,
-        (Sub, Some(z), _) if z == 0.0 => negate(rhs, span),
-        (Mul, Some(z), _) | (Mul, _, Some(z)) if z == 0.0 => number(0.0, span),
-        (Mul, Some(o), _) if o == 1.0 => rhs,
-        (Mul | Div, _, Some(o)) if o == 1.0 => lhs,
-        (Div, Some(z), _) if z == 0.0 => number(0.0, span),
-        (Pow, _, Some(o)) if o == 1.0 => lhs,
-        (Pow, _, Some(z)) if z == 0.0 => number(1.0, span),
+        (Add, Some(0.0), _) => rhs,
+        (Add | Sub, _, Some(0.0)) => lhs,
+        (Sub, Some(0.0), _) => negate(rhs, span),
+        (Mul, Some(0.0), _) | (Mul, _, Some(0.0)) => number(0.0, span),
+        (Mul, Some(1.0), _) => rhs,
+        (Mul | Div, _, Some(1.0)) => lhs,
+        (Div, Some(0.0), _) => number(0.0, span),
+        (Pow, _, Some(1.0)) => lhs,
+        (Pow, _, Some(0.0)) => number(1.0, span),
         _ => Expr::Binary { op, lhs: Box::new(lhs), rhs: Box::new(rhs), span },
     }
 }
@@ -82,7 +82,7 @@ impl Expr {
         self.refs().iter().any(|(r, _)| *r == super::Ref::Name(var))
     }
 
-    /// The tree of ∂self/∂var (see the [module docs](self)).
+    /// The tree of ∂self/∂var (see the module docs).
     pub fn derivative(&self, var: &str) -> Expr {
         let span = self.span();
         let zero = || number(0.0, span);

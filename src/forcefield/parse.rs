@@ -139,7 +139,11 @@ fn particle(s: &Statement) -> Result<ParticleType, InputError> {
     for pair in values.chunks(2) {
         let key = pair[0];
         if !FIELDS.contains(&key.text.as_str()) {
-            return Err(key.error(format!("found `{}`, expected one of {} or `fixed`", key.text, FIELDS.map(|f| format!("`{f}`")).join(", "))));
+            return Err(key.error(format!(
+                "found `{}`, expected one of {} or `fixed`",
+                key.text,
+                FIELDS.map(|f| format!("`{f}`")).join(", ")
+            )));
         }
         let Some(value) = pair.get(1) else {
             return Err(key.error(format!("`{}` has no value; expected `{} VALUE`", key.text, key.text)));
@@ -156,7 +160,9 @@ fn particle(s: &Statement) -> Result<ParticleType, InputError> {
     let fibre_keys = ["fibre", "points", "hydrodynamic_radius", "hydrodynamic_cutoff"];
     if let Some((_, extra)) = fibre_keys.iter().find_map(|f| fields.get(f)) {
         if !fields.contains_key("fibre") || !fields.contains_key("viscosity") {
-            return Err(extra.error(format!("`{}` belongs to a fibre's drag; expected `viscosity ETA fibre L points N` with it", extra.text)));
+            return Err(
+                extra.error(format!("`{}` belongs to a fibre's drag; expected `viscosity ETA fibre L points N` with it", extra.text))
+            );
         }
     }
     let drag = match (fixed, fields.get("drag"), fields.get("viscosity")) {
@@ -331,17 +337,27 @@ mod tests {
     /// 3π·5/(ln(5/0.025) + 0.312) = 47.1239/5.61033 = 8.39951 pN·s/µm in all, shared by the points.
     #[test]
     fn a_fibre_points_drag_is_cytosims_fibre_drag_shared_by_its_points() {
-        let ff = load(&[("main.ff", "particle a viscosity 1 fibre 5 points 51
+        let ff = load(&[(
+            "main.ff",
+            "particle a viscosity 1 fibre 5 points 51
 particle b viscosity 1 fibre 0.01 points 2 hydrodynamic_radius 0.0125
-")]).unwrap();
+",
+        )])
+        .unwrap();
         let total = 3.0 * std::f64::consts::PI * 5.0 / ((5.0f64 / 0.025).ln() + 0.312);
         assert!((total - 8.39951).abs() < 1e-5, "{total}");
         assert!((ff.particle_types[0].drag - total / 51.0).abs() < 1e-15);
         // Shorter than its diameter: the sphere's 6πηr.
         assert!((ff.particle_types[1].drag - 6.0 * std::f64::consts::PI * 0.0125 / 2.0).abs() < 1e-15);
         for (text, message) in [
-            ("particle a drag 1 fibre 5 points 51", "m.ff:1:19: `fibre` belongs to a fibre's drag; expected `viscosity ETA fibre L points N` with it"),
-            ("particle a viscosity 1 fibre 5", "m.ff:1:12: a fibre's drag is shared by its points; expected `points N` (the fibre's number of points)"),
+            (
+                "particle a drag 1 fibre 5 points 51",
+                "m.ff:1:19: `fibre` belongs to a fibre's drag; expected `viscosity ETA fibre L points N` with it",
+            ),
+            (
+                "particle a viscosity 1 fibre 5",
+                "m.ff:1:12: a fibre's drag is shared by its points; expected `points N` (the fibre's number of points)",
+            ),
             ("particle a viscosity 1 fibre 5 points 2.5", "m.ff:1:32: found points 2.5, expected a whole number ≥ 2"),
         ] {
             assert_eq!(load(&[("m.ff", text)]).unwrap_err(), message);

@@ -27,10 +27,11 @@ use super::contact::{reach_message, ContactPack, CONTACT_ONLY, FRACTION_SLOTS};
 use super::context::{storage_entry, GpuContext, WORKGROUP};
 use super::fire::DeviceFire;
 use super::implicit::ImplicitSolver;
-use super::implicit_split::HALT_BUDGET;
 use super::kinetics::{KinKernels, KinLayout};
 use super::nlist::NeighbourStorage;
 use super::pack::{cell_grid, pack, FixedPoint, Packed, Params};
+use super::prelude::implicit_split::HALT_BUDGET;
+use super::prelude::status::*;
 use super::protocol::{DeviceProtocol, PackedTerms, ProtocolPack, RAMP_ROWS};
 use super::shader;
 use super::shake::{DeviceShake, ShakeReport};
@@ -38,35 +39,9 @@ use crate::integrate::constraints::Constraints;
 use crate::integrate::context::StepContext;
 use crate::integrate::fire::FireSettings;
 use crate::integrate::implicit::{ImplicitSettings, SolveReport};
-use crate::neighbor::Exclusions;
+use crate::neighbor::{Exclusions, ImageShifts};
 use crate::system::{BondState, Model, SimBox, State};
 
-const STATUS_WORDS: usize = 11;
-const ST_HALTED: usize = 0;
-const ST_OVERFLOW_NEED: usize = 1;
-const ST_BUILDS: usize = 3;
-const ST_STEPS_DONE: usize = 4;
-const ST_BLOWUP_PARTICLE: usize = 5;
-const ST_FORCE_REBUILD: usize = 6;
-const ST_SPAN_BODY: usize = 7;
-const HALT_OVERFLOW: u32 = 1;
-const HALT_BLOWUP: u32 = 2;
-const HALT_SPAN: u32 = 4;
-const HALT_EVENTS: u32 = 16;
-/// This step's fraction of dt (f32 bits; the contact step clamp, src/gpu/contact.rs).
-const ST_FRACTION: usize = 8;
-/// The fractions of dt of this call's steps, summed (f32 bits; `sim_time` in integrate.wgsl).
-const ST_ELAPSED: usize = 9;
-/// A face edge outgrew the contact search (src/gpu/contact.rs).
-const HALT_REACH: u32 = 8;
-/// The implicit step's solve did not converge (src/gpu/implicit.rs).
-const HALT_SOLVE: u32 = 32;
-/// A step's `bind` formation was left to the host (src/gpu/bind.rs).
-const HALT_FORMATION: u32 = 64;
-/// A constraint projection did not converge (src/gpu/shake.rs).
-const HALT_CONSTRAINT: u32 = 128;
-/// FIRE converged: max |F| < ftol (src/gpu/fire.rs).
-const HALT_CONVERGED: u32 = 256;
 /// Steps per command buffer.
 const STEPS_PER_SUBMIT: u64 = 64;
 
@@ -128,25 +103,10 @@ pub struct StepSettings {
 }
 
 struct Kernels {
-    displacement: wgpu::ComputePipeline,
-    decide: wgpu::ComputePipeline,
-    clear: wgpu::ComputePipeline,
-    count: wgpu::ComputePipeline,
-    scan_blocks: wgpu::ComputePipeline,
-    scan_totals: wgpu::ComputePipeline,
-    scan_add: wgpu::ComputePipeline,
-    scatter: wgpu::ComputePipeline,
-    sort: wgpu::ComputePipeline,
-    build: wgpu::ComputePipeline,
-    after_step: wgpu::ComputePipeline,
-    /// The start of a step whose list was checked after the last `commit`: its overflow halt only.
-    list_ready: wgpu::ComputePipeline,
-    surface_faces: wgpu::ComputePipeline,
-    surface_bodies: wgpu::ComputePipeline,
-    surface_edges: wgpu::ComputePipeline,
-    surface_nodes: wgpu::ComputePipeline,
-    surface_edge_forces: wgpu::ComputePipeline,
-    surface_forces: wgpu::ComputePipeline,
+    /// The neighbour list's check and build (nlist.wgsl).
+    list: ListKernels,
+    /// The surface terms' passes (surface.wgsl).
+    surface: SurfaceKernels,
     forces: wgpu::ComputePipeline,
     integrate: wgpu::ComputePipeline,
     commit: wgpu::ComputePipeline,
@@ -164,6 +124,33 @@ struct Kernels {
     protocol_drive_advance: wgpu::ComputePipeline,
 }
 
+/// The neighbour list's kernels.
+struct ListKernels {
+    displacement: wgpu::ComputePipeline,
+    decide: wgpu::ComputePipeline,
+    clear: wgpu::ComputePipeline,
+    count: wgpu::ComputePipeline,
+    scan_blocks: wgpu::ComputePipeline,
+    scan_totals: wgpu::ComputePipeline,
+    scan_add: wgpu::ComputePipeline,
+    scatter: wgpu::ComputePipeline,
+    sort: wgpu::ComputePipeline,
+    build: wgpu::ComputePipeline,
+    after_step: wgpu::ComputePipeline,
+    /// The start of a step whose list was checked after the last `commit`: its overflow halt only.
+    list_ready: wgpu::ComputePipeline,
+}
+
+/// The surface terms' kernels: face, body, edge and node passes, then the gathers.
+struct SurfaceKernels {
+    faces: wgpu::ComputePipeline,
+    bodies: wgpu::ComputePipeline,
+    edges: wgpu::ComputePipeline,
+    nodes: wgpu::ComputePipeline,
+    edge_forces: wgpu::ComputePipeline,
+    forces: wgpu::ComputePipeline,
+}
+
 /// The GPU force engine and integrator for one model.
 pub struct GpuBackend {
     ctx: GpuContext,
@@ -171,6 +158,24 @@ pub struct GpuBackend {
     has_pairs: bool,
     sim_box: SimBox,
     fixed: FixedPoint,
+    buffers: MainBuffers,
+    bindings: Bindings,
+    kernels: Kernels,
+    /// The neighbour list and its bookkeeping.
+    list: ListState,
+    settings: StepSettings,
+    /// The user id of each packed body (for the span halt's message).
+    body_ids: Vec<u64>,
+    /// Read-backs so far (each waits for the GPU): tests count the synchronisations.
+    reads: std::cell::Cell<u64>,
+    /// Simulated time at the next step (see [`GpuBackend::set_time`]).
+    time: f64,
+    /// What the model asks of the device beyond pair, bond and surface forces.
+    features: Features,
+}
+
+/// The buffers of the main bind group (shaders/common/layout.wgsl), in binding order.
+struct MainBuffers {
     uniform: wgpu::Buffer,
     state: wgpu::Buffer,
     next: wgpu::Buffer,
@@ -179,42 +184,69 @@ pub struct GpuBackend {
     fparams: wgpu::Buffer,
     cell_count: wgpu::Buffer,
     cell_data: wgpu::Buffer,
-    nlist: NeighbourStorage,
-    /// The largest storage binding the neighbour list's chunks may take.
-    nlist_binding_limit: u64,
     force: wgpu::Buffer,
     status: wgpu::Buffer,
     /// Face, body and corner-slot values of the surface terms.
     surf: wgpu::Buffer,
-    /// The user id of each packed body (for the span halt's message).
-    body_ids: Vec<u64>,
-    args: wgpu::Buffer,
+    /// Bond kinetics on the device (src/gpu/kinetics.rs; binding 13).
+    kin: wgpu::Buffer,
+    /// The run's protocols (src/gpu/protocol.rs; binding 14).
+    protocol: wgpu::Buffer,
+}
+
+impl MainBuffers {
+    fn in_binding_order(&self) -> [&wgpu::Buffer; 13] {
+        let b = self;
+        [
+            &b.uniform,
+            &b.state,
+            &b.next,
+            &b.reference,
+            &b.topo,
+            &b.fparams,
+            &b.cell_count,
+            &b.cell_data,
+            &b.force,
+            &b.status,
+            &b.surf,
+            &b.kin,
+            &b.protocol,
+        ]
+    }
+}
+
+/// The main bind group, its layout, and the indirect dispatch arguments' group.
+struct Bindings {
     layout: wgpu::BindGroupLayout,
-    main_group: wgpu::BindGroup,
-    args_group: wgpu::BindGroup,
-    kernels: Kernels,
+    main: wgpu::BindGroup,
+    args: wgpu::BindGroup,
+    args_buffer: wgpu::Buffer,
+}
+
+/// The neighbour list's storage and what the host knows of its builds.
+struct ListState {
+    storage: NeighbourStorage,
+    /// The largest storage binding the neighbour list's chunks may take.
+    binding_limit: u64,
     builds: u64,
     grown: u32,
     /// The largest neighbour count of an overflow that did not halt the step (bind.wgsl).
     overflow_met: u32,
-    settings: StepSettings,
     /// The next `run` or `evaluate` rebuilds the neighbour list first.
     pending_rebuild: bool,
+}
+
+/// The device features a model may use, each owning its layout and kernels.
+struct Features {
     /// The contact bodies' faces and rules (src/gpu/contact.rs).
     contact: ContactPack,
     /// The fraction of dt each step of the last `run` took (with contact).
     fractions: Vec<f32>,
-    /// Bond kinetics on the device (src/gpu/kinetics.rs): its buffer (binding 13), layout and kernels.
-    kin: wgpu::Buffer,
-    kinetics: Option<(KinLayout, KinKernels)>,
-    /// Read-backs so far (each waits for the GPU): tests count the synchronisations.
-    reads: std::cell::Cell<u64>,
-    /// Simulated time at the next step (see [`GpuBackend::set_time`]).
-    time: f64,
     /// The area-weighted contact rules (src/gpu/adhesion.rs).
     adhesion: AdhesionPack,
-    /// The run's protocols (src/gpu/protocol.rs): their buffer (binding 14) and layout.
-    protocol_buffer: wgpu::Buffer,
+    /// Bond kinetics on the device (src/gpu/kinetics.rs): its layout and kernels.
+    kinetics: Option<(KinLayout, KinKernels)>,
+    /// The run's protocols (src/gpu/protocol.rs): their layout.
     protocol: Option<ProtocolPack>,
     /// The implicit step on the device (src/gpu/implicit.rs), in place of `integrate`.
     implicit: Option<ImplicitSolver>,
@@ -295,7 +327,7 @@ impl GpuBackend {
         constrained: &[[u32; 2]],
     ) -> Result<(), String> {
         let context = (settings.context.dt, settings.context.kt);
-        self.implicit = Some(ImplicitSolver::new(ctx, &self.layout, model, context, implicit, constrained)?);
+        self.features.implicit = Some(ImplicitSolver::new(ctx, &self.bindings.layout, model, context, implicit, constrained)?);
         self.implicit_list_check()
     }
 
@@ -303,9 +335,9 @@ impl GpuBackend {
     /// (src/gpu/shake.rs; the run must pass its `refusal`). Returns the
     /// tolerance the device projects to.
     pub fn constrain_bonds(&mut self, ctx: &GpuContext, model: &Model, constraints: &Constraints) -> Result<f64, String> {
-        let shake = DeviceShake::new(ctx, &self.layout, model, constraints)?;
+        let shake = DeviceShake::new(ctx, &self.bindings.layout, model, constraints)?;
         let tolerance = shake.tolerance;
-        self.shake = Some(shake);
+        self.features.shake = Some(shake);
         Ok(tolerance)
     }
 
@@ -313,9 +345,9 @@ impl GpuBackend {
     /// the last projection's report (one small read-back; None without
     /// constraints).
     pub fn constraint_state(&self) -> Option<(Vec<f64>, ShakeReport)> {
-        let shake = self.shake.as_ref()?;
+        let shake = self.features.shake.as_ref()?;
         let (mut tension, report) = shake.read(&self.read(&shake.buffer, 4 * (shake.count as u64 + 4)));
-        if let Some(solver) = self.implicit.as_ref().filter(|s| s.constraints > 0) {
+        if let Some(solver) = self.features.implicit.as_ref().filter(|s| s.constraints > 0) {
             // The implicit step's constraint forces, before SHAKE's (as the CPU sums them).
             let bytes = self.read_at(&solver.buffer, solver.constraints_at, 48 * solver.constraints as u64);
             tension.iter_mut().zip(solver.constraint_tensions(&bytes)).for_each(|(t, implicit)| *t += implicit);
@@ -328,26 +360,26 @@ impl GpuBackend {
     /// [`Self::run`] step is one iteration, and a run ends early when max |F|
     /// falls below `settings.ftol`. `dt`: the deck's timestep (Δt₀, masses γ·Δt₀).
     pub fn minimize_with_fire(&mut self, ctx: &GpuContext, model: &Model, settings: &FireSettings, dt: f64) -> Result<(), String> {
-        self.fire = Some(DeviceFire::new(ctx, &self.layout, model, settings, dt, WORKGROUP)?);
+        self.features.fire = Some(DeviceFire::new(ctx, &self.bindings.layout, model, settings, dt, WORKGROUP)?);
         Ok(())
     }
 
     /// FIRE iterations taken so far and the moves the contact step clamp
     /// shortened (one small read-back; None without FIRE).
     pub fn fire_counts(&self) -> Option<(u64, u64)> {
-        let fire = self.fire.as_ref()?;
+        let fire = self.features.fire.as_ref()?;
         Some(DeviceFire::counts(&self.read(&fire.buffer, DeviceFire::COUNT_BYTES)))
     }
 
     /// Whether the implicit step's CG is split over every workgroup (src/gpu/implicit_split.rs).
     pub fn implicit_is_split(&self) -> bool {
-        self.implicit.as_ref().is_some_and(ImplicitSolver::is_split)
+        self.features.implicit.as_ref().is_some_and(ImplicitSolver::is_split)
     }
 
     /// The last implicit step's iterations and relative residual (one small
     /// read-back; None without the implicit step).
     pub fn implicit_report(&self) -> Option<SolveReport> {
-        let solver = self.implicit.as_ref()?;
+        let solver = self.features.implicit.as_ref()?;
         Some(solver.report(&self.read_at(&solver.buffer, solver.report_at, 16)))
     }
 
@@ -364,6 +396,13 @@ impl GpuBackend {
             return Err(
                 "the GPU backend has no kernels for custom surface terms of bodies (`custom` body lines) yet; use `device cpu`".into()
             );
+        }
+        if model.max_pair_cutoff() > 0.0 && ImageShifts::new(sim_box, model.max_pair_cutoff() + settings.skin).is_some() {
+            return Err(format!(
+                "the GPU backend has no kernels yet for pairs through several periodic images (a periodic box edge shorter \
+                 than 2·(pair cutoff + skin) = {}); use `device cpu`",
+                2.0 * (model.max_pair_cutoff() + settings.skin)
+            ));
         }
         let n = model.len();
         if n == 0 {
@@ -545,24 +584,28 @@ impl GpuBackend {
             })
         };
         let kernels = Kernels {
-            displacement: pipeline("nb_displacement", &main_layout),
-            decide: pipeline("nb_decide", &decide_layout),
-            clear: pipeline("nb_clear", &main_layout),
-            count: pipeline("nb_count", &main_layout),
-            scan_blocks: pipeline("nb_scan_blocks", &main_layout),
-            scan_totals: pipeline("nb_scan_totals", &main_layout),
-            scan_add: pipeline("nb_scan_add", &main_layout),
-            scatter: pipeline("nb_scatter", &main_layout),
-            sort: pipeline("nb_sort", &main_layout),
-            build: pipeline("nb_build", &main_layout),
-            after_step: pipeline("nb_after_step", &main_layout),
-            list_ready: pipeline("nb_list_ready", &main_layout),
-            surface_faces: pipeline("surface_faces", &main_layout),
-            surface_bodies: pipeline("surface_bodies", &main_layout),
-            surface_edges: pipeline("surface_edges", &main_layout),
-            surface_nodes: pipeline("surface_nodes", &main_layout),
-            surface_edge_forces: pipeline("surface_edge_forces", &main_layout),
-            surface_forces: pipeline("surface_forces", &main_layout),
+            list: ListKernels {
+                displacement: pipeline("nb_displacement", &main_layout),
+                decide: pipeline("nb_decide", &decide_layout),
+                clear: pipeline("nb_clear", &main_layout),
+                count: pipeline("nb_count", &main_layout),
+                scan_blocks: pipeline("nb_scan_blocks", &main_layout),
+                scan_totals: pipeline("nb_scan_totals", &main_layout),
+                scan_add: pipeline("nb_scan_add", &main_layout),
+                scatter: pipeline("nb_scatter", &main_layout),
+                sort: pipeline("nb_sort", &main_layout),
+                build: pipeline("nb_build", &main_layout),
+                after_step: pipeline("nb_after_step", &main_layout),
+                list_ready: pipeline("nb_list_ready", &main_layout),
+            },
+            surface: SurfaceKernels {
+                faces: pipeline("surface_faces", &main_layout),
+                bodies: pipeline("surface_bodies", &main_layout),
+                edges: pipeline("surface_edges", &main_layout),
+                nodes: pipeline("surface_nodes", &main_layout),
+                edge_forces: pipeline("surface_edge_forces", &main_layout),
+                forces: pipeline("surface_forces", &main_layout),
+            },
             forces: pipeline("forces", &main_layout),
             integrate: pipeline("integrate", &main_layout),
             commit: pipeline("commit", &main_layout),
@@ -583,47 +626,50 @@ impl GpuBackend {
             &nlist,
         );
         let mut backend = Self {
+            ctx: ctx.clone(),
             params,
             has_pairs,
             sim_box: *sim_box,
             fixed,
-            uniform,
-            state: state_buffer,
-            next,
-            reference,
-            topo,
-            fparams,
-            cell_count,
-            cell_data,
-            nlist,
-            nlist_binding_limit,
-            force,
-            status,
-            surf,
-            body_ids: packed.body_ids,
-            args,
-            layout,
-            main_group,
-            args_group,
+            buffers: MainBuffers {
+                uniform,
+                state: state_buffer,
+                next,
+                reference,
+                topo,
+                fparams,
+                cell_count,
+                cell_data,
+                force,
+                status,
+                surf,
+                kin,
+                protocol,
+            },
+            bindings: Bindings { layout, main: main_group, args: args_group, args_buffer: args },
             kernels,
-            builds: 0,
-            grown: 0,
-            overflow_met: 0,
+            list: ListState {
+                storage: nlist,
+                binding_limit: nlist_binding_limit,
+                builds: 0,
+                grown: 0,
+                overflow_met: 0,
+                pending_rebuild: true,
+            },
             settings: *settings,
-            pending_rebuild: true,
-            ctx: ctx.clone(),
-            contact,
-            fractions: Vec::new(),
-            kin,
-            kinetics,
+            body_ids: packed.body_ids,
             reads: Default::default(),
             time: settings.context.time,
-            adhesion,
-            protocol_buffer: protocol,
-            protocol: protocol_pack,
-            implicit: None,
-            shake: None,
-            fire: None,
+            features: Features {
+                contact,
+                fractions: Vec::new(),
+                adhesion,
+                kinetics,
+                protocol: protocol_pack,
+                implicit: None,
+                shake: None,
+                fire: None,
+            },
         };
         backend.set_clock(settings.context.time);
         backend.upload(state);
@@ -631,23 +677,7 @@ impl GpuBackend {
     }
 
     fn bind_main(&self) -> wgpu::BindGroup {
-        let s = self;
-        let buffers = [
-            &s.uniform,
-            &s.state,
-            &s.next,
-            &s.reference,
-            &s.topo,
-            &s.fparams,
-            &s.cell_count,
-            &s.cell_data,
-            &s.force,
-            &s.status,
-            &s.surf,
-            &s.kin,
-            &s.protocol_buffer,
-        ];
-        bind_main(&self.ctx.device, &self.layout, buffers, &s.nlist)
+        bind_main(&self.ctx.device, &self.bindings.layout, self.buffers.in_binding_order(), &self.list.storage)
     }
 
     /// The adapter this backend runs on.
@@ -657,12 +687,12 @@ impl GpuBackend {
 
     /// Neighbour-list builds so far.
     pub fn neighbor_builds(&self) -> u64 {
-        self.builds
+        self.list.builds
     }
 
     /// How many times the neighbour list had to grow (overflow and retry).
     pub fn neighbor_list_growths(&self) -> u32 {
-        self.grown
+        self.list.grown
     }
 
     /// Caps the workgroups per dispatch along x (the adapter's limit, at most
@@ -679,17 +709,17 @@ impl GpuBackend {
 
     /// Chunks the neighbour list is bound in (1 unless it exceeds one binding).
     pub fn neighbor_chunks(&self) -> u32 {
-        self.nlist.chunks
+        self.list.storage.chunks
     }
 
     /// Caps the bytes of one neighbour-list binding (the adapter's limit by
     /// default) and lays the list out again; lowering it exercises the
     /// chunked list on small systems. An error when 64 particles' rows do not fit.
     pub fn limit_neighbor_binding(&mut self, bytes: u64) -> Result<(), String> {
-        self.nlist_binding_limit = bytes.min(self.nlist_binding_limit);
-        self.nlist = NeighbourStorage::new(&self.ctx, self.params.n, self.params.nlist_cap, self.nlist_binding_limit)?;
-        self.main_group = self.bind_main();
-        self.pending_rebuild = true;
+        self.list.binding_limit = bytes.min(self.list.binding_limit);
+        self.list.storage = NeighbourStorage::new(&self.ctx, self.params.n, self.params.nlist_cap, self.list.binding_limit)?;
+        self.bindings.main = self.bind_main();
+        self.list.pending_rebuild = true;
         Ok(())
     }
 
@@ -704,8 +734,8 @@ impl GpuBackend {
                 data[2 * n + i][a] = image[a] as u32;
             }
         }
-        self.ctx.queue.write_buffer(&self.state, 0, words(&data));
-        self.pending_rebuild = true;
+        self.ctx.queue.write_buffer(&self.buffers.state, 0, words(&data));
+        self.list.pending_rebuild = true;
     }
 
     /// Uploads the bond state of `state` (after bond kinetics changed it) as
@@ -714,24 +744,25 @@ impl GpuBackend {
     /// rebuild before the next step (when bonds broke or bound, so that the
     /// pair exclusions changed).
     pub fn update_bonds(&mut self, model: &Model, state: &State, rebuild: bool) -> Result<(), String> {
-        if self.kinetics.is_some() {
+        if self.features.kinetics.is_some() {
             return Err("the bond state of device kinetics lives on the device".into());
         }
-        let (packed, _, contact_fields, adhesion_fields) = pack_state(model, state, &self.settings, false, &self.contact, &self.adhesion)?;
+        let (packed, _, contact_fields, adhesion_fields) =
+            pack_state(model, state, &self.settings, false, &self.features.contact, &self.features.adhesion)?;
         let (topo, fparams) = (pad16(packed.topo), pad16(packed.fparams));
         let fits = |buffer: &wgpu::Buffer, bytes: usize| bytes as u64 <= buffer.size();
-        if fits(&self.topo, 4 * topo.len()) && fits(&self.fparams, 4 * fparams.len()) {
-            self.ctx.queue.write_buffer(&self.topo, 0, words(&topo));
-            self.ctx.queue.write_buffer(&self.fparams, 0, words(&fparams));
+        if fits(&self.buffers.topo, 4 * topo.len()) && fits(&self.buffers.fparams, 4 * fparams.len()) {
+            self.ctx.queue.write_buffer(&self.buffers.topo, 0, words(&topo));
+            self.ctx.queue.write_buffer(&self.buffers.fparams, 0, words(&fparams));
         } else {
             check_binding(&self.ctx, "the topology", 4 * topo.len() as u64)?;
             let uploads = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
             let init = |label: &str, contents: &[u8]| {
                 self.ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage: uploads })
             };
-            self.topo = init("topo", words(&topo));
-            self.fparams = init("fparams", words(&fparams));
-            self.main_group = self.bind_main();
+            self.buffers.topo = init("topo", words(&topo));
+            self.buffers.fparams = init("fparams", words(&fparams));
+            self.bindings.main = self.bind_main();
         }
         self.params.topo_offsets = packed.topo_offsets;
         self.params.fparam_offsets = packed.fparam_offsets;
@@ -740,31 +771,31 @@ impl GpuBackend {
         self.params.tetra_offsets = packed.tetra_offsets;
         self.params.special_offsets = packed.special_offsets;
         self.params.adhesion = adhesion_fields;
-        if let Some(pack) = &mut self.protocol {
+        if let Some(pack) = &mut self.features.protocol {
             // Bonds with their own terms were renumbered: the ramped slots follow.
             let slots =
                 pack.slots(model, &packed_terms(&packed.fparam_offsets, &packed.own_bonds, packed.first_own_term), state.bonds.as_ref());
-            self.ctx.queue.write_buffer(&self.protocol_buffer, 4 * pack.fields[4] as u64, words(&slots));
+            self.ctx.queue.write_buffer(&self.buffers.protocol, 4 * pack.fields[4] as u64, words(&slots));
             self.params.protocol = pack.fields;
         }
-        self.pending_rebuild |= rebuild;
+        self.list.pending_rebuild |= rebuild;
         Ok(())
     }
 
     fn reset_status(&self, force_rebuild: bool) {
         let mut status = [0u32; STATUS_WORDS];
-        status[ST_BLOWUP_PARTICLE] = u32::MAX;
-        status[ST_SPAN_BODY] = u32::MAX;
+        status[ST_BLOWUP_PARTICLE] = NO_PARTICLE;
+        status[ST_SPAN_BODY] = NO_PARTICLE;
         status[ST_FORCE_REBUILD] = force_rebuild as u32;
         status[ST_FRACTION] = 1f32.to_bits();
         status[ST_ELAPSED] = 0f32.to_bits();
-        self.ctx.queue.write_buffer(&self.status, 0, words(&status));
+        self.ctx.queue.write_buffer(&self.buffers.status, 0, words(&status));
     }
 
     /// Positions (wrapped, f64) and images of the current GPU state.
     pub fn download(&self, state: &mut State) {
         let n = state.len();
-        let data: Vec<[u32; 4]> = bytemuck::cast_slice(&self.read(&self.state, 48 * n as u64)).to_vec();
+        let data: Vec<[u32; 4]> = bytemuck::cast_slice(&self.read(&self.buffers.state, 48 * n as u64)).to_vec();
         for i in 0..n {
             let mut x = DVec3::ZERO;
             for a in 0..3 {
@@ -782,7 +813,7 @@ impl GpuBackend {
     /// Forces (f32, widened) and per-particle energy shares from the last force pass.
     pub fn forces_and_energies(&self) -> Vec<(DVec3, f64)> {
         let n = self.params.n as u64;
-        let data: Vec<[f32; 4]> = bytemuck::cast_slice(&self.read(&self.force, 16 * n)).to_vec();
+        let data: Vec<[f32; 4]> = bytemuck::cast_slice(&self.read(&self.buffers.force, 16 * n)).to_vec();
         data.iter().map(|f| (DVec3::new(f[0] as f64, f[1] as f64, f[2] as f64), f[3] as f64)).collect()
     }
 
@@ -790,7 +821,7 @@ impl GpuBackend {
     pub fn neighbor_lists(&self) -> Vec<Vec<u32>> {
         let n = self.params.n as usize;
         let cap = self.params.nlist_cap as usize;
-        let data: Vec<u32> = bytemuck::cast_slice(&self.read(&self.nlist.list, 4 * (n * (1 + cap)) as u64)).to_vec();
+        let data: Vec<u32> = bytemuck::cast_slice(&self.read(&self.list.storage.list, 4 * (n * (1 + cap)) as u64)).to_vec();
         (0..n)
             .map(|i| {
                 let start = i * (1 + cap);
@@ -809,17 +840,17 @@ impl GpuBackend {
 
     /// Whether the bond kinetics are decided on the device, and its buffer's layout.
     pub(super) fn device_kinetics(&self) -> Option<&KinLayout> {
-        self.kinetics.as_ref().map(|(layout, _)| layout)
+        self.features.kinetics.as_ref().map(|(layout, _)| layout)
     }
 
     /// `count` words of the device kinetics' buffer from word `at`.
     pub(super) fn read_kin(&self, at: u64, count: u64) -> Vec<u32> {
-        bytemuck::cast_slice(&self.read_at(&self.kin, 4 * at, 4 * count)).to_vec()
+        bytemuck::cast_slice(&self.read_at(&self.buffers.kin, 4 * at, 4 * count)).to_vec()
     }
 
     /// Writes `data` into the device kinetics' buffer at word `at`.
     pub(super) fn write_kin(&self, at: u64, data: &[u32]) {
-        self.ctx.queue.write_buffer(&self.kin, 4 * at, words(data));
+        self.ctx.queue.write_buffer(&self.buffers.kin, 4 * at, words(data));
     }
 
     /// Read-backs from the GPU so far (each one a synchronisation).
@@ -858,7 +889,7 @@ impl GpuBackend {
     /// `first_step`: they must cover every step of the next [`Self::run`]
     /// (src/gpu/protocol.rs; nothing without ramps).
     pub fn set_ramps(&mut self, first_step: u64, rows: Vec<Vec<f64>>) {
-        if let Some(pack) = &mut self.protocol {
+        if let Some(pack) = &mut self.features.protocol {
             pack.set_values(first_step, rows);
         }
     }
@@ -867,7 +898,7 @@ impl GpuBackend {
     /// per driven indenter (in the protocol's order) its centres from the
     /// current one, one per step of the run and one, and whether it holds.
     pub fn set_drives(&mut self, drives: Vec<(Vec<DVec3>, bool)>) {
-        if let Some(pack) = &mut self.protocol {
+        if let Some(pack) = &mut self.features.protocol {
             pack.set_drives(drives);
         }
     }
@@ -875,7 +906,7 @@ impl GpuBackend {
     /// Per driven indenter: how many steps of the last [`Self::run`] moved
     /// it, and whether it holds now.
     pub fn drive_states(&self) -> Vec<(u64, bool)> {
-        self.protocol.as_ref().map_or_else(Vec::new, ProtocolPack::drive_states)
+        self.features.protocol.as_ref().map_or_else(Vec::new, ProtocolPack::drive_states)
     }
 
     /// Writes `time` into the parameters as an f32 high part and remainder.
@@ -886,7 +917,7 @@ impl GpuBackend {
     }
 
     fn write_params(&self) {
-        self.ctx.queue.write_buffer(&self.uniform, 0, words(&[self.params]));
+        self.ctx.queue.write_buffer(&self.buffers.uniform, 0, words(&[self.params]));
     }
 
     /// Times each phase alone, `repetitions` times in one submission (after a
@@ -894,21 +925,21 @@ impl GpuBackend {
     /// is left as it was (integration is timed on a copy of the positions).
     pub fn profile(&mut self, repetitions: u32) -> Result<PhaseTimes, String> {
         self.evaluate()?;
-        let saved = self.read(&self.state, 48 * self.params.n as u64);
+        let saved = self.read(&self.buffers.state, 48 * self.params.n as u64);
         let particles = Over::Particles;
         let cells = Over::Groups(self.params.grid[3].div_ceil(WORKGROUP));
         let k = &self.kernels;
         let mut build: Vec<(&wgpu::ComputePipeline, Over)> = Vec::new();
         if self.has_pairs {
             build = vec![
-                (&k.clear, cells),
-                (&k.count, particles),
-                (&k.scan_blocks, cells),
-                (&k.scan_totals, Over::Groups(1)),
-                (&k.scan_add, cells),
-                (&k.scatter, particles),
-                (&k.sort, cells),
-                (&k.build, Over::Chunks),
+                (&k.list.clear, cells),
+                (&k.list.count, particles),
+                (&k.list.scan_blocks, cells),
+                (&k.list.scan_totals, Over::Groups(1)),
+                (&k.list.scan_add, cells),
+                (&k.list.scatter, particles),
+                (&k.list.sort, cells),
+                (&k.list.build, Over::Chunks),
             ];
         }
         // `group`: the bind group 1 the kernels read (the neighbour decision's
@@ -919,7 +950,7 @@ impl GpuBackend {
                 let mut encoder = this.ctx.device.create_command_encoder(&Default::default());
                 {
                     let mut pass = encoder.begin_compute_pass(&Default::default());
-                    pass.set_bind_group(0, &this.main_group, &this.nlist.offsets(0));
+                    pass.set_bind_group(0, &this.bindings.main, &this.list.storage.offsets(0));
                     if let Some(group) = group {
                         pass.set_bind_group(1, group, &[]);
                     }
@@ -936,19 +967,20 @@ impl GpuBackend {
             run(1);
             run(repetitions) / repetitions as f64
         };
-        let args = Some(&self.args_group);
-        let check = if self.has_pairs { time(self, &[(&k.displacement, particles), (&k.decide, Over::Groups(1))], args) } else { 0.0 };
+        let args = Some(&self.bindings.args);
+        let check =
+            if self.has_pairs { time(self, &[(&k.list.displacement, particles), (&k.list.decide, Over::Groups(1))], args) } else { 0.0 };
         let neighbor_build = if self.has_pairs { time(self, &build, None) } else { 0.0 };
         let mut force_pass = self.surface_passes();
         force_pass.push((&k.forces, Over::Chunks));
         let forces = time(self, &force_pass, None);
         let contact = if self.has_contact() { time(self, &[(&k.contact_forces, Over::Chunks)], None) } else { 0.0 };
-        let adhesion = if self.adhesion.rules() > 0 {
+        let adhesion = if self.features.adhesion.rules() > 0 {
             time(self, &[(&k.adhesion_nodes, Over::Chunks), (&k.adhesion_weights, Over::Particles)], None)
         } else {
             0.0
         };
-        let integrate = match &self.implicit {
+        let integrate = match &self.features.implicit {
             // The implicit step in place of `integrate` (src/gpu/implicit.rs).
             Some(solver) => {
                 // In the step's order (`encode_step`).
@@ -957,14 +989,14 @@ impl GpuBackend {
             }
             None => time(self, &[(&k.integrate, particles), (&k.commit, particles), (&k.advance, Over::Groups(1))], None),
         };
-        let constraints = match &self.shake {
+        let constraints = match &self.features.shake {
             Some(shake) => {
                 let place = Over::Groups(shake.particles.div_ceil(WORKGROUP));
                 time(self, &[(&shake.solve, Over::Groups(1)), (&shake.place, place)], Some(&shake.group))
             }
             None => 0.0,
         };
-        let kinetics = match &self.kinetics {
+        let kinetics = match &self.features.kinetics {
             Some((layout, kin)) => {
                 let bonds = Over::Groups(layout.bonds().div_ceil(WORKGROUP));
                 let mut passes = vec![(&kin.measure, bonds), (&kin.decide, bonds), (&kin.scan, Over::Groups(1)), (&kin.emit, bonds)];
@@ -982,11 +1014,11 @@ impl GpuBackend {
         };
         let started = std::time::Instant::now();
         for _ in 0..repetitions {
-            self.read(&self.state, 48 * self.params.n as u64);
+            self.read(&self.buffers.state, 48 * self.params.n as u64);
         }
         let readback = started.elapsed().as_secs_f64() / repetitions as f64;
-        self.ctx.queue.write_buffer(&self.state, 0, &saved);
-        self.pending_rebuild = true;
+        self.ctx.queue.write_buffer(&self.buffers.state, 0, &saved);
+        self.list.pending_rebuild = true;
         Ok(PhaseTimes { check, neighbor_build, forces, integrate, readback, contact, adhesion, kinetics, constraints })
     }
 
@@ -1001,19 +1033,19 @@ impl GpuBackend {
         match over {
             Over::Groups(groups) => direct(pass, groups),
             Over::Particles => direct(pass, self.params.n.div_ceil(WORKGROUP)),
-            Over::Chunks => self.per_chunk(pass, |pass| direct(pass, self.nlist.per_chunk.div_ceil(WORKGROUP))),
+            Over::Chunks => self.per_chunk(pass, |pass| direct(pass, self.list.storage.per_chunk.div_ceil(WORKGROUP))),
         }
     }
 
     /// Runs `dispatch` once per neighbour-list chunk with that chunk bound,
     /// then binds chunk 0 again (what every other kernel sees).
     fn per_chunk(&self, pass: &mut wgpu::ComputePass, mut dispatch: impl FnMut(&mut wgpu::ComputePass)) {
-        for c in 0..self.nlist.chunks {
-            pass.set_bind_group(0, &self.main_group, &self.nlist.offsets(c));
+        for c in 0..self.list.storage.chunks {
+            pass.set_bind_group(0, &self.bindings.main, &self.list.storage.offsets(c));
             dispatch(pass);
         }
-        if self.nlist.chunks > 1 {
-            pass.set_bind_group(0, &self.main_group, &self.nlist.offsets(0));
+        if self.list.storage.chunks > 1 {
+            pass.set_bind_group(0, &self.bindings.main, &self.list.storage.offsets(0));
         }
     }
 
@@ -1023,8 +1055,8 @@ impl GpuBackend {
     /// device), which was this step's check; only its overflow halt remains.
     fn encode_step(&self, pass: &mut wgpu::ComputePass, integrate: bool, checked_after_last: bool) {
         let k = &self.kernels;
-        pass.set_bind_group(0, &self.main_group, &self.nlist.offsets(0));
-        let kinetics = self.kinetics.as_ref().map(|(layout, kernels)| (Over::Groups(layout.bonds().div_ceil(WORKGROUP)), kernels));
+        pass.set_bind_group(0, &self.bindings.main, &self.list.storage.offsets(0));
+        let kinetics = self.features.kinetics.as_ref().map(|(layout, kernels)| (Over::Groups(layout.bonds().div_ceil(WORKGROUP)), kernels));
         if integrate && self.params.protocol[1] > 0 {
             self.dispatch(pass, &k.protocol_ramps, Over::Groups(self.params.protocol[1].div_ceil(WORKGROUP)));
         }
@@ -1032,7 +1064,7 @@ impl GpuBackend {
             self.dispatch(pass, &kin.room, Over::Groups(1));
         }
         if self.has_pairs && checked_after_last {
-            self.dispatch(pass, &k.list_ready, Over::Groups(1));
+            self.dispatch(pass, &k.list.list_ready, Over::Groups(1));
         } else if self.has_pairs {
             self.encode_neighbors(pass);
         }
@@ -1042,7 +1074,7 @@ impl GpuBackend {
         self.dispatch(pass, &k.forces, Over::Chunks);
         if self.has_contact() {
             // Area-weighted contact's node and weight passes first (src/gpu/adhesion.rs).
-            if self.adhesion.rules() > 0 {
+            if self.features.adhesion.rules() > 0 {
                 self.dispatch(pass, &k.adhesion_nodes, Over::Chunks);
                 self.dispatch(pass, &k.adhesion_weights, Over::Particles);
             }
@@ -1056,7 +1088,7 @@ impl GpuBackend {
             if let Some((bonds, kin)) = kinetics {
                 self.dispatch(pass, &kin.measure, bonds);
             }
-            if let Some(fire) = &self.fire {
+            if let Some(fire) = &self.features.fire {
                 // A FIRE iteration (src/gpu/fire.rs) in place of the step: it
                 // moves `state` itself, so there is nothing to commit.
                 pass.set_bind_group(1, &fire.group, &[]);
@@ -1066,7 +1098,7 @@ impl GpuBackend {
                 if let Some(clamped) = &fire.clamped_moves {
                     self.dispatch(pass, clamped, Over::Particles);
                 }
-            } else if let Some(solver) = &self.implicit {
+            } else if let Some(solver) = &self.features.implicit {
                 // The implicit step (src/gpu/implicit.rs) in place of `integrate`.
                 pass.set_bind_group(1, &solver.group, &[]);
                 for (kernel, groups) in solver.step_passes() {
@@ -1075,13 +1107,13 @@ impl GpuBackend {
             } else {
                 self.dispatch(pass, &k.integrate, Over::Particles);
             }
-            if let Some(shake) = &self.shake {
+            if let Some(shake) = &self.features.shake {
                 // The constraints' projection (src/gpu/shake.rs) on the new positions.
                 pass.set_bind_group(1, &shake.group, &[]);
                 self.dispatch(pass, &shake.solve, Over::Groups(1));
                 self.dispatch(pass, &shake.place, Over::Groups(shake.particles.div_ceil(WORKGROUP)));
             }
-            if self.fire.is_none() {
+            if self.features.fire.is_none() {
                 self.dispatch(pass, &k.commit, Over::Particles);
             }
             let binds = self.bind_kernels();
@@ -1090,9 +1122,9 @@ impl GpuBackend {
                 // list is checked (and rebuilt if due) now, for the capture
                 // search and the next step's forces, so no pair within the
                 // capture radius can be missing from it.
-                self.dispatch(pass, &k.after_step, Over::Groups(1));
+                self.dispatch(pass, &k.list.after_step, Over::Groups(1));
                 self.encode_neighbors(pass);
-                self.dispatch(pass, &k.after_step, Over::Groups(1));
+                self.dispatch(pass, &k.list.after_step, Over::Groups(1));
             }
             if drives {
                 self.dispatch(pass, &k.protocol_drive_advance, Over::Groups(1));
@@ -1117,32 +1149,32 @@ impl GpuBackend {
 
     /// The kinetics kernels when `bind` forms bonds on the device (src/gpu/bind.rs).
     fn bind_kernels(&self) -> Option<&KinKernels> {
-        self.kinetics.as_ref().filter(|(layout, _)| layout.binds()).map(|(_, kernels)| kernels)
+        self.features.kinetics.as_ref().filter(|(layout, _)| layout.binds()).map(|(_, kernels)| kernels)
     }
 
     /// The neighbour-list check and, when due, its rebuild (indirect dispatches).
     fn encode_neighbors(&self, pass: &mut wgpu::ComputePass) {
         let k = &self.kernels;
-        self.dispatch(pass, &k.displacement, Over::Particles);
-        pass.set_pipeline(&k.decide);
-        pass.set_bind_group(1, &self.args_group, &[]);
+        self.dispatch(pass, &k.list.displacement, Over::Particles);
+        pass.set_pipeline(&k.list.decide);
+        pass.set_bind_group(1, &self.bindings.args, &[]);
         pass.dispatch_workgroups(1, 1, 1);
         let indirect = |pass: &mut wgpu::ComputePass, pipeline: &wgpu::ComputePipeline, slot: u64| {
             pass.set_pipeline(pipeline);
-            pass.dispatch_workgroups_indirect(&self.args, 12 * slot);
+            pass.dispatch_workgroups_indirect(&self.bindings.args_buffer, 12 * slot);
         };
-        indirect(pass, &k.clear, 1);
-        indirect(pass, &k.count, 0);
-        indirect(pass, &k.scan_blocks, 1);
-        indirect(pass, &k.scan_totals, 2);
-        indirect(pass, &k.scan_add, 1);
-        indirect(pass, &k.scatter, 0);
-        indirect(pass, &k.sort, 1);
-        self.per_chunk(pass, |pass| indirect(pass, &k.build, 3));
+        indirect(pass, &k.list.clear, 1);
+        indirect(pass, &k.list.count, 0);
+        indirect(pass, &k.list.scan_blocks, 1);
+        indirect(pass, &k.list.scan_totals, 2);
+        indirect(pass, &k.list.scan_add, 1);
+        indirect(pass, &k.list.scatter, 0);
+        indirect(pass, &k.list.sort, 1);
+        self.per_chunk(pass, |pass| indirect(pass, &k.list.build, 3));
     }
 
     fn status(&self) -> [u32; STATUS_WORDS] {
-        bytemuck::cast_slice(&self.read(&self.status, 4 * STATUS_WORDS as u64)).try_into().expect("status words")
+        bytemuck::cast_slice(&self.read(&self.buffers.status, 4 * STATUS_WORDS as u64)).try_into().expect("status words")
     }
 
     /// The surface kernels in order (none without surface terms; the
@@ -1154,11 +1186,11 @@ impl GpuBackend {
         let over = |count: u32| Over::Groups(count.div_ceil(WORKGROUP));
         let mut passes = Vec::new();
         if faces > 0 {
-            passes.extend([(&k.surface_faces, over(faces)), (&k.surface_bodies, Over::Groups(bodies))]);
+            passes.extend([(&k.surface.faces, over(faces)), (&k.surface.bodies, Over::Groups(bodies))]);
             if edges > 0 {
-                passes.extend([(&k.surface_edges, over(edges)), (&k.surface_nodes, over(nodes)), (&k.surface_edge_forces, over(edges))]);
+                passes.extend([(&k.surface.edges, over(edges)), (&k.surface.nodes, over(nodes)), (&k.surface.edge_forces, over(edges))]);
             }
-            passes.push((&k.surface_forces, over(faces)));
+            passes.push((&k.surface.forces, over(faces)));
         }
         // Then the volume elements' pass (src/gpu/tetra.rs).
         if self.params.tetra_offsets[5] > 0 {
@@ -1171,20 +1203,20 @@ impl GpuBackend {
     /// face that outgrew the contact search ([`super::contact`]), if there was one.
     fn span_halt(&self, status: &[u32; STATUS_WORDS]) -> Option<String> {
         if status[ST_HALTED] & HALT_REACH != 0 {
-            return Some(reach_message(self.contact.edge_bound()));
+            return Some(reach_message(self.features.contact.edge_bound()));
         }
         (status[ST_HALTED] & HALT_SPAN != 0).then(|| super::surface::span_message(self.body_ids[status[ST_SPAN_BODY] as usize]))
     }
 
     /// Whether node–face contact runs ([`super::contact`]).
     fn has_contact(&self) -> bool {
-        self.contact.faces() > 0
+        self.features.contact.faces() > 0
     }
 
     /// The fraction of dt step `k` of the last [`Self::run`] took (below 1
     /// where the contact step clamp shortened it; 1 without contact).
     pub fn step_fraction(&self, k: u64) -> f64 {
-        self.fractions.get(k as usize).map_or(1.0, |&s| f64::from(s))
+        self.features.fractions.get(k as usize).map_or(1.0, |&s| f64::from(s))
     }
 
     /// The simulated time the first `steps` steps of the last [`Self::run`]
@@ -1211,11 +1243,11 @@ impl GpuBackend {
         }
         let need = need as u64;
         let cap = (need + need / 4 + 8).next_multiple_of(8) as u32;
-        self.nlist = NeighbourStorage::new(&self.ctx, self.params.n, cap, self.nlist_binding_limit)?;
+        self.list.storage = NeighbourStorage::new(&self.ctx, self.params.n, cap, self.list.binding_limit)?;
         self.params.nlist_cap = cap;
-        self.main_group = self.bind_main();
-        self.pending_rebuild = true;
-        self.grown += 1;
+        self.bindings.main = self.bind_main();
+        self.list.pending_rebuild = true;
+        self.list.grown += 1;
         self.implicit_list_check()
     }
 
@@ -1223,11 +1255,11 @@ impl GpuBackend {
     /// binding of the neighbour list (src/gpu/implicit.rs): a list bound in
     /// chunks is refused.
     fn implicit_list_check(&self) -> Result<(), String> {
-        if self.implicit.is_some() && self.has_pairs && self.nlist.chunks > 1 {
+        if self.features.implicit.is_some() && self.has_pairs && self.list.storage.chunks > 1 {
             return Err(format!(
                 "integrator implicit with pair terms: the neighbour list ({} particles × {} neighbours) needs {} bindings on {}; \
                  the device's implicit solve reads it from one (use `device cpu`)",
-                self.params.n, self.params.nlist_cap, self.nlist.chunks, self.ctx.info.name
+                self.params.n, self.params.nlist_cap, self.list.storage.chunks, self.ctx.info.name
             ));
         }
         Ok(())
@@ -1238,14 +1270,14 @@ impl GpuBackend {
     /// halts with [`GpuHalt::Formation`], src/gpu/bind.rs), so a backend
     /// built anew can [`Self::reserve_neighbors`] them.
     pub fn neighbors_met(&self) -> u32 {
-        self.params.nlist_cap.max(self.overflow_met)
+        self.params.nlist_cap.max(self.list.overflow_met)
     }
 
     /// Forces at the current state (neighbour list rebuilt first); an error
     /// if the neighbour list cannot grow to hold every neighbour.
     pub fn evaluate(&mut self) -> Result<(), String> {
         loop {
-            self.pending_rebuild = false;
+            self.list.pending_rebuild = false;
             self.reset_status(true);
             self.set_clock(self.time);
             self.write_params();
@@ -1256,7 +1288,7 @@ impl GpuBackend {
             }
             self.ctx.queue.submit([encoder.finish()]);
             let status = self.status();
-            self.builds += status[ST_BUILDS] as u64;
+            self.list.builds += status[ST_BUILDS] as u64;
             if let Some(message) = self.span_halt(&status) {
                 return Err(message);
             }
@@ -1270,23 +1302,23 @@ impl GpuBackend {
     /// Returns the number of steps done (all of them unless halted).
     pub fn run(&mut self, first_step: u64, steps: u64) -> Result<u64, GpuHalt> {
         let mut done = 0u64;
-        let mut force_rebuild = std::mem::take(&mut self.pending_rebuild);
-        self.fractions.clear();
+        let mut force_rebuild = std::mem::take(&mut self.list.pending_rebuild);
+        self.features.fractions.clear();
         while done < steps {
             let step = first_step + done;
             // With contact, the ring of step fractions bounds a chunk.
             let most = if self.has_contact() { FRACTION_SLOTS as u64 } else { u32::MAX as u64 / 2 };
             // With ramps or drives, so do the tables of their values (src/gpu/protocol.rs).
-            let ramped = self.protocol.as_ref().is_some_and(ProtocolPack::ramps);
-            let driven = self.protocol.as_ref().is_some_and(ProtocolPack::drives);
+            let ramped = self.features.protocol.as_ref().is_some_and(ProtocolPack::ramps);
+            let driven = self.features.protocol.as_ref().is_some_and(ProtocolPack::drives);
             let chunk = (steps - done).min(if ramped || driven { most.min(RAMP_ROWS) } else { most });
-            if let Some(pack) = self.protocol.as_mut() {
+            if let Some(pack) = self.features.protocol.as_mut() {
                 if ramped {
                     let rows = pack.rows(step, chunk);
-                    self.ctx.queue.write_buffer(&self.protocol_buffer, 4 * pack.fields[5] as u64, words(&rows));
+                    self.ctx.queue.write_buffer(&self.buffers.protocol, 4 * pack.fields[5] as u64, words(&rows));
                 }
                 for (at, data) in pack.drive_words(chunk) {
-                    self.ctx.queue.write_buffer(&self.protocol_buffer, 4 * at as u64, words(&data));
+                    self.ctx.queue.write_buffer(&self.buffers.protocol, 4 * at as u64, words(&data));
                 }
                 self.params.protocol = pack.fields;
             }
@@ -1313,21 +1345,21 @@ impl GpuBackend {
                 encoded += batch;
             }
             let status = self.status();
-            self.builds += status[ST_BUILDS] as u64;
+            self.list.builds += status[ST_BUILDS] as u64;
             done += status[ST_STEPS_DONE] as u64;
             if driven {
-                let (at, count) = self.protocol.as_ref().map(ProtocolPack::drive_state_range).expect("drives");
-                let state: Vec<u32> = bytemuck::cast_slice(&self.read_at(&self.protocol_buffer, 4 * at as u64, 4 * count as u64)).to_vec();
-                self.protocol.as_mut().expect("drives").follow_drives(&state);
+                let (at, count) = self.features.protocol.as_ref().map(ProtocolPack::drive_state_range).expect("drives");
+                let state: Vec<u32> = bytemuck::cast_slice(&self.read_at(&self.buffers.protocol, 4 * at as u64, 4 * count as u64)).to_vec();
+                self.features.protocol.as_mut().expect("drives").follow_drives(&state);
             }
             // A rebuild the last step asked for (device kinetics changed the exclusions) carries over.
             let requested = status[ST_FORCE_REBUILD] != 0;
-            self.pending_rebuild = requested;
+            self.list.pending_rebuild = requested;
             if self.has_contact() && status[ST_STEPS_DONE] > 0 {
                 let ring = 16 * self.params.contact[15] as u64;
                 let entries: Vec<[f32; 4]> =
-                    bytemuck::cast_slice(&self.read_at(&self.surf, ring, 16 * status[ST_STEPS_DONE] as u64)).to_vec();
-                self.fractions.extend(entries.iter().map(|e| e[0]));
+                    bytemuck::cast_slice(&self.read_at(&self.buffers.surf, ring, 16 * status[ST_STEPS_DONE] as u64)).to_vec();
+                self.features.fractions.extend(entries.iter().map(|e| e[0]));
             }
             if status[ST_HALTED] & HALT_CONVERGED != 0 {
                 // FIRE converged (src/gpu/fire.rs): no further iteration.
@@ -1340,22 +1372,23 @@ impl GpuBackend {
                 return Err(GpuHalt::Reach { step: first_step + done });
             }
             if status[ST_HALTED] & HALT_FORMATION != 0 {
-                self.overflow_met = self.overflow_met.max(status[ST_OVERFLOW_NEED]);
+                self.list.overflow_met = self.list.overflow_met.max(status[ST_OVERFLOW_NEED]);
                 return Err(GpuHalt::Formation { step: first_step + done });
             }
             if let Some(message) = self.span_halt(&status) {
                 return Err(GpuHalt::Capacity { step: first_step + done, message });
             }
-            if let Some(split) = self.implicit.as_mut().and_then(ImplicitSolver::split_mut).filter(|_| status[ST_HALTED] & HALT_BUDGET != 0)
+            if let Some(split) =
+                self.features.implicit.as_mut().and_then(ImplicitSolver::split_mut).filter(|_| status[ST_HALTED] & HALT_BUDGET != 0)
             {
                 // The step that ran out of iterations moved nothing: take it again with a larger budget.
                 split.grow();
             }
-            if let Some(solver) = self.implicit.as_ref().filter(|_| status[ST_HALTED] & HALT_SOLVE != 0) {
+            if let Some(solver) = self.features.implicit.as_ref().filter(|_| status[ST_HALTED] & HALT_SOLVE != 0) {
                 let message = solver.failure(&self.implicit_report().unwrap_or_default());
                 return Err(GpuHalt::Capacity { step: first_step + done, message });
             }
-            if let Some(shake) = self.shake.as_ref().filter(|_| status[ST_HALTED] & HALT_CONSTRAINT != 0) {
+            if let Some(shake) = self.features.shake.as_ref().filter(|_| status[ST_HALTED] & HALT_CONSTRAINT != 0) {
                 let report = self.constraint_state().map(|(_, report)| report).unwrap_or_default();
                 // The step the projection failed in is the one after the last done.
                 return Err(GpuHalt::Capacity { step: first_step + done, message: shake.failure(&report, first_step + done + 1) });
@@ -1375,12 +1408,12 @@ impl GpuBackend {
     /// After a run: the split solve's budget fitted to the most iterations a
     /// step took, and that count cleared (one small read-back).
     fn fit_split_budget(&mut self) {
-        let Some(solver) = self.implicit.as_ref().filter(|s| s.is_split()) else { return };
+        let Some(solver) = self.features.implicit.as_ref().filter(|s| s.is_split()) else { return };
         let bytes = self.read_at(&solver.buffer, solver.report_at, 16);
         self.ctx.queue.write_buffer(&solver.buffer, solver.report_at + 8, &[0; 4]);
         let most = ImplicitSolver::most_iterations(&bytes);
         if most > 0 {
-            self.implicit.as_mut().and_then(ImplicitSolver::split_mut).expect("a split solve").fit(most);
+            self.features.implicit.as_mut().and_then(ImplicitSolver::split_mut).expect("a split solve").fit(most);
         }
     }
 }
@@ -1458,44 +1491,4 @@ fn pack_state(
     let adhesion_base = packed.surf_entries + contact.surf_entries(n);
     let adhesion_fields = adhesion.append(&mut packed.topo, adhesion_base, n, contact.closest_entry(packed.surf_entries));
     Ok((packed, exclusions, fields, adhesion_fields))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The status words and halt bits the host reads are the kernels' (each
-    /// kernel file declares the bits it raises).
-    #[test]
-    fn the_status_constants_match_the_kernels() {
-        let program = shader::compose();
-        let words = [
-            ("ST_HALTED", ST_HALTED),
-            ("ST_OVERFLOW_NEED", ST_OVERFLOW_NEED),
-            ("ST_BUILDS", ST_BUILDS),
-            ("ST_STEPS_DONE", ST_STEPS_DONE),
-            ("ST_BLOWUP_PARTICLE", ST_BLOWUP_PARTICLE),
-            ("ST_FORCE_REBUILD", ST_FORCE_REBUILD),
-            ("ST_SPAN_BODY", ST_SPAN_BODY),
-            ("ST_FRACTION", ST_FRACTION),
-            ("ST_ELAPSED", ST_ELAPSED),
-        ];
-        for (name, value) in words {
-            assert!(program.contains(&format!("const {name}: u32 = {value}u;")), "{name}");
-        }
-        let bits = [
-            ("HALT_OVERFLOW", HALT_OVERFLOW),
-            ("HALT_BLOWUP", HALT_BLOWUP),
-            ("HALT_SPAN", HALT_SPAN),
-            ("HALT_REACH", HALT_REACH),
-            ("HALT_EVENTS", HALT_EVENTS),
-            ("HALT_SOLVE", HALT_SOLVE),
-            ("HALT_FORMATION", HALT_FORMATION),
-            ("HALT_CONSTRAINT", HALT_CONSTRAINT),
-            ("HALT_CONVERGED", HALT_CONVERGED),
-        ];
-        for (name, value) in bits {
-            assert!(program.contains(&format!("const {name}: u32 = {value}u;")), "{name}");
-        }
-    }
 }

@@ -39,20 +39,19 @@
 //! particle its candidate count; per block of 256 particles its count, then
 //! its base.
 
+use super::prelude::bind::*;
 use crate::system::Model;
 
+/// No slot, record or body (the kinetics' `KIN_NONE`).
 const NONE: u32 = u32::MAX;
-const RULE_WORDS: usize = 8;
-/// `bind` rules the device takes (`BIND_RULES` of bind.wgsl).
-const RULES: usize = 4;
 
 /// Why the model's `bind` rules cannot be decided on the device (None: they can, or it has none).
 pub fn refusal(model: &Model) -> Option<String> {
     if model.bind_rules.is_empty() {
         return None;
     }
-    if model.bind_rules.len() > RULES {
-        return Some(format!("more than {RULES} `bind` rules"));
+    if model.bind_rules.len() > BIND_RULES {
+        return Some(format!("more than {BIND_RULES} `bind` rules"));
     }
     if model.bind_rules.iter().any(|r| r.nearest) {
         return Some("`bind … partner nearest`".into());
@@ -116,7 +115,7 @@ pub(super) fn append(model: &Model, sizes: &BindSizes, pool_end: usize, words: &
         return;
     }
     let n = model.len();
-    header[16] = words.len() as u32;
+    header[KIN_SLOT_OF] = words.len() as u32;
     let mut takers = 0u32;
     for i in 0..n {
         words.push(if takes_part(model, i) {
@@ -126,15 +125,15 @@ pub(super) fn append(model: &Model, sizes: &BindSizes, pool_end: usize, words: &
             NONE
         });
     }
-    header[17] = words.len() as u32;
+    header[KIN_SLOTS] = words.len() as u32;
     words.resize(words.len() + takers as usize * sizes.width, NONE);
-    header[18] = sizes.width as u32;
-    header[19] = words.len() as u32;
-    header[20] = model.bind_rules.len() as u32;
+    header[KIN_SLOT_WIDTH] = sizes.width as u32;
+    header[KIN_RULES] = words.len() as u32;
+    header[KIN_RULE_COUNT] = model.bind_rules.len() as u32;
     for r in &model.bind_rules {
         let t = r.bond_type as usize;
         let rest = model.bond_kinetics[t].rest_index.map_or(f64::NAN, |k| model.bond_types[t].params[k]);
-        let record: [u32; RULE_WORDS] = [
+        let record: [u32; KIN_RULE_WORDS] = [
             r.type_a,
             r.type_b,
             r.bond_type,
@@ -146,19 +145,19 @@ pub(super) fn append(model: &Model, sizes: &BindSizes, pool_end: usize, words: &
         ];
         words.extend(record);
     }
-    header[21] = words.len() as u32;
+    header[KIN_BODY] = words.len() as u32;
     words.extend(model.body_of_particles());
-    header[22] = (pool_end - sizes.pool) as u32;
-    header[23] = pool_end as u32;
-    header[24] = model.bonds.len() as u32;
-    header[25] = words.len() as u32;
+    header[KIN_POOL_NEXT] = (pool_end - sizes.pool) as u32;
+    header[KIN_POOL_END] = pool_end as u32;
+    header[KIN_NEXT_BOND] = model.bonds.len() as u32;
+    header[KIN_CAND] = words.len() as u32;
     words.resize(words.len() + 3 * sizes.candidates, 0);
-    header[26] = sizes.candidates as u32;
-    header[27] = words.len() as u32;
+    header[KIN_CAND_CAP] = sizes.candidates as u32;
+    header[KIN_CAND_N] = words.len() as u32;
     words.resize(words.len() + n, 0);
-    header[28] = words.len() as u32;
+    header[KIN_CAND_BLOCK] = words.len() as u32;
     words.resize(words.len() + 2 * n.div_ceil(super::context::WORKGROUP as usize), 0);
-    header[31] = max_gain(model);
+    header[KIN_MAX_GAIN] = max_gain(model);
 }
 
 /// The largest capture radius of the model's `bind` rules (0: none).

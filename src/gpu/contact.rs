@@ -72,6 +72,8 @@
 //! bounding-sphere test. The list's skin is at least d̂: 0.005 rebuilds per
 //! step on cell_contact.in instead of 0.995 with the deck's skin 0.
 
+use super::prelude::contact::*;
+pub use super::prelude::contact::{CONTACT_ONLY, FRACTION_SLOTS};
 use crate::interactions::ContactLaw;
 use crate::system::{registry_index, Model};
 
@@ -79,24 +81,15 @@ use crate::system::{registry_index, Model};
 /// face edge at the start of the run (faces may stretch by this much).
 pub const EDGE_ALLOWANCE: f64 = 1.5;
 
-/// Steps whose fractions the device keeps between two host syncs.
-pub const FRACTION_SLOTS: u32 = 1024;
-
-/// Words per contact rule: registry index, then 8 parameters (f32 bits).
-const RULE_WORDS: usize = 9;
-
-/// Marks a neighbour-list entry kept only for the contact search (layout.wgsl's `CONTACT_ONLY`).
-pub const CONTACT_ONLY: u32 = 1 << 31;
-
 /// The contact sections of the GPU topology.
 #[derive(Default)]
 pub struct ContactPack {
     /// In the order of layout.wgsl's `off_cfaces` …: faces (corners, packed
     /// body), faces by first corner (CSR by particle), faces by corner (CSR
     /// by particle, 4·face + role), each particle's packed contact body
-    /// (`u32::MAX`: none), each packed body's type, the node–face rules per
+    /// (`NO_BODY`: none), each packed body's type, the node–face rules per
     /// (node type, face type) (CSR), whether any rule acts per type pair,
-    /// the rules ([`RULE_WORDS`] each).
+    /// the rules ([`CONTACT_RULE_WORDS`] each).
     sections: [Vec<u32>; 11],
     body_types: u32,
     dhat: f64,
@@ -116,7 +109,7 @@ impl ContactPack {
         let named = |t: usize| (0..types).any(|u| any[t * types + u] != 0 || any[u * types + t] != 0);
         let n = model.len();
         let images = sim_box.images();
-        let (mut faces, mut body_type, mut body) = (Vec::new(), Vec::new(), vec![u32::MAX; n]);
+        let (mut faces, mut body_type, mut body) = (Vec::new(), Vec::new(), vec![NO_BODY; n]);
         let (mut first, mut corner) = (vec![Vec::new(); n], vec![Vec::new(); n]);
         let mut longest = 0.0f64;
         for b in model.bodies.iter().filter(|b| named(b.body_type as usize)) {
@@ -142,7 +135,7 @@ impl ContactPack {
             let start = table.len();
             table.push(registry_index(term) as u32);
             table.extend(term.params.iter().map(|&p| (p as f32).to_bits()));
-            table.resize(start + RULE_WORDS, 0);
+            table.resize(start + CONTACT_RULE_WORDS, 0);
         }
         let mut sections: [Vec<u32>; 11] = Default::default();
         let mut csr = |rows: &[Vec<u32>], at: usize| {
@@ -236,18 +229,4 @@ pub fn reach_message(edge: f64) -> String {
          ({EDGE_ALLOWANCE} × the longest edge at the start of the run); run again from the last output (the reach is set \
          anew at the start of each run) or use `device cpu`"
     )
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The kernels' constants are the host's (the step fraction's: tests/suite/gpu.rs).
-    #[test]
-    fn the_shader_constants_match() {
-        let program = super::super::shader::compose();
-        assert!(program.contains(&format!("const FRACTION_SLOTS: u32 = {FRACTION_SLOTS}u;")));
-        assert!(program.contains(&format!("const CONTACT_ONLY: u32 = 0x{CONTACT_ONLY:08x}u;")));
-        assert!(program.contains(&format!("const CONTACT_RULE_WORDS: u32 = {RULE_WORDS}u;")));
-    }
 }

@@ -7,6 +7,8 @@
 //! defaults), so that buffers for ≥ 10⁶ particles and all twelve storage
 //! bindings fit.
 
+pub use super::prelude::context::WORKGROUP;
+
 /// The deck's `device` setting.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum DevicePreference {
@@ -32,9 +34,6 @@ impl DevicePreference {
 
 /// Storage buffers bound by the kernels at once (see shaders/common/layout.wgsl).
 pub const STORAGE_BINDINGS: u32 = 13;
-
-/// Invocations per workgroup of every kernel (`WORKGROUP` in shaders/common/layout.wgsl).
-pub const WORKGROUP: u32 = 256;
 
 /// An open device and its queue (cheap to clone: handles are shared).
 #[derive(Clone)]

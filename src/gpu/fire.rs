@@ -40,12 +40,10 @@
 use wgpu::util::DeviceExt;
 
 use super::context::GpuContext;
+use super::prelude::fire::*;
 use super::side_group::SideGroup;
 use crate::integrate::fire::{FireSettings, ALPHA0, DT_MAX_FACTOR};
 use crate::system::Model;
-
-/// `fire` entries before the per-workgroup partial sums.
-const CONTROL_ENTRIES: usize = 4;
 
 /// The device's FIRE: velocities, control words and partial sums, and the kernels.
 pub(super) struct DeviceFire {
@@ -72,10 +70,10 @@ impl DeviceFire {
     ) -> Result<Self, String> {
         let n = model.len();
         let blocks = (n as u32).div_ceil(workgroup);
-        let mut control = vec![[0f32; 4]; CONTROL_ENTRIES + blocks as usize];
-        control[0] = [dt as f32, ALPHA0 as f32, f32::from_bits(0), f32::from_bits(0)];
-        control[1] = [0.0, 0.0, dt as f32, (DT_MAX_FACTOR * dt) as f32];
-        control[2] = [settings.ftol as f32, settings.dmax as f32, 0.0, f32::from_bits(blocks)];
+        let mut control = vec![[0f32; 4]; FIRE_PARTIALS + blocks as usize];
+        control[FIRE_STATE] = [dt as f32, ALPHA0 as f32, f32::from_bits(0), f32::from_bits(0)];
+        control[FIRE_MIXING] = [0.0, 0.0, dt as f32, (DT_MAX_FACTOR * dt) as f32];
+        control[FIRE_LIMITS] = [settings.ftol as f32, settings.dmax as f32, 0.0, f32::from_bits(blocks)];
         let device = &ctx.device;
         // wgpu zeroes a new buffer: the velocities start at rest.
         let velocities = device.create_buffer(&wgpu::BufferDescriptor {
@@ -101,27 +99,12 @@ impl DeviceFire {
     }
 
     /// The bytes of the control entries that [`Self::counts`] reads.
-    pub(super) const COUNT_BYTES: u64 = 16 * CONTROL_ENTRIES as u64;
+    pub(super) const COUNT_BYTES: u64 = 16 * FIRE_PARTIALS as u64;
 
     /// The iterations taken and the moves the contact step clamp shortened,
     /// from the control entries' bytes.
     pub(super) fn counts(bytes: &[u8]) -> (u64, u64) {
-        let entries: [[f32; 4]; CONTROL_ENTRIES] = bytemuck::pod_read_unaligned(&bytes[..Self::COUNT_BYTES as usize]);
-        (u64::from(entries[0][3].to_bits()), u64::from(entries[3][0].to_bits()))
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use crate::integrate::fire::{ALPHA0, F_ALPHA, F_DEC, F_INC, N_MIN};
-
-    /// The kernels' FIRE parameters are the CPU's.
-    #[test]
-    fn the_shader_constants_match() {
-        let program = super::super::shader::compose();
-        assert!(program.contains(&format!("const FIRE_N_MIN: u32 = {N_MIN}u;")));
-        for (name, value) in [("F_INC", F_INC), ("F_DEC", F_DEC), ("ALPHA0", ALPHA0), ("F_ALPHA", F_ALPHA)] {
-            assert!(program.contains(&format!("const FIRE_{name}: f32 = {value:?};")), "FIRE_{name}");
-        }
+        let entries: [[f32; 4]; FIRE_PARTIALS] = bytemuck::pod_read_unaligned(&bytes[..Self::COUNT_BYTES as usize]);
+        (u64::from(entries[FIRE_STATE][3].to_bits()), u64::from(entries[FIRE_CLAMPED][0].to_bits()))
     }
 }

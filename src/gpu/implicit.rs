@@ -28,7 +28,7 @@
 //!   force) or its positive part written out (an indenter's 2K(R − r)·ûûᵀ,
 //!   without the negative transverse −K(R − r)²/r the CPU's projection drops).
 //! - **Volume elements**: the element's exact 12×12 Hessian
-//!   V_0·Σ_AB g_c[A]·g_d[B]·∂²W/∂F_αA∂F_βB (g_k the rows of D_m⁻¹, g_0 their
+//!   V_0·Σ_AB g_c\[A\]·g_d\[B\]·∂²W/∂F_αA∂F_βB (g_k the rows of D_m⁻¹, g_0 their
 //!   negative sum), with ∂²W/∂F∂F from the law's `NAME_tetra_hessian`,
 //!   projected like the angles' (kernel `implicit_tetras`; the CPU takes it
 //!   by central differences of the element's forces); each product gathers a
@@ -161,6 +161,8 @@ use wgpu::util::DeviceExt;
 use super::context::{GpuContext, WORKGROUP};
 use super::implicit_split::SplitSolve;
 use super::pack::push_csr;
+use super::prelude::implicit::*;
+use super::prelude::implicit_split::SPLIT_PARTIALS;
 use super::shader;
 use super::side_group::SideGroup;
 use crate::integrate::implicit::{GpuWorkgroups, ImplicitSettings, SolveReport};
@@ -180,17 +182,6 @@ pub const SPLIT_SOLVE_FROM: usize = 8192;
 const HEADER_WORDS: usize = 22;
 /// `imp` entries per particle (Δx, r, z, p, A·p, the Jacobi diagonal).
 const PARTICLE_VECTORS: usize = 6;
-/// `imp` entries of an angle's 9×9 block.
-const ANGLE_VEC4: usize = 21;
-/// `imp` entries of a volume element's 12×12 block.
-const TETRA_VEC4: usize = 36;
-/// `imp` entries of a face's 9×9 block (its body's surface terms).
-const FACE_VEC4: usize = 21;
-/// `imp` entries of a constraint (û and its flag; μ, r, p, q of the inner
-/// CG; its z, S's inverse diagonal and its tension).
-const CONSTRAINT_VEC4: usize = 3;
-/// Slot bit: the particle is the constraint's second end.
-const J_END: u32 = 0x8000_0000;
 
 /// Why the model's implicit step cannot run on the device (None: it can).
 pub fn refusal(model: &Model) -> Option<&'static str> {
@@ -370,8 +361,8 @@ impl ImplicitSolver {
         let angle_base = model.bond_types.len();
         let mut header = vec![0u32; HEADER_WORDS];
         let mut words = Vec::new();
-        header[0] = model.angles.len() as u32;
-        header[1] = HEADER_WORDS as u32;
+        header[IMP_ANGLES] = model.angles.len() as u32;
+        header[IMP_OFF_ANGLES] = HEADER_WORDS as u32;
         let mut slot_rows = vec![Vec::new(); n];
         for (a, &[i, j, k]) in model.angles.iter().enumerate() {
             words.extend([i, j, k, (angle_base + model.angle_type[a] as usize) as u32]);
@@ -381,17 +372,17 @@ impl ImplicitSolver {
         }
         let (mut starts, mut slots) = (Vec::new(), Vec::new());
         push_csr(&slot_rows, &mut starts, &mut slots);
-        header[2] = (HEADER_WORDS + words.len()) as u32;
+        header[IMP_OFF_SLOT_START] = (HEADER_WORDS + words.len()) as u32;
         words.extend(&starts);
-        header[3] = (HEADER_WORDS + words.len()) as u32;
+        header[IMP_OFF_SLOTS] = (HEADER_WORDS + words.len()) as u32;
         words.extend(slots.iter().flatten());
-        header[4] = implicit.max_iterations.min(u32::MAX as usize) as u32;
-        header[5] = (tolerance as f32).to_bits();
+        header[IMP_MAX_ITER] = implicit.max_iterations.min(u32::MAX as usize) as u32;
+        header[IMP_TOLERANCE] = (tolerance as f32).to_bits();
         let drag = |g: f64| if g.is_finite() { (g / dt) as f32 } else { 0.0 };
         let kick = |g: f64| if g.is_finite() && kt > 0.0 { (2.0 * kt * g / dt).sqrt() as f32 } else { 0.0 };
-        header[6] = (HEADER_WORDS + words.len()) as u32;
+        header[IMP_OFF_DRAG] = (HEADER_WORDS + words.len()) as u32;
         words.extend(model.type_drag.iter().map(|&g| drag(g).to_bits()));
-        header[7] = (HEADER_WORDS + words.len()) as u32;
+        header[IMP_OFF_KICK] = (HEADER_WORDS + words.len()) as u32;
         words.extend(model.type_drag.iter().map(|&g| kick(g).to_bits()));
         // `imp`: the particle vectors, then 2 entries per bond end and per
         // external entry, 21 per angle, 36 per volume element, 21 per face,
@@ -407,18 +398,18 @@ impl ImplicitSolver {
         let bodies_at = faces_at + FACE_VEC4 * faces;
         let nodes_at = bodies_at + bodies;
         let report = nodes_at + body_nodes;
-        header[17] = tetras_at as u32;
-        header[18] = faces_at as u32;
-        header[19] = bodies_at as u32;
-        header[20] = nodes_at as u32;
-        header[8] = bonds_at as u32;
-        header[9] = externals_at as u32;
-        header[10] = angles_at as u32;
-        header[11] = report as u32;
+        header[IMP_V_TETRAS] = tetras_at as u32;
+        header[IMP_V_FACES] = faces_at as u32;
+        header[IMP_V_BODIES] = bodies_at as u32;
+        header[IMP_V_NODES] = nodes_at as u32;
+        header[IMP_V_BONDS] = bonds_at as u32;
+        header[IMP_V_EXTERNALS] = externals_at as u32;
+        header[IMP_V_ANGLES] = angles_at as u32;
+        header[IMP_V_REPORT] = report as u32;
         // Constrained bonds (shaders/common/implicit_constraints.wgsl):
         // their ends, and each particle's slots (constraint, J_END where it is j).
-        header[12] = constrained.len() as u32;
-        header[13] = (HEADER_WORDS + words.len()) as u32;
+        header[IMP_CONSTRAINTS] = constrained.len() as u32;
+        header[IMP_OFF_CONSTRAINTS] = (HEADER_WORDS + words.len()) as u32;
         words.extend(constrained.iter().flatten());
         let mut constraint_rows = vec![Vec::new(); n];
         for (k, &[i, j]) in constrained.iter().enumerate() {
@@ -427,17 +418,17 @@ impl ImplicitSolver {
         }
         let (mut starts, mut slots) = (Vec::new(), Vec::new());
         push_csr(&constraint_rows, &mut starts, &mut slots);
-        header[14] = (HEADER_WORDS + words.len()) as u32;
+        header[IMP_OFF_CSLOT_START] = (HEADER_WORDS + words.len()) as u32;
         words.extend(&starts);
-        header[15] = (HEADER_WORDS + words.len()) as u32;
+        header[IMP_OFF_CSLOTS] = (HEADER_WORDS + words.len()) as u32;
         words.extend(&slots);
-        header[16] = (report + 1) as u32;
+        header[IMP_V_CONSTRAINTS] = (report + 1) as u32;
         // The split solve's scalars and one partial sum per workgroup
         // (shaders/common/implicit_split.wgsl), after the constraints'.
         let split_at = report + 1 + CONSTRAINT_VEC4 * constrained.len();
-        header[21] = split_at as u32;
+        header[IMP_V_SPLIT] = split_at as u32;
         let topo: Vec<u32> = header.into_iter().chain(words).collect();
-        let entries = (split_at + 3 + n.div_ceil(WORKGROUP as usize)) as u64;
+        let entries = (split_at + SPLIT_PARTIALS + n.div_ceil(WORKGROUP as usize)) as u64;
         let limit = ctx.limits.max_storage_buffer_binding_size.min(ctx.limits.max_buffer_size);
         if 16 * entries > limit || entries > u32::MAX as u64 {
             return Err(format!(

@@ -21,9 +21,6 @@
 use super::context::GpuContext;
 use super::side_group::SideGroup;
 
-/// The status bit of a step that outran its budget (`HALT_BUDGET` of the kernels).
-pub(super) const HALT_BUDGET: u32 = 512;
-
 /// The first iteration budget per step, and the least the fitting leaves.
 const FIRST_BUDGET: usize = 32;
 const LEAST_BUDGET: usize = 8;
@@ -113,11 +110,6 @@ impl SplitSolve {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn the_shader_constants_match() {
-        assert!(super::super::shader::compose().contains(&format!("const HALT_BUDGET: u32 = {HALT_BUDGET}u;")));
-    }
 
     /// The budget doubles up to the cap and is fitted to twice the most
     /// iterations, a power of two within [LEAST_BUDGET, cap].

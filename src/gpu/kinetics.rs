@@ -1,8 +1,11 @@
 //! Bond kinetics decided on the device (kernels: shaders/common/kinetics.wgsl).
 //!
-//! For models whose every kinetic rule has a rate in closed form of the
-//! bond's tension — `slip`, `catch_slip`, `cadherin`, `threshold` (breaking)
-//! and `rebind` (rebinding to the same partner) — each step's breaks and
+//! For models whose every kinetic rule has a device form
+//! ([`crate::kinetics::Effect::gpu_form`]: a rate in closed form of the
+//! bond's tension, a threshold, or rebinding to the same partner; today
+//! `slip`, `catch_slip`, `cadherin`, `threshold` and `rebind`, each with its
+//! evaluator beside it, `src/kinetics/NAME.wgsl`, dispatched by its registry
+//! code, src/gpu/shader.rs) each step's breaks and
 //! rebinds are decided on the GPU, with no read-back: the tension dE/dr and
 //! length of every kinetic bond are measured at x_s after the force pass, and
 //! after the step each bond draws the CPU's Philox number (seed, s, bond
@@ -27,9 +30,9 @@
 //! Which models: [`refusal`] says why a model's kinetics stay on the host
 //! (one GPU step per segment, as before): the `bind` rules that
 //! [`super::bind::refusal`] names (other `bind` formation runs on the
-//! device, src/gpu/bind.rs, in pool records after the kinetic bonds), the rules that
-//! change a bond's law every step or at a strain (`motor`, `ratchet`,
-//! `maturation`, `plastic`), more than [`RULES_PER_TYPE`] rules on a bond
+//! device, src/gpu/bind.rs, in pool records after the kinetic bonds), the rules
+//! without a device form (those that change a bond's law every step or at a
+//! strain: `motor`, `ratchet`, `maturation`, `plastic`), more than [`RULES_PER_TYPE`] rules on a bond
 //! type, `special_bonds` 1-3 or 1-4 weights other than 1 with pair terms (the
 //! exclusions of a broken bond would reach beyond its pair), or two bonds
 //! joining the same pair where one has kinetic rules.
@@ -37,7 +40,8 @@
 //! # The `kin` buffer (u32 words)
 //!
 //! A header of 32 words (word indices as the `KIN_*` constants of
-//! kinetics.wgsl, 16–31 those of bind.wgsl), then: per kinetic record (the
+//! `prelude::kinetics`, 16–31 those of `prelude::bind`; both generated into
+//! the program's prelude, src/gpu/prelude.rs), then: per kinetic record (the
 //! bonds with a term of their own, in bond order, then `bind`'s pool) its
 //! record (i, j, bond type, bond index, term, rest length), bound flag, age
 //! (high, low words of the f64), tension, length and k·dt (f32 bits) and this
@@ -49,24 +53,15 @@
 //! length, age high, low); then `bind`'s sections (src/gpu/bind.rs).
 
 use super::backend::GpuBackend;
-use super::pack::{Packed, PARAM_SLOTS};
+use super::pack::Packed;
+pub use super::prelude::kinetics::RULES_PER_TYPE;
+use super::prelude::kinetics::*;
+use super::shader::rule_code;
 use crate::kinetics_engine::EventKind;
 use crate::neighbor::Exclusions;
 use crate::system::{BondState, Model};
 
-/// Rules a bond type may combine with kinetics on the device.
-pub const RULES_PER_TYPE: usize = 4;
 const HEADER_WORDS: usize = 32;
-const BOND_WORDS: usize = 6;
-const TYPE_WORDS: usize = 44;
-const EVENT_WORDS: usize = 8;
-const NONE: u32 = u32::MAX;
-const CURSOR: usize = 9;
-
-/// The rule codes of kinetics.wgsl (`RULE_*`).
-fn rule_code(name: &str) -> Option<u32> {
-    ["slip", "catch_slip", "cadherin", "threshold", "rebind"].iter().position(|&r| r == name).map(|k| k as u32 + 1)
-}
 
 /// Why the model's bond kinetics cannot be decided on the device (None: they can).
 pub fn refusal(model: &Model) -> Option<String> {
@@ -78,7 +73,7 @@ pub fn refusal(model: &Model) -> Option<String> {
         if kinetics.rules.len() > RULES_PER_TYPE {
             return Some(format!("bond type `{label}` has more than {RULES_PER_TYPE} kinetic rules"));
         }
-        if let Some(r) = kinetics.rules.iter().find(|r| rule_code(r.rule.name()).is_none()) {
+        if let Some(r) = kinetics.rules.iter().find(|r| rule_code(r.rule).is_none()) {
             return Some(format!("kinetic rule `{}` (bond type `{label}`)", r.rule.name()));
         }
     }
@@ -192,7 +187,8 @@ impl KinLayout {
         let blocks = count.div_ceil(super::context::WORKGROUP as usize);
         let capacity = 2 * count + 1024 + bind.candidates;
         let mut header = [0u32; HEADER_WORDS];
-        let sizes = [BOND_WORDS * count, count, 2 * count, 3 * count, count, 2 * blocks, TYPE_WORDS * model.bond_types.len()];
+        // The sections at header words KIN_BONDS … KIN_TYPE, in that order.
+        let sizes = [KIN_BOND_WORDS * count, count, 2 * count, 3 * count, count, 2 * blocks, KIN_TYPE_WORDS * model.bond_types.len()];
         let mut at = HEADER_WORDS;
         for (k, size) in sizes.iter().enumerate() {
             header[k] = at as u32;
@@ -201,59 +197,59 @@ impl KinLayout {
         let mut words = vec![0u32; at];
         // Bonds, bound flags, ages.
         let kinetic_of = {
-            let mut of = vec![NONE; model.bonds.len()];
+            let mut of = vec![KIN_NONE; model.bonds.len()];
             own.iter().enumerate().for_each(|(k, &b)| of[b as usize] = k as u32);
             of
         };
         // Pool records not yet taken: i = none (src/gpu/bind.rs).
         for k in own.len()..count {
-            let at = header[0] as usize + BOND_WORDS * k;
-            words[at..at + BOND_WORDS].fill(NONE);
+            let at = header[KIN_BONDS] as usize + KIN_BOND_WORDS * k;
+            words[at..at + KIN_BOND_WORDS].fill(KIN_NONE);
         }
         for (k, &b) in own.iter().enumerate() {
             let b = b as usize;
             let [i, j] = model.bonds[b];
             let rest = model.rest_length(b, Some(bonds)) as f32;
             let record = [i, j, model.bond_type[b], b as u32, packed.first_own_term + k as u32, rest.to_bits()];
-            let at = header[0] as usize + BOND_WORDS * k;
-            words[at..at + BOND_WORDS].copy_from_slice(&record);
-            words[header[1] as usize + k] = bonds.bound[b] as u32;
-            let age = header[2] as usize + 2 * k;
+            let at = header[KIN_BONDS] as usize + KIN_BOND_WORDS * k;
+            words[at..at + KIN_BOND_WORDS].copy_from_slice(&record);
+            words[header[KIN_BOUND] as usize + k] = bonds.bound[b] as u32;
+            let age = header[KIN_AGE] as usize + 2 * k;
             words[age..age + 2].copy_from_slice(&f64_words(bonds.age[b]));
         }
         // Bond types and their rules.
         for (t, kinetics) in model.bond_kinetics.iter().enumerate() {
-            let at = header[6] as usize + TYPE_WORDS * t;
+            let at = header[KIN_TYPE] as usize + KIN_TYPE_WORDS * t;
             words[at] = kinetics.rules.len() as u32;
             words[at + 1] = warned.get(t).is_some_and(|&w| w) as u32;
-            words[at + 2] = NONE;
+            words[at + 2] = KIN_NONE;
             for (r, rule) in kinetics.rules.iter().enumerate() {
-                let slot = at + 8 + (1 + PARAM_SLOTS) * r;
-                words[slot] = rule_code(rule.rule.name()).expect("refusal() checked the rules");
+                let slot = at + KIN_TYPE_RULES + KIN_RULE_STRIDE * r;
+                words[slot] = rule_code(rule.rule).expect("refusal() checked the rules");
                 for (q, &p) in rule.params.iter().enumerate() {
                     words[slot + 1 + q] = (p as f32).to_bits();
                 }
             }
         }
         // Exclusion tags: an entry holds while its kinetic bond is bound.
-        header[7] = words.len() as u32;
+        header[KIN_EXCL] = words.len() as u32;
         let mut tag = std::collections::HashMap::new();
         for (b, &[i, j]) in model.bonds.iter().enumerate() {
             let kinetic = !model.bond_kinetics[model.bond_type[b] as usize].rules.is_empty();
-            tag.insert((i.min(j), i.max(j)), if kinetic { kinetic_of[b] } else { NONE });
+            tag.insert((i.min(j), i.max(j)), if kinetic { kinetic_of[b] } else { KIN_NONE });
         }
         for i in 0..model.len() as u32 {
             for &j in exclusions.partners(i) {
-                words.push(tag.get(&(i.min(j), i.max(j))).copied().unwrap_or(NONE));
+                words.push(tag.get(&(i.min(j), i.max(j))).copied().unwrap_or(KIN_NONE));
             }
         }
-        header[8] = words.len() as u32;
-        words.resize(words.len() + EVENT_WORDS * capacity, 0);
+        header[KIN_EVENTS] = words.len() as u32;
+        words.resize(words.len() + KIN_EVENT_WORDS * capacity, 0);
         let [dt_hi, dt_lo] = f64_words(dt);
-        header[10] = dt_hi;
-        header[11] = dt_lo;
-        header[12] = (dt as f32).to_bits();
-        header[13] = (kt as f32).to_bits();
+        header[KIN_DT_HI] = dt_hi;
+        header[KIN_DT_LO] = dt_lo;
+        header[KIN_DT] = (dt as f32).to_bits();
+        header[KIN_KT] = (kt as f32).to_bits();
         super::bind::append(model, &bind, count, &mut words, &mut header);
         words[..HEADER_WORDS].copy_from_slice(&header);
         let layout = Self {
@@ -292,13 +288,18 @@ impl GpuBackend {
         let mut out = DeviceDecisions::default();
         let Some(kinetics) = self.device_kinetics() else { return out };
         let header = kinetics.header;
-        let (types_at, types) = (header[6] as u64, kinetics.types);
-        let count = self.read_kin(CURSOR as u64, 1)[0] as usize;
+        let (types_at, types) = (header[KIN_TYPE] as u64, kinetics.types);
+        let count = self.read_kin(KIN_CURSOR as u64, 1)[0] as usize;
         if count > 0 {
-            let words = self.read_kin(header[8] as u64, (EVENT_WORDS * count) as u64);
+            let words = self.read_kin(header[KIN_EVENTS] as u64, (KIN_EVENT_WORDS * count) as u64);
             let formed = self.formed_records(&words);
-            for e in words.chunks_exact(EVENT_WORDS) {
-                let kind = [EventKind::Break, EventKind::Rebind, EventKind::Form][e[3] as usize - 1];
+            for e in words.chunks_exact(KIN_EVENT_WORDS) {
+                let kind = match e[3] {
+                    EVENT_BREAK => EventKind::Break,
+                    EVENT_REBIND => EventKind::Rebind,
+                    EVENT_FORM => EventKind::Form,
+                    other => unreachable!("event kind {other} from the device"),
+                };
                 let bond = e[2] as usize;
                 out.events.push(DeviceEvent {
                     step: (e[1] as u64) << 32 | e[0] as u64,
@@ -310,13 +311,13 @@ impl GpuBackend {
                     age: f64::from_bits((e[6] as u64) << 32 | e[7] as u64),
                 });
             }
-            self.write_kin(CURSOR as u64, &[0]);
+            self.write_kin(KIN_CURSOR as u64, &[0]);
         }
-        let records = self.read_kin(types_at, (TYPE_WORDS * types) as u64);
-        for (t, r) in records.chunks_exact(TYPE_WORDS).enumerate() {
-            if r[1] == 1 && r[2] != NONE {
+        let records = self.read_kin(types_at, (KIN_TYPE_WORDS * types) as u64);
+        for (t, r) in records.chunks_exact(KIN_TYPE_WORDS).enumerate() {
+            if r[1] == 1 && r[2] != KIN_NONE {
                 out.coarse.push((t, (r[4] as u64) << 32 | r[3] as u64, f32::from_bits(r[5]) as f64));
-                self.write_kin(types_at + (TYPE_WORDS * t) as u64 + 2, &[NONE]);
+                self.write_kin(types_at + (KIN_TYPE_WORDS * t) as u64 + 2, &[KIN_NONE]);
             }
         }
         out
@@ -329,8 +330,8 @@ impl GpuBackend {
         let Some(kinetics) = self.device_kinetics() else { return };
         let formed = bonds.len().saturating_sub(kinetics.bond_base as usize).min((kinetics.records - kinetics.pool_first) as usize);
         let n = kinetics.own_bonds.len() as u64 + formed as u64;
-        let bound = self.read_kin(kinetics.header[1] as u64, n);
-        let ages = self.read_kin(kinetics.header[2] as u64, 2 * n);
+        let bound = self.read_kin(kinetics.header[KIN_BOUND] as u64, n);
+        let ages = self.read_kin(kinetics.header[KIN_AGE] as u64, 2 * n);
         let pool = (0..formed).map(|f| kinetics.bond_base + f as u32);
         for (k, b) in kinetics.own_bonds.iter().copied().chain(pool).enumerate() {
             bonds.bound[b as usize] = bound[k] == 1;
@@ -343,17 +344,17 @@ impl GpuBackend {
     fn formed_records(&self, events: &[u32]) -> impl Fn(usize) -> (u32, [u32; 2]) {
         let kinetics = self.device_kinetics().expect("events come from device kinetics");
         // Formed bonds take consecutive indices, in event order.
-        let formed: Vec<usize> = events.chunks_exact(EVENT_WORDS).filter(|e| e[3] == 3).map(|e| e[2] as usize).collect();
+        let formed: Vec<usize> = events.chunks_exact(KIN_EVENT_WORDS).filter(|e| e[3] == EVENT_FORM).map(|e| e[2] as usize).collect();
         let first = formed.first().copied().unwrap_or(0);
         let records = match formed.last() {
             Some(&last) => self.read_kin(
-                kinetics.header[0] as u64 + BOND_WORDS as u64 * kinetics.pool_record(first),
-                (BOND_WORDS * (last - first + 1)) as u64,
+                kinetics.header[KIN_BONDS] as u64 + KIN_BOND_WORDS as u64 * kinetics.pool_record(first),
+                (KIN_BOND_WORDS * (last - first + 1)) as u64,
             ),
             None => Vec::new(),
         };
         move |bond: usize| {
-            let r = &records[BOND_WORDS * (bond - first)..];
+            let r = &records[KIN_BOND_WORDS * (bond - first)..];
             (r[2], [r[0], r[1]])
         }
     }

@@ -1,12 +1,16 @@
 //! The GPU backend (wgpu, Vulkan; WGSL kernels in `shaders/`).
 //!
 //! - [`context`]: adapter choice (`device gpu|auto`), limits for ≥ 10⁶ particles.
-//! - [`shader`]: the program composed from `shaders/common/` and one
-//!   evaluator file per interaction type, validated by naga.
+//! - [`shader`]: the program composed from `shaders/common/`, one
+//!   evaluator file per interaction type and per kinetic rule with a device
+//!   form (`src/kinetics/NAME.wgsl`), validated by naga.
+//! - `prelude`: the constants the host and the kernels share (buffer layouts,
+//!   halt bits, record sizes, physics constants), written once
+//!   in Rust and generated into the program.
 //! - [`custom`]: evaluators generated from a model's `custom` expressions.
 //! - [`pack`]: the model flattened into the buffers the kernels read.
 //! - [`backend`]: buffers, pipelines and the GPU-resident step loop.
-//! - [`nlist`]: the neighbour list's buffer, bound in chunks of particles
+//! - `nlist`: the neighbour list's buffer, bound in chunks of particles
 //!   where it exceeds the adapter's largest storage binding.
 //! - [`surface`]: surface (body) terms: face, body, edge and node passes,
 //!   deterministic (no float atomics).
@@ -18,7 +22,7 @@
 //!   compacted in bond order and drained by the host at synchronisations.
 //! - [`bind`]: `bind` formation on the device: candidates from the GPU
 //!   neighbour list, accepted in the CPU's order into a preallocated pool.
-//! - [`special`]: pairs of bonded neighbours with a fractional
+//! - `special`: pairs of bonded neighbours with a fractional
 //!   `special_bonds` weight, each particle's own list.
 //! - [`tetra`]: volume elements (`[ tetrahedra ]`): one pass per element
 //!   into corner slots, gathered per particle.
@@ -60,7 +64,9 @@
 //!
 //! Not on the GPU (refused by [`GpuBackend::new`], and by `device gpu`
 //! before a run; `device auto` falls back to the CPU): custom surface terms
-//! of bodies, which have no kernel yet; the implicit
+//! of bodies, which have no kernel yet; pairs through several periodic
+//! images (a periodic edge shorter than 2·(pair cutoff + skin), walked by
+//! the CPU's list, `neighbor::ImageShifts`); the implicit
 //! step of the models [`implicit::refusal`] names; constraints where
 //! [`shake::refusal`] names why. Bond kinetics
 //! are decided on the device for the rules [`kinetics`] ports, else on the
@@ -92,6 +98,7 @@ mod implicit_split;
 pub mod kinetics;
 mod nlist;
 pub mod pack;
+mod prelude;
 pub mod protocol;
 pub mod shader;
 pub mod shake;

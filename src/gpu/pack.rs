@@ -13,7 +13,7 @@
 //!   nodes), at `surface_offsets`.
 //!
 //! - `topo` also holds each particle's partners of fractional
-//!   `special_bonds` weight ([`super::special`]), at `special_offsets`.
+//!   `special_bonds` weight (`special.rs`), at `special_offsets`.
 //! - `topo` and `fparams` also hold the volume elements' sections of
 //!   [`super::tetra::TetraPack`] (elements, each particle's corner slots;
 //!   rest shapes), at `tetra_offsets`.
@@ -35,8 +35,7 @@ use crate::neighbor::Exclusions;
 use crate::system::BondState;
 use crate::system::{Model, SimBox};
 
-/// Parameter slots per term on the GPU.
-pub const PARAM_SLOTS: usize = 8;
+pub use super::prelude::pack::PARAM_SLOTS;
 
 /// The uniform block (must match `Params` in layout.wgsl).
 #[repr(C)]

@@ -37,6 +37,7 @@ use std::fmt::Write;
 use glam::DVec3;
 
 use super::pack::FixedPoint;
+use super::prelude::protocol::*;
 use crate::expr::wgsl::wgsl;
 use crate::expr::Expr;
 use crate::system::{BondState, Model};
@@ -44,9 +45,6 @@ use crate::system::{BondState, Model};
 /// Rows of the device's ramp table: the longest chunk of a call with ramps
 /// or driven indenters (a drive's table has one row more).
 pub const RAMP_ROWS: u64 = 1024;
-
-/// Words of a driven indenter's record (protocol.wgsl).
-const DRIVE_WORDS: usize = 16;
 
 /// The index of each kind's first term in pack's order: bond types, angle
 /// types, pair rules, externals, body rules.

@@ -32,19 +32,39 @@
 //! declares one constant per schema entry, `NAME_PARAM` in upper case with
 //! its schema index ([`param_constants`]: `const HARMONIC_K: u32 = 0u;`,
 //! `const HARMONIC_R0: u32 = 1u;`), so `harmonic.wgsl` writes `p[HARMONIC_K]`.
-//! A test refuses any `p[<digit>` in `shaders/interactions/`. (A new
-//! evaluator, e.g. a volume element's, follows the same rule.)
+//! A test refuses any `p[<digit>` in `shaders/interactions/` and in the
+//! kinetic rules' files. (A new evaluator, e.g. a volume element's, follows
+//! the same rule.)
+//!
+//! Kinetic rules decided on the device (src/gpu/kinetics.rs) are
+//! dispatched the same way: each rule with a [`GpuForm`] has its evaluator
+//! beside it (`src/kinetics/NAME.wgsl`, defining `NAME_rate`,
+//! `NAME_beyond` or `NAME_on_rate`), preceded by its parameter names
+//! (`const CATCH_SLIP_KC0: u32 = 0u;`); the generated `rule_form`,
+//! `unbind_law`, `threshold_law` and `rebind_law` switch on the rule's code,
+//! its registry index + 1 ([`rule_code`]), which the host writes into the
+//! kinetics buffer. No list of rule names exists outside [`RULES`].
+//!
+//! The program starts with its prelude: every constant the host and the
+//! kernels share, generated from its Rust definition (src/gpu/prelude.rs).
+//! Geometry both sides compute (the closest point of a triangle) has its WGSL
+//! twin beside the Rust, in `src/mesh.wgsl`.
 
 use std::fmt::Write;
 
 use super::custom::CustomSource;
-use crate::interactions::{Interaction, Law, SurfaceGpu, REGISTRY};
+use super::prelude::TABLES;
+use crate::interactions::{Entry, Law, SurfaceGpu, REGISTRY};
+use crate::kinetics::{rule_index, GpuForm, KineticRule, RULES};
 
 mod embedded {
     include!(concat!(env!("OUT_DIR"), "/shaders.rs"));
 }
 
-pub use embedded::{COMMON_SHADERS, INTERACTION_SHADERS};
+pub use embedded::{COMMON_SHADERS, INTERACTION_SHADERS, KINETIC_SHADERS};
+
+/// The WGSL twins of the mesh geometry the kernels need, beside src/mesh.rs.
+const MESH_SHADER: &str = include_str!("../mesh.wgsl");
 
 /// The common files in the order they must appear (declarations first).
 const COMMON_ORDER: [&str; 19] = [
@@ -76,6 +96,53 @@ fn common(name: &str) -> &'static str {
 /// The evaluator file of a registered interaction type.
 pub fn interaction_source(name: &str) -> Option<&'static str> {
     INTERACTION_SHADERS.iter().find(|(stem, _)| *stem == name).map(|(_, src)| *src)
+}
+
+/// The evaluator file of a registered kinetic rule (src/kinetics/NAME.wgsl).
+pub fn kinetic_source(name: &str) -> Option<&'static str> {
+    KINETIC_SHADERS.iter().find(|(stem, _)| *stem == name).map(|(_, src)| *src)
+}
+
+/// The code of a kinetic rule in the kinetics buffer and the generated
+/// dispatch: its registry index + 1 (0: no rule); None for a rule the device
+/// does not decide.
+pub fn rule_code(rule: &dyn KineticRule) -> Option<u32> {
+    rule.effect().gpu_form().map(|_| rule_index(rule) as u32 + 1)
+}
+
+/// The prelude: one declaration per shared constant.
+fn prelude() -> String {
+    let mut out = String::from("// Generated from the Rust definitions (src/gpu/prelude.rs).\n");
+    TABLES.iter().flat_map(|t| t.iter()).for_each(|c| out.push_str(&c.declaration()));
+    out
+}
+
+/// The device forms' codes and the dispatch of the kinetic rules by code
+/// (see the module doc).
+fn kinetic_dispatch() -> String {
+    let form_name = |form: GpuForm| format!("FORM_{}", form.suffix().to_uppercase());
+    let out: String = GpuForm::ALL.iter().map(|&f| format!("const {}: u32 = {}u;\n", form_name(f), f as u32)).collect();
+    let mut form = String::from("fn rule_form(code: u32) -> u32 {\n    switch code {\n");
+    let mut unbind = String::from("fn unbind_law(code: u32, p: array<f32, 8>, f: f32, kt: f32) -> f32 {\n    switch code {\n");
+    let mut threshold =
+        String::from("fn threshold_law(code: u32, p: array<f32, 8>, force: f32, strain: f32, u: f32) -> Beyond {\n    switch code {\n");
+    let mut rebind = String::from("fn rebind_law(code: u32, p: array<f32, 8>) -> vec2<f32> {\n    switch code {\n");
+    for rule in RULES.iter().copied() {
+        let (Some(gpu), Some(code)) = (rule.effect().gpu_form(), rule_code(rule)) else { continue };
+        let name = rule.name();
+        writeln!(form, "        case {code}u: {{ return {}; }}", form_name(gpu)).unwrap();
+        let (table, call) = match gpu {
+            GpuForm::Unbind => (&mut unbind, format!("{name}_rate(p, f, kt)")),
+            GpuForm::Threshold => (&mut threshold, format!("{name}_beyond(p, force, strain, u)")),
+            GpuForm::Rebind => (&mut rebind, format!("{name}_on_rate(p)")),
+        };
+        writeln!(table, "        case {code}u: {{ return {call}; }}").unwrap();
+    }
+    form.push_str("        default: { return 0u; }\n    }\n}\n");
+    unbind.push_str("        default: { return 0.0; }\n    }\n}\n");
+    threshold.push_str("        default: { return Beyond(false, 0.0); }\n    }\n}\n");
+    rebind.push_str("        default: { return vec2<f32>(0.0); }\n    }\n}\n");
+    out + &form + &unbind + &threshold + &rebind
 }
 
 /// The dispatch functions over the registry (and a model's custom terms).
@@ -140,26 +207,34 @@ pub fn compose() -> String {
     compose_with(&CustomSource::default())
 }
 
-/// The WGSL constants naming an interaction's parameters: `const NAME_PARAM:
-/// u32 = INDEX;` for each entry of its schema (see the module doc).
-pub fn param_constants(interaction: &dyn Interaction) -> String {
-    let prefix = interaction.name().to_uppercase();
-    let lines = interaction.params().iter().enumerate().map(|(k, p)| format!("const {prefix}_{}: u32 = {k}u;\n", p.name.to_uppercase()));
+/// The WGSL constants naming an interaction's (or a kinetic rule's)
+/// parameters: `const NAME_PARAM: u32 = INDEX;` for each entry of its schema
+/// (see the module doc).
+pub fn param_constants(entry: &dyn Entry) -> String {
+    let prefix = entry.name().to_uppercase();
+    let lines = entry.params().iter().enumerate().map(|(k, p)| format!("const {prefix}_{}: u32 = {k}u;\n", p.name.to_uppercase()));
     lines.collect()
 }
 
 /// The whole program, with a model's generated custom evaluators.
 pub fn compose_with(custom: &CustomSource) -> String {
-    let mut program = String::new();
+    let mut program = prelude();
     for name in &COMMON_ORDER[..2] {
         program.push_str(common(name));
     }
+    program.push_str(MESH_SHADER);
     for interaction in REGISTRY.iter().filter(|i| i.law().runs_on_gpu()) {
         let source = interaction_source(interaction.name())
             .unwrap_or_else(|| panic!("interaction `{}` has no shaders/interactions/{0}.wgsl", interaction.name()));
         program.push_str(&param_constants(*interaction));
         program.push_str(source);
     }
+    for rule in RULES.iter().filter(|r| r.effect().gpu_form().is_some()) {
+        let source = kinetic_source(rule.name()).unwrap_or_else(|| panic!("kinetic rule `{}` has no src/kinetics/{0}.wgsl", rule.name()));
+        program.push_str(&param_constants(*rule));
+        program.push_str(source);
+    }
+    program.push_str(&kinetic_dispatch());
     program.push_str(&custom.functions);
     writeln!(program, "const BODY_TERMS: bool = {};", custom.body_terms).unwrap();
     writeln!(program, "const CONTACT_TERMS: bool = {};", custom.contact_terms).unwrap();
@@ -234,7 +309,7 @@ mod tests {
     /// Evaluators read parameters by their generated names: no `p[0]`.
     #[test]
     fn shaders_index_parameters_by_name_only() {
-        for (stem, source) in INTERACTION_SHADERS {
+        for (stem, source) in INTERACTION_SHADERS.iter().chain(KINETIC_SHADERS) {
             let bare = source.match_indices("p[").any(|(at, _)| {
                 let before = source[..at].chars().next_back();
                 let after = source[at + 2..].chars().next();
@@ -247,6 +322,41 @@ mod tests {
             "const HARMONIC_K: u32 = 0u;\nconst HARMONIC_R0: u32 = 1u;\n"
         );
         assert!(compose().contains("const FENE_SIGMA: u32 = 3u;\n"));
+    }
+
+    /// One evaluator file beside each kinetic rule the device decides,
+    /// defining the function of its form, and none for the others; each is
+    /// dispatched by its code.
+    #[test]
+    fn every_device_rule_has_exactly_one_shader_file_and_no_other_has_one() {
+        let program = compose();
+        for rule in RULES {
+            let name = rule.name();
+            match rule.effect().gpu_form() {
+                Some(form) => {
+                    let source = kinetic_source(name).unwrap_or_else(|| panic!("{name} has no src/kinetics/{name}.wgsl"));
+                    assert!(source.contains(&format!("fn {name}_{}(", form.suffix())), "{name}.wgsl lacks fn {name}_{}", form.suffix());
+                    let code = rule_code(*rule).unwrap();
+                    assert!(program.contains(&format!("case {code}u: {{ return {name}_{}(", form.suffix())), "{name} is not dispatched");
+                }
+                None => {
+                    assert!(kinetic_source(name).is_none(), "src/kinetics/{name}.wgsl exists, but the device does not decide its effect")
+                }
+            }
+        }
+        for (stem, _) in KINETIC_SHADERS {
+            assert!(crate::kinetics::lookup_rule(stem).is_some(), "src/kinetics/{stem}.wgsl names no registered rule");
+        }
+        assert!(program.contains("const CATCH_SLIP_KC0: u32 = 0u;\n"));
+    }
+
+    /// Each shared constant is declared once, by the prelude.
+    #[test]
+    fn prelude_names_are_unique() {
+        let mut seen = std::collections::HashSet::new();
+        for c in TABLES.iter().flat_map(|t| t.iter()) {
+            assert!(seen.insert(c.name), "{} is in two tables", c.name);
+        }
     }
 
     #[test]

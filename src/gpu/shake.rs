@@ -48,6 +48,7 @@
 use wgpu::util::DeviceExt;
 
 use super::context::GpuContext;
+use super::prelude::shake::*;
 use super::side_group::SideGroup;
 use crate::integrate::constraints::{failure_message, ConstraintMethod, Constraints};
 use crate::integrate::fibre::chains::Chains;
@@ -132,23 +133,23 @@ impl DeviceShake {
         order.sort_by_key(|&k| (color[k], k));
         let mut header = vec![0u32; HEADER_WORDS];
         let mut words = Vec::new();
-        header[0] = constraints.list.len() as u32;
-        header[1] = n_colors;
-        header[2] = HEADER_WORDS as u32;
+        header[SH_COUNT] = constraints.list.len() as u32;
+        header[SH_COLORS] = n_colors;
+        header[SH_OFF_COLOR_START] = HEADER_WORDS as u32;
         words.extend((0..=n_colors).map(|c| order.iter().filter(|&&k| color[k] < c).count() as u32));
-        header[3] = (HEADER_WORDS + words.len()) as u32;
+        header[SH_OFF_RECORDS] = (HEADER_WORDS + words.len()) as u32;
         for &k in &order {
             let c = constraints.list[k];
             let [i, j] = model.bonds[c.bond];
             words.extend([i, j, (c.length as f32).to_bits(), k as u32]);
         }
-        header[4] = constraints.max_iterations.max(1).min(u32::MAX as usize) as u32;
-        header[5] = (tolerance as f32).to_bits();
+        header[SH_MAX_SWEEPS] = constraints.max_iterations.max(1).min(u32::MAX as usize) as u32;
+        header[SH_TOLERANCE] = (tolerance as f32).to_bits();
         let mut particles: Vec<u32> = constraints.list.iter().flat_map(|c| model.bonds[c.bond]).collect();
         particles.sort_unstable();
         particles.dedup();
-        header[6] = (HEADER_WORDS + words.len()) as u32;
-        header[7] = particles.len() as u32;
+        header[SH_OFF_PARTICLES] = (HEADER_WORDS + words.len()) as u32;
+        header[SH_PARTICLES] = particles.len() as u32;
         words.extend(&particles);
         let topo: Vec<u32> = header.into_iter().chain(words).collect();
         let device = &ctx.device;

@@ -19,7 +19,7 @@ pub fn pack_special(model: &Model, bound: Option<&[bool]>) -> (Vec<u32>, Vec<u32
             rows[i as usize].extend([j, (w as f32).to_bits()]);
             rows[j as usize].extend([i, (w as f32).to_bits()]);
         }
-        rows.iter_mut().for_each(|row| sort_pairs(row));
+        rows.iter_mut().for_each(sort_pairs);
     }
     let (mut offsets, mut flat) = (Vec::new(), Vec::new());
     push_csr(&rows, &mut offsets, &mut flat);

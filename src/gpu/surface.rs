@@ -38,19 +38,14 @@
 //! slot (force); per body node (∂E/∂M, ∂E/∂A); per body node (energy in w).
 
 use super::pack::push_csr;
+use super::prelude::surface::*;
 use crate::interactions::{Law, SurfaceGpu};
 use crate::system::Model;
-
-/// Words per face record: corners, body, the corners' body nodes (or
-/// `u32::MAX` without a curvature law), padding.
-const FACE_WORDS: usize = 8;
-/// Words per edge record: ends, wings (particles), the ends' body nodes, body, padding.
-const EDGE_WORDS: usize = 8;
 
 /// The surface sections of the GPU topology.
 #[derive(Default)]
 pub struct SurfacePack {
-    /// Face records ([`FACE_WORDS`]); faces of a body contiguous.
+    /// Face records (`FACE_WORDS`); faces of a body contiguous.
     pub faces: Vec<u32>,
     /// Body b's faces are `body_faces[b]..body_faces[b + 1]`.
     pub body_faces: Vec<u32>,
@@ -61,7 +56,7 @@ pub struct SurfacePack {
     /// Particle i's `surf` entries are `node_slots[node_slot_offsets[i]..node_slot_offsets[i + 1]]`.
     pub node_slot_offsets: Vec<u32>,
     pub node_slots: Vec<u32>,
-    /// Edge records ([`EDGE_WORDS`]) of the bodies with a curvature law.
+    /// Edge records (`EDGE_WORDS`) of the bodies with a curvature law.
     pub edges: Vec<u32>,
     /// The packed body of each body node.
     pub node_body: Vec<u32>,
@@ -159,7 +154,7 @@ pub fn pack_surfaces(model: &Model, term_base: usize) -> SurfacePack {
         let packed_body = out.body_ids.len() as u32;
         let curvature = has_curvature(model, &rules);
         let node_base = out.node_body.len() as u32;
-        let body_node = |k: u32| if curvature { node_base + k } else { u32::MAX };
+        let body_node = |k: u32| if curvature { node_base + k } else { NO_NODE };
         let particle = |k: u32| body.nodes[k as usize];
         if curvature {
             out.node_body.extend(std::iter::repeat_n(packed_body, body.nodes.len()));

@@ -19,17 +19,15 @@
 //! surface regions of [`super::surface`].
 
 use super::pack::push_csr;
+use super::prelude::tetra::*;
 use crate::system::Model;
-
-/// Words of an element record in `topo` (tetra.wgsl's `TETRA_WORDS`).
-const TETRA_WORDS: usize = 5;
 
 /// The volume elements' sections of the GPU buffers.
 #[derive(Default)]
 pub struct TetraPack {
     /// Per element: its four corners (particles) and its term.
     pub elements: Vec<u32>,
-    /// Per element: D_m⁻¹ by columns, then V_0 (tetra.wgsl's `TETRA_REST_FLOATS`).
+    /// Per element: D_m⁻¹ by columns, then V_0 (TETRA_REST_FLOATS).
     pub rest: Vec<f32>,
     /// CSR by particle (n + 1 offsets) of its corner slots' `surf` indices.
     pub slot_offsets: Vec<u32>,

@@ -6,12 +6,20 @@
 //! process environment as a topology echoes one clipped word and line of it,
 //! never more of the file, and an error at column 10⁶ of a 1 MB line renders
 //! as quickly and as narrowly as one at column 1.
+//!
+//! Files named by another input (topologies, force fields, `include`s) show
+//! even less until their first word is accepted: an error at that word, or
+//! on its line, shows no line and quotes none of it (`/etc/shadow` named as
+//! a topology is "not shown: it does not read as a cellmd input"). And no
+//! diagnostic prints a control character or a bidirectional-text control
+//! raw: the shown line has `?` (or `¿`, `�`: the same number of bytes) in
+//! their place, a message their `\u{…}` escape.
 
 use std::fmt;
 
 use miette::{Diagnostic, LabeledSpan, MietteError, MietteSpanContents, SourceCode, SourceSpan, SpanContents};
 
-use super::lexer::{SourceFile, Token};
+use super::lexer::{is_unprintable, SourceFile, Token};
 
 /// Characters of the offending line an error shows, at most.
 pub const SNIPPET_CHARS: usize = 80;
@@ -27,7 +35,7 @@ pub struct InputError {
     pub line: u32,
     pub col: u32,
     pub message: String,
-    snippet: Option<Snippet>,
+    snippet: Option<Box<Snippet>>,
 }
 
 /// The clipped line an error shows, with the span it underlines (byte
@@ -56,13 +64,27 @@ impl Snippet {
         let skipped = text[line_start..lead].chars().count();
         Self {
             path: file.path.clone(),
-            text: text[lead..end].to_string(),
+            text: printable_line(&text[lead..end]),
             start: lead,
             line: line as usize - 1,
             col: skipped,
             label: (offset, label_end - offset),
         }
     }
+}
+
+/// `line` with each character a terminal must not get raw replaced by one
+/// of the same UTF-8 length, so byte offsets into the line still hold.
+fn printable_line(line: &str) -> String {
+    line.chars().map(|c| if is_unprintable(c) { ['?', '¿', '�', '�'][c.len_utf8() - 1] } else { c }).collect()
+}
+
+/// `message` with each character a terminal must not get raw escaped.
+fn printable_message(message: String) -> String {
+    if !message.chars().any(is_unprintable) {
+        return message;
+    }
+    message.chars().map(|c| if is_unprintable(c) { c.escape_unicode().to_string() } else { c.to_string() }).collect()
 }
 
 fn floor_char_boundary(text: &str, mut i: usize) -> usize {
@@ -100,28 +122,43 @@ fn clip_quotes(message: String) -> String {
     clipped.join("`")
 }
 
+/// Whether an error at `offset` of `file` falls where the file has not yet
+/// shown itself to be a cellmd input (see [`SourceFile::unrecognised`]).
+fn unrecognised(file: &SourceFile, offset: usize) -> bool {
+    file.unrecognised.is_some_and(|(_, line_end)| offset <= line_end)
+}
+
+/// `message` with every backtick quote of the text of `line` replaced by
+/// `…`, and a note why.
+fn without_content(message: String, line: &str) -> String {
+    let parts: Vec<&str> = message.split('`').collect();
+    let hidden: Vec<&str> =
+        parts.iter().enumerate().map(|(i, part)| if i % 2 == 1 && !part.is_empty() && line.contains(part) { "…" } else { part }).collect();
+    format!("{} (the file's first line is not shown: it does not read as a cellmd input)", hidden.join("`"))
+}
+
 impl InputError {
-    /// An error at a token.
+    /// An error at a token. At the first word of a file named by another
+    /// input, nothing of the file is shown (see the module docs).
     pub fn at(token: &Token, message: impl Into<String>) -> Self {
-        Self {
-            path: token.file.path.clone(),
-            line: token.line,
-            col: token.col,
-            message: clip_quotes(message.into()),
-            snippet: Some(Snippet::new(&token.file, token.offset, token.text_len.max(1), token.line)),
-        }
+        let file = &token.file;
+        let (message, snippet) = match file.unrecognised {
+            Some((first, line_end)) if token.offset == first => (without_content(message.into(), &file.text[first..line_end]), None),
+            _ => (message.into(), Some(Box::new(Snippet::new(file, token.offset, token.text_len.max(1), token.line)))),
+        };
+        Self { path: file.path.clone(), line: token.line, col: token.col, message: printable_message(clip_quotes(message)), snippet }
     }
 
     /// An error at a position of a file (used by the lexer).
     pub fn at_offset(file: &SourceFile, offset: usize, message: impl Into<String>) -> Self {
         let (line, col) = file.line_col(offset);
-        let snippet = Some(Snippet::new(file, offset, 1, line));
-        Self { path: file.path.clone(), line, col, message: clip_quotes(message.into()), snippet }
+        let snippet = (!unrecognised(file, offset)).then(|| Box::new(Snippet::new(file, offset, 1, line)));
+        Self { path: file.path.clone(), line, col, message: printable_message(clip_quotes(message.into())), snippet }
     }
 
     /// An error about a whole file (e.g. it cannot be read); reported at 1:1.
     pub fn in_file(path: &str, message: impl Into<String>) -> Self {
-        Self { path: path.to_string(), line: 1, col: 1, message: clip_quotes(message.into()), snippet: None }
+        Self { path: path.to_string(), line: 1, col: 1, message: printable_message(clip_quotes(message.into())), snippet: None }
     }
 }
 
@@ -135,7 +172,7 @@ impl std::error::Error for InputError {}
 
 impl Diagnostic for InputError {
     fn source_code(&self) -> Option<&dyn SourceCode> {
-        self.snippet.as_ref().map(|s| s as &dyn SourceCode)
+        self.snippet.as_deref().map(|s| s as &dyn SourceCode)
     }
 
     fn labels(&self) -> Option<Box<dyn Iterator<Item = LabeledSpan> + '_>> {

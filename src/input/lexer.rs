@@ -4,17 +4,21 @@
 //! file       := physical_line*
 //! line       := blank* (token blank*)* ("#" any*)? EOL
 //! token      := quoted | bare
-//! quoted     := '"' [^"\n]* '"'
+//! quoted     := '"' [^"<control characters but tab>]* '"'
 //! bare       := [^ #"<control characters>]+
+//! comment    := [^<control characters but tab>]*
 //! ```
 //! A statement ends at the end of a line unless its last token is `&`, in
-//! which case it continues on the next line.
+//! which case it continues on the next line. A control character other
+//! than a tab (a NUL of a binary file, a lone carriage return, a terminal
+//! escape `\x1b[…`) is an error wherever it stands, comments and quotes
+//! included, and a diagnostic never shows one raw (see [`super::error`]).
 
 use std::sync::Arc;
 
 use nom::branch::alt;
 use nom::bytes::complete::{tag, take_while, take_while1};
-use nom::character::complete::{char, line_ending, not_line_ending, space0};
+use nom::character::complete::{char, line_ending, space0};
 use nom::combinator::{eof, opt};
 use nom::multi::many0;
 use nom::sequence::{delimited, preceded, terminated};
@@ -31,11 +35,46 @@ type Span<'a> = LocatedSpan<&'a str>;
 pub struct SourceFile {
     pub path: String,
     pub text: String,
+    /// For a file named by another input (a topology, a force field, an
+    /// `include`): the byte offset of its first word and the end of that
+    /// word's line. Until that word is accepted the file may not be a cellmd
+    /// input at all (`/etc/shadow` named as a topology), so an error there
+    /// quotes none of it (see [`InputError::at`]).
+    pub(crate) unrecognised: Option<(usize, usize)>,
+}
+
+/// A character a diagnostic must not print raw: a control character
+/// other than tab and newline, or a bidirectional-text control (which
+/// reorders what a terminal shows).
+pub(crate) fn is_unprintable(c: char) -> bool {
+    (c.is_control() && c != '\t' && c != '\n')
+        || matches!(c, '\u{200e}' | '\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}' | '\u{061c}')
+}
+
+/// Where the first word of `text` starts, and the end of its line.
+fn first_word_line(text: &str) -> (usize, usize) {
+    let mut start = 0;
+    for line in text.split_inclusive('\n') {
+        let body = line.trim_end_matches(['\n', '\r']);
+        if let Some(k) = body.find(|c: char| c != ' ' && c != '\t') {
+            if !body[k..].starts_with('#') {
+                return (start + k, start + body.len());
+            }
+        }
+        start += line.len();
+    }
+    (text.len(), text.len())
 }
 
 impl SourceFile {
     pub fn new(path: impl Into<String>, text: impl Into<String>) -> Arc<Self> {
-        Arc::new(Self { path: path.into(), text: text.into() })
+        Arc::new(Self { path: path.into(), text: text.into(), unrecognised: None })
+    }
+
+    /// A file named by another input (see [`Self::unrecognised`]).
+    fn named(path: String, text: String) -> Arc<Self> {
+        let unrecognised = Some(first_word_line(&text));
+        Arc::new(Self { path, text, unrecognised })
     }
 
     /// Reads a file (see [`read_input_file`]); a missing, unreadable,
@@ -58,7 +97,8 @@ impl SourceFile {
                 Err(e) => {
                     let valid = e.utf8_error().valid_up_to();
                     let byte = e.as_bytes()[valid];
-                    let prefix = Self::new(shown, String::from_utf8_lossy(&e.as_bytes()[..valid]).into_owned());
+                    let text = String::from_utf8_lossy(&e.as_bytes()[..valid]).into_owned();
+                    let prefix = if requested_by.is_some() { Self::named(shown, text) } else { Self::new(shown, text) };
                     return Err(InputError::at_offset(
                         &prefix,
                         valid,
@@ -68,7 +108,7 @@ impl SourceFile {
             },
         };
         super::sources::note(&shown, &text);
-        Ok(Self::new(shown, text))
+        Ok(if requested_by.is_some() { Self::named(shown, text) } else { Self::new(shown, text) })
     }
 
     /// 1-based line and column (in characters) of a byte offset.
@@ -129,8 +169,13 @@ impl Statement {
     }
 }
 
+/// What may stand in quotes and comments: anything but control characters (tab is fine).
+fn printable(c: char) -> bool {
+    c == '\t' || !c.is_control()
+}
+
 fn quoted(input: Span) -> IResult<Span, Span> {
-    delimited(char('"'), take_while(|c| c != '"' && c != '\n'), char('"')).parse(input)
+    delimited(char('"'), take_while(|c| c != '"' && printable(c)), char('"')).parse(input)
 }
 
 /// Control characters (a NUL of a binary file, a lone carriage return)
@@ -144,9 +189,45 @@ fn token(input: Span) -> IResult<Span, (Span, bool)> {
     alt((quoted.map(|s| (s, true)), bare.map(|s| (s, false)))).parse(input)
 }
 
-/// Tokens of one physical line, then the optional comment (not the line end).
-fn physical_line(input: Span) -> IResult<Span, Vec<(Span, bool)>> {
-    terminated(preceded(space0, many0(terminated(token, space0))), opt(preceded(tag("#"), not_line_ending))).parse(input)
+/// Tokens of one physical line, then the optional comment (not the line
+/// end), and whether there was one.
+fn physical_line(input: Span) -> IResult<Span, (Vec<(Span, bool)>, bool)> {
+    (preceded(space0, many0(terminated(token, space0))), opt(preceded(tag("#"), take_while(printable))))
+        .map(|(words, comment)| (words, comment.is_some()))
+        .parse(input)
+}
+
+/// Why a line stops short of its end at `after` (its first unread character).
+fn stopped_at(file: &Arc<SourceFile>, after: Span, in_comment: bool) -> InputError {
+    let rest = *after.fragment();
+    let found = rest.chars().next().unwrap_or(' ');
+    let control = |what: &str, c: char, offset: usize| {
+        InputError::at_offset(
+            file,
+            offset,
+            format!(
+                "found control character `{}` {what}; expected printable text (control characters other than tab are an error)",
+                c.escape_unicode()
+            ),
+        )
+    };
+    if found == '"' {
+        let body = &rest[1..];
+        if let Some((k, c)) = body.char_indices().find(|&(_, c)| c == '"' || !printable(c)) {
+            if c != '"' && c != '\n' && !body[k..].starts_with("\r\n") {
+                return control("inside quotes", c, after.location_offset() + 1 + k);
+            }
+        }
+        return InputError::at_offset(
+            file,
+            after.location_offset(),
+            "unterminated quoted string; expected a closing `\"` on the same line",
+        );
+    }
+    if in_comment {
+        return control("in a comment", found, after.location_offset());
+    }
+    InputError::at_offset(file, after.location_offset(), format!("unexpected `{}`; expected a blank-separated word", found.escape_debug()))
 }
 
 /// Splits a file into statements.
@@ -178,16 +259,10 @@ impl Iterator for Statements<'_> {
             let input = self.input;
             let line = physical_line(input)
                 .map_err(|_| InputError::at_offset(file, input.location_offset(), "unreadable line; expected blank-separated words"))
-                .and_then(|(after, words)| {
-                    let (after, _) = alt((line_ending, eof)).parse(after).map_err(|_: nom::Err<nom::error::Error<Span>>| {
-                        let found = after.fragment().chars().next().unwrap_or(' ');
-                        let message = if found == '"' {
-                            "unterminated quoted string; expected a closing `\"` on the same line".to_string()
-                        } else {
-                            format!("unexpected `{}`; expected a blank-separated word", found.escape_debug())
-                        };
-                        InputError::at_offset(file, after.location_offset(), message)
-                    })?;
+                .and_then(|(after, (words, comment))| {
+                    let (after, _) = alt((line_ending, eof))
+                        .parse(after)
+                        .map_err(|_: nom::Err<nom::error::Error<Span>>| stopped_at(file, after, comment))?;
                     Ok((after, words))
                 });
             let (after, words) = match line {

@@ -3,7 +3,7 @@
 //! All three are line-oriented: one statement per line, `#` starts a comment,
 //! a trailing `&` continues a statement on the next line, tokens are separated
 //! by blanks, and `"double quoted"` tokens may contain blanks and `#`. The nom
-//! grammar in [`lexer`] turns a file into [`Statement`]s of [`Token`]s that
+//! grammar in `lexer` turns a file into [`Statement`]s of [`Token`]s that
 //! remember their `line:col`, and every later error is an [`InputError`]
 //! pointing at the offending token (`file:line:col: message`). Files are read
 //! by [`read_input_file`]: regular files of at most [`MAX_INPUT_BYTES`]. Every

@@ -84,7 +84,15 @@ pub struct ConstraintFailure {
 
 impl Default for Constraints {
     fn default() -> Self {
-        Self { list: Vec::new(), tolerance: 1e-10, max_iterations: 1000, tension: Vec::new(), iterations: 0, method: ConstraintMethod::Fibre, fibres: Fibres::default() }
+        Self {
+            list: Vec::new(),
+            tolerance: 1e-10,
+            max_iterations: 1000,
+            tension: Vec::new(),
+            iterations: 0,
+            method: ConstraintMethod::Fibre,
+            fibres: Fibres::default(),
+        }
     }
 }
 
@@ -104,7 +112,8 @@ impl Constraints {
         self.fibres.prepare(model, self.list.iter().map(|c| c.bond), self.method == ConstraintMethod::Fibre, false);
         let list = &self.list;
         let length = |k: usize| list[k].length;
-        let inputs = FibreInputs { model, positions: &state.positions, images: &images, constraint_length: &length, held: &[], bond_block: None };
+        let inputs =
+            FibreInputs { model, positions: &state.positions, images: &images, constraint_length: &length, held: &[], bond_block: None };
         self.fibres.load(&inputs);
         let before = state.positions.clone();
         let projected = self.project(model, &before, state, sim_box, &StepContext { dt: 1.0, ..Default::default() });

@@ -90,6 +90,7 @@ pub fn clamp_fraction(moves: &[DVec3], limits: &[f64]) -> f64 {
 /// with the refusal check, then the commit; with `limits`, one more before
 /// them for s, which draws the noise again rather than storing it (the
 /// stream is counter-based, so the draw is the same).
+#[allow(clippy::too_many_arguments)]
 pub fn overdamped_step(
     model: &Model,
     state: &mut State,

@@ -49,14 +49,24 @@ struct GeneralConstraints {
 }
 
 impl GeneralConstraints {
-    fn new(constrained: &ConstrainedBonds, chained: &[bool], mobile: &[bool], dinv: &[f64], positions: &[DVec3], sim_box: &SimBox) -> Result<Self, ImplicitError> {
+    fn new(
+        constrained: &ConstrainedBonds,
+        chained: &[bool],
+        mobile: &[bool],
+        dinv: &[f64],
+        positions: &[DVec3],
+        sim_box: &SimBox,
+    ) -> Result<Self, ImplicitError> {
         let images = sim_box.images();
         let rows: Vec<(usize, usize, DVec3)> = constrained
             .pairs
             .iter()
-            .map(|&[i, j]| (i as usize, j as usize, images.minimum_image(positions[j as usize] - positions[i as usize]).normalize_or_zero()))
+            .map(|&[i, j]| {
+                (i as usize, j as usize, images.minimum_image(positions[j as usize] - positions[i as usize]).normalize_or_zero())
+            })
             .collect();
-        let active: Vec<bool> = rows.iter().enumerate().map(|(k, &(i, j, _))| (mobile[i] || mobile[j]) && !chained.get(k).copied().unwrap_or(false)).collect();
+        let active: Vec<bool> =
+            rows.iter().enumerate().map(|(k, &(i, j, _))| (mobile[i] || mobile[j]) && !chained.get(k).copied().unwrap_or(false)).collect();
         let m = rows.len();
         if !active.iter().any(|&a| a) {
             return Ok(Self { rows, active, schur: None });
@@ -76,7 +86,8 @@ impl GeneralConstraints {
                 }
             }
         }
-        let schur = SparseColMat::<usize, f64>::try_new_from_triplets(m, m, &triplets).map_err(|e| ImplicitError::Solve(format!("{e:?}")))?;
+        let schur =
+            SparseColMat::<usize, f64>::try_new_from_triplets(m, m, &triplets).map_err(|e| ImplicitError::Solve(format!("{e:?}")))?;
         let schur = schur.sp_cholesky(Side::Lower).map_err(|e| ImplicitError::Solve(format!("constraint matrix JD⁻¹Jᵀ: {e:?}")))?;
         Ok(Self { rows, active, schur: Some(schur) })
     }

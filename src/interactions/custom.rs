@@ -115,7 +115,7 @@ impl CustomLaw {
             }
         }
         for (index, d) in declared.iter().enumerate() {
-            if !energy.depends_on(&d.name) && !(kind == Kind::Pair && index == 0) {
+            if !(energy.depends_on(&d.name) || kind == Kind::Pair && index == 0) {
                 return Err(CustomError::Parameter {
                     index,
                     message: format!("parameter `{}` is not used in the expression; expected every declared parameter in it", d.name),
@@ -298,9 +298,12 @@ mod tests {
     /// F = −∇E, Σf = 0, Σr×f = 0, rigid-motion invariance, E″ against
     /// differences of E′ and the force-only path against `eval`, for radial laws
     /// of several shapes (piecewise ones included, away from their kinks).
+    /// A custom law's kind, energy expression and parameters.
+    type Case<'a> = (Kind, &'a str, &'a [(&'a str, f64)]);
+
     #[test]
     fn shared_checks_on_radial_expressions() {
-        let cases: [(Kind, &str, &[(&str, f64)]); 6] = [
+        let cases: [Case; 6] = [
             (Kind::Bond, "0.5*k*(r-r0)^2", &[("k", 40.0), ("r0", 0.3)]),
             (Kind::Bond, "-0.5*k*R^2*ln(1-(r/R)^2)", &[("k", 30.0), ("R", 1.5)]),
             (Kind::Bond, "k*(r>r0)*(r-r0)^3 + e*exp(-r)", &[("k", 5.0), ("r0", 0.5), ("e", 0.1)]),

@@ -5,12 +5,14 @@
 //! [`documentation`] of either kind of entry, and the force-field parser
 //! checks `name value` pairs against [`Entry::params`] for both.
 //!
+//! The schema is a list of [`ParamSpec`]s (name, unit, allowed range with
+//! its [`Bound`]s, default, doc), defined here for both registries.
+//!
 //! [`entry!`] implements the trait for a unit struct; the registries' own
 //! macros (`interaction!`, `kinetic_rule!`) call it and add what their kind
 //! of entry has beyond it (a law, an effect).
 
-use super::ParamSpec;
-use crate::units::UnitSystem;
+use crate::units::{Dim, UnitSystem};
 
 /// An entry of a registry (an interaction type or a kinetic rule).
 pub trait Entry: Sync + Send {
@@ -81,3 +83,92 @@ macro_rules! entry {
     };
 }
 pub(crate) use entry;
+
+/// Inclusive/exclusive numeric bound of a parameter.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Bound {
+    None,
+    Inclusive(f64),
+    Exclusive(f64),
+}
+
+/// One named, documented parameter of an interaction type.
+#[derive(Clone, Copy, Debug)]
+pub struct ParamSpec {
+    pub name: &'static str,
+    pub dim: Dim,
+    pub min: Bound,
+    pub max: Bound,
+    /// `None` means the parameter is required.
+    pub default: Option<f64>,
+    pub doc: &'static str,
+}
+
+impl ParamSpec {
+    /// A required parameter with no bounds; refine with the builder methods.
+    pub const fn new(name: &'static str, dim: Dim, doc: &'static str) -> Self {
+        Self { name, dim, min: Bound::None, max: Bound::None, default: None, doc }
+    }
+    pub const fn positive(mut self) -> Self {
+        self.min = Bound::Exclusive(0.0);
+        self
+    }
+    pub const fn non_negative(mut self) -> Self {
+        self.min = Bound::Inclusive(0.0);
+        self
+    }
+    pub const fn at_most(mut self, max: f64) -> Self {
+        self.max = Bound::Inclusive(max);
+        self
+    }
+    pub const fn below(mut self, max: f64) -> Self {
+        self.max = Bound::Exclusive(max);
+        self
+    }
+    pub const fn default(mut self, value: f64) -> Self {
+        self.default = Some(value);
+        self
+    }
+
+    /// Checks a value against the range; the error says what was expected.
+    pub fn check(&self, value: f64) -> Result<(), String> {
+        if !value.is_finite() {
+            return Err(format!("a finite number for `{}`, found {value}", self.name));
+        }
+        let low_ok = match self.min {
+            Bound::None => true,
+            Bound::Inclusive(m) => value >= m,
+            Bound::Exclusive(m) => value > m,
+        };
+        let high_ok = match self.max {
+            Bound::None => true,
+            Bound::Inclusive(m) => value <= m,
+            Bound::Exclusive(m) => value < m,
+        };
+        if low_ok && high_ok {
+            Ok(())
+        } else {
+            Err(format!("`{}` {}, found {value}", self.name, self.range_text()))
+        }
+    }
+
+    /// The allowed range in words, e.g. `> 0` or `in [0, 1]`.
+    pub fn range_text(&self) -> String {
+        // (bracket, comparison, value) of each side that is bounded.
+        let lower = match self.min {
+            Bound::None => None,
+            Bound::Inclusive(a) => Some(('[', ">=", a)),
+            Bound::Exclusive(a) => Some(('(', ">", a)),
+        };
+        let upper = match self.max {
+            Bound::None => None,
+            Bound::Inclusive(b) => Some((']', "<=", b)),
+            Bound::Exclusive(b) => Some((')', "<", b)),
+        };
+        match (lower, upper) {
+            (None, None) => "any finite value".into(),
+            (Some((_, op, v)), None) | (None, Some((_, op, v))) => format!("{op} {v}"),
+            (Some((l, _, a)), Some((r, _, b))) => format!("in {l}{a}, {b}{r}"),
+        }
+    }
+}

@@ -13,7 +13,7 @@
 //! NAME` prints [`documentation`] of either.
 //!
 //! Parameters reach an evaluator as a slice in schema order, already checked
-//! against the schema and by [`Interaction::validate`].
+//! against the schema and by [`Entry::validate`].
 //!
 //! Many-body terms of closed surfaces (cell shells) use [`Law::Surface`]: the
 //! evaluator sees one body's whole mesh ([`SurfaceMesh`]) with image-consistent
@@ -40,7 +40,7 @@
 use glam::{DMat3, DVec3};
 
 pub(crate) use self::entry::entry;
-pub use self::entry::{documentation, Entry};
+pub use self::entry::{documentation, Bound, Entry, ParamSpec};
 pub use self::wall::plane as wall_plane;
 pub use crate::hessian::SurfaceHessian;
 pub use crate::mesh::{SurfaceMesh, TetraRest};
@@ -312,7 +312,7 @@ pub enum Law {
     /// (x_j − x_i)·force: what the step loop calls. It is the same
     /// derivative as `eval`'s without the energy and d²E/dr², so it skips
     /// their work (`soft` takes a sine, no cosine), and it takes r² so a law
-    /// that needs no r skips the square root (`wca`, `lj`). [`radial_force!`]
+    /// that needs no r skips the square root (`wca`, `lj`). `radial_force!`
     /// derives it from `eval`: inlined, the unused energy terms are dropped.
     Radial { eval: fn(&[f64], f64) -> Radial, force: fn(&[f64], f64) -> f64, range: fn(&[f64]) -> f64 },
     /// E(r_i, r_j, r_k) for angles; positions are made image-consistent
@@ -345,7 +345,8 @@ pub enum Law {
     /// (s ≡ 0 for d ≥ `range`): a face counts in proportion to how fully all
     /// three corners touch. The CPU backend finds the nearest faces (with the
     /// node–face candidates of [`Law::Contact`]) and adds both the area and
-    /// the distance gradients. No GPU kernel yet.
+    /// the distance gradients; the GPU backend's area-weighted contact passes
+    /// do the same on the device (src/gpu/adhesion.rs).
     ContactArea { switch: fn(&[f64], f64) -> Radial, density: fn(&[f64]) -> f64, range: fn(&[f64]) -> f64 },
     /// E(x_0 … x_3) of one linear tetrahedron with rest shape `TetraRest`;
     /// positions are image-consistent (around x_0). On the GPU its
@@ -495,95 +496,6 @@ pub enum SurfaceGpu {
 pub fn node_face_forces(radial: &Radial, pt: &crate::mesh::PointTriangle) -> [DVec3; 4] {
     let g = radial.de_dr * pt.normal;
     [-g, pt.weights[0] * g, pt.weights[1] * g, pt.weights[2] * g]
-}
-
-/// Inclusive/exclusive numeric bound of a parameter.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Bound {
-    None,
-    Inclusive(f64),
-    Exclusive(f64),
-}
-
-/// One named, documented parameter of an interaction type.
-#[derive(Clone, Copy, Debug)]
-pub struct ParamSpec {
-    pub name: &'static str,
-    pub dim: Dim,
-    pub min: Bound,
-    pub max: Bound,
-    /// `None` means the parameter is required.
-    pub default: Option<f64>,
-    pub doc: &'static str,
-}
-
-impl ParamSpec {
-    /// A required parameter with no bounds; refine with the builder methods.
-    pub const fn new(name: &'static str, dim: Dim, doc: &'static str) -> Self {
-        Self { name, dim, min: Bound::None, max: Bound::None, default: None, doc }
-    }
-    pub const fn positive(mut self) -> Self {
-        self.min = Bound::Exclusive(0.0);
-        self
-    }
-    pub const fn non_negative(mut self) -> Self {
-        self.min = Bound::Inclusive(0.0);
-        self
-    }
-    pub const fn at_most(mut self, max: f64) -> Self {
-        self.max = Bound::Inclusive(max);
-        self
-    }
-    pub const fn below(mut self, max: f64) -> Self {
-        self.max = Bound::Exclusive(max);
-        self
-    }
-    pub const fn default(mut self, value: f64) -> Self {
-        self.default = Some(value);
-        self
-    }
-
-    /// Checks a value against the range; the error says what was expected.
-    pub fn check(&self, value: f64) -> Result<(), String> {
-        if !value.is_finite() {
-            return Err(format!("a finite number for `{}`, found {value}", self.name));
-        }
-        let low_ok = match self.min {
-            Bound::None => true,
-            Bound::Inclusive(m) => value >= m,
-            Bound::Exclusive(m) => value > m,
-        };
-        let high_ok = match self.max {
-            Bound::None => true,
-            Bound::Inclusive(m) => value <= m,
-            Bound::Exclusive(m) => value < m,
-        };
-        if low_ok && high_ok {
-            Ok(())
-        } else {
-            Err(format!("`{}` {}, found {value}", self.name, self.range_text()))
-        }
-    }
-
-    /// The allowed range in words, e.g. `> 0` or `in [0, 1]`.
-    pub fn range_text(&self) -> String {
-        // (bracket, comparison, value) of each side that is bounded.
-        let lower = match self.min {
-            Bound::None => None,
-            Bound::Inclusive(a) => Some(('[', ">=", a)),
-            Bound::Exclusive(a) => Some(('(', ">", a)),
-        };
-        let upper = match self.max {
-            Bound::None => None,
-            Bound::Inclusive(b) => Some((']', "<=", b)),
-            Bound::Exclusive(b) => Some((')', "<", b)),
-        };
-        match (lower, upper) {
-            (None, None) => "any finite value".into(),
-            (Some((_, op, v)), None) | (None, Some((_, op, v))) => format!("{op} {v}"),
-            (Some((l, _, a)), Some((r, _, b))) => format!("in {l}{a}, {b}{r}"),
-        }
-    }
 }
 
 /// A registered interaction type.

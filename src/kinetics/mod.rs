@@ -24,6 +24,15 @@
 //! each is a documented registry [`Entry`] (name, summary, Markdown page,
 //! schema: `cellmd list NAME`).
 //!
+//! A rule whose effect the GPU backend decides on the device
+//! ([`Effect::gpu_form`]: unbinding, threshold breaking, rebinding) has its
+//! WGSL evaluator beside it, `NAME.wgsl`, defining `NAME_SUFFIX` with the
+//! suffix of its [`GpuForm`] (`slip_rate`, `threshold_beyond`,
+//! `rebind_on_rate`). It reads its parameters by names generated from its
+//! schema (`p[CATCH_SLIP_KC0]`), and the shader composer dispatches it by
+//! its registry index, as interactions are (src/gpu/shader.rs): adding such a
+//! rule is its `.rs`, `.md` and `.wgsl` and one line in [`RULES`].
+//!
 //! This folder is the registry only: what each rule is (parameters, effect,
 //! documentation). The force-field parser reads rule names and parameters
 //! here, so the registry sits below `forcefield`; the engine that applies the
@@ -57,6 +66,11 @@ pub static RULES: &[&dyn KineticRule] = &[
     &ratchet::Ratchet,
 ];
 
+/// The registry index of a rule (its place in [`RULES`]).
+pub fn rule_index(rule: &dyn KineticRule) -> usize {
+    RULES.iter().position(|r| r.name() == rule.name()).expect("a registered rule")
+}
+
 /// Looks a kinetic rule up by name.
 pub fn lookup_rule(name: &str) -> Option<&'static dyn KineticRule> {
     RULES.iter().copied().find(|r| r.name() == name)
@@ -80,6 +94,46 @@ pub enum Effect {
     PlasticReset(fn(&[f64]) -> f64),
     /// Stiffness (energy and force) scale as a function of the bond's age.
     Maturation(fn(&[f64], f64) -> f64),
+}
+
+/// How the GPU backend decides a rule's effect: the WGSL function its
+/// `NAME.wgsl` defines (`NAME_` + [`Self::suffix`]), with the signature of
+/// its effect's evaluator in f32.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GpuForm {
+    /// `fn NAME_rate(p: array<f32, 8>, f: f32, kt: f32) -> f32`: k_off(F, kT).
+    Unbind = 1,
+    /// `fn NAME_beyond(p: array<f32, 8>, force: f32, strain: f32, u: f32) -> Beyond`:
+    /// whether the bond is beyond its threshold, and its break rate there (0: at once).
+    Threshold = 2,
+    /// `fn NAME_on_rate(p: array<f32, 8>) -> vec2<f32>`: (k_on, capture radius).
+    Rebind = 3,
+}
+
+impl GpuForm {
+    pub const ALL: [GpuForm; 3] = [GpuForm::Unbind, GpuForm::Threshold, GpuForm::Rebind];
+
+    /// The evaluator's name after the rule's: `slip_rate`.
+    pub fn suffix(self) -> &'static str {
+        match self {
+            GpuForm::Unbind => "rate",
+            GpuForm::Threshold => "beyond",
+            GpuForm::Rebind => "on_rate",
+        }
+    }
+}
+
+impl Effect {
+    /// The device form of this effect, where the GPU backend decides it
+    /// (None: rules with this effect keep a model's kinetics on the host).
+    pub fn gpu_form(&self) -> Option<GpuForm> {
+        match self {
+            Effect::Unbind(_) => Some(GpuForm::Unbind),
+            Effect::Threshold(_) => Some(GpuForm::Threshold),
+            Effect::Rebind(_) => Some(GpuForm::Rebind),
+            Effect::RestLengthRate(_) | Effect::PlasticReset(_) | Effect::Maturation(_) => None,
+        }
+    }
 }
 
 /// A registered kinetic rule; its [`Entry`] doc has the headings Rate,

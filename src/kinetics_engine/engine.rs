@@ -42,11 +42,11 @@ impl Event {
 }
 
 /// Philox stream of per-step kinetic decisions.
-const STREAM_KINETICS: u32 = 2;
+pub const STREAM_KINETICS: u32 = 2;
 /// Philox stream of quenched per-bond disorder (threshold spread).
-const STREAM_QUENCHED: u32 = 3;
+pub const STREAM_QUENCHED: u32 = 3;
 /// k·dt above which a step is too coarse to resolve a bond's lifetime.
-const COARSE_RATE_DT: f64 = 0.1;
+pub const COARSE_RATE_DT: f64 = 0.1;
 
 fn uniform(x: u32) -> f64 {
     (x as f64 + 0.5) / 4_294_967_296.0

@@ -41,7 +41,7 @@ use crate::rng::philox4x32_10;
 use crate::system::{Model, SimBox, State, StepClock};
 
 /// Philox key salt separating formation decisions from every other stream.
-const FORMATION_SALT: u32 = 0x6269_6E64; // ASCII "bind"
+pub const FORMATION_SALT: u32 = 0x6269_6E64; // ASCII "bind"
 
 fn uniform_for_pair(seed: u64, step: u64, i: u32, j: u32) -> f64 {
     let x = philox4x32_10([i, j, step as u32, (step >> 32) as u32], [seed as u32, (seed >> 32) as u32 ^ FORMATION_SALT])[0];

@@ -7,6 +7,6 @@ mod engine;
 mod events;
 mod formation;
 
-pub use self::engine::{initial_bond_state, Kinetics, KineticsReport};
+pub use self::engine::{initial_bond_state, Kinetics, KineticsReport, COARSE_RATE_DT, STREAM_KINETICS, STREAM_QUENCHED};
 pub use self::events::{Event, EventKind};
-pub use self::formation::{Binding, Formation};
+pub use self::formation::{Binding, Formation, FORMATION_SALT};

@@ -53,7 +53,9 @@ pub const PLANES: usize = 24;
 /// Where a segment ends relative to a plane it crosses: +1 on the + side,
 /// −1 on the − side, 0 when it does not cross. `a` is the start coordinate,
 /// `d` the segment's extent along the normal, `period` the box length on a
-/// periodic axis (|d| < period).
+/// periodic axis: the plane's periodic copies crossed, signed (more than
+/// one for a pair through a far image in a box shorter than twice the
+/// cutoff, `neighbor::ImageShifts`).
 #[inline]
 fn crossing(a: f64, d: f64, pos: f64, period: Option<f64>) -> f64 {
     match period {
@@ -62,17 +64,7 @@ fn crossing(a: f64, d: f64, pos: f64, period: Option<f64>) -> f64 {
             (true, false) => -1.0,
             _ => 0.0,
         },
-        Some(l) => {
-            let a = pos + (a - pos).rem_euclid(l);
-            let b = a + d;
-            if b < pos {
-                -1.0
-            } else if b >= pos + l {
-                1.0
-            } else {
-                0.0
-            }
-        }
+        Some(l) => (((a - pos).rem_euclid(l) + d) / l).floor(),
     }
 }
 
@@ -172,6 +164,10 @@ mod tests {
         assert_eq!(crossing(-9.2, -0.5, 0.5, Some(10.0)), -1.0);
         assert_eq!(crossing(3.0, 1.0, 0.5, Some(10.0)), 0.0);
         assert_eq!(crossing(20.2, 0.5, 0.5, Some(10.0)), 1.0);
+        // Longer than the period: every copy of the plane crossed counts.
+        assert_eq!(crossing(3.0, 25.0, 0.5, Some(10.0)), 2.0);
+        assert_eq!(crossing(3.0, -12.0, 0.5, Some(10.0)), -1.0);
+        assert_eq!(crossing(3.0, -13.0, 0.5, Some(10.0)), -2.0);
     }
 
     #[test]

@@ -171,7 +171,7 @@ impl Exclusions {
 
     /// Whether the types of `i` and `j` are an excluded type pair (a table
     /// look-up; the list build never meets such a pair, as it visits only
-    /// the bins of [`Self::partner_classes`]). False beyond the particles
+    /// the bins of `partner_classes`). False beyond the particles
     /// the types were given for.
     #[inline]
     pub fn excludes_types_of(&self, i: u32, j: u32) -> bool {

@@ -46,8 +46,11 @@
 //! * **Periodic axes**: the coordinate is wrapped into `[lo, hi)` first and
 //!   neighbouring cells wrap around. With fewer than three cells on an axis the
 //!   offsets −1, 0, +1 would name the same cell twice; they are deduplicated.
-//!   A periodic edge shorter than `2·r_list` is an error: the minimum image
-//!   of a pair within range would be ambiguous.
+//!   A periodic edge shorter than `2·r_list` is an error for a plain list
+//!   (the minimum image of a pair within range would be ambiguous); a list
+//!   made [`NeighborList::with_periodic_images`] (the pair forces') instead
+//!   lists every pair with some image in range and walks their images
+//!   ([`ImageShifts`], module `images`), as LAMMPS' ghost atoms do.
 //! * **Non-periodic axes**: particles outside `[lo, hi)` are put in the
 //!   nearest edge cell. The clamped cell index is still monotone and
 //!   1-Lipschitz in the coordinate, so partners remain in adjacent cells.
@@ -85,7 +88,9 @@
 //! ```
 
 mod exclusions;
+mod images;
 mod verlet;
 
 pub use self::exclusions::Exclusions;
+pub use self::images::ImageShifts;
 pub use self::verlet::NeighborList;

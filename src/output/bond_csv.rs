@@ -21,23 +21,23 @@
 //! opened.
 
 use std::fs::File;
-use std::io::{self, BufWriter, Write};
-use std::path::Path;
+use std::io::{self, Write};
 
+use super::records::RecordFile;
 use super::{check_frame, check_topology, invalid_input, FrameView, Needs, Real, TopologyView, TrajectoryWriter};
 use crate::units::Dim;
 
 /// Writes one CSV row per bond per frame.
 pub struct BondCsvWriter {
-    out: BufWriter<File>,
+    out: RecordFile,
     ids: Vec<u64>,
     bonds: Vec<[u32; 2]>,
     type_name: Vec<String>,
 }
 
 impl BondCsvWriter {
-    /// Creates (or truncates) `path` and writes the header.
-    pub fn create(path: &Path, topology: &TopologyView) -> io::Result<Self> {
+    /// Writes the header to `file` (empty, as opened for output).
+    pub fn new(file: File, topology: &TopologyView) -> io::Result<Self> {
         check_topology(topology)?;
         let type_name = (0..topology.bonds.len())
             .map(|b| match topology.bond_types.get(b) {
@@ -45,10 +45,11 @@ impl BondCsvWriter {
                 None => "_".into(),
             })
             .collect();
-        let mut out = BufWriter::new(File::create(path)?);
+        let mut out = RecordFile::new(file);
         let u = topology.units;
         let (l, t, f) = (u.label(Dim::Length), u.label(Dim::Time), u.label(Dim::Force));
         writeln!(out, "step,time[{t}],bond,type,id1,id2,length[{l}],tension[{f}],x[{l}],y[{l}],z[{l}]")?;
+        out.commit()?;
         Ok(Self { out, ids: topology.ids.to_vec(), bonds: topology.bonds.to_vec(), type_name })
     }
 }
@@ -81,12 +82,12 @@ impl TrajectoryWriter for BondCsvWriter {
                 Real(mid.z)
             )?;
         }
-        Ok(())
+        // The frame's rows go to the file whole.
+        self.out.commit()
     }
 
     fn finish(mut self: Box<Self>) -> io::Result<()> {
-        self.out.flush()?;
-        self.out.get_ref().sync_data()
+        self.out.finish()
     }
 
     fn needs(&self) -> Needs {
@@ -110,7 +111,7 @@ mod tests {
         let types = [1u32, 0];
         topology.bond_types = &types;
         topology.bond_type_names = &names;
-        let mut w: Box<dyn TrajectoryWriter> = Box::new(BondCsvWriter::create(&path, &topology).unwrap());
+        let mut w: Box<dyn TrajectoryWriter> = Box::new(BondCsvWriter::new(File::create(&path).unwrap(), &topology).unwrap());
         assert!(w.write_frame(&s.frame(0)).is_err(), "a frame without tensions is refused");
         let mut frame = s.frame(0);
         frame.measures = Measures { bond_tension: &[1.5, -0.25], bond_length: &[0.1, 5.0], ..Default::default() };

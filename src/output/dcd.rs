@@ -7,7 +7,8 @@
 //!
 //! 1. `CORD` and 20 `i32` control words: frame count (`NSET`), first step
 //!    (`ISTART`), steps between frames (`NSAVC`), last step (`NSTEP`), the
-//!    time step as an `f32` (`DELTA`, word 10), 1 in word 11 (a unit cell
+//!    time step as an `f32` in AKMA time units (`DELTA`, word 10; see
+//!    below), 1 in word 11 (a unit cell
 //!    precedes each frame) and 24 in word 20 (CHARMM version, which readers
 //!    take as "CHARMM format");
 //! 2. two 80-byte title lines (`cellmd VERSION`, the unit system);
@@ -19,31 +20,40 @@
 //! Particles are sorted by user id (like the LAMMPS dump), so a topology
 //! written in id order (a LAMMPS data file from `cellmd export-lammps`, a PDB)
 //! lines up with the coordinates. Positions are the stored (wrapped) ones in
-//! the deck's length unit, rounded to `f32`; readers label them Å and
-//! picoseconds, so for `cell` units read "Å" as µm and the frame time
-//! `DELTA·NSAVC` as seconds (DCD has no unit field). The box origin is not
+//! the deck's length unit, rounded to `f32`; readers label them Å.
+//!
+//! Time: CHARMM's DCD stores `DELTA` in AKMA time units (1 AKMA =
+//! 4.888821·10⁻² ps), and readers convert it: MDAnalysis reports
+//! `dt = DELTA·NSAVC·0.04888821` ps. cellmd writes `DELTA = dt / 0.04888821`
+//! (dt the deck's time step in its own unit), so that a reader's time is the
+//! deck's number for number, as its lengths are: MDAnalysis reads a frame
+//! interval of 0.01 s as `dt = 0.01` ("ps") and each frame's `time` as
+//! step·dt. For `cell` units read "Å" as µm and "ps" as seconds (DCD has no
+//! unit field; the second title line names the unit system). The box origin is not
 //! stored (DCD has none); image counters are not either: use the LAMMPS dump
 //! (`xu yu zu`) or the MCAP for unwrapped paths.
 //!
 //! The header's counters are rewritten after every frame, so a file cut off
 //! after a frame is a valid trajectory up to it. `NSAVC` and `DELTA` come
-//! from the first two frames (`DELTA = Δtime/Δstep`); a single-frame file has
+//! from the first two frames (`DELTA = Δtime/Δstep/0.04888821`); a single-frame file has
 //! `NSAVC = 1` and `DELTA = 0`.
 
 use std::fs::File;
-use std::io::{self, BufWriter, Seek, SeekFrom, Write};
-use std::path::Path;
+use std::io::{self, Write};
 
+use super::records::RecordFile;
 use super::{check_frame, check_topology, units_keyword, FrameView, TopologyView, TrajectoryWriter};
 
 /// Byte offset of the control words (after the record marker and `CORD`).
 const CONTROL_OFFSET: u64 = 8;
 /// The CHARMM version written in control word 20.
 const CHARMM_VERSION: i32 = 24;
+/// One AKMA time unit in picoseconds (CHARMM's, as MDAnalysis converts it).
+pub const AKMA_PS: f64 = 4.888821e-2;
 
 /// Writes DCD frames to a file.
 pub struct DcdWriter {
-    out: BufWriter<File>,
+    out: RecordFile,
     /// Internal indices sorted by user id.
     order: Vec<usize>,
     frames: i32,
@@ -56,8 +66,8 @@ pub struct DcdWriter {
 }
 
 impl DcdWriter {
-    /// Creates (or truncates) `path` and writes the header.
-    pub fn create(path: &Path, topology: &TopologyView) -> io::Result<Self> {
+    /// Writes the header to `file` (empty, as opened for output).
+    pub fn new(file: File, topology: &TopologyView) -> io::Result<Self> {
         check_topology(topology)?;
         let n = i32::try_from(topology.ids.len())
             .ok()
@@ -66,7 +76,7 @@ impl DcdWriter {
         let mut order: Vec<usize> = (0..topology.ids.len()).collect();
         order.sort_by_key(|&i| topology.ids[i]);
         let mut w = Self {
-            out: BufWriter::new(File::create(path)?),
+            out: RecordFile::new(file),
             order,
             frames: 0,
             first: None,
@@ -83,6 +93,7 @@ impl DcdWriter {
         }
         record(&mut w.out, &title)?;
         record(&mut w.out, &n.to_le_bytes())?;
+        w.out.commit()?;
         Ok(w)
     }
 
@@ -125,7 +136,8 @@ impl TrajectoryWriter for DcdWriter {
             None => self.first = Some((frame.step, frame.time)),
             Some((step0, time0)) if self.interval.is_none() => {
                 let steps = frame.step.saturating_sub(step0).max(1);
-                self.interval = Some((clamp_i32(steps), ((frame.time - time0) / steps as f64) as f32));
+                // The deck's time per step, as AKMA units whose picoseconds are the same number.
+                self.interval = Some((clamp_i32(steps), ((frame.time - time0) / steps as f64 / AKMA_PS) as f32));
             }
             Some(_) => {}
         }
@@ -139,19 +151,14 @@ impl TrajectoryWriter for DcdWriter {
             self.coords.extend(self.order.iter().flat_map(|&i| (frame.positions[i][a] as f32).to_le_bytes()));
             record(&mut self.out, &self.coords)?;
         }
-        // Keep the header's counts true for the frames on disk.
+        // The frame goes to the file whole, then the header counts it.
+        self.out.commit()?;
         let control: Vec<u8> = self.control().iter().flat_map(|c| c.to_le_bytes()).collect();
-        self.out.flush()?;
-        let file = self.out.get_mut();
-        file.seek(SeekFrom::Start(CONTROL_OFFSET))?;
-        file.write_all(&control)?;
-        file.seek(SeekFrom::End(0))?;
-        Ok(())
+        self.out.overwrite(CONTROL_OFFSET, &control)
     }
 
     fn finish(mut self: Box<Self>) -> io::Result<()> {
-        self.out.flush()?;
-        self.out.get_ref().sync_data()
+        self.out.finish()
     }
 }
 
@@ -183,7 +190,7 @@ mod tests {
         let s = Sample::new(3);
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("t.dcd");
-        let mut w: Box<dyn TrajectoryWriter> = Box::new(DcdWriter::create(&path, &s.topology()).unwrap());
+        let mut w: Box<dyn TrajectoryWriter> = Box::new(DcdWriter::new(File::create(&path).unwrap(), &s.topology()).unwrap());
         for f in 0..3 {
             w.write_frame(&s.frame(f)).unwrap();
         }
@@ -196,7 +203,7 @@ mod tests {
         assert_eq!(control.len(), 20);
         // Three frames from step 0 every 100 steps, 0.1 time units per 100 steps.
         assert_eq!(control[..4], [3, 0, 100, 200]);
-        assert_eq!(f32::from_bits(control[9] as u32), (0.1f64 / 100.0) as f32);
+        assert_eq!(f32::from_bits(control[9] as u32), (0.1f64 / 100.0 / AKMA_PS) as f32);
         assert_eq!((control[10], control[19]), (1, CHARMM_VERSION));
         assert_eq!(words(&r[1][..4]), [2]);
         assert_eq!(r[1].len(), 4 + 160);
@@ -221,7 +228,7 @@ mod tests {
         let s = Sample::new(1);
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("t.dcd");
-        let mut w = DcdWriter::create(&path, &s.topology()).unwrap();
+        let mut w = DcdWriter::new(File::create(&path).unwrap(), &s.topology()).unwrap();
         w.write_frame(&s.frame(0)).unwrap();
         let bytes = std::fs::read(&path).unwrap();
         let control = words(&records(&bytes)[0][4..]);

@@ -6,21 +6,28 @@
 //! length when the event was decided, `age` the time the bond had been bound
 //! through the end of that step (a break's age is the bond's lifetime, to
 //! within the step in which it broke; rebinds and formations have age 0).
+//!
+//! Rows reach the file in whole steps, batched: at most
+//! [`BATCH_INTERVAL`](super::records::BATCH_INTERVAL) (1 s) of wall time or
+//! 64 KiB after they were decided, and at the end of the run; a SIGKILL
+//! loses at most that last batch, never part of a row.
 
 use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::Write;
+
+use super::records::RecordFile;
 
 use crate::kinetics_engine::Event;
 use crate::units::{Dim, UnitSystem};
 
 /// The CSV event file.
 pub struct EventLog {
-    out: BufWriter<File>,
+    out: RecordFile,
 }
 
 impl EventLog {
     pub fn create(file: File, units: UnitSystem) -> std::io::Result<Self> {
-        let mut out = BufWriter::new(file);
+        let mut out = RecordFile::new(file);
         writeln!(
             out,
             "step,time[{}],event,bond,type,i,j,force[{}],length[{}],age[{}]",
@@ -29,6 +36,7 @@ impl EventLog {
             units.label(Dim::Length),
             units.label(Dim::Time)
         )?;
+        out.commit()?;
         Ok(Self { out })
     }
 
@@ -49,11 +57,16 @@ impl EventLog {
                 e.age
             )?;
         }
-        Ok(())
+        self.out.commit_batched()
+    }
+
+    /// Writes the rows that have waited their interval (called once per
+    /// step, so a batch is bounded in time even when no new event comes).
+    pub fn flush_due(&mut self) -> std::io::Result<()> {
+        self.out.commit_batched()
     }
 
     pub fn finish(mut self) -> std::io::Result<()> {
-        self.out.flush()?;
-        self.out.get_ref().sync_data()
+        self.out.finish()
     }
 }

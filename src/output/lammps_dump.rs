@@ -14,7 +14,7 @@
 //! 0 10
 //! -5 5
 //! ITEM: ATOMS id type element x y z ix iy iz
-//! 3 1 cortex 3 7.25 -1.5 0 0 0
+//! 3 1 H 3 7.25 -1.5 0 0 0
 //! ...
 //! ```
 //!
@@ -22,9 +22,18 @@
 //!   (`p` periodic, `f` fixed).
 //! * Atom lines are sorted by user id; `type` is the 1-based type number
 //!   (type index + 1, the order of the force field's type names) and
-//!   `element` its name (whitespace replaced by `_`) — the column OVITO and
-//!   VMD take particle type names from (LAMMPS writes it with
-//!   `dump_modify element`); positions are the stored (wrapped) ones with
+//!   `element` the chemical symbol standing for the type: type index `t` is
+//!   the element of atomic number `t + 1` (H, He, Li, …, as
+//!   [`super::element_symbol`] and the extended XYZ's `Z`
+//!   column). LAMMPS' `dump_modify element` column holds chemical elements,
+//!   and readers take it so: ASE (`ase.io.read(…, format="lammps-dump-text")`)
+//!   maps it to atomic numbers and fails on any other name, OVITO and VMD
+//!   name the particle types after it. Type names have no column in a dump
+//!   that every reader accepts (OVITO refuses a text column it does not
+//!   know); the extended XYZ (`species`, `type_name`) and the MCAP carry
+//!   them, and the mapping is fixed by the force field's type order (the
+//!   first `particle` line is `1`/H, the second `2`/He, …). Positions are
+//!   the stored (wrapped) ones with
 //!   image flags `ix iy iz`, so the unwrapped position is `x + ix·Lx`. Reals
 //!   use shortest round-trip form.
 //! * `dump … lammps FILE columns C...` selects the atom columns instead
@@ -37,17 +46,17 @@
 //!   and XYZ outputs carry it.
 
 use std::fs::File;
-use std::io::{self, BufWriter, Write};
-use std::path::Path;
+use std::io::{self, Write};
 
-use super::{check_frame, check_topology, invalid_input, token, FrameView, Needs, Real, TopologyView, TrajectoryWriter};
+use super::records::RecordFile;
+use super::{check_frame, check_topology, element_symbol, invalid_input, FrameView, Needs, Real, TopologyView, TrajectoryWriter};
 
 /// A per-atom column of a LAMMPS dump (`dump … lammps FILE columns ...`).
 ///
 /// | name | meaning | unit (`cell`) |
 /// |---|---|---|
 /// | `id`, `type` | user id, 1-based type number | – |
-/// | `element` | type name (OVITO and VMD read it as the particle type) | – |
+/// | `element` | the chemical symbol whose atomic number is the type number (H for type 1, He for 2, …; ASE, OVITO and VMD read it as the particle type) | – |
 /// | `x y z` | stored (wrapped) position | µm |
 /// | `ix iy iz` | image flags | – |
 /// | `xu yu zu` | unwrapped position x + ix·Lx | µm |
@@ -131,11 +140,9 @@ impl AtomColumn {
 
 /// Writes LAMMPS text dump frames to a file.
 pub struct LammpsDumpWriter {
-    out: BufWriter<File>,
+    out: RecordFile,
     ids: Vec<u64>,
     types: Vec<u32>,
-    /// Type-name token per type.
-    type_names: Vec<String>,
     /// Internal indices sorted by user id.
     order: Vec<usize>,
     columns: Vec<AtomColumn>,
@@ -144,13 +151,8 @@ pub struct LammpsDumpWriter {
 }
 
 impl LammpsDumpWriter {
-    /// Creates (or truncates) `path`, with the default columns.
-    pub fn create(path: &Path, topology: &TopologyView) -> io::Result<Self> {
-        Self::with_columns(path, topology, &[])
-    }
-
-    /// Creates (or truncates) `path` writing `columns` (empty: the defaults).
-    pub fn with_columns(path: &Path, topology: &TopologyView, columns: &[AtomColumn]) -> io::Result<Self> {
+    /// Writes frames of `columns` (empty: the defaults) to `file` (empty, as opened for output).
+    pub fn new(file: File, topology: &TopologyView, columns: &[AtomColumn]) -> io::Result<Self> {
         check_topology(topology)?;
         let mut order: Vec<usize> = (0..topology.ids.len()).collect();
         order.sort_by_key(|&i| topology.ids[i]);
@@ -160,10 +162,9 @@ impl LammpsDumpWriter {
             Needs { forces: a.forces || n.forces, virial: a.virial || n.virial, bonds: a.bonds || n.bonds }
         });
         Ok(Self {
-            out: BufWriter::new(File::create(path)?),
+            out: RecordFile::new(file),
             ids: topology.ids.to_vec(),
             types: topology.types.to_vec(),
-            type_names: topology.type_names.iter().map(|n| token(n)).collect(),
             order,
             columns,
             needs,
@@ -205,7 +206,7 @@ impl TrajectoryWriter for LammpsDumpWriter {
                 let _ = match *c {
                     AtomColumn::Id => write!(line, "{}", self.ids[i]),
                     AtomColumn::Type => write!(line, "{}", self.types[i] + 1),
-                    AtomColumn::Element => line.write_str(&self.type_names[self.types[i] as usize]),
+                    AtomColumn::Element => line.write_str(element_symbol(self.types[i] as usize)),
                     AtomColumn::X(a) => write!(line, "{}", Real(frame.positions[i][a])),
                     AtomColumn::Image(a) => write!(line, "{}", frame.image(i)[a]),
                     AtomColumn::Unwrapped(a) => write!(line, "{}", Real(b.unwrap(frame.positions[i], frame.image(i))[a])),
@@ -217,7 +218,8 @@ impl TrajectoryWriter for LammpsDumpWriter {
             }
             writeln!(out, "{line}")?;
         }
-        Ok(())
+        // The frame goes to the file whole.
+        out.commit()
     }
 
     fn needs(&self) -> Needs {
@@ -225,8 +227,7 @@ impl TrajectoryWriter for LammpsDumpWriter {
     }
 
     fn finish(mut self: Box<Self>) -> io::Result<()> {
-        self.out.flush()?;
-        self.out.get_ref().sync_data()
+        self.out.finish()
     }
 }
 
@@ -240,7 +241,7 @@ mod tests {
         let s = Sample::new(2);
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("t.lammpstrj");
-        let mut w: Box<dyn TrajectoryWriter> = Box::new(LammpsDumpWriter::create(&path, &s.topology()).unwrap());
+        let mut w: Box<dyn TrajectoryWriter> = Box::new(LammpsDumpWriter::new(File::create(&path).unwrap(), &s.topology(), &[]).unwrap());
         w.write_frame(&s.frame(0)).unwrap();
         w.write_frame(&s.frame(1)).unwrap();
         w.finish().unwrap();
@@ -267,7 +268,7 @@ mod tests {
                 last_id = id;
                 let i = s.ids.iter().position(|&x| x == id).unwrap();
                 assert_eq!(cols[1].parse::<u32>().unwrap(), s.types[i] + 1);
-                assert_eq!(cols[2], ["cortex", "adhesion_site"][s.types[i] as usize]);
+                assert_eq!(cols[2], ["H", "He"][s.types[i] as usize]);
                 for a in 0..3 {
                     let x: f64 = cols[3 + a].parse().unwrap();
                     assert_eq!(x.to_bits(), s.frames[f][i][a].to_bits(), "{line}");
@@ -275,8 +276,8 @@ mod tests {
                 }
             }
         }
-        assert_eq!(lines[9], "3 1 cortex 3 7.25 -1.5 0 0 0");
-        assert_eq!(lines[10], "7 2 adhesion_site 9.95 5 2.5 -1 2 0");
+        assert_eq!(lines[9], "3 1 H 3 7.25 -1.5 0 0 0");
+        assert_eq!(lines[10], "7 2 He 9.95 5 2.5 -1 2 0");
     }
 
     #[test]
@@ -286,7 +287,7 @@ mod tests {
         let path = dir.path().join("s.lammpstrj");
         let names = "id xu fx wxy sxx syy szz sxy vonmises";
         let columns: Vec<AtomColumn> = names.split(' ').map(|n| AtomColumn::from_name(n).unwrap()).collect();
-        let mut w = LammpsDumpWriter::with_columns(&path, &s.topology(), &columns).unwrap();
+        let mut w = LammpsDumpWriter::new(File::create(&path).unwrap(), &s.topology(), &columns).unwrap();
         assert_eq!(w.needs(), Needs { forces: true, virial: true, bonds: false });
         // Without the measures the frame is refused, not written with zeros.
         assert!(w.write_frame(&s.frame(0)).is_err());

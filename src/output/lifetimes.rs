@@ -24,7 +24,7 @@
 use std::io::{self, Write};
 use std::path::Path;
 
-use super::atomic::write_atomically;
+use super::files::write_atomically;
 use crate::kinetics_engine::{Event, EventKind};
 use crate::system::{BondState, Model};
 use crate::units::Dim;
@@ -58,10 +58,11 @@ impl LifetimeTable {
         }
     }
 
-    /// Writes the table for every bond type with kinetic rules.
-    pub fn write(&self, path: &Path, model: &Model, bonds: Option<&BondState>) -> io::Result<()> {
+    /// Writes the table for every bond type with kinetic rules, atomically,
+    /// through no link below `root` (the output directory).
+    pub fn write(&self, root: &Path, path: &Path, model: &Model, bonds: Option<&BondState>) -> io::Result<()> {
         let units = model.units;
-        write_atomically(path, |out| {
+        write_atomically(root, path, |out| {
             writeln!(
                 out,
                 "type,breaks,surviving,force[{f}],tau[{t}],stderr[{t}],tau_censored[{t}]",

@@ -32,11 +32,29 @@
 //! bonds the state is no longer written (it would not match the topology):
 //! `/cellmd/events` carries every change.
 //!
+//! # Chunks: what survives a kill
+//!
+//! Each frame ends its chunk: the chunk is assembled in memory, compressed,
+//! and written to the file with its message indexes in one write when the
+//! frame is complete (see [`records`](super::records)), so after a SIGKILL
+//! or a full disk the file is the header and whole chunks, and only the
+//! summary and footer, which a clean end writes, are missing. Readers that
+//! stream the file recover every message of every frame written before:
+//! Python's `mcap.reader.NonSeekingReader(f).iter_messages(log_time_order=False)`
+//! (or `mcap.stream_reader.StreamReader(f).records`) and Rust's
+//! `mcap::MessageStream::new_with_options(bytes, Options::IgnoreEndMagic.into())`
+//! yield them all before they report the missing footer; indexed readers
+//! (`make_reader`, which starts from the footer) need the file finished
+//! (or rewritten by `mcap recover`). Bond events between frames go into the
+//! next frame's chunk, or into a chunk of their own once the oldest of them
+//! has waited [`BATCH_INTERVAL`] (1 s; checked every step), so a kill loses
+//! at most the last second of them.
+//!
 //! # Compression
 //!
-//! Chunks are compressed with zstd (default level, the MCAP default chunk
-//! size of 768 KiB, single-threaded so the bytes do not depend on the
-//! machine). The quickstart shortened to 9 frames of 1500 particles
+//! Chunks are compressed with zstd (default level, single-threaded so the
+//! bytes do not depend on the machine); a frame larger than the MCAP default
+//! chunk size of 768 KiB spans several chunks. The quickstart shortened to 9 frames of 1500 particles
 //! (`--var steps=2000`) writes 0.73 MB for 2.98 MB of messages; its frames
 //! take 365 kB in protobuf and 874 kB as JSON, and with `encoding json`
 //! 7.25 MB of messages compress to 0.75 MB. Every MCAP reader (the `mcap`
@@ -53,13 +71,14 @@
 
 use std::collections::BTreeMap;
 use std::fs::File;
-use std::io::{self, BufWriter, Write};
-use std::path::Path;
+use std::io;
+use std::time::Instant;
 
 use foxglove::Encode;
 use mcap::records::MessageHeader;
 
 use super::mcap_messages::{self as proto, descriptor_set, JsonForm};
+use super::records::{RecordFile, BATCH_INTERVAL};
 use super::scene::{Scene, SCENE_UPDATE_SCHEMA};
 use super::{check_frame, check_topology, invalid_input, units_keyword, Encoding, FrameView, TopologyView, TrajectoryWriter};
 
@@ -180,9 +199,11 @@ pub struct McapWriter {
 
 /// The MCAP writer with per-channel sequence numbers and a reused buffer.
 struct Sink {
-    writer: mcap::Writer<BufWriter<File>>,
+    writer: mcap::Writer<RecordFile>,
     sequence: BTreeMap<u16, u32>,
     buffer: Vec<u8>,
+    /// When the oldest message not yet in a written chunk was published.
+    unwritten_since: Option<Instant>,
 }
 
 impl Sink {
@@ -196,27 +217,31 @@ impl Sink {
         let sequence = self.sequence.entry(channel_id).or_insert(0);
         *sequence += 1;
         let header = MessageHeader { channel_id, sequence: *sequence, log_time: ns, publish_time: ns };
+        self.unwritten_since.get_or_insert_with(Instant::now);
         self.writer.write_to_known_channel(&header, &self.buffer).map_err(mcap_err)
+    }
+
+    /// Ends the chunk and writes it whole (see the module docs).
+    fn end_chunk(&mut self) -> io::Result<()> {
+        self.unwritten_since = None;
+        self.writer.flush().map_err(mcap_err)
     }
 }
 
 impl McapWriter {
-    /// Creates (or truncates) `path` with protobuf channels.
-    pub fn create(path: &Path, topology: &TopologyView) -> io::Result<Self> {
-        Self::create_with(path, topology, Encoding::Protobuf)
-    }
-
-    /// Creates (or truncates) `path` and registers the schemas and channels
-    /// in `encoding`.
-    pub fn create_with(path: &Path, topology: &TopologyView, encoding: Encoding) -> io::Result<Self> {
+    /// Writes to `file` (empty, as opened for output) and registers the
+    /// schemas and channels in `encoding`.
+    pub fn new(file: File, topology: &TopologyView, encoding: Encoding) -> io::Result<Self> {
         check_topology(topology)?;
         let options = mcap::WriteOptions::new()
             .compression(Some(mcap::Compression::Zstd))
             // One thread: the bytes then never depend on the machine's core count.
             .compression_threads(0)
+            // Chunks assembled in memory and written whole (see the module docs).
+            .disable_seeking(true)
             .profile("")
             .library(format!("cellmd {}", env!("CARGO_PKG_VERSION")));
-        let mut writer = options.create(BufWriter::new(File::create(path)?)).map_err(mcap_err)?;
+        let mut writer = options.create(RecordFile::new(file)).map_err(mcap_err)?;
         let no_metadata = BTreeMap::new();
         let mut channel =
             |schema_name: &str, schema_encoding: &str, schema: &[u8], topic: &str, message_encoding: &str| -> io::Result<u16> {
@@ -256,8 +281,11 @@ impl McapWriter {
             }
         };
         let [channel_topology, channel_frame, channel_bond_state, channel_events, channel_scene] = channels;
+        let mut sink = Sink { writer, sequence: BTreeMap::new(), buffer: Vec::new(), unwritten_since: None };
+        // The header and a first chunk with the schemas and channels.
+        sink.end_chunk()?;
         Ok(Self {
-            sink: Sink { writer, sequence: BTreeMap::new(), buffer: Vec::new() },
+            sink,
             channel_topology,
             channel_frame,
             channel_bond_state,
@@ -349,7 +377,8 @@ impl TrajectoryWriter for McapWriter {
         if self.scene_enabled {
             self.write_scene(ns, frame)?;
         }
-        Ok(())
+        // The frame ends its chunk, which goes to the file whole.
+        self.sink.end_chunk()
     }
 
     fn write_bond_events(&mut self, events: &[crate::kinetics_engine::Event], bound: &[bool]) -> io::Result<()> {
@@ -362,11 +391,16 @@ impl TrajectoryWriter for McapWriter {
         Ok(())
     }
 
+    fn flush_due(&mut self) -> io::Result<()> {
+        match self.sink.unwritten_since {
+            Some(since) if since.elapsed() >= BATCH_INTERVAL => self.sink.end_chunk(),
+            _ => Ok(()),
+        }
+    }
+
     fn finish(mut self: Box<Self>) -> io::Result<()> {
         self.sink.writer.finish().map_err(mcap_err)?;
-        let mut out = self.sink.writer.into_inner();
-        out.flush()?;
-        out.get_ref().sync_data()
+        self.sink.writer.into_inner().finish()
     }
 }
 
@@ -381,231 +415,4 @@ fn time_ns(time: f64) -> u64 {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::super::mcap_messages::message_json;
-    use super::super::scene;
-    use super::super::test_support::Sample;
-    use super::*;
-    use serde_json::Value;
-
-    fn write_sample(path: &Path, s: &Sample, times: &[f64], encoding: Encoding) {
-        let mut w = McapWriter::create_with(path, &s.topology(), encoding).unwrap();
-        for (f, &t) in times.iter().enumerate() {
-            let mut frame = s.frame(f);
-            frame.time = t;
-            w.write_frame(&frame).unwrap();
-        }
-        Box::new(w).finish().unwrap();
-    }
-
-    #[test]
-    fn schemas_are_valid_json() {
-        for (name, schema) in [
-            ("cellmd.Topology", TOPOLOGY_SCHEMA),
-            ("cellmd.Frame", FRAME_SCHEMA),
-            ("cellmd.BondState", BOND_STATE_SCHEMA),
-            ("cellmd.BondEvents", BOND_EVENTS_SCHEMA),
-            ("foxglove.SceneUpdate", SCENE_UPDATE_SCHEMA),
-        ] {
-            let v: Value = serde_json::from_str(schema).unwrap_or_else(|e| panic!("{name}: {e}"));
-            assert_eq!(v["title"], name);
-        }
-    }
-
-    /// The file is chunked with zstd, and both encodings carry the same
-    /// messages on every channel: protobuf decoded equals the JSON written.
-    #[test]
-    fn chunks_are_zstd_and_both_encodings_agree() {
-        let s = Sample::new(2);
-        let dir = tempfile::tempdir().unwrap();
-        let mut messages = Vec::new();
-        for (encoding, name) in [(Encoding::Protobuf, "p.mcap"), (Encoding::Json, "j.mcap")] {
-            let path = dir.path().join(name);
-            write_sample(&path, &s, &[0.1, 0.2], encoding);
-            let bytes = std::fs::read(&path).unwrap();
-            let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
-            assert!(!summary.chunk_indexes.is_empty());
-            assert!(summary.chunk_indexes.iter().all(|c| c.compression == "zstd"), "{:?}", summary.chunk_indexes);
-            let scene = summary.channels.values().find(|c| c.topic == TOPIC_SCENE).unwrap();
-            let schema = scene.schema.as_ref().unwrap();
-            assert_eq!(schema.name, "foxglove.SceneUpdate");
-            let want = match encoding {
-                Encoding::Protobuf => ("protobuf", "protobuf"),
-                Encoding::Json => ("json", "jsonschema"),
-            };
-            assert_eq!((scene.message_encoding.as_str(), schema.encoding.as_str()), want);
-            if encoding == Encoding::Protobuf {
-                // The schema is a FileDescriptorSet that declares foxglove.SceneUpdate.
-                let set = <prost_types::FileDescriptorSet as prost::Message>::decode(&schema.data[..]).unwrap();
-                assert!(set.file.iter().any(|f| f.package() == "foxglove" && f.message_type.iter().any(|m| m.name() == "SceneUpdate")));
-            }
-            let stream = mcap::MessageStream::new(&bytes).unwrap().map(|m| m.unwrap());
-            messages.push(stream.map(|m| (m.channel.topic.clone(), message_json(&m).unwrap())).collect::<Vec<_>>());
-        }
-        // topology, bond state, then frame and scene twice.
-        assert_eq!(messages[0].len(), 6);
-        assert_eq!(messages[0], messages[1]);
-    }
-
-    #[test]
-    fn three_frames_read_back() {
-        let s = Sample::new(3);
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("t.mcap");
-        // The second and third times collide at ns resolution: stamps are forced up.
-        let times = [0.1, 0.2, 0.2 + 1e-12];
-        write_sample(&path, &s, &times, Encoding::Protobuf);
-        let bytes = std::fs::read(&path).unwrap();
-
-        let summary = mcap::Summary::read(&bytes).unwrap().expect("summary section");
-        let stats = summary.stats.expect("statistics");
-        assert_eq!(stats.message_count, 1 + 1 + 3 + 3);
-        // topology, frame, bond state, scene and (empty here) bond events.
-        assert_eq!(summary.channels.len(), 5);
-
-        let mut counts: BTreeMap<String, usize> = BTreeMap::new();
-        let mut frame_stamps = Vec::new();
-        let mut frames = Vec::new();
-        let mut scenes = Vec::new();
-        let mut topology = None;
-        let mut bond_state = None;
-        for message in mcap::MessageStream::new(&bytes).unwrap() {
-            let message = message.unwrap();
-            let channel = &message.channel;
-            let schema = channel.schema.as_ref().expect("every channel has a schema");
-            let expected_schema = match channel.topic.as_str() {
-                TOPIC_TOPOLOGY => "cellmd.Topology",
-                TOPIC_FRAME => "cellmd.Frame",
-                TOPIC_BOND_STATE => "cellmd.BondState",
-                TOPIC_SCENE => "foxglove.SceneUpdate",
-                other => panic!("unexpected topic {other}"),
-            };
-            assert_eq!(schema.name, expected_schema);
-            if channel.topic != TOPIC_SCENE {
-                assert_eq!(channel.message_encoding, "protobuf");
-                assert_eq!(schema.encoding, "protobuf");
-                assert_eq!(schema.data, descriptor_set());
-            }
-            assert_eq!(message.log_time, message.publish_time);
-            *counts.entry(channel.topic.clone()).or_default() += 1;
-            match channel.topic.as_str() {
-                TOPIC_TOPOLOGY => topology = Some(message_json(&message).unwrap()),
-                TOPIC_BOND_STATE => bond_state = Some(message_json(&message).unwrap()),
-                TOPIC_FRAME => {
-                    frame_stamps.push(message.log_time);
-                    frames.push(message_json(&message).unwrap());
-                }
-                _ => scenes.push((message.log_time, message_json(&message).unwrap())),
-            }
-        }
-        assert_eq!(counts[TOPIC_TOPOLOGY], 1);
-        assert_eq!(counts[TOPIC_BOND_STATE], 1);
-        assert_eq!(counts[TOPIC_FRAME], 3);
-        assert_eq!(counts[TOPIC_SCENE], 3);
-        assert_eq!(frame_stamps, vec![100_000_000, 200_000_000, 200_000_001]);
-
-        let topology = topology.unwrap();
-        assert_eq!(topology["units"], "cell");
-        assert_eq!(topology["ids"], serde_json::json!([40, 7, 12, 3]));
-        assert_eq!(topology["type_names"], serde_json::json!(["cortex", "adhesion site"]));
-        assert_eq!(topology["types"], serde_json::json!([0, 1, 1, 0]));
-        assert_eq!(topology["radii"], serde_json::json!([0.25, 0.0, 0.0, 0.25]));
-        assert_eq!(topology["bonds"], serde_json::json!([[7, 12], [40, 3]]));
-        assert_eq!(topology["angles"], serde_json::json!([[40, 7, 12]]));
-        assert_eq!(topology["triangles"], serde_json::json!([[40, 7, 3]]));
-        let bond_state = bond_state.unwrap();
-        assert_eq!(bond_state["bound"], serde_json::json!([true, true]));
-        assert_eq!(bond_state["step"], 0);
-
-        for (f, frame) in frames.iter().enumerate() {
-            assert_eq!(frame["step"], 100 * f as u64);
-            assert_eq!(frame["time"].as_f64().unwrap().to_bits(), times[f].to_bits());
-            assert_eq!(frame["box"]["lo"], serde_json::json!([0.0, 0.0, -5.0]));
-            assert_eq!(frame["box"]["periodic"], serde_json::json!([true, true, false]));
-            let flat: Vec<f64> = frame["positions"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
-            assert_eq!(flat.len(), 12);
-            for (i, x) in s.frames[f].iter().enumerate() {
-                for a in 0..3 {
-                    assert_eq!(flat[3 * i + a].to_bits(), x[a].to_bits(), "frame {f} particle {i} axis {a}");
-                }
-            }
-            let images: Vec<i64> = frame["images"].as_array().unwrap().iter().map(|v| v.as_i64().unwrap()).collect();
-            assert_eq!(images, s.images.iter().flatten().map(|&v| v as i64).collect::<Vec<_>>());
-        }
-
-        let (stamp, scene) = &scenes[0];
-        assert_eq!(*stamp, 100_000_000);
-        let entity = &scene["entities"][0];
-        assert_eq!(entity["frame_id"], "world");
-        assert_eq!(entity["id"], "particles");
-        assert_eq!(entity["timestamp"], serde_json::json!({"sec": 0, "nsec": 100_000_000}));
-        let spheres = entity["spheres"].as_array().unwrap();
-        assert_eq!(spheres.len(), 4);
-        assert_eq!(spheres[0]["size"]["x"], 0.5);
-        assert_eq!(spheres[1]["size"]["x"], 2.0 * scene::DEFAULT_RADIUS);
-        assert_eq!(spheres[1]["pose"]["position"]["x"], 9.95);
-        assert_ne!(spheres[0]["color"], spheres[1]["color"]);
-        assert_eq!(spheres[1]["color"], spheres[2]["color"]);
-        let lines = entity["lines"].as_array().unwrap();
-        assert_eq!(lines.len(), 1);
-        assert_eq!(lines[0]["type"], 2);
-        let points = lines[0]["points"].as_array().unwrap();
-        assert_eq!(points.len(), 4);
-        // Bond 7–12 crosses the periodic x face: 9.95 → 9.95 + 0.1, not 0.05.
-        assert_eq!(points[0]["x"], 9.95);
-        assert!((points[1]["x"].as_f64().unwrap() - 10.05).abs() < 1e-12);
-        // The surface: one triangle list, three points per face, each face whole.
-        let triangles = entity["triangles"].as_array().unwrap();
-        assert_eq!(triangles.len(), 1);
-        let corners = triangles[0]["points"].as_array().unwrap();
-        assert_eq!(corners.len(), 3 * s.triangles.len());
-        let xs: Vec<f64> = corners.iter().map(|p| p["x"].as_f64().unwrap()).collect();
-        assert!(xs.iter().all(|x| (x - xs[0]).abs() < 5.0), "a face split across the periodic box: {xs:?}");
-        for key in ["arrows", "cubes", "cylinders", "texts", "models", "metadata"] {
-            assert_eq!(entity[key], serde_json::json!([]), "{key}");
-        }
-        // The box: its 12 edges, and no walls in this frame.
-        let frame_box = &scene["entities"][1];
-        assert_eq!(frame_box["id"], "box");
-        assert_eq!(frame_box["lines"][0]["points"].as_array().unwrap().len(), 24);
-        assert_eq!(frame_box["triangles"], serde_json::json!([]));
-    }
-
-    #[test]
-    fn later_bond_states_and_scene_toggle() {
-        let s = Sample::new(2);
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("t.mcap");
-        let mut w = McapWriter::create(&path, &s.topology()).unwrap();
-        w.write_frame(&s.frame(0)).unwrap();
-        w.write_bond_state(50, 0.05, &[true, false]).unwrap();
-        assert!(w.write_bond_state(50, 0.05, &[true]).is_err());
-        w.set_scene(false);
-        w.write_frame(&s.frame(1)).unwrap();
-        Box::new(w).finish().unwrap();
-        let bytes = std::fs::read(&path).unwrap();
-        let mut states = Vec::new();
-        let mut scenes = 0;
-        for message in mcap::MessageStream::new(&bytes).unwrap() {
-            let message = message.unwrap();
-            match message.channel.topic.as_str() {
-                TOPIC_BOND_STATE => {
-                    assert_eq!(message.sequence as usize, states.len() + 1);
-                    states.push(message_json(&message).unwrap()["bound"].clone());
-                }
-                TOPIC_SCENE => scenes += 1,
-                _ => {}
-            }
-        }
-        assert_eq!(states, vec![serde_json::json!([true, true]), serde_json::json!([true, false])]);
-        assert_eq!(scenes, 1);
-    }
-
-    #[test]
-    fn time_stamps_round_and_clamp() {
-        assert_eq!(time_ns(1.5e-9), 2);
-        assert_eq!(time_ns(-3.0), 0);
-        assert_eq!(time_ns(f64::NAN), 0);
-        assert_eq!(time_ns(1e30), u64::MAX);
-    }
-}
+mod tests;

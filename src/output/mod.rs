@@ -8,8 +8,8 @@
 //! | format | keyword | module | contents |
 //! |---|---|---|---|
 //! | MCAP (Foxglove), zstd chunks | `mcap` | [`mcap_writer`], [`scene`] | topology, frames, bond state, a protobuf (or JSON) 3D scene |
-//! | extended XYZ (OVITO, ASE) | `xyz` | [`xyz`] | element symbol, position, type name, id; box and pbc per frame |
-//! | LAMMPS text dump | `lammps` | [`lammps_dump`] | id, type, element (type name), position, image flags, sorted by id; or the columns the deck names (forces, per-particle stress, von Mises) |
+//! | extended XYZ (OVITO, ASE) | `xyz` | [`xyz`] | type name (species), position, atomic number Z standing for the type, type name, id; box and pbc per frame |
+//! | LAMMPS text dump | `lammps` | [`lammps_dump`] | id, type, element (chemical symbol standing for the type), position, image flags, sorted by id; or the columns the deck names (forces, per-particle stress, von Mises) |
 //! | DCD (CHARMM/NAMD binary; MDAnalysis, MDTraj, VMD) | `dcd` | [`dcd`] | f32 positions sorted by id, box lengths per frame |
 //! | per-bond tension (CSV) | `bonds` | [`bond_csv`] | per frame and bond: ids, type, length, tension dE/dr, midpoint |
 //! | restart (JSON) | — | [`restart`] | step, time, box, ids, positions, images, bond state, counters, the deck's inputs |
@@ -22,9 +22,11 @@
 //!   internal indices and are written as user ids.
 //! * `types[i]` indexes `type_names` (and `type_radius`); LAMMPS dumps write
 //!   the 1-based number `types[i] + 1`. Where a reader expects a chemical
-//!   element (ASE's extended XYZ species), type `t` is written as the element
-//!   of atomic number `t + 1` ([`element_symbol`]: H, He, Li, …) and the type
-//!   name goes in a column of its own.
+//!   element (the LAMMPS dump's `element` column, the extended XYZ's `Z`,
+//!   which ASE reads), type `t` is written as the element of atomic number
+//!   `t + 1` ([`element_symbol`], [`atomic_number`]: H, He, Li, …) and the
+//!   type name goes where readers take names from (the extended XYZ's
+//!   `species`, which OVITO names its types after, and `type_name`).
 //! * Positions are the stored ones (wrapped into the box on periodic axes);
 //!   the image counters give the unwrapped position `x + image·L`.
 //! * `images` may be empty (e.g. a minimiser that does not track images): it
@@ -32,24 +34,39 @@
 //! * Text formats print f64 in Rust's shortest round-trip form (`{}`, or
 //!   `{:e}` outside `1e-5 ≤ |x| < 1e16`), so a value read back is bit-identical
 //!   to the one written.
+//!
+//! # What survives a kill or a full disk
+//!
+//! Files are opened through [`files`]: inside the output directory no
+//! symbolic link (file or subdirectory) is followed. Streams are written in
+//! whole records through [`records`]: each trajectory frame (an MCAP chunk,
+//! an XYZ/LAMMPS/DCD frame, the bond rows of a frame) and each thermo row is
+//! written with one write as soon as it is complete; the event log's rows,
+//! and an MCAP's bond events between frames, are batched for at most 1 s. After a SIGKILL every output therefore ends
+//! at its last complete record (an MCAP lacks only its summary and footer;
+//! streaming readers recover every message before the cut). A failed write
+//! (`ENOSPC`) is cut back to the last whole record and stops the run with
+//! `OUTPUT_ERROR_STATUS`. Restarts and the lifetime table are written
+//! atomically (a synced `NAME.tmp` renamed over `NAME`).
 
 use std::fmt;
+use std::fs::File;
 use std::io;
-use std::path::Path;
 
 use glam::DVec3;
 
 use crate::system::SimBox;
 use crate::units::UnitSystem;
 
-pub mod atomic;
 pub mod bond_csv;
 pub mod dcd;
 pub mod event_log;
+pub mod files;
 pub mod lammps_dump;
 pub mod lifetimes;
 pub mod mcap_messages;
 pub mod mcap_writer;
+pub mod records;
 pub mod restart;
 pub mod run_log;
 pub mod scene;
@@ -163,6 +180,12 @@ pub trait TrajectoryWriter: Send {
     fn write_bond_events(&mut self, _events: &[crate::kinetics_engine::Event], _bound: &[bool]) -> io::Result<()> {
         Ok(())
     }
+    /// Writes the whole records that have waited in memory for
+    /// [`records::BATCH_INTERVAL`] (an MCAP's bond events between frames);
+    /// called once per step, between records.
+    fn flush_due(&mut self) -> io::Result<()> {
+        Ok(())
+    }
     /// The quantities the writer reads from [`FrameView::measures`].
     fn needs(&self) -> Needs {
         Needs::default()
@@ -245,16 +268,12 @@ pub struct WriterOptions {
     pub encoding: Encoding,
 }
 
-/// Opens a writer of `format` at `path` (created or truncated), with default options.
-pub fn open_writer(format: DumpFormat, path: &Path, topology: &TopologyView) -> io::Result<Box<dyn TrajectoryWriter>> {
-    open_writer_with(format, path, topology, &WriterOptions::default())
-}
-
-/// [`open_writer`] with options: LAMMPS dumps take `columns`, MCAP files an
-/// `encoding`; a non-default option for another format is an error.
-pub fn open_writer_with(
+/// A writer of `format` into `file` (empty, as [`files::create`] opens it),
+/// with options: LAMMPS dumps take `columns`, MCAP files an `encoding`; a
+/// non-default option for another format is an error.
+pub fn open_writer(
     format: DumpFormat,
-    path: &Path,
+    file: File,
     topology: &TopologyView,
     options: &WriterOptions,
 ) -> io::Result<Box<dyn TrajectoryWriter>> {
@@ -265,11 +284,11 @@ pub fn open_writer_with(
         return Err(invalid_input(format!("only `mcap` dumps take an encoding, not `{}`", format.keyword())));
     }
     Ok(match format {
-        DumpFormat::Mcap => Box::new(McapWriter::create_with(path, topology, options.encoding)?),
-        DumpFormat::Xyz => Box::new(XyzWriter::create(path, topology)?),
-        DumpFormat::Lammps => Box::new(LammpsDumpWriter::with_columns(path, topology, &options.columns)?),
-        DumpFormat::Bonds => Box::new(BondCsvWriter::create(path, topology)?),
-        DumpFormat::Dcd => Box::new(DcdWriter::create(path, topology)?),
+        DumpFormat::Mcap => Box::new(McapWriter::new(file, topology, options.encoding)?),
+        DumpFormat::Xyz => Box::new(XyzWriter::new(file, topology)?),
+        DumpFormat::Lammps => Box::new(LammpsDumpWriter::new(file, topology, &options.columns)?),
+        DumpFormat::Bonds => Box::new(BondCsvWriter::new(file, topology)?),
+        DumpFormat::Dcd => Box::new(DcdWriter::new(file, topology)?),
     })
 }
 
@@ -358,6 +377,11 @@ const ELEMENTS: [&str; 118] = [
 /// atomic number `t + 1` (H, He, Li, …), cycling after the 118th type.
 pub fn element_symbol(t: usize) -> &'static str {
     ELEMENTS[t % ELEMENTS.len()]
+}
+
+/// The atomic number of [`element_symbol`]`(t)`: `t + 1`, wrapping after 118.
+pub fn atomic_number(t: usize) -> usize {
+    t % ELEMENTS.len() + 1
 }
 
 /// A type name usable as one whitespace-free token (whitespace becomes `_`).
@@ -456,6 +480,7 @@ mod tests {
         assert_eq!(Encoding::from_keyword("json"), Some(Encoding::Json));
         assert_eq!(Encoding::from_keyword("cbor"), None);
         assert_eq!((element_symbol(0), element_symbol(1), element_symbol(117), element_symbol(118)), ("H", "He", "Og", "H"));
+        assert_eq!((atomic_number(0), atomic_number(117), atomic_number(118)), (1, 118, 1));
     }
 
     #[test]
@@ -499,13 +524,13 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         for format in [DumpFormat::Mcap, DumpFormat::Xyz, DumpFormat::Lammps, DumpFormat::Dcd] {
             let path = dir.path().join(format!("traj.{}", format.extension()));
-            let mut w = open_writer(format, &path, &s.topology()).unwrap();
+            let mut w = open_writer(format, File::create(&path).unwrap(), &s.topology(), &WriterOptions::default()).unwrap();
             w.write_frame(&s.frame(0)).unwrap();
             w.write_frame(&s.frame(1)).unwrap();
             w.finish().unwrap();
             assert!(std::fs::metadata(&path).unwrap().len() > 0);
         }
         let json = WriterOptions { encoding: Encoding::Json, ..Default::default() };
-        assert!(open_writer_with(DumpFormat::Xyz, &dir.path().join("x.xyz"), &s.topology(), &json).is_err());
+        assert!(open_writer(DumpFormat::Xyz, File::create(dir.path().join("x.xyz")).unwrap(), &s.topology(), &json).is_err());
     }
 }

@@ -21,7 +21,7 @@
 //! ```
 //!
 //! * `ids` are the user ids by internal index: on restart they are checked
-//!   against the topology ([`RestartData::check_ids`]) so a restart is never
+//!   against the topology ([`RestartData::check_against`]) so a restart is never
 //!   applied to a different system or ordering.
 //! * `positions` are stored (wrapped) positions, `images` their counters.
 //! * `bonds` is the bond state ([`BondState`](crate::system::BondState)),
@@ -41,6 +41,19 @@
 //! * Unknown keys are ignored and `counters`/`resume` are optional, so files
 //!   of earlier builds still read, and later versions may add fields.
 //!
+//! # Checked before use
+//!
+//! A restart is data from disk, so it is checked before anything uses it —
+//! when `cellmd check` validates a deck's `read_state`, and before
+//! `--continue` opens any output — and an error names the file and the
+//! field, `s.restart: bonds.age: found an array of 9, expected 10 entries (…)`:
+//! [`RestartData::check`] on its own (array lengths, a finite box with
+//! `lo < hi`, positions in it, image counters, `0 <= time` finite, `step <=
+//! 2^53`, `run_end >= step`) and [`RestartData::check_against`] against the
+//! deck (units, ids and their order, periodic axes, one bond state entry
+//! per bond with finite ages and scales and rest lengths > 0). A file that
+//! is not a cellmd restart is named so without quoting any of it.
+//!
 //! Every f64 round-trips bit-exactly: serde_json prints the shortest string
 //! that parses back to the same value, and this crate enables serde_json's
 //! `float_roundtrip` feature so the parser is correctly rounded (the default
@@ -53,22 +66,24 @@
 //! `<path>`, so an interrupted write leaves either the old file or the new
 //! one, never a truncated mix.
 
-use std::fs::File;
-use std::io::{self, BufReader, Write};
+use std::io::{self, Write};
 use std::path::Path;
 
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
-use super::atomic::write_atomically;
-use crate::input::DeckInputs;
-use crate::system::{SimBox, State};
+use super::files::write_atomically;
+use crate::input::{read_input_file, DeckInputs};
+use crate::system::{Model, SimBox, State};
 use crate::units::UnitSystem;
 
 /// The `format` tag of a restart file.
 pub const RESTART_FORMAT: &str = "cellmd-restart";
 /// The restart format version this build writes and reads.
 pub const RESTART_VERSION: u64 = 1;
+/// The largest step a restart may hold (2⁵³): step counts stay exact in
+/// the f64 arithmetic that derives times and intervals from them.
+pub const MAX_STEP: u64 = 1 << 53;
 
 /// Everything needed to continue a run, besides the deck and topology.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -146,38 +161,83 @@ impl RestartData {
         }
     }
 
-    /// Checks that the restart belongs to a topology with these ids, in this order.
-    pub fn check_ids(&self, ids: &[u64]) -> Result<(), String> {
+    /// Why the restart is not a state a run can continue from, whatever the
+    /// deck: array lengths, a box that cannot hold a system, positions
+    /// outside it, image counters, step and time, the step its `run` ends
+    /// at (`field: found …, expected …`).
+    pub fn check(&self) -> Result<(), String> {
+        self.check_lengths()?;
+        if self.step > MAX_STEP {
+            return Err(format!("step: found {}, expected at most {MAX_STEP} (2^53)", self.step));
+        }
+        if !(self.time.is_finite() && self.time >= 0.0) {
+            return Err(format!("time: found {:e}, expected a finite time >= 0", self.time));
+        }
+        self.sim_box.check()?;
+        let b = &self.sim_box;
+        if let Some(i) = self.positions.iter().position(|&x| b.misplaced_axis(x).is_some()) {
+            let x = self.positions[i];
+            let why = b.misplacement(x, b.misplaced_axis(x).expect("found above"));
+            return Err(format!("positions[{i}]: {why}; expected a position in the box"));
+        }
+        let bad_image = |im: &[i64; 3]| (0..3).any(|a| if b.periodic[a] { im[a].unsigned_abs() > 1 << 62 } else { im[a] != 0 });
+        if let Some(i) = self.images.iter().position(bad_image) {
+            return Err(format!(
+                "images[{i}]: found {:?}, expected 0 on fixed axes and at most 2^62 in magnitude on periodic ones",
+                self.images[i]
+            ));
+        }
+        match self.resume.as_ref().and_then(|r| r.run_end) {
+            Some(end) if end < self.step => Err(format!("resume.run_end: found {end}, expected at least the restart's step {}", self.step)),
+            _ => Ok(()),
+        }
+    }
+
+    /// Why the restart does not belong to `model` in a box with these
+    /// periodic flags (the deck's): units, particle ids and their order,
+    /// periodic axes, and the bond state against the model's bonds.
+    pub fn check_against(&self, model: &Model, periodic: [bool; 3]) -> Result<(), String> {
+        if self.units != model.units {
+            return Err(format!("units: found {}, expected {} (the deck's)", units_name(self.units), units_name(model.units)));
+        }
+        let ids = &model.ids;
         if self.ids.len() != ids.len() {
-            return Err(format!("the restart file has {} particles but the topology has {}", self.ids.len(), ids.len()));
+            return Err(format!("ids: found {} particles, expected {} (the topology's)", self.ids.len(), ids.len()));
         }
         if let Some(i) = (0..ids.len()).find(|&i| self.ids[i] != ids[i]) {
             return Err(format!(
-                "particle {i} has id {} in the restart file but id {} in the topology \
-                 (the restart belongs to a different system or particle order)",
+                "ids[{i}]: found id {}, expected id {} (the topology's order; the restart belongs to a different system or particle order)",
                 self.ids[i], ids[i]
             ));
         }
-        Ok(())
+        if self.sim_box.periodic != periodic {
+            return Err(format!("box.periodic: found {:?}, expected {periodic:?} (the deck's box)", self.sim_box.periodic));
+        }
+        match &self.bonds {
+            Some(bonds) => bonds.check(model.len(), model.topology_bonds, model.bond_types.len()),
+            None => Ok(()),
+        }
     }
 
-    fn check_consistent(&self) -> Result<(), String> {
+    fn check_lengths(&self) -> Result<(), String> {
         let n = self.ids.len();
-        if self.positions.len() != n || self.images.len() != n {
-            return Err(format!(
-                "{} ids, {} positions and {} image counters; they must all have the same length",
-                n,
-                self.positions.len(),
-                self.images.len()
-            ));
+        for (field, len) in [("positions", self.positions.len()), ("images", self.images.len())] {
+            if len != n {
+                return Err(format!("{field}: found an array of {len}, expected {n} entries (one per id)"));
+            }
         }
         Ok(())
     }
 }
 
-/// Writes `data` to `path` atomically (via `<path>.tmp` and a rename).
-pub fn write_state(path: &Path, data: &RestartData) -> Result<(), String> {
-    data.check_consistent().map_err(|e| format!("cannot write restart file '{}': {e}", path.display()))?;
+fn units_name(units: UnitSystem) -> &'static str {
+    super::units_keyword(units)
+}
+
+/// Writes `data` to `path` atomically (via `<path>.tmp` and a rename),
+/// through no link below `root` (the output directory, see [`files`](super::files)).
+pub fn write_state(root: &Path, path: &Path, data: &RestartData) -> Result<(), String> {
+    data.check_lengths().map_err(|e| format!("cannot write restart file '{}': {e}", path.display()))?;
     let finite = data.time.is_finite()
         && data.positions.iter().all(|x| x.is_finite())
         && data.sim_box.lo.is_finite()
@@ -193,37 +253,39 @@ pub fn write_state(path: &Path, data: &RestartData) -> Result<(), String> {
         #[serde(flatten)]
         data: &'a RestartData,
     }
-    write_atomically(path, |out| {
+    write_atomically(root, path, |out| {
         serde_json::to_writer(&mut *out, &Document { format: RESTART_FORMAT, version: RESTART_VERSION, data }).map_err(io::Error::other)?;
         out.write_all(b"\n")
     })
     .map_err(|e| format!("cannot write restart file '{}': {e}", path.display()))
 }
 
-/// Reads a restart file, checking its format tag, version and array lengths.
+/// Reads a restart file (a regular file of at most 1 GiB, see
+/// [`read_input_file`]) and checks it ([`RestartData::check`]). Errors start
+/// with the path; a file that is not a cellmd restart is named so, and no
+/// byte of it is quoted.
 pub fn read_state(path: &Path) -> Result<RestartData, String> {
+    let data = parse_state(path)?;
+    data.check().map_err(|e| format!("{}: {e}", path.display()))?;
+    Ok(data)
+}
+
+/// The restart in `path`, as written (its tag and version checked).
+fn parse_state(path: &Path) -> Result<RestartData, String> {
     let shown = path.display();
-    let file = File::open(path).map_err(|e| match e.kind() {
-        io::ErrorKind::NotFound => format!("restart file '{shown}' not found"),
-        _ => format!("cannot open restart file '{shown}': {e}"),
-    })?;
-    let value: serde_json::Value =
-        serde_json::from_reader(BufReader::new(file)).map_err(|e| format!("restart file '{shown}' is not valid JSON: {e}"))?;
-    match value.get("format").and_then(|f| f.as_str()) {
-        Some(RESTART_FORMAT) => {}
-        Some(other) => {
-            return Err(format!("'{shown}' is not a cellmd restart file (format is \"{other}\", expected \"{RESTART_FORMAT}\")"))
-        }
-        None => return Err(format!("'{shown}' is not a cellmd restart file (no \"format\": \"{RESTART_FORMAT}\" entry)")),
+    let bytes = read_input_file(path).map_err(|why| format!("{shown}: cannot read it: {why}"))?;
+    let not_restart = |why: &str| format!("{shown}: not a cellmd restart file ({why}; expected one written by `write_state`)");
+    // serde_json's syntax errors name a position, not the bytes there.
+    let value: serde_json::Value = serde_json::from_slice(&bytes).map_err(|e| not_restart(&format!("not JSON: {e}")))?;
+    if value.get("format").and_then(|f| f.as_str()) != Some(RESTART_FORMAT) {
+        return Err(not_restart(&format!("no \"format\": \"{RESTART_FORMAT}\" entry")));
     }
     match value.get("version").and_then(|v| v.as_u64()) {
         Some(RESTART_VERSION) => {}
-        Some(v) => return Err(format!("restart file '{shown}' has format version {v}; this cellmd reads version {RESTART_VERSION}")),
-        None => return Err(format!("restart file '{shown}' has no valid \"version\" entry")),
+        Some(v) => return Err(format!("{shown}: version: found {v}, expected {RESTART_VERSION} (the restart version this cellmd reads)")),
+        None => return Err(format!("{shown}: version: found no valid entry, expected {RESTART_VERSION}")),
     }
-    let data: RestartData = serde_json::from_value(value).map_err(|e| format!("restart file '{shown}' is malformed: {e}"))?;
-    data.check_consistent().map_err(|e| format!("restart file '{shown}' is inconsistent: {e}"))?;
-    Ok(data)
+    serde_json::from_value(value).map_err(|e| format!("{shown}: malformed restart: {e}"))
 }
 
 /// Serializes a [`UnitSystem`] as its deck keyword (`cell`, `lj`).
@@ -247,7 +309,7 @@ mod tests {
     use std::fs;
 
     use super::*;
-    use crate::output::atomic::tmp_path;
+    use crate::output::files::tmp_path;
 
     fn sample() -> RestartData {
         RestartData {
@@ -301,9 +363,9 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("state.json");
         let data = sample();
-        write_state(&path, &data).unwrap();
+        write_state(dir.path(), &path, &data).unwrap();
         assert!(!tmp_path(&path).exists());
-        let back = read_state(&path).unwrap();
+        let back = parse_state(&path).unwrap();
         assert_eq!(back, data);
         assert_eq!(bits(&back), bits(&data), "-0.0 and every other value keep their bits");
         let text = fs::read_to_string(&path).unwrap();
@@ -335,8 +397,8 @@ mod tests {
         let data = RestartData { ids: (0..positions.len() as u64).collect(), images: vec![[0; 3]; positions.len()], positions, ..sample() };
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("state.json");
-        write_state(&path, &data).unwrap();
-        assert_eq!(bits(&read_state(&path).unwrap()), bits(&data));
+        write_state(dir.path(), &path, &data).unwrap();
+        assert_eq!(bits(&parse_state(&path).unwrap()), bits(&data));
     }
 
     #[test]
@@ -348,10 +410,7 @@ mod tests {
         let b = SimBox::new(DVec3::ZERO, DVec3::splat(4.0), [true; 3]);
         let data = RestartData::from_state(UnitSystem::Lj, &state, &b, &[5, 6]);
         assert_eq!(data.to_state(), state);
-        assert!(data.check_ids(&[5, 6]).is_ok());
-        assert!(data.check_ids(&[5]).unwrap_err().contains("2 particles but the topology has 1"));
-        let err = data.check_ids(&[5, 9]).unwrap_err();
-        assert!(err.contains("particle 1 has id 6 in the restart file but id 9"), "{err}");
+        assert_eq!(data.check(), Ok(()));
     }
 
     #[test]
@@ -359,40 +418,66 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("missing.json");
         let err = read_state(&path).unwrap_err();
-        assert!(err.contains("not found") && err.contains("missing.json"), "{err}");
+        assert!(err.starts_with(&format!("{}: cannot read it: ", path.display())), "{err}");
 
         let write = |name: &str, text: &str| {
             let p = dir.path().join(name);
             fs::write(&p, text).unwrap();
             p
         };
-        let err = read_state(&write("garbage.json", "{ not json")).unwrap_err();
-        assert!(err.contains("not valid JSON"), "{err}");
-        let err = read_state(&write("other.json", r#"{"format": "xyz", "version": 1}"#)).unwrap_err();
-        assert!(err.contains("not a cellmd restart file") && err.contains("\"xyz\""), "{err}");
-        let err = read_state(&write("untagged.json", r#"{"version": 1}"#)).unwrap_err();
-        assert!(err.contains("not a cellmd restart file"), "{err}");
+        let err = read_state(&write("garbage.json", "root:secret:0:0\n")).unwrap_err();
+        assert!(err.contains("garbage.json: not a cellmd restart file (not JSON: expected value at line 1 column 1;"), "{err}");
+        assert!(!err.contains("secret"), "{err}");
+        let err = read_state(&write("other.json", r#"{"format": "secret", "version": 1}"#)).unwrap_err();
+        assert!(err.contains("not a cellmd restart file (no \"format\": \"cellmd-restart\" entry") && !err.contains("secret"), "{err}");
         let err = read_state(&write("v2.json", r#"{"format": "cellmd-restart", "version": 2}"#)).unwrap_err();
-        assert!(err.contains("version 2") && err.contains("reads version 1"), "{err}");
+        assert!(err.ends_with("v2.json: version: found 2, expected 1 (the restart version this cellmd reads)"), "{err}");
         let err = read_state(&write("partial.json", r#"{"format": "cellmd-restart", "version": 1, "step": 3}"#)).unwrap_err();
-        assert!(err.contains("malformed") && err.contains("missing field"), "{err}");
+        assert!(err.contains("malformed restart") && err.contains("missing field"), "{err}");
 
         // Inconsistent lengths are refused on write and on read.
         let mut bad = sample();
         bad.images.pop();
         let p = dir.path().join("bad.json");
-        assert!(write_state(&p, &bad).unwrap_err().contains("same length"));
-        let mut text = serde_json::to_value(sample()).unwrap();
-        text["format"] = RESTART_FORMAT.into();
-        text["version"] = 1.into();
-        text["images"].as_array_mut().unwrap().pop();
-        let err = read_state(&write("short.json", &text.to_string())).unwrap_err();
-        assert!(err.contains("inconsistent"), "{err}");
-
+        assert!(write_state(dir.path(), &p, &bad).unwrap_err().contains("images: found an array of 2, expected 3 entries (one per id)"));
         let mut nan = sample();
         nan.positions[0].x = f64::NAN;
-        assert!(write_state(&p, &nan).unwrap_err().contains("non-finite"));
+        assert!(write_state(dir.path(), &p, &nan).unwrap_err().contains("non-finite"));
         assert!(!p.exists());
+    }
+
+    /// Each way a restart can be unusable is refused by field.
+    #[test]
+    fn unusable_states_are_named_by_field() {
+        let good = || {
+            let b = SimBox::new(DVec3::ZERO, DVec3::splat(4.0), [true, true, false]);
+            let mut d = RestartData::from_state(UnitSystem::Lj, &State::new(vec![DVec3::ONE, DVec3::splat(2.0)]), &b, &[5, 6]);
+            d.resume = Some(Resume { inputs: DeckInputs::default(), action: 3, run_end: Some(100) });
+            d.step = 10;
+            d
+        };
+        assert_eq!(good().check(), Ok(()));
+        type Spoil = Box<dyn Fn(&mut RestartData)>;
+        let cases: Vec<(Spoil, &str)> = vec![
+            (Box::new(|d| d.positions.pop().map(|_| ()).unwrap()), "positions: found an array of 1, expected 2 entries (one per id)"),
+            (Box::new(|d| d.time = -1e308), "time: found -1e308, expected a finite time >= 0"),
+            (Box::new(|d| d.time = f64::INFINITY), "time: found inf"),
+            (Box::new(|d| d.step = u64::MAX), "step: found 18446744073709551615, expected at most 9007199254740992"),
+            (Box::new(|d| d.sim_box.lo.x = -f64::INFINITY), "box: found x from -inf to 4e0"),
+            (Box::new(|d| (d.sim_box.lo.z, d.sim_box.hi.z) = (-1e308, 1e308)), "box: found z from"),
+            (Box::new(|d| d.positions[1].z = 5.0), "positions[1]: z = 5e0 is outside the fixed box"),
+            (Box::new(|d| d.images[0] = [0, 0, 1]), "images[0]: found [0, 0, 1], expected 0 on fixed axes"),
+            (
+                Box::new(|d| d.resume.as_mut().unwrap().run_end = Some(5)),
+                "resume.run_end: found 5, expected at least the restart's step 10",
+            ),
+        ];
+        for (spoil, expected) in cases {
+            let mut d = good();
+            spoil(&mut d);
+            let err = d.check().unwrap_err();
+            assert!(err.starts_with(expected), "{err}\n  expected {expected}");
+        }
     }
 
     #[test]
@@ -400,12 +485,12 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("state.json");
         let mut data = sample();
-        write_state(&path, &data).unwrap();
+        write_state(dir.path(), &path, &data).unwrap();
         data.step += 1;
         // A stale temporary from an interrupted earlier write is simply replaced.
         fs::write(tmp_path(&path), "partial garbage").unwrap();
-        write_state(&path, &data).unwrap();
-        assert_eq!(read_state(&path).unwrap().step, data.step);
+        write_state(dir.path(), &path, &data).unwrap();
+        assert_eq!(parse_state(&path).unwrap().step, data.step);
         assert!(!tmp_path(&path).exists());
     }
 }

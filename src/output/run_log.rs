@@ -2,8 +2,9 @@
 //! hash, command line), what it read (the deck and force fields, as read),
 //! the resolved parameters of each `run`, and where the time went.
 //!
-//! Every section is flushed when written, so a killed run's log ends with
-//! its last complete section. The closing table is LAMMPS' "MPI task
+//! Every section goes to the file whole when written (see
+//! [`records`](super::records)), so a killed run's log ends with its last
+//! complete section. The closing table is LAMMPS' "MPI task
 //! timing breakdown" for the CPU step loop:
 //!
 //! ```text
@@ -23,6 +24,7 @@ use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
+use super::records::RecordFile;
 use crate::forcefield::TermType;
 use crate::input::DeckInputs;
 use crate::system::Model;
@@ -113,14 +115,15 @@ pub struct LogHeader {
 
 /// The open log file.
 pub struct RunLog {
-    file: File,
+    file: RecordFile,
     pub path: PathBuf,
 }
 
 impl RunLog {
-    /// Creates the log with its head: program, command line, input files.
-    pub fn create(path: &Path, header: &LogHeader, inputs: &DeckInputs) -> io::Result<Self> {
-        let mut log = Self { file: File::create(path)?, path: path.to_path_buf() };
+    /// Writes the log's head — program, command line, input files — to
+    /// `file` (empty, as opened for output), the log at `path`.
+    pub fn create(file: File, path: &Path, header: &LogHeader, inputs: &DeckInputs) -> io::Result<Self> {
+        let mut log = Self { file: RecordFile::new(file), path: path.to_path_buf() };
         let mut head = format!("{}\ncommand: {}\ndeck: {}\n", header.version, header.command_line, inputs.deck);
         for (name, value) in &inputs.vars {
             let _ = writeln!(head, "variable override: {name}={value}");
@@ -139,13 +142,13 @@ impl RunLog {
         Ok(log)
     }
 
-    /// Appends a block of text and flushes it.
+    /// Appends a block of text, written whole.
     pub fn section(&mut self, text: &str) -> io::Result<()> {
         self.file.write_all(text.as_bytes())?;
         if !text.ends_with('\n') {
             self.file.write_all(b"\n")?;
         }
-        self.file.flush()
+        self.file.commit()
     }
 }
 

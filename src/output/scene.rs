@@ -295,7 +295,7 @@ pub fn to_json(update: &SceneUpdate) -> Value {
         c.as_ref().map_or(json!({"r": 0.0, "g": 0.0, "b": 0.0, "a": 0.0}), |c| json!({"r": c.r, "g": c.g, "b": c.b, "a": c.a}))
     };
     let pose = |p: &Option<Pose>| {
-        let p = p.clone().unwrap_or_default();
+        let p = (*p).unwrap_or_default();
         let q = p.orientation.unwrap_or(Quaternion { x: 0.0, y: 0.0, z: 0.0, w: 1.0 });
         json!({"position": vec3(&p.position), "orientation": {"x": q.x, "y": q.y, "z": q.z, "w": q.w}})
     };

@@ -25,7 +25,7 @@ use crate::integrate::fire::FireReport;
 use crate::integrate::implicit::SolveReport;
 use crate::integrate::Integrator;
 use crate::kinetics_engine::{initial_bond_state, Formation, Kinetics};
-use crate::output::open_writer_with;
+use crate::output::open_writer;
 use crate::output::restart::{read_state, write_state, RestartData};
 use crate::output::run_log::{LogHeader, PhaseTimes, RunLog};
 use crate::output::{EventLog, LifetimeTable};
@@ -214,9 +214,8 @@ impl Simulation {
     /// `run` in progress is finished and the rest of the deck is applied.
     /// The final state is the uninterrupted run's, bit for bit (on the CPU).
     pub fn resume(plan: Plan, data: RestartData, restart: &Path, options: RunOptions) -> Result<Simulation, RunError> {
-        let Some(resume) = data.resume.clone() else {
-            return Err(RunError::Setup(format!("{}: the restart carries no deck to continue", restart.display())));
-        };
+        Simulation::check_restart(&plan, &data, restart).map_err(RunError::Setup)?;
+        let resume = data.resume.clone().expect("check_restart requires one");
         let Plan { deck_path, model, sim_box, positions, actions, inputs, .. } = plan;
         let mut sim = Simulation::start(model, sim_box, positions, &deck_path, inputs, options);
         let result = (|| {
@@ -318,7 +317,7 @@ impl Simulation {
     }
 
     /// Applies one action (jumps only make sense within their plan: see
-    /// [`Self::perform`]).
+    /// `perform`).
     pub fn apply(&mut self, action: &Action) -> Result<(), RunError> {
         match action {
             Action::Branch { .. } | Action::Skip(_) => {
@@ -339,7 +338,7 @@ impl Simulation {
             }
             Action::EventFile(path) => {
                 let path = self.output_path(path);
-                let file = std::fs::File::create(&path).map_err(|e| self.output_error(&path, e))?;
+                let file = self.create_output(&path)?;
                 let log = EventLog::create(file, self.model.units).map_err(|e| self.output_error(&path, e))?;
                 if let Some((old, old_path)) = self.event_log.replace((log, path)) {
                     old.finish().map_err(|e| self.output_error(&old_path, e))?;
@@ -348,13 +347,14 @@ impl Simulation {
             Action::LifetimeFile(path) => self.lifetime_file = Some(self.output_path(path)),
             Action::ThermoFile(path) => {
                 let path = self.output_path(path);
-                let file = std::fs::File::create(&path).map_err(|e| self.output_error(&path, e))?;
+                let file = self.create_output(&path)?;
                 self.thermo.set_file(file, path).map_err(|(path, e)| self.output_error(&path, e))?;
             }
             Action::Dump(spec) => {
                 let path = self.output_path(&spec.path);
+                let file = self.create_output(&path)?;
                 let writer =
-                    open_writer_with(spec.format, &path, &self.topology_view(), &spec.options).map_err(|e| self.output_error(&path, e))?;
+                    open_writer(spec.format, file, &self.topology_view(), &spec.options).map_err(|e| self.output_error(&path, e))?;
                 self.dumps.push(ActiveDump { spec: spec.clone(), path, writer, last_step: None });
             }
             Action::Undump(name) => {
@@ -410,7 +410,7 @@ impl Simulation {
             Action::Run(steps) => self.run(*steps)?,
             Action::WriteState(path) => {
                 let path = self.output_path(&with_step(path, self.state.step));
-                write_state(&path, &self.restart_data()).map_err(|e| self.output_error(&path, e))?;
+                write_state(&self.options.output_dir, &path, &self.restart_data()).map_err(|e| self.output_error(&path, e))?;
                 self.say(&format!("wrote state at step {} to {}", self.state.step, path.display()));
             }
             Action::Checkpoint(spec) => {
@@ -418,7 +418,7 @@ impl Simulation {
             }
             Action::ReadState(path) => {
                 let path = if path.exists() { path.clone() } else { self.output_path(path) };
-                let data = read_state(&path).map_err(|e| RunError::Setup(format!("{}: {e}", path.display())))?;
+                let data = read_state(&path).map_err(RunError::Setup)?;
                 self.load_restart(data, &path)?;
             }
             Action::Print(text) => self.say(text),

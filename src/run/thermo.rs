@@ -23,18 +23,18 @@
 //! | `volume/BODYTYPE`, `area/BODYTYPE` | summed enclosed volume and area of the bodies of a type | µm³, µm² |
 //! | `mindist` | smallest node–face distance between different bodies (exact below the largest contact d̂; `inf` when no pair is within the search range) | µm |
 //! | `nclamp` | steps (explicit or implicit) and FIRE moves shortened by the contact step clamp so far | – |
-//! | `planetension/AXIS/POS` | normal force transmitted across the plane x_AXIS = POS by every bond, pair, angle and body term crossing it; positive = tension ([`planes`](crate::measure::planes)) | pN |
-//! | `gamma/BODYTYPE` | cortical tension γ = ⟨Σ_cut T·\|û·n̂\|⟩/(2πR) over diametral planes of each body, mean over the type's bodies ([`planes`](crate::measure::planes)) | pN/µm |
-//! | `e2e/BONDTYPE` | mean end-to-end distance of the chains of bonds of the type ([`filaments`](crate::measure::filaments)) | µm |
+//! | `planetension/AXIS/POS` | normal force transmitted across the plane x_AXIS = POS by every bond, pair, angle and body term crossing it; positive = tension ([`planes`]) | pN |
+//! | `gamma/BODYTYPE` | cortical tension γ = ⟨Σ_cut T·\|û·n̂\|⟩/(2πR) over diametral planes of each body, mean over the type's bodies ([`planes`]) | pN/µm |
+//! | `e2e/BONDTYPE` | mean end-to-end distance of the chains of bonds of the type ([`filaments`]) | µm |
 //! | `tcorr/BONDTYPE/LAG` | tangent correlation ⟨t_s·t_{s+LAG}⟩ along those chains, LAG in bonds | – |
-//! | `fracture/BONDTYPE/QUANTITY` | a sheet's junctions: `broken` original junctions, `rearranged` (bound junctions to new neighbours), `ratio` (rearranged per broken), largest `crack` (broken junctions), `pieces`, `label` (0 elastic, 1 ductile, 2 brittle) ([`fracture`](crate::measure::fracture)) | – |
-//! | `clustering/BONDTYPE/GROUP_A/GROUP_B` | fibre clustering S_max/S_min: the densest 7 of 21 strips across the band between two cells against the 3 outermost at each end ([`clustering`](crate::measure::clustering)) | – |
+//! | `fracture/BONDTYPE/QUANTITY` | a sheet's junctions: `broken` original junctions, `rearranged` (bound junctions to new neighbours), `ratio` (rearranged per broken), largest `crack` (broken junctions), `pieces`, `label` (0 elastic, 1 ductile, 2 brittle) ([`fracture`]) | – |
+//! | `clustering/BONDTYPE/GROUP_A/GROUP_B` | fibre clustering S_max/S_min: the densest 7 of 21 strips across the band between two cells against the 3 outermost at each end ([`clustering`]) | – |
 //! | `fx/GROUP`, `fy/GROUP`, `fz/GROUP` | Σ_{i∈GROUP} F_i along the axis; on `fixed` particles the reaction of their anchors (a sheared plate's load) | pN |
 //! | `xu/GROUP`, `yu/GROUP`, `zu/GROUP` | mean unwrapped coordinate (1/N)Σ_{i∈GROUP} (x_i + n_i·L) along the axis | µm |
 //! | `load/NAME`, `depth/NAME` | an indenter external's load \|Σ F\| on its group (its reaction) and its deepest penetration δ = (3E/K)^{1/3} | pN, µm |
 
 use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::Write;
 use std::path::PathBuf;
 
 use super::protocol::indenter_load;
@@ -42,6 +42,7 @@ use crate::backend::Forces;
 use crate::deck::{GroupQuantity, ThermoColumn};
 use crate::interactions::REGISTRY;
 use crate::measure::{clustering, filaments, fracture, planes};
+use crate::output::records::RecordFile;
 use crate::units::{Dim, UnitSystem};
 use glam::DVec2;
 
@@ -302,7 +303,7 @@ pub struct Thermo {
     pub(crate) labels: Vec<String>,
     pub units: UnitSystem,
     /// The CSV file and its path (for error messages).
-    file: Option<(BufWriter<File>, PathBuf)>,
+    file: Option<(RecordFile, PathBuf)>,
     file_header_written: bool,
     /// Whether rows are kept in `log` (the Python API's `thermo()`).
     pub(crate) record: bool,
@@ -348,7 +349,7 @@ impl Thermo {
 
     pub fn set_file(&mut self, file: File, path: PathBuf) -> Result<(), FileError> {
         self.close()?;
-        self.file = Some((BufWriter::new(file), path));
+        self.file = Some((RecordFile::new(file), path));
         self.file_header_written = false;
         Ok(())
     }
@@ -400,7 +401,8 @@ impl Thermo {
                     .map(|(c, v)| if is_integer(c) { format!("{}", *v as u64) } else { format!("{v:e}") })
                     .collect();
                 writeln!(file, "{}", fields.join(","))?;
-                file.flush()
+                // The row goes to the file whole.
+                file.commit()
             };
             write().map_err(|e| (path.clone(), e))?;
         }
@@ -409,7 +411,7 @@ impl Thermo {
 
     pub fn close(&mut self) -> Result<(), FileError> {
         if let Some((mut file, path)) = self.file.take() {
-            file.flush().map_err(|e| (path, e))?;
+            file.finish().map_err(|e| (path, e))?;
         }
         Ok(())
     }

@@ -86,7 +86,7 @@ pub fn check_custom_terms(model: &Model, externals: &[&External], positions: &[D
 /// Warnings (`file:line:col: warning: …`, at the law's label) for the
 /// custom terms of `model` whose energy or force is not finite at the
 /// deck's initial geometry or at a declared rest value (`r0`, `theta0`), and
-/// for custom pair laws truncated at their cutoff (see [`at_cutoff`]).
+/// for custom pair laws truncated at their cutoff (see `at_cutoff`).
 /// `externals` are the deck's `external` commands.
 pub fn custom_warnings(model: &Model, externals: &[&External], positions: &[DVec3], sim_box: &SimBox) -> Vec<String> {
     let custom = |t: &TermType| t.interaction.name() == "custom";
@@ -153,9 +153,9 @@ pub fn custom_warnings(model: &Model, externals: &[&External], positions: &[DVec
     }
     for (term, &(a, b)) in model.pair_rules.iter().zip(&model.pair_rule_types).filter(|(t, _)| custom(t)) {
         let note = at_cutoff(term, term.params[0]);
-        if note.starts_with("warning: ") {
+        if let Some(note) = note.strip_prefix("warning: ") {
             let what = format!("pair {} {}", model.type_names[a as usize], model.type_names[b as usize]);
-            out.push(warn(term, &what, format!("{}; the dynamics feel the jump (`cellmd check --selftest` runs every check)", &note[9..])));
+            out.push(warn(term, &what, format!("{}; the dynamics feel the jump (`cellmd check --selftest` runs every check)", note)));
         }
     }
     out

@@ -25,6 +25,22 @@ impl SimBox {
         Self { lo, hi, periodic }
     }
 
+    /// Why this box cannot hold a system (read from a restart, say): an
+    /// axis whose bounds are not finite, not ordered, or whose edge or its
+    /// inverse overflows; `field: found …, expected …`.
+    pub fn check(&self) -> Result<(), String> {
+        for (a, axis) in ["x", "y", "z"].iter().enumerate() {
+            let (lo, hi) = (self.lo[a], self.hi[a]);
+            let edge = hi - lo;
+            if !(lo.is_finite() && hi.is_finite() && hi > lo && edge.is_finite() && (1.0 / edge).is_finite()) {
+                return Err(format!(
+                    "box: found {axis} from {lo:e} to {hi:e}, expected finite bounds lo < hi whose edge hi − lo and its inverse are finite"
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// Edge lengths `hi − lo`.
     pub fn lengths(&self) -> DVec3 {
         self.hi - self.lo
@@ -57,7 +73,7 @@ impl SimBox {
     /// counter: one box length is added or subtracted (the usual case, as a
     /// step crosses at most one box), more by floor arithmetic, never by a loop
     /// (1e300 in a 10 µm box, or 1 in a 1e-12 one, never ended). A coordinate
-    /// that cannot be wrapped — not finite, or [`MAX_IMAGE`] box lengths or
+    /// that cannot be wrapped — not finite, or `MAX_IMAGE` box lengths or
     /// more away — is left as it is, for [`Self::misplaced_axis`] to report.
     #[inline]
     pub fn wrap(&self, x: &mut DVec3, image: &mut [i64; 3]) {
@@ -220,5 +236,14 @@ mod tests {
         assert_eq!(b.misplaced_axis(DVec3::new(0.0, 0.0, 10.0)), None);
         assert_eq!(b.misplaced_axis(DVec3::new(0.0, 0.0, 10.000001)), Some(2));
         assert_eq!(b.misplacement(DVec3::new(0.0, 0.0, -1.0), 2), "z = -1e0 is outside the fixed box [0e0, 1e1]");
+    }
+
+    #[test]
+    fn boxes_that_cannot_hold_a_system_are_named() {
+        assert_eq!(periodic_box().check(), Ok(()));
+        for (lo, hi) in [(-1e308, 1e308), (0.0, f64::INFINITY), (f64::NAN, 1.0), (1.0, 1.0), (2.0, 1.0), (0.0, 1e-310)] {
+            let b = SimBox::new(DVec3::new(0.0, lo, 0.0), DVec3::new(1.0, hi, 1.0), [false; 3]);
+            assert!(b.check().unwrap_err().starts_with("box: found y from"), "{lo} {hi}");
+        }
     }
 }

@@ -13,16 +13,15 @@
 //!   translations and rotations in its null space;
 //! - runs are bit-identical on 1 and 2 threads; the GPU refuses the term.
 
-
 use std::cell::RefCell;
 
+use crate::common::{position_bits, two_cells, Case};
 use cellmd::backend::{CpuBackend, Forces};
 use cellmd::deck::Plan;
 use cellmd::interactions::testing::assert_checks_of;
 use cellmd::interactions::REGISTRY;
 use cellmd::mesh::{point_triangle, triangle_area, PointTriangle};
 use cellmd::system::State;
-use crate::common::{position_bits, two_cells, Case};
 use faer::{Mat, Side};
 use glam::DVec3;
 

@@ -1,10 +1,9 @@
 //! A run that blows up stops with the step, the particle and the interaction
 //! responsible, writes the last good frame, and leaves complete output files.
 
-
+use crate::common::Case;
 use cellmd::deck::validate_file;
 use cellmd::run::{RunError, RunOptions, Simulation};
-use crate::common::Case;
 
 fn run_to_error(case: &Case) -> RunError {
     let plan = validate_file(&case.path("deck.in"), &[]).unwrap();
@@ -82,7 +81,7 @@ fn coincident_particles_on_a_slack_bond_are_not_a_blowup() {
     let sim = slack.run();
     assert!(sim.state.positions.iter().all(|x| *x == glam::DVec3::ONE), "{:?}", sim.state.positions);
     let stretched = Case::new(&[("t.top", top), ("f.ff", "particle a drag 1\nbond s harmonic k 10 r0 1\n"), ("deck.in", deck)]);
-    let error = validate_file(&stretched.path("deck.in"), &[]).err().expect("refused").to_string();
+    let error = validate_file(&stretched.path("deck.in"), &[]).expect_err("refused").to_string();
     assert!(error.ends_with("t.top:5:1: bond `s` joins particles 1 and 2 at the same position, where its law `harmonic` exerts a force of undefined direction; expected bonded particles apart"), "{error}");
 }
 

@@ -10,9 +10,9 @@ use crate::common;
 use std::path::Path;
 use std::process::Command;
 
+use crate::common::Case;
 use cellmd::deck::{validate_file, Plan};
 use cellmd::run::{RunOptions, Simulation};
-use crate::common::Case;
 
 /// Largest |F| on any particle at the deck's start (pN).
 fn max_force(plan: &Plan) -> f64 {

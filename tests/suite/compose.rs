@@ -1,7 +1,6 @@
 //! Composition: several `topology` lines make one system with offset particle
 //! and body ids and shared type names.
 
-
 use crate::common::Case;
 
 const DIMER: &str = "[ particles ]\n1 p 0 0 0\n2 p 1.5 0 0\n[ bonds ]\ns 1 2\n";

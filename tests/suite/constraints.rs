@@ -3,8 +3,8 @@
 
 use crate::common;
 
-use cellmd::run::{RunOptions, Simulation};
 use crate::common::Case;
+use cellmd::run::{RunOptions, Simulation};
 
 /// A chain of `n` segments of 0.1 along x, its first `anchors` beads fixed
 /// (1: pinned, 2: clamped), its tip pulled by `load` (pN) along (lx, ly, 0);

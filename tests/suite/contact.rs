@@ -14,13 +14,12 @@
 //!   `contact_barrier` (tests/suite/gpu.rs compares it with the CPU).
 //! - `topologies/cell_contact.top` is two `cellmd build icosphere` cells merged.
 
-
+use crate::common::{merge_topologies, position_bits, squeezed_cells, two_cells, Case};
 use cellmd::build::{icosphere_cell, IcosphereCell};
 use cellmd::deck::validate_file;
 use cellmd::integrate::fire::FireSettings;
 use cellmd::mesh::point_triangle;
 use cellmd::run::{RunOptions, Simulation};
-use crate::common::{merge_topologies, position_bits, squeezed_cells, two_cells, Case};
 use glam::DVec3;
 
 const SHELLS: &str = "body cell turgor k 1000 dp0 100 v0 32.4\nbody cell surface_tension gamma 100\n";

@@ -11,6 +11,9 @@
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
+/// The bad decks' directory, with a valid topology and force field.
+const BAD: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/decks/bad");
+
 /// Generous: every case takes well under a second in the test profile.
 const LIMIT: Duration = Duration::from_secs(60);
 
@@ -90,14 +93,41 @@ fn generated_crashers_are_diagnosed_quickly() {
         // Quadratic lexing: 26 s for a 1 MB line.
         (write("long.in", format!("units lj\nprint {}\n", "x ".repeat(500_000)).as_bytes()), ":2:1: `print` needs a system".into(), 1),
         (write("latin1.in", b"units lj\nprint caf\xe9\n"), ":2:10: found byte 0xE9, which is not UTF-8".into(), 1),
-        // A password file named as a topology: one clipped word, no other line.
+        // A password file named as a topology, a force field or an include: no byte of it.
         (
             write(
                 "topology.in",
                 format!("units lj\ntopology {}\n", write("passwd", format!("root:x:0:0:{}\n{secret}", "r".repeat(300)).as_bytes()))
                     .as_bytes(),
             ),
-            "passwd:1:1: found `root:x:0:0:rrrr".into(),
+            "passwd:1:1: found `…` before any section".into(),
+            1,
+        ),
+        (
+            write("forcefield.in", format!("units lj\ntopology {BAD}/base.top\nforcefield {}/passwd\n", dir.path().display()).as_bytes()),
+            "passwd:1:1: found `…`, expected `include`".into(),
+            1,
+        ),
+        // 2 000 nested `if`s overflowed the stack (exit 134); 1 500 passed.
+        (
+            write("nested_ifs.in", format!("units lj\n{}run 1\n{}", "if 1 then\n".repeat(2000), "endif\n".repeat(2000)).as_bytes()),
+            ":102:1: found `if` at nesting depth 101, expected at most 100".into(),
+            1,
+        ),
+        // Two nested loops of 10⁵ never finished `check` (and a `print` in them took GBs).
+        (
+            write(
+                "nested_loops.in",
+                format!("units lj\ntopology {BAD}/base.top\nforcefield {BAD}/base.ff\nloop i 1 100000\nloop j 1 100000\nprint ${{i}} ${{j}}\nendloop\nendloop\n")
+                    .as_bytes(),
+            ),
+            ":5:10: found more than 100000 loop iterations in this deck".into(),
+            1,
+        ),
+        // Terminal escapes in a comment were accepted and echoed raw.
+        (
+            write("escape.in", b"units lj # \x1b]0;owned\x07\x1b[2J\n"),
+            ":1:12: found control character `\\u{1b}` in a comment".into(),
             1,
         ),
     ];
@@ -105,7 +135,8 @@ fn generated_crashers_are_diagnosed_quickly() {
         let got = cellmd(&["check", deck]);
         assert_eq!(got.status, *status, "{deck}:\n{}", got.stderr);
         assert!(got.stderr.contains(expected.as_str()), "{deck}: stderr lacks `{expected}`:\n{}", got.stderr);
-        assert!(!got.stderr.contains("secret"), "{deck} echoed more of a file:\n{}", got.stderr);
+        assert!(!got.stderr.contains("secret") && !got.stderr.contains("root:"), "{deck} echoed a file:\n{}", got.stderr);
+        assert!(!got.stderr.contains('\x1b') && !got.stderr.contains('\x07'), "{deck}: a raw control character in\n{}", got.stderr);
         // The headline is our message (its quotes clipped); every other line is the file's.
         let mut quoted = got.stderr.lines().filter(|l| !l.trim_start().starts_with('×'));
         assert!(quoted.all(|l| l.chars().count() < 400), "{deck}: a long line in\n{}", got.stderr);

@@ -8,8 +8,8 @@ use crate::common;
 
 use std::process::Command;
 
-use cellmd::run::{RunOptions, Simulation};
 use crate::common::{position_bits, Case};
+use cellmd::run::{RunOptions, Simulation};
 use glam::DVec3;
 
 /// 300 particles in a periodic box with bonds, angles, two pair rules and

@@ -1,10 +1,9 @@
 //! Deck features end to end: variables, continuation lines, repeated commands,
 //! parameter changes between runs, groups, externals and dumps.
 
-
+use crate::common::Case;
 use cellmd::deck::{validate_file, Action};
 use cellmd::run::{RunOptions, Simulation};
-use crate::common::Case;
 
 const TOP: &str = "[ particles ]\n1 p 0 0 0\n2 p 1.5 0 0\n3 q 5 5 5\n4 q 6 5 5\n[ bonds ]\ns 1 2\n";
 const FF: &str = "particle p drag 2\nparticle q radius 0.5 viscosity 0.1\nbond s harmonic k 3 r0 1\n";

@@ -4,11 +4,10 @@
 //! expressions of x, y, z and t (`field`, a moving wall), the temperature
 //! guard. The bad forms are in tests/decks/bad/ (tests/suite/bad_decks.rs).
 
-
+use crate::common::Case;
 use cellmd::deck::{Action, Plan, ThermoColumn};
 use cellmd::export::{export, ExportOptions};
 use cellmd::run::Simulation;
-use crate::common::Case;
 
 /// One bead of drag 1 at the origin, LJ units, dt = 0.01, then `body`.
 fn bead(body: &str) -> Case {

@@ -52,12 +52,11 @@
 //! pins on the path the larger steps take). `-- --ignored
 //! implicit_doublet_time_step_table` prints the sweep from 1× to 30000×.
 
-
 use std::f64::consts::PI;
 
+use crate::common::Case;
 use cellmd::mesh::{point_triangle, triangle_area};
 use cellmd::run::{RunOptions, Simulation};
-use crate::common::Case;
 use glam::{DMat4, DVec3, DVec4};
 
 const RADIUS: f64 = 2.0;

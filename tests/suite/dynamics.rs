@@ -1,6 +1,5 @@
 //! Overdamped dynamics and FIRE against exact results (issue: engine core, Dynamics).
 
-
 use crate::common::{grid_topology, Case};
 
 /// Free diffusion: MSD = 6·D·t with D = kT/γ, within 4 standard errors.

@@ -2,9 +2,8 @@
 //! errors for what LAMMPS cannot express. (Agreement with LAMMPS itself is
 //! checked by tests/suite/golden.rs and `scripts/test-all`.)
 
-
-use cellmd::export::{export, ExportOptions};
 use crate::common::Case;
+use cellmd::export::{export, ExportOptions};
 
 const TOP: &str = "[ particles ]\n1 a 0 0 0.5\n2 a 1.1 0 0.5\n3 a 1.5 0.9 0.5\n[ bonds ]\nh 1 2\nc 2 3\n[ angles ]\nw 1 2 3\n";
 const FF: &str = "particle a drag 2\nbond h harmonic k 50 r0 1\nbond c cable k 40 r0 1 tau 0.1\nangle w wlc_bending kappa 0.5 l0 0.25\n\

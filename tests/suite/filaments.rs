@@ -2,11 +2,10 @@
 //! oracles (issue 6): the worm-like-chain bending energy of an arc, and the
 //! Euler buckling load from the linear stability of the engine's own forces.
 
-
+use crate::common::{self, Case};
 use cellmd::backend::{CpuBackend, Forces};
 use cellmd::deck::Plan;
 use cellmd::system::State;
-use crate::common::{self, Case};
 use faer::{Mat, Side};
 use glam::DVec3;
 

@@ -1,14 +1,15 @@
 //! Trajectory formats read back by the programs users open them with: the
-//! extended XYZ by ASE (`ase.io.read`), the DCD by MDAnalysis, both compared
-//! with the LAMMPS dump of the same frames (text, bit-exact); the LAMMPS
-//! dump's `element` column; the MCAP's compressed chunks and protobuf scene
+//! extended XYZ by ASE (`ase.io.read`) and OVITO (`ovito.io.import_file`),
+//! the DCD by MDAnalysis (positions and times), the LAMMPS dump by ASE and
+//! OVITO, each compared with the LAMMPS dump of the same frames (text,
+//! bit-exact); the LAMMPS dump's `element` column (the chemical symbol
+//! standing for each type); the MCAP's compressed chunks and protobuf scene
 //! (box, walls, bound bonds only), and its own protobuf channels as the
 //! Python `mcap-protobuf-support` decoder reads them from their descriptors.
 //!
-//! ASE, MDAnalysis and the mcap libraries come from the reference venv (`scripts/reference-venv`,
+//! ASE, MDAnalysis, OVITO and the mcap libraries come from the reference venv (`scripts/reference-venv`,
 //! which `scripts/test-all` creates before the tests run). Where it is absent
 //! the reader checks print why and pass without reading.
-
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -116,19 +117,119 @@ from MDAnalysis.coordinates.DCD import DCDReader
 r = DCDReader(sys.argv[1])
 print(json.dumps({
     "n_atoms": r.n_atoms,
-    "frames": [{"positions": [[float(v) for v in p] for p in ts.positions], "dimensions": [float(v) for v in ts.dimensions]} for ts in r],
+    "dt": float(r.dt),
+    "frames": [{"positions": [[float(v) for v in p] for p in ts.positions], "dimensions": [float(v) for v in ts.dimensions],
+                "time": float(ts.time)} for ts in r],
 }))
 "#;
 
+/// ASE's LAMMPS-dump reader: chemical symbols and positions per frame.
+const ASE_READ_DUMP: &str = r#"
+import json, sys
+import ase.io
+frames = ase.io.read(sys.argv[1], index=":", format="lammps-dump-text")
+print(json.dumps([{"symbols": a.get_chemical_symbols(), "positions": a.get_positions().tolist()} for a in frames]))
+"#;
+
+/// OVITO's importer: the particle type names and positions per frame.
+const OVITO_READ: &str = r#"
+import json, sys
+from ovito.io import import_file
+pipeline = import_file(sys.argv[1])
+out = []
+for frame in range(pipeline.num_frames):
+    data = pipeline.compute(frame)
+    types = data.particles.particle_types
+    names = {t.id: t.name for t in types.types}
+    out.append({"types": [names[int(t)] for t in types[...]], "positions": data.particles.positions[...].tolist(),
+                "ids": [int(i) for i in data.particles.identifiers[...]]})
+print(json.dumps(out))
+"#;
+
+/// Whether the reference venv has OVITO (added to it later than the others).
+fn has_ovito(python: &PathBuf) -> bool {
+    Command::new(python).args(["-c", "import ovito"]).output().is_ok_and(|o| o.status.success())
+}
+
+/// The dump's `element` column holds the chemical symbol standing for each
+/// type (type 1 → H, 2 → He), which ASE can map.
 #[test]
-fn the_lammps_dump_names_each_type_in_its_element_column() {
+fn the_lammps_dump_writes_the_element_standing_for_each_type() {
     let case = dumped_case();
     let frames = read_dump(&case.path("t.lammpstrj"));
     assert_eq!(frames.iter().map(|f| f.step).collect::<Vec<_>>(), [0, 10, 20, 30]);
     for f in &frames {
         assert_eq!(f.header.join(" "), "id type element x y z ix iy iz");
         for (ty, element) in f.column("type").iter().zip(f.column("element")) {
-            assert_eq!(element, ["a", "b"][ty.parse::<usize>().unwrap() - 1]);
+            assert_eq!(element, ["H", "He"][ty.parse::<usize>().unwrap() - 1]);
+        }
+    }
+}
+
+/// The type names of the 400 particles by id, from the dump's type numbers
+/// (`a` is type 1, `b` type 2: the force field's order).
+fn names_by_id(dump: &DumpFrame) -> BTreeMap<u64, &'static str> {
+    dump.column("id").iter().zip(dump.column("type")).map(|(id, t)| (id.parse().unwrap(), if t == "1" { "a" } else { "b" })).collect()
+}
+
+/// ASE reads cellmd's LAMMPS dump (it failed on type names in `element`):
+/// every frame, H for type 1 and He for type 2, positions bit for bit.
+#[test]
+fn ase_reads_the_lammps_dump() {
+    let Some(python) = reference_python() else {
+        eprintln!("SKIPPED: no reference venv (run `bash scripts/reference-venv`); ASE cannot read the LAMMPS dump");
+        return;
+    };
+    let case = dumped_case();
+    let dump = read_dump(&case.path("t.lammpstrj"));
+    let frames = python_json(&python, ASE_READ_DUMP, &[&case.path("t.lammpstrj")]);
+    let frames = frames.as_array().unwrap();
+    assert_eq!(frames.len(), dump.len());
+    for (frame, want) in frames.iter().zip(&dump) {
+        let symbols: Vec<String> = serde_json::from_value(frame["symbols"].clone()).unwrap();
+        let positions: Vec<[f64; 3]> = serde_json::from_value(frame["positions"].clone()).unwrap();
+        // ASE sorts by id, as the dump is.
+        let want_symbols: Vec<&str> = want.column("type").iter().map(|t| if *t == "1" { "H" } else { "He" }).collect();
+        assert_eq!(symbols, want_symbols);
+        assert!(want_symbols.contains(&"H") && want_symbols.contains(&"He"));
+        for (got, x) in positions.iter().zip(want.positions()) {
+            assert_eq!(got.map(f64::to_bits), x.map(f64::to_bits));
+        }
+    }
+}
+
+/// OVITO names the XYZ's particle types after the type names (`a`, `b`,
+/// not H/He) and the dump's after their elements; positions to the last
+/// bit but one (OVITO's parser rounds some 17-digit numbers one ulp off).
+#[test]
+fn ovito_reads_the_xyz_with_type_names_and_the_lammps_dump() {
+    let Some(python) = reference_python().filter(has_ovito) else {
+        eprintln!("SKIPPED: no reference venv with OVITO (run `bash scripts/reference-venv`); OVITO cannot read the XYZ and dump");
+        return;
+    };
+    let case = dumped_case();
+    let dump = read_dump(&case.path("t.lammpstrj"));
+    let xyz = python_json(&python, OVITO_READ, &[&case.path("t.xyz")]);
+    let ovito_dump = python_json(&python, OVITO_READ, &[&case.path("t.lammpstrj")]);
+    let (xyz, ovito_dump) = (xyz.as_array().unwrap(), ovito_dump.as_array().unwrap());
+    assert_eq!((xyz.len(), ovito_dump.len()), (dump.len(), dump.len()));
+    for ((from_xyz, from_dump), want) in xyz.iter().zip(ovito_dump).zip(&dump) {
+        let names = names_by_id(want);
+        let by_id: BTreeMap<u64, [f64; 3]> = want.column("id").iter().map(|id| id.parse().unwrap()).zip(want.positions()).collect();
+        for (from, names) in
+            [(from_xyz, names.clone()), (from_dump, names.iter().map(|(&id, &n)| (id, if n == "a" { "H" } else { "He" })).collect())]
+        {
+            let types: Vec<String> = serde_json::from_value(from["types"].clone()).unwrap();
+            let positions: Vec<[f64; 3]> = serde_json::from_value(from["positions"].clone()).unwrap();
+            let ids: Vec<u64> = serde_json::from_value(from["ids"].clone()).unwrap();
+            assert_eq!(ids.len(), by_id.len());
+            for ((id, t), x) in ids.iter().zip(&types).zip(&positions) {
+                assert_eq!(t, names[id], "id {id}");
+                // OVITO's number parser is not correctly rounded: it reads the
+                // `1.4036974322645301` written by cellmd as 1.40369743226453, one ulp below.
+                let ulps = (0..3).map(|a| x[a].to_bits().abs_diff(by_id[id][a].to_bits())).max().unwrap();
+                assert!(ulps <= 1, "id {id}: OVITO read {x:?}, the file holds {:?}", by_id[id]);
+            }
         }
     }
 }
@@ -148,10 +249,10 @@ fn ase_reads_the_extended_xyz_with_elements_and_type_names() {
         assert_eq!(frame["step"].as_u64().unwrap(), want.step);
         assert_eq!(frame["pbc"], serde_json::json!([true, true, true]));
         let cell: Vec<Vec<f64>> = serde_json::from_value(frame["cell"].clone()).unwrap();
-        for a in 0..3 {
-            for b in 0..3 {
-                let edge = want.bounds[a][1] - want.bounds[a][0];
-                assert_eq!(cell[a][b], if a == b { edge } else { 0.0 });
+        for (a, row) in cell.iter().enumerate() {
+            let edge = want.bounds[a][1] - want.bounds[a][0];
+            for (b, &value) in row.iter().enumerate() {
+                assert_eq!(value, if a == b { edge } else { 0.0 });
             }
         }
         // ASE keeps the file's (internal) order; the dump is sorted by id.
@@ -166,14 +267,14 @@ fn ase_reads_the_extended_xyz_with_elements_and_type_names() {
         for i in 0..ids.len() {
             let (x, element) = by_id[&ids[i]];
             assert_eq!(positions[i].map(f64::to_bits), x.map(f64::to_bits), "id {}", ids[i]);
-            assert_eq!(type_names[i], element);
-            assert_eq!(symbols[i], if element == "a" { "H" } else { "He" });
+            assert_eq!(type_names[i], if element == "H" { "a" } else { "b" });
+            assert_eq!(symbols[i], element);
         }
     }
 }
 
 #[test]
-fn mdanalysis_reads_the_dcd_in_id_order() {
+fn mdanalysis_reads_the_dcd_in_id_order_with_its_times() {
     let Some(python) = reference_python() else {
         eprintln!("SKIPPED: no reference venv (run `bash scripts/reference-venv`); MDAnalysis cannot read the DCD");
         return;
@@ -182,9 +283,16 @@ fn mdanalysis_reads_the_dcd_in_id_order() {
     let dump = read_dump(&case.path("t.lammpstrj"));
     let read = python_json(&python, MDANALYSIS_READ, &[&case.path("t.dcd")]);
     assert_eq!(read["n_atoms"], 400);
+    // Frames every 10 steps of 0.001: MDAnalysis reads the interval as 0.01
+    // (the deck's number; DELTA is an f32 in AKMA units, so to f32 precision).
+    let dt = read["dt"].as_f64().unwrap();
+    assert!((dt - 0.01).abs() <= 1e-7 * 0.01, "MDAnalysis reads dt = {dt}, expected 0.01");
     let frames = read["frames"].as_array().unwrap();
     assert_eq!(frames.len(), dump.len());
     for (frame, want) in frames.iter().zip(&dump) {
+        let time = frame["time"].as_f64().unwrap();
+        let expected = want.step as f64 * 0.001;
+        assert!((time - expected).abs() <= 1e-7 * 0.03, "frame at step {}: time {time}, expected {expected}", want.step);
         let dimensions: Vec<f64> = serde_json::from_value(frame["dimensions"].clone()).unwrap();
         assert_eq!(dimensions, [8.0, 8.0, 8.0, 90.0, 90.0, 90.0]);
         let positions: Vec<[f64; 3]> = serde_json::from_value(frame["positions"].clone()).unwrap();

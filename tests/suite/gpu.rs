@@ -4,6 +4,9 @@
 
 use crate::common;
 
+use crate::common::{
+    assert_clamped_runs_agree, contact_case, random_case, CONTACT_ADHESION, CONTACT_BARRIER, CONTACT_GPU_EPSILON, CONTACT_SHELLS,
+};
 use cellmd::backend::{CpuBackend, Forces};
 use cellmd::deck::{Action, Plan};
 use cellmd::gpu::backend::StepSettings;
@@ -15,9 +18,6 @@ use cellmd::integrate::Integrator;
 use cellmd::rng::Noise;
 use cellmd::run::{RunOptions, Simulation};
 use cellmd::system::State;
-use crate::common::{
-    assert_clamped_runs_agree, contact_case, random_case, CONTACT_ADHESION, CONTACT_BARRIER, CONTACT_GPU_EPSILON, CONTACT_SHELLS,
-};
 use glam::DVec3;
 
 fn context() -> GpuContext {
@@ -610,6 +610,29 @@ fn a_custom_body_term_is_refused_by_the_gpu() {
     assert!(refusal.contains("no kernels for custom surface terms of bodies"), "{refusal}");
     let why = Simulation::before_first_run(&plan, RunOptions::default()).unwrap().cpu_only_feature();
     assert_eq!(why, Some("custom surface terms of bodies (`custom` body lines) run on the CPU backend only"));
+}
+
+/// A periodic box shorter than twice the pair range (pairs through several
+/// images, which the CPU's list walks) has no GPU kernel: the GPU backend
+/// and `device gpu` refuse it rather than use the minimum image alone.
+#[test]
+fn a_box_shorter_than_twice_the_pair_range_is_refused_by_the_gpu() {
+    let top = "[ particles ]\n1 a 0.2 0.3 0.4\n2 a 1.1 1.6 2.0\n3 a 2.4 0.9 1.3\n";
+    let ff = "particle a drag 1\npair a a soft A 1 rc 1.5\n";
+    let small = "units lj\ntopology t.top\nforcefield f.ff\nbox x 0 3 p y 0 3 p z 0 3 p\nneighbor skin 0.3\ntimestep 1e-4\nrun 10\n";
+    let case = common::Case::new(&[("t.top", top), ("f.ff", ff), ("deck.in", small)]);
+    let plan = case.plan();
+    let state = initial_state(&plan);
+    let refusal = GpuBackend::new(&context(), &plan.model, &state, &plan.sim_box, &settings(0.3, 1e-4, 0.0)).err().unwrap_or_default();
+    assert!(refusal.contains("several periodic images") && refusal.contains("= 3.6"), "{refusal}");
+    let why = Simulation::before_first_run(&plan, RunOptions::default()).unwrap().cpu_only_feature();
+    assert!(why.is_some_and(|w| w.starts_with("pairs through several periodic images")), "{why:?}");
+    // With edges of 2·(cutoff + skin) the minimum image is the only one: the GPU takes it.
+    std::fs::write(case.path("deck.in"), small.replace("0 3 p", "0 3.6 p")).unwrap();
+    let plan = case.plan();
+    let state = initial_state(&plan);
+    GpuBackend::new(&context(), &plan.model, &state, &plan.sim_box, &settings(0.3, 1e-4, 0.0)).unwrap();
+    assert_eq!(Simulation::before_first_run(&plan, RunOptions::default()).unwrap().cpu_only_feature(), None);
 }
 
 /// A body wider than half the periodic box has no consistent minimum
@@ -1408,9 +1431,6 @@ fn device_auto_announces_its_choice_and_runs_on_it() {
 /// energies within [`CONTACT_GPU_EPSILON`] (its derivation is this case).
 #[test]
 fn contact_barrier_forces_match_the_cpu() {
-    // The kernel's step clamp is the CPU's.
-    let step = cellmd::backend::CONTACT_STEP_FRACTION;
-    assert!(cellmd::gpu::shader::compose().contains(&format!("const STEP_FRACTION: f32 = {step};")));
     for ff in [CONTACT_BARRIER.to_string(), format!("{CONTACT_SHELLS}{CONTACT_BARRIER}")] {
         let (force_error, energy_error, pairs, _) = contact_forces_gpu_vs_cpu(&ff, 0.03);
         println!(

@@ -3,12 +3,12 @@
 
 use crate::common;
 
+use crate::common::{assert_clamped_runs_agree, contact_case, CONTACT_ADHESION, CONTACT_BARRIER, CONTACT_SHELLS};
 use cellmd::backend::{CpuBackend, Forces};
 use cellmd::gpu::implicit::F32_TOLERANCE;
 use cellmd::gpu::DevicePreference;
 use cellmd::run::{RunOptions, Simulation};
 use cellmd::system::State;
-use crate::common::{assert_clamped_runs_agree, contact_case, CONTACT_ADHESION, CONTACT_BARRIER, CONTACT_SHELLS};
 use glam::DVec3;
 
 /// A bent 12-bead filament (stiff harmonic bonds, wlc_bending angles),
@@ -412,8 +412,11 @@ fn implicit_decks_the_device_cannot_solve_are_refused_with_the_reason() {
     let case = filament(1, 0.0);
     let options = RunOptions { output_dir: case.output_dir().to_path_buf(), device: Some(DevicePreference::Gpu), ..Default::default() };
     let deck = std::fs::read_to_string(case.path("deck.in")).unwrap();
-    std::fs::write(case.path("deck.in"), deck.replace("integrator implicit\n", "constrain rod method shake reshape yes\nintegrator implicit gpu_workgroups all\n"))
-        .unwrap();
+    std::fs::write(
+        case.path("deck.in"),
+        deck.replace("integrator implicit\n", "constrain rod method shake reshape yes\nintegrator implicit gpu_workgroups all\n"),
+    )
+    .unwrap();
     let refused = Simulation::execute(case.plan(), options).err().map(|e| e.to_string()).unwrap_or_default();
     assert!(refused.contains("`gpu_workgroups all` with `constrain`"), "{refused}");
 }

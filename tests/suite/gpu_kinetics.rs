@@ -227,9 +227,9 @@ fn device_kinetics_with_contact_take_the_clamped_step_lengths() {
         assert_eq!(e.age.to_bits(), aged(e.step).to_bits(), "bond {} broke at step {} with age {}", e.bond, e.step, e.age);
         broke_at[e.bond] = Some(e.step);
     }
-    for b in 0..bonds.len() {
-        assert_eq!(bonds.bound[b], broke_at[b].is_none(), "bond {b}");
-        let expected = aged(broke_at[b].unwrap_or(steps - 1));
+    for (b, broke) in broke_at.iter().enumerate() {
+        assert_eq!(bonds.bound[b], broke.is_none(), "bond {b}");
+        let expected = aged(broke.unwrap_or(steps - 1));
         assert_eq!(
             bonds.age[b].to_bits(),
             expected.to_bits(),

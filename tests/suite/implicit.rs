@@ -3,8 +3,8 @@
 
 use crate::common;
 
-use cellmd::run::{RunError, RunOptions, Simulation};
 use crate::common::Case;
+use cellmd::run::{RunError, RunOptions, Simulation};
 use glam::DVec3;
 
 /// A clamped cantilever: `n` beads ℓ apart along x, the first two fixed,

@@ -5,14 +5,13 @@
 //! Print the Young–Laplace table with
 //! `cargo test --release --test suite measure:: -- --nocapture`.
 
-
 use std::f64::consts::PI;
 
+use crate::common::{random_case, Case};
 use cellmd::build::{icosphere_cell, IcosphereCell};
 use cellmd::deck::ThermoColumn;
 use cellmd::measure::von_mises;
 use cellmd::run::Simulation;
-use crate::common::{random_case, Case};
 use glam::DVec3;
 
 /// Σ_i W_i over particles.

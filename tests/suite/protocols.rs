@@ -4,9 +4,8 @@
 //! rest lengths reset to the current geometry. Every expectation is exact
 //! arithmetic of the overdamped update, not a recorded output.
 
-
-use cellmd::deck::{Group, GroupQuantity, ThermoColumn};
 use crate::common::Case;
+use cellmd::deck::{Group, GroupQuantity, ThermoColumn};
 
 const TOP: &str = "[ particles ]\n1 p 0 0 0\n2 p 1.5 0 0\n3 q 5 5 5\n4 q 6 5 5\n[ bonds ]\ns 1 2\n";
 const FF: &str = "particle p drag 2\nparticle q radius 0.5 viscosity 0.1\nbond s harmonic k 3 r0 1\n";

@@ -1,6 +1,5 @@
 //! Bit-reproducibility: thread count and restarts (issue: engine core).
 
-
 use crate::common::{position_bits, Case};
 
 /// A periodic bead-spring system with pairs, bonds, angles and noise.

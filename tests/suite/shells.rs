@@ -12,13 +12,12 @@
 //! Each table is printed (`cargo test --release --test suite shells:: -- --nocapture`)
 //! and reported in the README.
 
-
 use std::f64::consts::PI;
 
+use crate::common::{merge_topologies, position_bits, stretch_particles, Case};
 use cellmd::build::{icosphere_cell, IcosphereCell};
 use cellmd::deck::validate_file;
 use cellmd::run::{RunOptions, Simulation};
-use crate::common::{merge_topologies, position_bits, stretch_particles, Case};
 use glam::DVec3;
 
 /// Enclosed volume and area of body 0 of a simulation.

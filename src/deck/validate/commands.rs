@@ -126,7 +126,14 @@ impl Validator {
             }
             Some((Form::Line(parse), usage)) => parse(self, s, usage),
             // Block words never reach here: the deck's blocks consumed them.
-            Some((Form::Block, _)) | None => Err(kw.error(format!("found unknown command `{}`, expected one of: {}", kw.text, accepted()))),
+            Some((Form::Block, _)) | None => {
+                let words: Vec<&str> = s.iter().map(|t| t.text.as_str()).collect();
+                let message = match super::foreign::hint(&words) {
+                    Some(hint) => format!("found unknown command `{}`: {hint}; expected one of: {}", kw.text, accepted()),
+                    None => format!("found unknown command `{}`, expected one of: {}", kw.text, accepted()),
+                };
+                Err(kw.error(message))
+            }
         }
     }
 }
@@ -143,5 +150,9 @@ mod tests {
             assert_eq!(c.usage.split_whitespace().next(), Some(c.name), "the usage of `{}` starts with another word", c.name);
         }
         assert!(accepted().starts_with("units, variable, loop,") && accepted().ends_with("read_state, print"));
+        // A hint for a word the deck accepts would never be shown.
+        for word in super::super::foreign::words().chain(["fix"]) {
+            assert!(!seen.contains(word), "`{word}` has a foreign-command hint but is a cellmd command");
+        }
     }
 }

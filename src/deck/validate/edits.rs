@@ -5,14 +5,13 @@ use glam::DVec3;
 
 use super::{expect_len, options, positive, yes_no, NamedExpr, Validator};
 use crate::deck::expression::DeckExpr;
-use crate::integrate::constraints::ConstraintMethod;
 use crate::deck::plan::{Action, Group};
 use crate::expr::{ExprError, Ref};
 use crate::forcefield::{param_value, parse_params, typed, TermType};
 use crate::input::{parse_f64, parse_u64, InputError, Token};
+use crate::integrate::constraints::ConstraintMethod;
 use crate::interactions::{param_index, Kind};
 use crate::system::{position_or_time, External};
-
 
 /// The largest relative distance from its rest length a constrained bond may
 /// start at without `reshape yes` (the first step's projection removes smaller ones).
@@ -76,6 +75,7 @@ impl Validator {
         if members.is_empty() {
             return Err(s[1].error(format!("group `{name}` is empty; expected a selection that matches particles")));
         }
+        self.spend_bytes(&s[0], 4 * members.len() as u64)?;
         self.groups.insert(name.clone(), Group { name, members });
         Ok(())
     }

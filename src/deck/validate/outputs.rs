@@ -4,15 +4,13 @@
 
 use std::path::PathBuf;
 
+use super::output_names::OutputKind;
 use super::{expect_len, Validator};
 use crate::deck::plan::{Action, CheckpointSpec, DumpSpec, GroupQuantity, ThermoColumn};
 use crate::input::{check_input_file, is_replaying, parse_u64, InputError, Token};
 use crate::interactions::REGISTRY;
 use crate::kinetics_engine::EventKind;
-use crate::output::{AtomColumn, DumpFormat, Encoding, WriterOptions};
-
-/// Whether a thermo column prefix names a group measurement: (force (`fx`,
-/// `fy`, `fz`) or mean unwrapped position (`xu`, `yu`, `zu`), axis).
+use crate::output::{read_state, AtomColumn, DumpFormat, Encoding, WriterOptions};
 
 impl Validator {
     pub(super) fn thermo(&mut self, s: &[Token], usage: &str) -> Result<(), InputError> {
@@ -33,19 +31,22 @@ impl Validator {
 
     pub(super) fn thermo_file(&mut self, s: &[Token], usage: &str) -> Result<(), InputError> {
         expect_len(s, 1..=1, usage)?;
-        self.actions.push(Action::ThermoFile(self.output_file(&s[1])?));
+        let path = self.output_of(&s[1], OutputKind::ThermoFile)?;
+        self.actions.push(Action::ThermoFile(path));
         Ok(())
     }
 
     pub(super) fn events(&mut self, s: &[Token], usage: &str) -> Result<(), InputError> {
         expect_len(s, 1..=1, usage)?;
-        self.actions.push(Action::EventFile(self.output_file(&s[1])?));
+        let path = self.output_of(&s[1], OutputKind::Events)?;
+        self.actions.push(Action::EventFile(path));
         Ok(())
     }
 
     pub(super) fn lifetimes(&mut self, s: &[Token], usage: &str) -> Result<(), InputError> {
         expect_len(s, 1..=1, usage)?;
-        self.actions.push(Action::LifetimeFile(self.output_file(&s[1])?));
+        let path = self.output_of(&s[1], OutputKind::Lifetimes)?;
+        self.actions.push(Action::LifetimeFile(path));
         Ok(())
     }
 
@@ -62,7 +63,7 @@ impl Validator {
             let names: Vec<String> = DumpFormat::ALL.iter().map(|f| format!("`{}`", f.keyword())).collect();
             s[4].error(format!("found format `{}`, expected one of {}", s[4].text, names.join(", ")))
         })?;
-        let path = self.output_file(&s[5])?;
+        let path = self.output_of(&s[5], OutputKind::Dump)?;
         let options = self.dump_options(format, &s[6..], usage)?;
         if self.dumps.contains_key(&s[1].text) {
             return Err(s[1].error(format!("dump `{}` is already active; expected a new name or `undump {}` first", s[1].text, s[1].text)));
@@ -98,6 +99,11 @@ impl Validator {
                 );
             }
             check_input_file(&path).map_err(|why| s[1].error(format!("cannot read `{}`: {why}", path.display())))?;
+            // Checked now against the system, so a bad restart fails `check`, before any output exists.
+            let data = read_state(&path).map_err(|e| s[1].error(e))?;
+            let periodic = self.sim_box.as_ref().expect("built with the model").periodic;
+            let model = self.model(kw)?;
+            data.check_against(model, periodic).map_err(|e| s[1].error(format!("{}: {e}", path.display())))?;
         }
         self.actions.push(Action::ReadState(path));
         Ok(())
@@ -108,7 +114,7 @@ impl Validator {
     pub(super) fn write_state(&mut self, s: &[Token], usage: &str) -> Result<(), InputError> {
         expect_len(s, 1..=5, usage)?;
         self.model(&s[0])?;
-        let path = self.output_file(&s[1])?;
+        let path = self.output_of(&s[1], OutputKind::Restart)?;
         if s.len() == 2 {
             self.states_written.insert(path.clone());
             self.actions.push(Action::WriteState(path));

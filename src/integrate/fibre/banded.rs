@@ -86,6 +86,7 @@ impl Banded {
     /// Factorises in place into L·D·Lᵀ (right-looking: column j's
     /// multipliers l = a_·j/d_j update the trailing triangle). Fails,
     /// naming the row, on a zero or non-finite pivot.
+    #[allow(clippy::needless_range_loop)] // slot arithmetic reads clearer with indices
     pub fn factorize(&mut self) -> Result<(), usize> {
         let n = self.rows.len();
         // Columns with a full band below them: fixed bounds, so the loops unroll.

@@ -123,7 +123,13 @@ impl Chains {
     /// indices, in list order): with `chain_constraints`, the constrained
     /// chains; with `elastic`, the elastic chains, which never take a
     /// constrained bond.
-    pub fn find(model: &Model, constrained: &[usize], chain_constraints: bool, elastic: bool, strength: impl Fn(u32) -> Option<f64>) -> Chains {
+    pub fn find(
+        model: &Model,
+        constrained: &[usize],
+        chain_constraints: bool,
+        elastic: bool,
+        strength: impl Fn(u32) -> Option<f64>,
+    ) -> Chains {
         let n = model.len();
         let mut place = vec![None; n];
         let mut owned_bonds = vec![false; model.bonds.len()];
@@ -169,7 +175,9 @@ impl Chains {
         }
         let mut owned_angles = vec![false; model.angles.len()];
         for (a, &[i, j, k]) in model.angles.iter().enumerate() {
-            let (Some((c, m)), Some((ci, mi)), Some((ck, mk))) = (place[j as usize], place[i as usize], place[k as usize]) else { continue };
+            let (Some((c, m)), Some((ci, mi)), Some((ck, mk))) = (place[j as usize], place[i as usize], place[k as usize]) else {
+                continue;
+            };
             let consecutive = ci == c && ck == c && mi.abs_diff(m) == 1 && mk.abs_diff(m) == 1 && mi != mk;
             if consecutive && strength(model.angle_type[a]).is_some() {
                 chains[c as usize].joints.push((m, a as u32));

@@ -41,7 +41,6 @@ use glam::{DMat3, DVec3};
 
 use super::banded::Banded;
 
-
 /// Index of coordinate `a` of point `i`, and of the multiplier of segment
 /// `k`, which follows both its points (slot 3 of point 0 is unused).
 #[inline(always)]
@@ -67,6 +66,7 @@ enum Which {
 }
 
 /// Adds θ·s_j/(ℓ_{j−1}ℓ_j)·D2ᵀD2 of every joint j to `m` (each axis alike).
+#[allow(clippy::needless_range_loop)] // the stencil's indices are the points'
 fn add_bending(m: &mut Banded, strength: &[f64], length: &[f64], theta: f64) {
     let n = strength.len();
     const STENCIL: [f64; 3] = [1.0, -2.0, 1.0];
@@ -302,9 +302,9 @@ mod tests {
     fn quadratic(s: &ChainSystem, dt: f64, theta: f64, d: &[DVec3], bending: bool) -> f64 {
         let n = s.points();
         let mut e = 0.0;
-        for i in 0..n {
-            if s.drag[i].is_finite() {
-                e += s.drag[i] / (2.0 * dt) * d[i].length_squared();
+        for (drag, d) in s.drag.iter().zip(d) {
+            if drag.is_finite() {
+                e += drag / (2.0 * dt) * d.length_squared();
             }
         }
         for j in (1..n - 1).filter(|_| bending) {

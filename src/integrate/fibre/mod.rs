@@ -143,14 +143,30 @@ pub struct FibreStep<'a> {
 impl FibreStep<'_> {
     /// Assembles every fibre's system at `positions` for a step of length `dt`.
     pub fn assemble(&mut self, model: &Model, positions: &[DVec3], images: &Images, dt: f64) -> Result<(), SingularFibre> {
-        let inputs = FibreInputs { model, positions, images, constraint_length: self.constraint_length, held: self.held, bond_block: self.bond_block };
+        let inputs = FibreInputs {
+            model,
+            positions,
+            images,
+            constraint_length: self.constraint_length,
+            held: self.held,
+            bond_block: self.bond_block,
+        };
         self.fibres.assemble(&inputs, dt, self.theta)
     }
 
     /// The displacement of every fibre point in a step of length `dt` from
     /// `positions`, into `out` (see [`Fibres::displacements`]).
     #[allow(clippy::too_many_arguments)]
-    pub fn displace(&mut self, model: &Model, positions: &[DVec3], images: &Images, forces: &[DVec3], ctx: &StepContext, dt: f64, out: &mut [DVec3]) -> Result<(), SingularFibre> {
+    pub fn displace(
+        &mut self,
+        model: &Model,
+        positions: &[DVec3],
+        images: &Images,
+        forces: &[DVec3],
+        ctx: &StepContext,
+        dt: f64,
+        out: &mut [DVec3],
+    ) -> Result<(), SingularFibre> {
         self.assemble(model, positions, images, dt)?;
         self.fibres.displacements(forces, ctx, dt, out);
         Ok(())
@@ -308,7 +324,9 @@ impl Fibres {
         let outcome: Result<(), (usize, ReshapeFailure)> =
             self.work.par_iter_mut().zip(self.chains.chains.par_iter()).enumerate().filter(|(_, (_, c))| c.is_constrained()).try_for_each(
                 |(c, (work, chain))| {
-                    work.reshape.restore(&work.system, |m| now[chain.points[m] as usize], images, tolerance, max_iterations).map_err(|f| (c, f))
+                    work.reshape
+                        .restore(&work.system, |m| now[chain.points[m] as usize], images, tolerance, max_iterations)
+                        .map_err(|f| (c, f))
                 },
             );
         if let Err((c, failure)) = outcome {

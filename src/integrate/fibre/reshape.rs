@@ -155,8 +155,9 @@ mod tests {
         let off = [0.7, 0.2, -1.0];
         let diagonal = [4.0, 3.0, 5.0, 2.0];
         let x = [1.0, -2.0, 0.5, 3.0];
-        let mut rhs: Vec<f64> =
-            (0..4).map(|k| diagonal[k] * x[k] + if k > 0 { off[k - 1] * x[k - 1] } else { 0.0 } + if k < 3 { off[k] * x[k + 1] } else { 0.0 }).collect();
+        let mut rhs: Vec<f64> = (0..4)
+            .map(|k| diagonal[k] * x[k] + if k > 0 { off[k - 1] * x[k - 1] } else { 0.0 } + if k < 3 { off[k] * x[k + 1] } else { 0.0 })
+            .collect();
         let mut d = diagonal;
         assert!(thomas(&mut d, &off, &mut rhs));
         for (a, b) in rhs.iter().zip(x) {
@@ -177,7 +178,8 @@ mod tests {
         }
         system.drag.fill(2.0);
         system.drag[0] = f64::INFINITY;
-        let after: Vec<DVec3> = before.iter().enumerate().map(|(i, x)| *x + 0.004 * DVec3::new((i as f64 * 1.3).cos(), (i as f64).sin(), 0.5)).collect();
+        let after: Vec<DVec3> =
+            before.iter().enumerate().map(|(i, x)| *x + 0.004 * DVec3::new((i as f64 * 1.3).cos(), (i as f64).sin(), 0.5)).collect();
         let after = {
             let mut a = after;
             a[0] = before[0];
@@ -219,8 +221,11 @@ mod tests {
             system.length[k] = 0.1;
         }
         system.drag.fill(0.137);
-        let after: Vec<DVec3> =
-            before.iter().enumerate().map(|(i, x)| *x + 0.008 * DVec3::new((i as f64 * 7.3).sin(), (i as f64 * 5.1).cos(), (i as f64 * 1.9).sin())).collect();
+        let after: Vec<DVec3> = before
+            .iter()
+            .enumerate()
+            .map(|(i, x)| *x + 0.008 * DVec3::new((i as f64 * 7.3).sin(), (i as f64 * 5.1).cos(), (i as f64 * 1.9).sin()))
+            .collect();
         let images = SimBox::new(DVec3::splat(-100.0), DVec3::splat(100.0), [false; 3]).images();
         let mut reshape = Reshape::default();
         reshape.restore(&system, |i| after[i], &images, 1e-12, 8).unwrap();

@@ -138,7 +138,12 @@ impl Stepper for CpuSteps {
 impl Simulation {
     /// One implicit step; returns the fraction of dt it took (below 1 where
     /// the contact clamp shortened it).
-    fn implicit_step(&mut self, ctx: &StepContext, settings: &OverdampedSettings, implicit: &ImplicitSettings) -> Result<Result<f64, Blowup>, RunError> {
+    fn implicit_step(
+        &mut self,
+        ctx: &StepContext,
+        settings: &OverdampedSettings,
+        implicit: &ImplicitSettings,
+    ) -> Result<Result<f64, Blowup>, RunError> {
         let backend = self.cpu.get(&self.model, &self.state, &self.sim_box, self.neighbor.skin)?;
         let limited = backend.contact_step_limits(self.model.len(), &mut self.step_limits);
         let backend = &*backend;
@@ -155,13 +160,7 @@ impl Simulation {
             let state = &self.state;
             let block = |b: usize| backend.bond_block(b, model, state, &images).unwrap_or(DMat3::ZERO);
             let length = |k: usize| list[k].length;
-            let mut step = FibreStep {
-                fibres,
-                constraint_length: &length,
-                held: &held,
-                bond_block: Some(&block),
-                theta: settings.theta,
-            };
+            let mut step = FibreStep { fibres, constraint_length: &length, held: &held, bond_block: Some(&block), theta: settings.theta };
             if let Err(singular) = step.assemble(model, &state.positions, &images, ctx.dt) {
                 return Ok(Err(Blowup { particle: singular.particle as usize, displacement: f64::NAN }));
             }

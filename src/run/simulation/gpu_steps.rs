@@ -14,6 +14,10 @@ use crate::system::StepClock;
 /// Why custom surface terms of bodies keep a run (or a minimisation) on the CPU.
 const CUSTOM_SURFACE_TERMS: &str = "custom surface terms of bodies (`custom` body lines) run on the CPU backend only";
 
+/// Why a box with periodic edges shorter than twice the pair range keeps a run on the CPU.
+const SHORT_PERIODIC_EDGES: &str =
+    "pairs through several periodic images (a periodic box edge shorter than 2·(pair cutoff + skin)) run on the CPU backend only";
+
 /// The longest GPU segment between read-backs when no output is due.
 const GPU_SYNC_STEPS: u64 = 1000;
 
@@ -285,6 +289,10 @@ impl Simulation {
             Some(why)
         } else if self.model.has_cpu_only_surface_terms() {
             Some(CUSTOM_SURFACE_TERMS)
+        } else if self.model.max_pair_cutoff() > 0.0
+            && crate::neighbor::ImageShifts::new(&self.sim_box, self.model.max_pair_cutoff() + self.neighbor.skin).is_some()
+        {
+            Some(SHORT_PERIODIC_EDGES)
         } else {
             None
         }

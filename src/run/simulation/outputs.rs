@@ -1,6 +1,7 @@
 //! The outputs of a run: the run log, messages, dumps, thermo rows, the
 //! lifetime table, and closing them all.
 
+use std::fs::File;
 use std::path::{Path, PathBuf};
 
 use glam::DVec3;
@@ -8,6 +9,7 @@ use indicatif::ProgressBar;
 
 use super::Simulation;
 use crate::deck::DumpSpec;
+use crate::output::files;
 use crate::output::run_log::{model_parameters, RunLog};
 use crate::output::{FrameView, Measures, TopologyView, TrajectoryWriter, WallPlane};
 use crate::run::RunError;
@@ -25,7 +27,8 @@ impl Simulation {
     pub(super) fn open_log(&mut self) -> Result<(), RunError> {
         let Some(header) = &self.options.log else { return Ok(()) };
         let path = self.output_path(Path::new(&format!("{}.log", self.deck_stem)));
-        let log = RunLog::create(&path, header, &self.inputs).map_err(|e| self.output_error(&path, e))?;
+        let file = self.create_output(&path)?;
+        let log = RunLog::create(file, &path, header, &self.inputs).map_err(|e| self.output_error(&path, e))?;
         self.log = Some(log);
         Ok(())
     }
@@ -68,6 +71,12 @@ impl Simulation {
         } else {
             self.options.output_dir.join(path)
         }
+    }
+
+    /// Creates (or truncates) the output file `path` (as [`Self::output_path`]
+    /// gives it), through no link inside the output directory.
+    pub(super) fn create_output(&self, path: &Path) -> Result<File, RunError> {
+        files::create(&self.options.output_dir, path).map_err(|e| self.output_error(path, e))
     }
 
     /// An output that could not be written, with the step it happened at.
@@ -134,6 +143,15 @@ impl Simulation {
 
     pub(super) fn outputs_at_step(&mut self, bar: &Option<ProgressBar>, force_thermo: bool) -> Result<(), RunError> {
         let step = self.state.step;
+        if let Some((log, path)) = &mut self.event_log {
+            if let Err(e) = log.flush_due() {
+                let path = path.clone();
+                return Err(self.output_error(&path, e));
+            }
+        }
+        if let Some((path, e)) = self.dumps.iter_mut().find_map(|d| d.writer.flush_due().err().map(|e| (d.path.clone(), e))) {
+            return Err(self.output_error(&path, e));
+        }
         for i in 0..self.dumps.len() {
             if step.is_multiple_of(self.dumps[i].spec.every) && self.dumps[i].last_step != Some(step) {
                 self.write_dump(i)?;
@@ -154,7 +172,8 @@ impl Simulation {
     /// The lifetime table, rewritten after every `run` (and when stopped).
     pub(super) fn write_lifetimes(&self) -> Result<(), RunError> {
         match &self.lifetime_file {
-            Some(path) => self.lifetimes.write(path, &self.model, self.state.bonds.as_ref()).map_err(|e| self.output_error(path, e)),
+            Some(path) => (self.lifetimes.write(&self.options.output_dir, path, &self.model, self.state.bonds.as_ref()))
+                .map_err(|e| self.output_error(path, e)),
             None => Ok(()),
         }
     }

@@ -7,8 +7,9 @@ use std::path::{Path, PathBuf};
 use rayon::prelude::*;
 
 use super::Simulation;
-use crate::deck::CheckpointSpec;
+use crate::deck::{Action, CheckpointSpec, Plan};
 use crate::kinetics_engine::{initial_bond_state, Formation};
+use crate::output::files;
 use crate::output::restart::{write_state, Counters, RestartData, Resume};
 use crate::run::blowup::culprit;
 use crate::run::RunError;
@@ -30,6 +31,30 @@ pub(super) fn with_step(path: &Path, step: u64) -> PathBuf {
 }
 
 impl Simulation {
+    /// Why `data` (read from `restart`) cannot continue `plan` with
+    /// [`Simulation::resume`]: the restart against the deck's system (see
+    /// [`RestartData::check_against`]), and where it stands in the deck
+    /// against the deck's actions. `cellmd run --continue` checks this before
+    /// it creates any output.
+    pub fn check_restart(plan: &Plan, data: &RestartData, restart: &Path) -> Result<(), String> {
+        let fail = |e: String| format!("{}: {e}", restart.display());
+        data.check_against(&plan.model, plan.sim_box.periodic).map_err(fail)?;
+        let Some(resume) = &data.resume else { return Err(fail("resume: found none, expected the deck to continue".into())) };
+        let actions = plan.actions.len();
+        match (plan.actions.get(resume.action), resume.run_end) {
+            (None, _) if resume.action > actions => {
+                Err(fail(format!("resume.action: found {}, expected at most {actions} (the deck's actions)", resume.action)))
+            }
+            (Some(Action::Run(steps)), Some(end)) if end.saturating_sub(data.step) > *steps => Err(fail(format!(
+                "resume.run_end: found {end}, expected at most {} (step {} + the {steps} steps of its `run`)",
+                data.step.saturating_add(*steps),
+                data.step
+            ))),
+            (Some(Action::Run(_)), _) | (_, None) => Ok(()),
+            (_, Some(end)) => Err(fail(format!("resume.run_end: found {end}, expected none (action {} is not a `run`)", resume.action))),
+        }
+    }
+
     /// When a stop was requested: writes `NAME.restart` (with the deck and
     /// where the run stands in it) and the lifetime table, and returns
     /// [`RunError::Stopped`]; the caller's error path closes the outputs.
@@ -37,7 +62,7 @@ impl Simulation {
         let Some(reason) = self.options.stop.requested() else { return Ok(()) };
         let restart = self.output_path(Path::new(&format!("{}.restart", self.deck_stem)));
         self.write_lifetimes()?;
-        write_state(&restart, &self.restart_data()).map_err(|e| self.output_error(&restart, e))?;
+        write_state(&self.options.output_dir, &restart, &self.restart_data()).map_err(|e| self.output_error(&restart, e))?;
         Err(RunError::Stopped { step: self.state.step, reason: reason.to_string(), restart: restart.display().to_string() })
     }
 
@@ -63,7 +88,7 @@ impl Simulation {
             return Ok(());
         };
         let path = self.output_path(&with_step(&due.spec.path, step));
-        write_state(&path, &self.restart_data()).map_err(|e| self.output_error(&path, e))?;
+        write_state(&self.options.output_dir, &path, &self.restart_data()).map_err(|e| self.output_error(&path, e))?;
         let checkpoints = self.checkpoints.as_mut().expect("due above");
         checkpoints.last_step = Some(step);
         let mut stale = Vec::new();
@@ -74,21 +99,15 @@ impl Simulation {
             }
         }
         for old in stale {
-            std::fs::remove_file(&old).map_err(|e| self.output_error(&old, e))?;
+            files::remove(&self.options.output_dir, &old).map_err(|e| self.output_error(&old, e))?;
         }
         Ok(())
     }
 
+    /// Continues from a restart, checked against the system first (see
+    /// [`RestartData::check_against`]).
     pub(super) fn load_restart(&mut self, data: RestartData, path: &Path) -> Result<(), RunError> {
-        data.check_ids(&self.model.ids).map_err(|e| RunError::Setup(format!("{}: {e}", path.display())))?;
-        if data.units != self.model.units {
-            return Err(RunError::Setup(format!(
-                "{}: the restart was written in {:?} units, the deck uses {:?}",
-                path.display(),
-                data.units,
-                self.model.units
-            )));
-        }
+        data.check_against(&self.model, self.sim_box.periodic).map_err(|e| RunError::Setup(format!("{}: {e}", path.display())))?;
         let counters = data.counters;
         self.kinetics.breaks = counters.breaks;
         self.kinetics.rebinds = counters.rebinds;
@@ -140,7 +159,7 @@ impl Simulation {
             }
         }
         let restart = self.output_path(Path::new(&format!("{}.lastgood.restart", self.deck_stem)));
-        if write_state(&restart, &self.restart_data()).is_ok() {
+        if write_state(&self.options.output_dir, &restart, &self.restart_data()).is_ok() {
             last_good.push(restart.display().to_string());
         }
         RunError::Blowup { step, particle_id: self.model.ids[particle], what, culprit: culprit(parts), last_good }

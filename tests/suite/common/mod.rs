@@ -382,3 +382,34 @@ pub fn worm_like_chains(chains: usize, segments: usize, a: f64, seed: u64) -> St
     }
     top + &bonds + &angles
 }
+
+/// A fixed seed's pseudo-random fraction in [0, 1) (splitmix64).
+pub fn seeded_fraction(seed: u64) -> f64 {
+    let mut z = seed.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+}
+
+/// Bits of every position, image counter, bond state and counter of a restart.
+pub fn state_bits(path: &Path) -> (Vec<u64>, String, String, cellmd::output::restart::Counters, u64) {
+    let data = cellmd::output::read_state(path).unwrap_or_else(|e| panic!("{e}"));
+    let bits = data.positions.iter().flat_map(|x| x.to_array().map(f64::to_bits)).collect();
+    (bits, serde_json::to_string(&data.images).unwrap(), serde_json::to_string(&data.bonds).unwrap(), data.counters, data.step)
+}
+
+/// Every line of a thermo CSV is whole: a header, then rows with one number per column.
+pub fn assert_complete_csv(path: &Path) -> usize {
+    let text = std::fs::read_to_string(path).unwrap();
+    assert!(text.ends_with('\n'), "{} ends inside a line", path.display());
+    let mut lines = text.lines();
+    let columns = lines.next().expect("a header").split(',').count();
+    let mut rows = 0;
+    for line in lines {
+        let fields: Vec<&str> = line.split(',').collect();
+        assert_eq!(fields.len(), columns, "a partial line in {}: {line}", path.display());
+        assert!(fields.iter().all(|f| f.parse::<f64>().is_ok()), "not numbers: {line}");
+        rows += 1;
+    }
+    rows
+}
