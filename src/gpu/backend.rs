@@ -397,7 +397,7 @@ impl GpuBackend {
                 "the GPU backend has no kernels for custom surface terms of bodies (`custom` body lines) yet; use `device cpu`".into()
             );
         }
-        if model.max_pair_cutoff() > 0.0 && ImageShifts::new(sim_box, model.max_pair_cutoff() + settings.skin).is_some() {
+        if model.max_pair_cutoff() > 0.0 && ImageShifts::has_short_edges(sim_box, model.max_pair_cutoff() + settings.skin) {
             return Err(format!(
                 "the GPU backend has no kernels yet for pairs through several periodic images (a periodic box edge shorter \
                  than 2·(pair cutoff + skin) = {}); use `device cpu`",

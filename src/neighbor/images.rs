@@ -23,6 +23,10 @@ use glam::DVec3;
 
 use crate::system::SimBox;
 
+/// The most images one pair may walk (each costs a distance test per pair
+/// per step): 9 261 = 21³, ten images to each side on all three axes.
+pub const MAX_IMAGES_PER_PAIR: usize = 9261;
+
 /// The image shifts of a box with short periodic edges.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ImageShifts {
@@ -33,18 +37,40 @@ pub struct ImageShifts {
 }
 
 impl ImageShifts {
+    /// Whether some periodic edge of `sim_box` is shorter than `2·range`, so
+    /// that pairs within `range` have images beyond the minimum one.
+    pub fn has_short_edges(sim_box: &SimBox, range: f64) -> bool {
+        let l = sim_box.lengths();
+        (0..3).any(|a| sim_box.periodic[a] && l[a] < 2.0 * range)
+    }
+
     /// The shifts for pairs within `range` in `sim_box`; `None` when every
     /// periodic edge is at least `2·range` (the minimum image is the only one).
-    pub fn new(sim_box: &SimBox, range: f64) -> Option<Self> {
+    /// An error when a pair would have more than [`MAX_IMAGES_PER_PAIR`]
+    /// images to walk (an edge many times shorter than the range).
+    pub fn new(sim_box: &SimBox, range: f64) -> Result<Option<Self>, String> {
         let l = sim_box.lengths();
         let mut reach = [0i32; 3];
+        let mut images = 1.0;
         for a in 0..3 {
             if sim_box.periodic[a] && l[a] < 2.0 * range {
-                reach[a] = (range / l[a] + 0.5).floor() as i32;
+                let r = (range / l[a] + 0.5).floor();
+                images *= 2.0 * r + 1.0;
+                if !(images <= MAX_IMAGES_PER_PAIR as f64) {
+                    return Err(format!(
+                        "neighbour list: the periodic box edge along {} is {:e}, so a pair within the list range {range:e} has {images:.3e} \
+                         images or more; expected periodic edges long enough for at most {MAX_IMAGES_PER_PAIR} images per pair \
+                         (edges ≥ {:e} with this range)",
+                        ['x', 'y', 'z'][a],
+                        l[a],
+                        2.0 * range / (MAX_IMAGES_PER_PAIR as f64).cbrt()
+                    ));
+                }
+                reach[a] = r as i32;
             }
         }
         if reach == [0; 3] {
-            return None;
+            return Ok(None);
         }
         let mut positive = Vec::new();
         for sx in 0..=reach[0] {
@@ -56,7 +82,7 @@ impl ImageShifts {
                 }
             }
         }
-        Some(Self { reach, positive })
+        Ok(Some(Self { reach, positive }))
     }
 
     /// Number of images per pair walked (minimum image included).
@@ -101,7 +127,7 @@ mod tests {
     fn shifts_cover_every_image_in_range_once() {
         let b = SimBox::new(DVec3::ZERO, DVec3::new(1.3, 5.0, 0.7), [true, true, true]);
         let range = 2.0;
-        let shifts = ImageShifts::new(&b, range).unwrap();
+        let shifts = ImageShifts::new(&b, range).unwrap().unwrap();
         assert_eq!(shifts.reach, [2, 0, 3]);
         let d0 = b.minimum_image(DVec3::new(0.6, -2.4, 0.33));
         let mut seen = Vec::new();
@@ -127,6 +153,18 @@ mod tests {
         shifts.for_each(DVec3::ZERO, range * range, false, true, false, |_| both += 1);
         assert_eq!(2 * own, both);
         assert!(own > 0);
-        assert!(ImageShifts::new(&SimBox::new(DVec3::ZERO, DVec3::splat(4.0), [true; 3]), range).is_none());
+        assert!(ImageShifts::new(&SimBox::new(DVec3::ZERO, DVec3::splat(4.0), [true; 3]), range).unwrap().is_none());
+    }
+
+    /// An edge far shorter than the range is refused, naming the axis,
+    /// instead of walking ~10¹² images a pair; 21³ images are allowed.
+    #[test]
+    fn too_many_images_are_refused() {
+        let b = SimBox::new(DVec3::ZERO, DVec3::new(10.0, 10.0, 1e-12), [false, false, true]);
+        let e = ImageShifts::new(&b, 1.3).unwrap_err();
+        assert!(e.contains("along z is 1e-12"), "{e}");
+        let b = SimBox::new(DVec3::ZERO, DVec3::splat(0.1), [true; 3]);
+        assert_eq!(ImageShifts::new(&b, 1.0).unwrap().unwrap().count(), MAX_IMAGES_PER_PAIR);
+        assert!(ImageShifts::new(&b, 1.06).is_err());
     }
 }

@@ -250,7 +250,7 @@ impl NeighborList {
             return Err(format!("neighbour list: particle {i} has a non-finite position {}", positions[i]));
         }
 
-        let shifts = if self.periodic_images && range > 0.0 { ImageShifts::new(sim_box, range) } else { None };
+        let shifts = if self.periodic_images && range > 0.0 { ImageShifts::new(sim_box, range)? } else { None };
         self.skip_minimum.clear();
         if range == 0.0 || n == 0 {
             self.offsets.clear();

@@ -290,7 +290,7 @@ impl Simulation {
         } else if self.model.has_cpu_only_surface_terms() {
             Some(CUSTOM_SURFACE_TERMS)
         } else if self.model.max_pair_cutoff() > 0.0
-            && crate::neighbor::ImageShifts::new(&self.sim_box, self.model.max_pair_cutoff() + self.neighbor.skin).is_some()
+            && crate::neighbor::ImageShifts::has_short_edges(&self.sim_box, self.model.max_pair_cutoff() + self.neighbor.skin)
         {
             Some(SHORT_PERIODIC_EDGES)
         } else {
