@@ -7,7 +7,10 @@
 //! cell would add 4·10⁵ blocks per term. So A = S + U·Uᵀ with S = D + C,
 //! D the drag diagonal, C sparse (the blocks; none for a system of free
 //! fibres, whose blocks live in the fibre solver) and U one column √w·g
-//! per rank-one term:
+//! per rank-one term. With blocks, S is one sparse matrix (D merged into
+//! C's diagonal blocks, so each product row adds in one fixed order: the
+//! settled angle of the adhesive doublet at 10× the explicit step moved by
+//! 1.4° when D·v was added apart, tests/suite/doublet.rs); without, D alone:
 //!
 //! - **Products** A·v = D·v + C·v + Σ_k w_k·g_k (g_k·v) (conjugate gradients
 //!   and the projected CG of constrained bonds), and the Jacobi diagonal
@@ -31,12 +34,14 @@ use glam::{DMat3, DVec3};
 use crate::backend::Stiffness;
 
 /// A = D + C + Σ_k w_k·g_k g_kᵀ over 3n degrees of freedom: D the diagonal
-/// γ/dt (1 on pinned coordinates), C the sparse couplings θ·K̃ (`None`
-/// when K̃ has no blocks: a system of free fibres and loose particles).
+/// γ/dt (1 on pinned coordinates), C the sparse couplings θ·K̃ (none when
+/// K̃ has no blocks: a system of free fibres and loose particles).
 #[derive(Debug)]
 pub struct SystemMatrix {
+    /// D.
     drag: Vec<f64>,
-    couplings: Option<SparseColMat<usize, f64>>,
+    /// S = D + C when K̃ has blocks (`None`: S = D).
+    sparse: Option<SparseColMat<usize, f64>>,
     /// Per rank-one term: w and the entries (particle, g) on mobile particles.
     rank_one: Vec<(f64, Vec<(usize, DVec3)>)>,
 }
@@ -50,18 +55,21 @@ impl SystemMatrix {
         let fixed = |i: usize| drag[i].is_infinite();
         let pinned = |k: usize| fixed(k / 3) || held.get(k).copied().unwrap_or(false);
         let diagonal: Vec<f64> = (0..dim).map(|k| if pinned(k) { 1.0 } else { drag[k / 3] / dt }).collect();
-        // The blocks between mobile particles, merged per (i, j) in column
-        // order (a stable sort: duplicates add in term order) so the
-        // triplets arrive sorted, 9 per distinct block.
-        let mut blocks: Vec<(usize, usize, DMat3)> = stiffness
+        let couplings = stiffness
             .blocks
             .iter()
             .filter(|b| !fixed(b.i as usize) && !fixed(b.j as usize))
-            .map(|b| (b.i as usize, b.j as usize, theta * b.block))
-            .collect();
-        let couplings = if blocks.is_empty() {
+            .map(|b| (b.i as usize, b.j as usize, theta * b.block));
+        // With couplings, S = D + C as one sparse matrix: the drag blocks,
+        // then the blocks between mobile particles, merged per (i, j) in
+        // column order (a stable sort: duplicates add in term order, the drag
+        // first) so the triplets arrive sorted, 9 per distinct block.
+        let mut blocks: Vec<(usize, usize, DMat3)> = couplings.collect();
+        let sparse = if blocks.is_empty() {
             None
         } else {
+            let drag_blocks = (0..n).map(|i| (i, i, DMat3::from_diagonal(DVec3::from_array(std::array::from_fn(|a| diagonal[3 * i + a])))));
+            blocks.splice(0..0, drag_blocks);
             blocks.sort_by_key(|&(i, j, _)| (j, i));
             let mut triplets = Vec::with_capacity(9 * blocks.len());
             let mut k = 0;
@@ -77,6 +85,8 @@ impl SystemMatrix {
                         let (r, c) = (3 * i + row, 3 * j + col);
                         if !pinned(r) && !pinned(c) {
                             triplets.push(Triplet::new(r, c, block.col(col)[row]));
+                        } else if r == c {
+                            triplets.push(Triplet::new(r, c, 1.0));
                         }
                     }
                 }
@@ -94,7 +104,7 @@ impl SystemMatrix {
                 (theta * r.weight, entries.collect())
             })
             .collect();
-        Ok(Self { drag: diagonal, couplings, rank_one })
+        Ok(Self { drag: diagonal, sparse, rank_one })
     }
 
     pub fn dim(&self) -> usize {
@@ -103,7 +113,7 @@ impl SystemMatrix {
 
     /// The diagonal entries A_kk.
     pub fn diagonal(&self) -> Col<f64> {
-        let mut d = Col::from_fn(self.dim(), |k| self.drag[k] + self.couplings.as_ref().and_then(|c| c.get(k, k).copied()).unwrap_or(0.0));
+        let mut d = Col::from_fn(self.dim(), |k| self.sparse.as_ref().map_or(self.drag[k], |s| s.get(k, k).copied().unwrap_or(0.0)));
         for (w, entries) in &self.rank_one {
             for &(p, g) in entries {
                 for a in 0..3 {
@@ -130,13 +140,17 @@ impl SystemMatrix {
 
     /// out = A·rhs, column by column.
     fn apply_to(&self, mut out: MatMut<'_, f64>, rhs: MatRef<'_, f64>) {
-        for column in 0..rhs.ncols() {
-            for k in 0..self.dim() {
-                out[(k, column)] = self.drag[k] * rhs[(k, column)];
+        match &self.sparse {
+            Some(s) => {
+                faer::sparse::linalg::matmul::sparse_dense_matmul(out.as_mut(), faer::Accum::Replace, s.as_ref(), rhs, 1.0, Par::Seq)
             }
-        }
-        if let Some(c) = &self.couplings {
-            faer::sparse::linalg::matmul::sparse_dense_matmul(out.as_mut(), faer::Accum::Add, c.as_ref(), rhs, 1.0, Par::Seq);
+            None => {
+                for column in 0..rhs.ncols() {
+                    for k in 0..self.dim() {
+                        out[(k, column)] = self.drag[k] * rhs[(k, column)];
+                    }
+                }
+            }
         }
         self.add_rank_one(out, rhs);
     }
@@ -158,15 +172,15 @@ impl SystemMatrix {
     /// A⁻¹·b by sparse Cholesky of S = D + C and Sherman–Morrison–Woodbury.
     pub fn solve_direct(&self, b: &Col<f64>) -> Result<Mat<f64>, String> {
         let dim = self.dim();
-        let mut triplets: Vec<Triplet<usize, usize, f64>> = (0..dim).map(|k| Triplet::new(k, k, self.drag[k])).collect();
-        if let Some(c) = &self.couplings {
-            for col in 0..dim {
-                for (row, value) in c.row_idx_of_col(col).zip(c.val_of_col(col)) {
-                    triplets.push(Triplet::new(row, col, *value));
-                }
+        let diagonal;
+        let sparse = match &self.sparse {
+            Some(s) => s,
+            None => {
+                let triplets: Vec<Triplet<usize, usize, f64>> = (0..dim).map(|k| Triplet::new(k, k, self.drag[k])).collect();
+                diagonal = SparseColMat::<usize, f64>::try_new_from_triplets(dim, dim, &triplets).map_err(|e| format!("{e:?}"))?;
+                &diagonal
             }
-        }
-        let sparse = SparseColMat::<usize, f64>::try_new_from_triplets(dim, dim, &triplets).map_err(|e| format!("{e:?}"))?;
+        };
         let llt = sparse.sp_cholesky(Side::Lower).map_err(|e| format!("sparse Cholesky: {e:?}"))?;
         let y = llt.solve(b.as_mat());
         let m = self.rank_one.len();

@@ -92,5 +92,5 @@ mod images;
 mod verlet;
 
 pub use self::exclusions::Exclusions;
-pub use self::images::ImageShifts;
+pub use self::images::{ImageShifts, MAX_IMAGES_PER_PAIR};
 pub use self::verlet::NeighborList;

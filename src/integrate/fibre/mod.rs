@@ -31,15 +31,24 @@
 //! back onto the constraint surface. No metric (Fixman) force is added:
 //! a random step followed by a projection back onto the constraints
 //! generates the drift of the infinitely stiff spring limit by itself
-//! (Hinch 1994), so the fibres sample e^(−E/kT) on the flexible measure —
+//! (Hinch 1994), so the fibres should sample e^(−E/kT) on the flexible measure —
 //! the discrete worm-like chain's independent joints — not the rigid
-//! measure e^(−E/kT)·√det G. Measured (tests/suite/inextensible_fibres.rs,
-//! dt = 0.01 joint relaxation times): freely jointed chains keep ⟨cos²θ⟩ =
-//! 1/3 within 2 standard errors, and adding the Fixman force
-//! −∇(kT/2)·ln det G biased it by 5 of them, the other way. Not yet right:
-//! the chains come out too straight, ⟨cos θ⟩ = 0.033 ± 0.006 for freely
-//! jointed chains (0 exact) and ⟨t_i·t_{i+1}⟩ = 0.724 ± 0.004 against
-//! 0.672 at a = κ/(ℓkT) = 3; those two tests are ignored until it is. A linear mode of stiffness k relaxes by 1/(1 + a) per step at
+//! measure e^(−E/kT)·√det G. Measured (tests/suite/inextensible_fibres.rs)
+//! at D·dt/ℓ² = 0.0025 (D = kT/γ; a 1 ms step of actin's 0.1 µm segments in
+//! 1 Pa·s is 0.0028): a = κ/(ℓkT) = 3 chains keep the exact tangent
+//! correlations within 2 standard errors at θ = ½ (lag 1: 0.6751 ± 0.0042
+//! against 0.6716 in a deck run) and come out 3 standard errors straight at
+//! θ = 1; freely jointed chains still show ⟨cos θ⟩ = 0.006–0.019 (± 0.006,
+//! three runs) where it is 0, and ⟨cos²θ⟩ = 0.320–0.336 (± 0.003), between
+//! the flexible 1/3 and the rigid 0.318 — not yet right. The step is first
+//! order in dt and its error straightens chains: at D·dt/ℓ² = 0.01 freely
+//! jointed chains show ⟨cos θ⟩ = 0.035 ± 0.006 and a = 3 chains
+//! ⟨t_i·t_{i+1}⟩ = 0.724 ± 0.004 against 0.672 (a Python model of this step
+//! on three-bead chains gives ⟨cos θ⟩ = 0.036 at 0.01 and 0.005 at 0.0025;
+//! projecting back along the directions before the step, SHAKE's choice,
+//! showed none within ± 0.009 there but diverges on some chains at 0.01). Adding the
+//! Fixman force −∇(kT/2)·ln det G biased ⟨cos²θ⟩ by 5 standard errors at
+//! 0.01. A linear mode of stiffness k relaxes by 1/(1 + a) per step at
 //! θ = 1 (a = k·dt/γ), and its stationary energy is (kT/2)·2/(2 + a):
 //! backward Euler damps fast modes, as Cytosim's step does; θ = ½ keeps
 //! kT/2 exactly at any dt for linear modes.
