@@ -165,6 +165,7 @@ use super::prelude::implicit::*;
 use super::prelude::implicit_split::SPLIT_PARTIALS;
 use super::shader;
 use super::side_group::SideGroup;
+use super::step::{Dispatcher, Over, Phase, StepFeature};
 use crate::integrate::implicit::{GpuWorkgroups, ImplicitSettings, SolveReport};
 use crate::interactions::{Law, SurfaceGpu, REGISTRY};
 use crate::system::Model;
@@ -554,5 +555,16 @@ mod tests {
         assert!(!auto(SPLIT_SOLVE_FROM - 1, false) && auto(SPLIT_SOLVE_FROM, false) && !auto(10 * SPLIT_SOLVE_FROM, true));
         assert!(!splits(GpuWorkgroups::One, 1 << 20, false).unwrap() && splits(GpuWorkgroups::All, 10, false).unwrap());
         assert!(splits(GpuWorkgroups::All, 10, true).unwrap_err().contains("constrain"));
+    }
+}
+
+impl StepFeature for ImplicitSolver {
+    fn encode(&self, phase: Phase, at: &Dispatcher, pass: &mut wgpu::ComputePass) {
+        if phase == Phase::Move {
+            pass.set_bind_group(1, &self.group, &[]);
+            for (kernel, groups) in self.step_passes() {
+                at.dispatch(pass, kernel, Over::Groups(groups));
+            }
+        }
     }
 }
