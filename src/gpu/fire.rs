@@ -11,7 +11,7 @@
 //! held axes carry no force, as the CPU masks them. Each iteration is the
 //! neighbour check and force pass of a step followed by three kernels (four with contact); the
 //! host runs the iterations as the steps of the backend's `run`
-//! (src/gpu/backend.rs), which stops at convergence (a halt bit the control
+//! (src/gpu/backend/mod.rs), which stops at convergence (a halt bit the control
 //! kernel sets) and reads nothing back in between.
 //!
 //! # Determinism and precision

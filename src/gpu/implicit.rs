@@ -545,6 +545,17 @@ impl ImplicitSolver {
     }
 }
 
+impl StepFeature for ImplicitSolver {
+    fn encode(&self, phase: Phase, at: &Dispatcher, pass: &mut wgpu::ComputePass) {
+        if phase == Phase::Move {
+            pass.set_bind_group(1, &self.group, &[]);
+            for (kernel, groups) in self.step_passes() {
+                at.dispatch(pass, kernel, Over::Groups(groups));
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -555,16 +566,5 @@ mod tests {
         assert!(!auto(SPLIT_SOLVE_FROM - 1, false) && auto(SPLIT_SOLVE_FROM, false) && !auto(10 * SPLIT_SOLVE_FROM, true));
         assert!(!splits(GpuWorkgroups::One, 1 << 20, false).unwrap() && splits(GpuWorkgroups::All, 10, false).unwrap());
         assert!(splits(GpuWorkgroups::All, 10, true).unwrap_err().contains("constrain"));
-    }
-}
-
-impl StepFeature for ImplicitSolver {
-    fn encode(&self, phase: Phase, at: &Dispatcher, pass: &mut wgpu::ComputePass) {
-        if phase == Phase::Move {
-            pass.set_bind_group(1, &self.group, &[]);
-            for (kernel, groups) in self.step_passes() {
-                at.dispatch(pass, kernel, Over::Groups(groups));
-            }
-        }
     }
 }
