@@ -76,7 +76,7 @@ impl GpuBackend {
 
     /// The neighbours per particle the list met, at least its capacity: with
     /// the largest count of a check after `commit` that overflowed (which
-    /// halts with [`GpuHalt::Formation`], src/gpu/bind.rs), so a backend
+    /// halts with [`GpuHalt::Formation`](super::GpuHalt::Formation), src/gpu/bind.rs), so a backend
     /// built anew can [`Self::reserve_neighbors`] them.
     pub fn neighbors_met(&self) -> u32 {
         self.params.nlist_cap.max(self.list.overflow_met)
