@@ -279,9 +279,9 @@ mod tests {
     #[test]
     fn summary_sections_are_replaced_between_their_markers_and_a_missing_marker_is_named() {
         let manual = generate(&[]);
-        let summary = "# S\n<!-- generated: reference -->\nold\n<!-- end generated: reference -->\n<!-- generated: examples -->\n<!-- end generated: examples -->\n";
+        let summary = "# S\n<!-- generated: reference -->\nSTALE LINE\n<!-- end generated: reference -->\n<!-- generated: examples -->\n<!-- end generated: examples -->\n";
         let text = summary_with(summary, &manual).unwrap();
-        assert!(!text.contains("old") && text.contains("- [harmonic](reference/interactions/harmonic.md)"));
+        assert!(!text.contains("STALE LINE") && text.contains("- [harmonic](reference/interactions/harmonic.md)"));
         assert_eq!(summary_with(&text, &manual).unwrap(), text);
         let error = summary_with("# S\n", &manual).unwrap_err();
         assert!(error.contains("<!-- generated: examples -->"), "{error}");
