@@ -143,7 +143,7 @@ fn internal_name(line: &str) -> Option<&'static str> {
         })
     };
     let tracker = lower.match_indices('#').any(|(at, _)| {
-        let rest = lower[at + 1..].as_bytes();
+        let rest = &lower.as_bytes()[at + 1..];
         rest.len() >= 2 && rest[0].is_ascii_digit() && rest[1].is_ascii_digit()
     });
     if digits_after("seed ", 3) {
