@@ -29,6 +29,7 @@ mod custom;
 mod cytosim_bench;
 mod deck_features;
 mod deck_language;
+mod docs;
 mod doublet;
 mod dynamics;
 mod export_lammps;
