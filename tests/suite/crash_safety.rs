@@ -427,6 +427,10 @@ fn plant_old(dir: &Path, names: &[&str]) {
     }
 }
 
+/// A command that writes files: its reference run's directory, its
+/// arguments for an output directory, and the files it writes there.
+type WritingCommand<'a> = (&'a str, &'a dyn Fn(&str) -> Vec<String>, &'a [&'a str]);
+
 /// `cellmd export-lammps` and `import-lammps` write each file atomically:
 /// killed at seeded moments, on a full disk (a small tmpfs where one can be
 /// mounted) and past a file size limit, every file they write holds its old
@@ -451,7 +455,7 @@ fn export_and_import_leave_each_file_old_or_whole_after_a_kill_or_a_full_disk() 
         assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
         started.elapsed().as_secs_f64()
     };
-    let commands: [(&str, &dyn Fn(&str) -> Vec<String>, &[&str]); 2] = [("ref", &export, &EXPORTED), ("imp_ref", &import, &IMPORTED)];
+    let commands: [WritingCommand; 2] = [("ref", &export, &EXPORTED), ("imp_ref", &import, &IMPORTED)];
     let seconds: Vec<f64> = commands.iter().map(|(reference, args, _)| timed(&args(reference))).collect();
     let mut replaced = 0;
     for (k, (reference, args, names)) in commands.iter().enumerate() {

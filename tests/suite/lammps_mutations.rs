@@ -83,7 +83,7 @@ fn mutate_lammps(text: &str, rng: &mut Rng) -> Vec<u8> {
         }
         out
     };
-    let replace = |range: (usize, usize), by: &str| [text[..range.0].as_bytes(), by.as_bytes(), text[range.1..].as_bytes()].concat();
+    let replace = |range: (usize, usize), by: &str| [&text.as_bytes()[..range.0], by.as_bytes(), &text.as_bytes()[range.1..]].concat();
     match rng.below(8) {
         0 => text.as_bytes()[..rng.below(text.len() + 1)].to_vec(),
         1 => {
