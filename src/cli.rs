@@ -298,8 +298,8 @@ where
                         ExitCode::SUCCESS
                     }
                     Err(e) => {
-                        eprintln!("error: {}: {e}", outdir.display());
-                        ExitCode::from(1)
+                        eprintln!("error: {e}");
+                        ExitCode::from(OUTPUT_ERROR_STATUS)
                     }
                 },
                 Err(e) => {
@@ -308,8 +308,12 @@ where
                 }
             }
         }
-        Command::ImportLammps { data, input, output } => match export::import_lammps::import_files(&data, input.as_deref(), &output) {
+        Command::ImportLammps { data, input, output } => match export::import_lammps::read_files(&data, input.as_deref()) {
             Ok(imported) => {
+                if let Err(e) = imported.write(&output) {
+                    eprintln!("error: {e}");
+                    return ExitCode::from(OUTPUT_ERROR_STATUS);
+                }
                 out!("wrote {0}/system.top, {0}/system.ff and {0}/system.in", output.display());
                 for note in &imported.notes {
                     out!("note: {note}");

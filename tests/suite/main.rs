@@ -49,6 +49,7 @@ mod import_lammps;
 mod inextensible_fibres;
 mod inputs;
 mod kinetics;
+mod lammps_mutations;
 mod measure;
 mod mutations;
 mod protocols;
