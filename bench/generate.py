@@ -11,7 +11,7 @@ LAMMPS `-var`) and print the potential energy at step 0 and at the end with
 all 17 significant digits (cellmd: thermo CSV; LAMMPS: log), so the harness
 can check the physics before timing it.
 
-Conventions mapped (see README): cellmd `harmonic` k = 2·K of LAMMPS bond
+Conventions mapped (see docs/src/coming-from/lammps.md): cellmd `harmonic` k = 2·K of LAMMPS bond
 harmonic; `soft` = pair soft (A, rc); `wca` = lj/cut at 2^(1/6)σ with
 pair_modify shift yes; `wlc_bending` κ/ℓ = K of angle cosine; cellmd's default
 special_bonds (exclude 1-2 only) = `special_bonds lj 0.0 1.0 1.0`.

@@ -1,5 +1,5 @@
-//! The `cellmd` command line: run | check | list | export-lammps | compare |
-//! build | profile-gpu. The `cellmd` binary (src/main.rs) and the Python
+//! The `cellmd` command line: run | check | list | docs | export-lammps |
+//! compare | build | profile-gpu. The `cellmd` binary (src/main.rs) and the Python
 //! package's `cellmd` console script both call [`main`].
 
 use std::io::{IsTerminal, Write};
@@ -138,6 +138,20 @@ enum Command {
         #[command(subcommand)]
         what: Box<crate::build::Generator>,
     },
+    /// Write the manual's generated pages (one per interaction type, kinetic
+    /// rule, deck command and example deck) into the mdBook's source, or
+    /// with `--check` list those that are missing, stale or left over.
+    Docs {
+        /// The book's source folder (its SUMMARY.md has the generated sections' markers).
+        #[arg(long, default_value = "docs/src")]
+        book: PathBuf,
+        /// The example decks shown in the gallery.
+        #[arg(long, default_value = "inputs")]
+        inputs: PathBuf,
+        /// Write nothing: exit with status 1 if any generated page differs.
+        #[arg(long)]
+        check: bool,
+    },
     /// List interaction types and kinetic rules, or print one's documentation.
     List {
         name: Option<String>,
@@ -200,6 +214,7 @@ where
     let cli = Cli::parse_from(args);
     match cli.command {
         Command::Build { what } => build(what),
+        Command::Docs { book, inputs, check } => docs(&book, &inputs, check),
         Command::List { name, lj } => {
             let units = if lj { UnitSystem::Lj } else { UnitSystem::Cell };
             match name {
@@ -283,8 +298,8 @@ where
                         ExitCode::SUCCESS
                     }
                     Err(e) => {
-                        eprintln!("error: {}: {e}", outdir.display());
-                        ExitCode::from(1)
+                        eprintln!("error: {e}");
+                        ExitCode::from(OUTPUT_ERROR_STATUS)
                     }
                 },
                 Err(e) => {
@@ -293,8 +308,12 @@ where
                 }
             }
         }
-        Command::ImportLammps { data, input, output } => match export::import_lammps::import_files(&data, input.as_deref(), &output) {
+        Command::ImportLammps { data, input, output } => match export::import_lammps::read_files(&data, input.as_deref()) {
             Ok(imported) => {
+                if let Err(e) = imported.write(&output) {
+                    eprintln!("error: {e}");
+                    return ExitCode::from(OUTPUT_ERROR_STATUS);
+                }
                 out!("wrote {0}/system.top, {0}/system.ff and {0}/system.in", output.display());
                 for note in &imported.notes {
                     out!("note: {note}");
@@ -421,6 +440,35 @@ where
 /// when the variable is unset, as in batch jobs and containers: a private
 /// directory (mode 0700, removed at exit) stands in for it. Called before
 /// any thread starts and before the Vulkan instance exists.
+/// `cellmd docs`: writes (or with `check` compares) the manual's generated pages.
+fn docs(book: &Path, inputs: &Path, check: bool) -> ExitCode {
+    let decks = match crate::manual::read_decks(book, inputs) {
+        Ok(decks) => decks,
+        Err(e) => {
+            eprintln!("error: {}: {e}", inputs.display());
+            return ExitCode::from(1);
+        }
+    };
+    let manual = crate::manual::generate(&decks);
+    let result = if check { crate::manual::check(book, &manual) } else { crate::manual::write(book, &manual).map(|_| Vec::new()) };
+    match result {
+        Ok(problems) if problems.is_empty() => {
+            out!("{}: {} generated pages up to date", book.display(), manual.pages.len());
+            ExitCode::SUCCESS
+        }
+        Ok(problems) => {
+            for problem in &problems {
+                eprintln!("error: {}/{problem}", book.display());
+            }
+            ExitCode::from(1)
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(1)
+        }
+    }
+}
+
 fn headless_runtime_dir() -> Option<tempfile::TempDir> {
     if std::env::var_os("XDG_RUNTIME_DIR").is_some() {
         return None;

@@ -5,7 +5,7 @@
 //! leaves (`units`, `expr`, `input`, `rng`, `mesh`), then `hessian`,
 //! `interactions`, `kinetics`, `forcefield`, `topology`, `system`,
 //! `neighbor`, `backend`, `integrate`, `kinetics_engine`, `measure`,
-//! `output`, `gpu`, `deck`, `run`, `export`, `compare`, `build`, `cli`.
+//! `output`, `gpu`, `deck`, `run`, `export`, `compare`, `build`, `manual`, `cli`.
 //! `tests/suite/architecture.rs` fails on any cycle among them.
 //!
 //! | module | role |
@@ -31,6 +31,7 @@
 //! | [`compare`] | cellmd vs LAMMPS probes, agreement table, golden reference files (`cellmd compare`) |
 //! | [`build`] | topology generators (`cellmd build`: icosphere, filament, network, aster, cortex, branched, filopodium, cells, sheet, tensegrity) |
 //! | [`run`] | executes a plan: run loop, thermo, blow-up diagnosis, minimise; clean stop on signals, `--continue` from a restart |
+//! | [`manual`] | the user manual's pages generated from the registries, the command table and `inputs/` (`cellmd docs`) |
 //! | [`cli`] | the `cellmd` command line (the binary and the Python package's console script call [`cli::main`]) |
 
 pub mod backend;
@@ -48,6 +49,7 @@ pub mod integrate;
 pub mod interactions;
 pub mod kinetics;
 pub mod kinetics_engine;
+pub mod manual;
 pub mod measure;
 pub mod mesh;
 pub mod neighbor;

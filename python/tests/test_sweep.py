@@ -72,7 +72,7 @@ def test_the_worked_example_follows_young_laplace(tmp_path):
     assert [float(r["radius"]) for r in rows] == [3.0, 6.0]
     for r in rows:
         assert r["converged"] == "True"
-        # Level-1 meshes: the polyhedron's excess area puts ΔP 1.6 % above 2γ/R_V (README, Young–Laplace table).
+        # Level-1 meshes: the polyhedron's excess area puts ΔP 1.6 % above 2γ/R_V (docs/src/tutorials/python-sweep.md).
         assert abs(float(r["turgor"]) / float(r["laplace"]) - 1) < 0.03
     slurm = subprocess.run([sys.executable, str(EXAMPLE), "--quick", "--out", str(tmp_path / "array"), "--slurm"], capture_output=True, text=True)
     assert slurm.returncode == 0 and (tmp_path / "array" / "sweep.sbatch").exists()

@@ -114,7 +114,7 @@ impl Lmp {
 /// probes; returns them with LAMMPS' version line.
 pub fn run_lammps(plan: &Plan, lmp: &Lmp, dir: &Path) -> Result<(Probes, String), String> {
     let deck = lammps::export(plan, ExportOptions { probes: true })?;
-    lammps::write(&deck, dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    lammps::write(&deck, dir).map_err(|e| e.to_string())?;
     let version = lmp.run(dir)?;
     let bond_types = crate::export::bond_types::LammpsBondTypes::new(&plan.model).labels(&plan.model);
     Ok((lammps_probes(dir, &bond_types)?, version))

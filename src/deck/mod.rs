@@ -11,7 +11,8 @@
 //! Paths of inputs (`topology`, `forcefield`, `read_state`) are relative to the
 //! deck's directory; outputs (`dump`, `thermo_file`, `write_state`) are
 //! relative to the output directory (the working directory unless `cellmd run
-//! -o DIR`). See README.md for the command reference.
+//! -o DIR`). The manual's reference (`docs/src/reference/commands.md`, written by
+//! `cellmd docs`) has a page per command.
 //!
 //! File-level circles that remain (the folder as a whole imports no module
 //! that imports it back, `tests/suite/architecture.rs`):
@@ -40,5 +41,5 @@ pub use self::expression::Condition;
 pub use self::open::OpenDeck;
 pub use self::plan::{Action, CheckpointSpec, CoeffTarget, DumpSpec, Group, GroupQuantity, NeighborSettings, Plan, ThermoColumn};
 pub use self::protocol::{Protocol, Ramp, Velocity};
-pub use self::validate::{validate, validate_file, validate_file_with, validate_with, ValidateOptions};
+pub use self::validate::{command_docs, validate, validate_file, validate_file_with, validate_with, CommandDoc, ValidateOptions};
 pub use self::variables::Variables;

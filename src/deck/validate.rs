@@ -28,6 +28,8 @@ mod settings;
 mod setup;
 mod targets;
 
+pub use self::commands::{command_docs, CommandDoc};
+
 /// The state of a deck being validated: what its commands so far defined.
 #[derive(Clone)]
 pub(super) struct Validator {

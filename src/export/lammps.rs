@@ -580,9 +580,10 @@ pub fn export(plan: &Plan, options: ExportOptions) -> Result<LammpsDeck, String>
     Ok(LammpsDeck { data: data_file(plan, &w.bond_types, &title), input: w.out })
 }
 
-/// Writes `data.lammps` and `in.lammps` into `dir` (created if needed).
+/// Writes `data.lammps` and then `in.lammps` (which reads it) into `dir`
+/// (created if needed), each atomically and through no link inside `dir`
+/// (`output::files`): a kill or a full disk leaves each name whole, old or
+/// new. The error names the file.
 pub fn write(deck: &LammpsDeck, dir: &std::path::Path) -> std::io::Result<()> {
-    std::fs::create_dir_all(dir)?;
-    std::fs::write(dir.join(DATA_FILE), &deck.data)?;
-    std::fs::write(dir.join(INPUT_FILE), &deck.input)
+    crate::output::files::write_all_atomically(dir, &[(DATA_FILE, &deck.data), (INPUT_FILE, &deck.input)])
 }

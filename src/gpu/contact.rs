@@ -74,6 +74,7 @@
 
 use super::prelude::contact::*;
 pub use super::prelude::contact::{CONTACT_ONLY, FRACTION_SLOTS};
+use super::step::{Dispatcher, Over, Phase, StepFeature};
 use crate::interactions::ContactLaw;
 use crate::system::{registry_index, Model};
 
@@ -229,4 +230,50 @@ pub fn reach_message(edge: f64) -> String {
          ({EDGE_ALLOWANCE} × the longest edge at the start of the run); run again from the last output (the reach is set \
          anew at the start of each run) or use `device cpu`"
     )
+}
+
+/// Node–face contact as a step feature: the area-weighted contact's node
+/// and weight passes ([`super::adhesion`]) and then the contact pass, after
+/// the force pass; nothing without contact faces.
+pub(super) struct ContactPasses {
+    adhesion_nodes: wgpu::ComputePipeline,
+    adhesion_weights: wgpu::ComputePipeline,
+    contact_forces: wgpu::ComputePipeline,
+    /// Whether the model has contact faces, and area-weighted contact rules.
+    active: bool,
+    adhesion: bool,
+}
+
+impl ContactPasses {
+    pub(super) fn new(faces: u32, adhesion_rules: u32, pipeline: impl Fn(&str) -> wgpu::ComputePipeline) -> Self {
+        Self {
+            adhesion_nodes: pipeline("adhesion_nodes"),
+            adhesion_weights: pipeline("adhesion_weights"),
+            contact_forces: pipeline("contact_forces"),
+            active: faces > 0,
+            adhesion: adhesion_rules > 0,
+        }
+    }
+
+    /// The contact pass, as `profile` times it (none without contact).
+    pub(super) fn contact_passes(&self) -> Vec<(&wgpu::ComputePipeline, Over)> {
+        self.active.then_some((&self.contact_forces, Over::Chunks)).into_iter().collect()
+    }
+
+    /// The area-weighted contact's passes, as `profile` times them (none without them).
+    pub(super) fn adhesion_passes(&self) -> Vec<(&wgpu::ComputePipeline, Over)> {
+        match self.active && self.adhesion {
+            true => vec![(&self.adhesion_nodes, Over::Chunks), (&self.adhesion_weights, Over::Particles)],
+            false => Vec::new(),
+        }
+    }
+}
+
+impl StepFeature for ContactPasses {
+    fn encode(&self, phase: Phase, at: &Dispatcher, pass: &mut wgpu::ComputePass) {
+        if phase == Phase::Forces {
+            at.dispatch_all(pass, &self.adhesion_passes());
+            at.dispatch_all(pass, &self.contact_passes());
+        }
+    }
 }

@@ -11,7 +11,7 @@
 //! held axes carry no force, as the CPU masks them. Each iteration is the
 //! neighbour check and force pass of a step followed by three kernels (four with contact); the
 //! host runs the iterations as the steps of the backend's `run`
-//! (src/gpu/backend.rs), which stops at convergence (a halt bit the control
+//! (src/gpu/backend/mod.rs), which stops at convergence (a halt bit the control
 //! kernel sets) and reads nothing back in between.
 //!
 //! # Determinism and precision
@@ -42,6 +42,7 @@ use wgpu::util::DeviceExt;
 use super::context::GpuContext;
 use super::prelude::fire::*;
 use super::side_group::SideGroup;
+use super::step::{Dispatcher, Over, Phase, StepFeature};
 use crate::integrate::fire::{FireSettings, ALPHA0, DT_MAX_FACTOR};
 use crate::system::Model;
 
@@ -106,5 +107,17 @@ impl DeviceFire {
     pub(super) fn counts(bytes: &[u8]) -> (u64, u64) {
         let entries: [[f32; 4]; FIRE_PARTIALS] = bytemuck::pod_read_unaligned(&bytes[..Self::COUNT_BYTES as usize]);
         (u64::from(entries[FIRE_STATE][3].to_bits()), u64::from(entries[FIRE_CLAMPED][0].to_bits()))
+    }
+}
+
+impl StepFeature for DeviceFire {
+    fn encode(&self, phase: Phase, at: &Dispatcher, pass: &mut wgpu::ComputePass) {
+        if phase == Phase::Move {
+            pass.set_bind_group(1, &self.group, &[]);
+            at.dispatch_all(pass, &[(&self.partials, Over::Particles), (&self.control, Over::Groups(1)), (&self.moves, Over::Particles)]);
+            if let Some(clamped) = &self.clamped_moves {
+                at.dispatch(pass, clamped, Over::Particles);
+            }
+        }
     }
 }

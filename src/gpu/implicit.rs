@@ -165,6 +165,7 @@ use super::prelude::implicit::*;
 use super::prelude::implicit_split::SPLIT_PARTIALS;
 use super::shader;
 use super::side_group::SideGroup;
+use super::step::{Dispatcher, Over, Phase, StepFeature};
 use crate::integrate::implicit::{GpuWorkgroups, ImplicitSettings, SolveReport};
 use crate::interactions::{Law, SurfaceGpu, REGISTRY};
 use crate::system::Model;
@@ -541,6 +542,17 @@ impl ImplicitSolver {
              (tolerance {:e}, max_iterations {})",
             report.relative_residual, report.iterations, self.tolerance, self.max_iterations
         )
+    }
+}
+
+impl StepFeature for ImplicitSolver {
+    fn encode(&self, phase: Phase, at: &Dispatcher, pass: &mut wgpu::ComputePass) {
+        if phase == Phase::Move {
+            pass.set_bind_group(1, &self.group, &[]);
+            for (kernel, groups) in self.step_passes() {
+                at.dispatch(pass, kernel, Over::Groups(groups));
+            }
+        }
     }
 }
 

@@ -57,6 +57,7 @@ use super::pack::Packed;
 pub use super::prelude::kinetics::RULES_PER_TYPE;
 use super::prelude::kinetics::*;
 use super::shader::rule_code;
+use super::step::{Dispatcher, Over, Phase, StepFeature};
 use crate::kinetics_engine::EventKind;
 use crate::neighbor::Exclusions;
 use crate::system::{BondState, Model};
@@ -138,6 +139,48 @@ impl KinKernels {
             bind_write: pipeline("bind_write"),
             bind_accept: pipeline("bind_accept"),
             bind_halt: pipeline("bind_halt"),
+        }
+    }
+}
+
+/// Bond kinetics on the device as a step feature: the buffer's layout and the kernels.
+pub(super) struct DeviceKinetics {
+    pub(super) layout: KinLayout,
+    pub(super) kernels: KinKernels,
+}
+
+impl DeviceKinetics {
+    /// The decision's kernels (and `bind` formation's), each timed alone by `profile`.
+    pub(super) fn profiled(&self) -> Vec<(&wgpu::ComputePipeline, Over)> {
+        let (k, bonds) = (&self.kernels, Over::each(self.layout.bonds()));
+        let mut passes = vec![(&k.measure, bonds), (&k.decide, bonds), (&k.scan, Over::Groups(1)), (&k.emit, bonds)];
+        if self.layout.binds() {
+            passes.extend(self.formation());
+        }
+        passes
+    }
+
+    /// `bind` formation's kernels after the decisions (src/gpu/bind.rs).
+    fn formation(&self) -> [(&wgpu::ComputePipeline, Over); 4] {
+        let k = &self.kernels;
+        [(&k.bind_count, Over::Chunks), (&k.bind_scan, Over::Groups(1)), (&k.bind_write, Over::Chunks), (&k.bind_accept, Over::Groups(1))]
+    }
+}
+
+impl StepFeature for DeviceKinetics {
+    fn encode(&self, phase: Phase, at: &Dispatcher, pass: &mut wgpu::ComputePass) {
+        let (k, bonds) = (&self.kernels, Over::each(self.layout.bonds()));
+        match phase {
+            Phase::Start => at.dispatch(pass, &k.room, Over::Groups(1)),
+            Phase::BeforeMove => at.dispatch(pass, &k.measure, bonds),
+            Phase::AfterCommit => {
+                at.dispatch_all(pass, &[(&k.decide, bonds), (&k.scan, Over::Groups(1)), (&k.emit, bonds)]);
+                if self.layout.binds() {
+                    at.dispatch_all(pass, &self.formation());
+                }
+            }
+            Phase::End if self.layout.binds() => at.dispatch(pass, &k.bind_halt, Over::Groups(1)),
+            _ => {}
         }
     }
 }

@@ -9,9 +9,16 @@
 //!   in Rust and generated into the program.
 //! - [`custom`]: evaluators generated from a model's `custom` expressions.
 //! - [`pack`]: the model flattened into the buffers the kernels read.
-//! - [`backend`]: buffers, pipelines and the GPU-resident step loop.
-//! - `nlist`: the neighbour list's buffer, bound in chunks of particles
-//!   where it exceeds the adapter's largest storage binding.
+//! - [`backend`]: the GPU-resident step loop composing the features below,
+//!   the buffers they share, the build, the read-backs and the profile.
+//! - `step`: the phases of a device step, the dispatcher and the
+//!   `StepFeature` trait through which each feature encodes its kernels of
+//!   each phase (the neighbour list, the force passes, contact, protocols
+//!   and device kinetics so far).
+//! - `neighbours`: the neighbour list's check and rebuild as a feature;
+//!   `nlist`: its buffer, bound in chunks of particles where it exceeds the
+//!   adapter's largest storage binding.
+//! - `forces`: the force passes (surface, volume, pair, bonded, external).
 //! - [`surface`]: surface (body) terms: face, body, edge and node passes,
 //!   deterministic (no float atomics).
 //! - [`contact`]: node–face contact between bodies (`Law::Contact`) and
@@ -44,9 +51,9 @@
 //! File-level circles, on purpose: `pack.rs` ↔ `surface.rs`, `tetra.rs`
 //! and `special.rs`. `pack.rs` lays out the whole topology, their sections
 //! included, and they build those sections' CSR lists with pack's
-//! `push_csr`, the one CSR builder of the GPU buffers. And `backend.rs` ↔
+//! `push_csr`, the one CSR builder of the GPU buffers. And `backend/` ↔
 //! `kinetics.rs`: the backend owns the device kinetics' buffer and
-//! dispatches its kernels in each step, and `kinetics.rs` lays that buffer
+//! composes its step feature, and `kinetics.rs` lays that buffer
 //! out and adds to `GpuBackend` the methods that read its events and bond
 //! state back, so the buffer's layout has one home. And `shader.rs` ↔
 //! `implicit.rs` (and through `side_group.rs`): the composer appends the
@@ -93,9 +100,11 @@ pub mod contact;
 pub mod context;
 pub mod custom;
 pub mod fire;
+mod forces;
 pub mod implicit;
 mod implicit_split;
 pub mod kinetics;
+mod neighbours;
 mod nlist;
 pub mod pack;
 mod prelude;
@@ -104,6 +113,7 @@ pub mod shader;
 pub mod shake;
 mod side_group;
 mod special;
+mod step;
 pub mod surface;
 pub mod tetra;
 

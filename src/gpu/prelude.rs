@@ -88,7 +88,7 @@ pub(super) mod pack {
     }
 }
 
-/// Shared by src/gpu/backend.rs and its kernels.
+/// Shared by src/gpu/backend/ and its kernels.
 pub(super) mod status {
     shared_constants! {
         /// Words of `status`, read back by the host at every synchronisation.

@@ -38,6 +38,7 @@ use glam::DVec3;
 
 use super::pack::FixedPoint;
 use super::prelude::protocol::*;
+use super::step::{Dispatcher, Over, Phase, StepFeature};
 use crate::expr::wgsl::wgsl;
 use crate::expr::Expr;
 use crate::system::{BondState, Model};
@@ -306,5 +307,37 @@ impl ProtocolPack {
         self.fields[2] = step as u32;
         debug_assert!(self.ramp_of_slot.len() <= self.slot_capacity as usize);
         rows.iter().flat_map(|row| self.ramp_of_slot.iter().map(|&r| (row[r] as f32).to_bits())).collect()
+    }
+}
+
+/// The protocols as a step feature: the ramped parameters' values of the
+/// step at its start, and the driven indenters' load check before the move
+/// and advance after the commit; each only where the layout has ramps or
+/// drives (`Params::protocol`).
+pub(super) struct ProtocolKernels {
+    ramps: wgpu::ComputePipeline,
+    drive_check: wgpu::ComputePipeline,
+    drive_advance: wgpu::ComputePipeline,
+}
+
+impl ProtocolKernels {
+    pub(super) fn new(pipeline: impl Fn(&str) -> wgpu::ComputePipeline) -> Self {
+        Self {
+            ramps: pipeline("protocol_ramps"),
+            drive_check: pipeline("protocol_drive_check"),
+            drive_advance: pipeline("protocol_drive_advance"),
+        }
+    }
+}
+
+impl StepFeature for ProtocolKernels {
+    fn encode(&self, phase: Phase, at: &Dispatcher, pass: &mut wgpu::ComputePass) {
+        let (ramped, drives) = (at.params.protocol[1], at.params.protocol[6] > 0);
+        match phase {
+            Phase::Start if ramped > 0 => at.dispatch(pass, &self.ramps, Over::each(ramped)),
+            Phase::BeforeMove if drives => at.dispatch(pass, &self.drive_check, Over::Groups(1)),
+            Phase::AfterCommit if drives => at.dispatch(pass, &self.drive_advance, Over::Groups(1)),
+            _ => {}
+        }
     }
 }

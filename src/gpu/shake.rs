@@ -50,6 +50,7 @@ use wgpu::util::DeviceExt;
 use super::context::GpuContext;
 use super::prelude::shake::*;
 use super::side_group::SideGroup;
+use super::step::{Dispatcher, Over, Phase, StepFeature};
 use crate::integrate::constraints::{failure_message, ConstraintMethod, Constraints};
 use crate::integrate::fibre::chains::Chains;
 use crate::system::Model;
@@ -119,6 +120,11 @@ pub(super) struct DeviceShake {
 }
 
 impl DeviceShake {
+    /// The sweeps in one workgroup, then each particle's placement (bind group 1: [`Self::group`]).
+    pub(super) fn passes(&self) -> [(&wgpu::ComputePipeline, Over); 2] {
+        [(&self.solve, Over::Groups(1)), (&self.place, Over::each(self.particles))]
+    }
+
     /// Packs the coloured constraints and compiles the kernels against the
     /// backend's main bind group layout.
     pub(super) fn new(
@@ -190,5 +196,14 @@ impl DeviceShake {
     /// Why a projection halted the run (the CPU's message, at the step it was taking).
     pub(super) fn failure(&self, report: &ShakeReport, step: u64) -> String {
         failure_message(self.ends[report.worst], self.max_sweeps, step, report.relative_error, self.tolerance)
+    }
+}
+
+impl StepFeature for DeviceShake {
+    fn encode(&self, phase: Phase, at: &Dispatcher, pass: &mut wgpu::ComputePass) {
+        if phase == Phase::Constrain {
+            pass.set_bind_group(1, &self.group, &[]);
+            at.dispatch_all(pass, &self.passes());
+        }
     }
 }

@@ -49,6 +49,23 @@ pub fn write_atomically(root: &Path, path: &Path, fill: impl FnOnce(&mut BufWrit
     }
 }
 
+/// Writes each `(name, text)` of `files` into `dir` (created if needed),
+/// one after the other and each atomically (see [`write_atomically`], with
+/// `dir` as the root beneath which no link is followed): a kill or a full
+/// disk leaves every name with its old contents or its new ones, never part
+/// of a file. A file that names the others should come last. The error
+/// names the file that could not be written.
+pub fn write_all_atomically(dir: &Path, files: &[(&str, &str)]) -> io::Result<()> {
+    use std::io::Write;
+    let named = |path: &Path, e: io::Error| io::Error::new(e.kind(), format!("{}: {e}", path.display()));
+    fs::create_dir_all(dir).map_err(|e| named(dir, e))?;
+    for (name, text) in files {
+        let path = dir.join(name);
+        write_atomically(dir, &path, |out| out.write_all(text.as_bytes())).map_err(|e| named(&path, e))?;
+    }
+    Ok(())
+}
+
 /// Removes the output file `path` (an old checkpoint); below `root` through
 /// no link.
 pub fn remove(root: &Path, path: &Path) -> io::Result<()> {

@@ -623,7 +623,7 @@ fn tensegrity() {
     }
     // Stress fibres: FIRE (anchors' loads left out of its convergence test,
     // converging to ftol) ends with some of the 36 fibre cables slack, so
-    // only their net pull is asserted; see the README.
+    // only their net pull is asserted; see docs/src/user-guide/builders.md.
     let slack = of("stress_fibre").iter().filter(|b| b.2 <= 0.0).count();
     println!("slack stress-fibre cables: {slack} of {}", of("stress_fibre").len());
     assert!(range("stress_fibre").2 > 0.0, "every stress fibre is slack: {report:?}");

@@ -1,6 +1,6 @@
 //! Collagen clustering (seed 002, Ouyang et al. 2022; issue #19): the study
 //! deck `inputs/collagen_two_cells.in` on its two-cell network with shorter
-//! stages (see the README section *Collagen clustering study*), and the thermo column
+//! stages (see docs/src/validation/collagen.md), and the thermo column
 //! `clustering/BONDTYPE/GROUP_A/GROUP_B` on a configuration whose profile is
 //! known exactly.
 //!
@@ -101,7 +101,7 @@ fn fibres_cluster_between_contracting_cells_whether_or_not_they_are_asymmetric()
     }
     // The paper's claim that the asymmetry drives it is NOT what this model
     // gives: with compression as stiff as tension the ratio grows as much
-    // (within 5 % of the asymmetric growth). Over five realisations (README,
+    // (within 5 % of the asymmetric growth). Over five realisations (docs/src/validation/collagen.md,
     // *Asymmetric against symmetric fibres*) the difference is +0.03 ± 0.03
     // against a spread of 0.38 between networks; longer stages do not change
     // it, 10× stiffer bending gives +0.08 ± 0.05 and one bond per segment

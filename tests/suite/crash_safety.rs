@@ -394,3 +394,105 @@ fn a_restart_that_does_not_fit_is_refused_before_any_output() {
         assert!(written.is_empty(), "{restart}: outputs were opened: {written:?}");
     }
 }
+
+/// The files `cellmd export-lammps` and `cellmd import-lammps` write.
+const EXPORTED: [&str; 2] = ["data.lammps", "in.lammps"];
+const IMPORTED: [&str; 3] = ["system.top", "system.ff", "system.in"];
+
+/// `dir`'s `names` must each hold `old` or exactly the reference's bytes
+/// (from `reference`), and no temporary may be left when `clean`; returns
+/// how many hold the new bytes.
+fn old_or_new(dir: &Path, reference: &Path, names: &[&str], clean: bool) -> usize {
+    let mut new = 0;
+    for name in names {
+        let got = std::fs::read(dir.join(name)).unwrap_or_else(|e| panic!("{}: {e}", dir.join(name).display()));
+        if got != b"old\n" {
+            assert!(
+                got == std::fs::read(reference.join(name)).unwrap(),
+                "{}: neither the old file nor the whole new one",
+                dir.join(name).display()
+            );
+            new += 1;
+        }
+        assert!(!clean || !dir.join(format!("{name}.tmp")).exists(), "{name}.tmp left in {}", dir.display());
+    }
+    new
+}
+
+/// `dir` (created) with each of `names` holding `old`.
+fn plant_old(dir: &Path, names: &[&str]) {
+    std::fs::create_dir_all(dir).unwrap();
+    for name in names {
+        std::fs::write(dir.join(name), "old\n").unwrap();
+    }
+}
+
+/// A command that writes files: its reference run's directory, its
+/// arguments for an output directory, and the files it writes there.
+type WritingCommand<'a> = (&'a str, &'a dyn Fn(&str) -> Vec<String>, &'a [&'a str]);
+
+/// `cellmd export-lammps` and `import-lammps` write each file atomically:
+/// killed at seeded moments, on a full disk (a small tmpfs where one can be
+/// mounted) and past a file size limit, every file they write holds its old
+/// contents or the whole new ones, and a failed write exits with the output
+/// error status naming the file, leaving no temporary behind.
+#[test]
+fn export_and_import_leave_each_file_old_or_whole_after_a_kill_or_a_full_disk() {
+    // 64 000 particles: files of megabytes, written over a measurable time.
+    let case = Case::new(&[
+        ("t.top", &common::grid_topology(40, 1.0)),
+        ("f.ff", "particle p drag 1\npair p p wca epsilon 1 sigma 0.8\n"),
+        (
+            "deck.in",
+            "units lj\ntopology t.top\nforcefield f.ff\nbox x -1 40 p y -1 40 p z -1 40 p\ntemperature 1\ntimestep 0.001\nrun 10\n",
+        ),
+    ]);
+    let export = |dir: &str| -> Vec<String> { vec!["export-lammps".into(), "deck.in".into(), dir.into()] };
+    let import = |dir: &str| -> Vec<String> { vec!["import-lammps".into(), "ref/in.lammps".into(), "-o".into(), dir.into()] };
+    let timed = |args: &[String]| {
+        let started = Instant::now();
+        let out = cellmd().args(args).current_dir(case.output_dir()).output().unwrap();
+        assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+        started.elapsed().as_secs_f64()
+    };
+    let commands: [WritingCommand; 2] = [("ref", &export, &EXPORTED), ("imp_ref", &import, &IMPORTED)];
+    let seconds: Vec<f64> = commands.iter().map(|(reference, args, _)| timed(&args(reference))).collect();
+    let mut replaced = 0;
+    for (k, (reference, args, names)) in commands.iter().enumerate() {
+        let reference = case.path(reference);
+        for trial in 0..4 {
+            let dir = format!("killed{k}.{trial}");
+            plant_old(&case.path(&dir), names);
+            let mut child =
+                cellmd().args(args(&dir)).current_dir(case.output_dir()).stdout(Stdio::null()).stderr(Stdio::null()).spawn().unwrap();
+            std::thread::sleep(Duration::from_secs_f64(seconds[k] * (0.2 + 0.8 * seeded_fraction(450 + 10 * k as u64 + trial))));
+            assert!(Command::new("kill").args(["-KILL", &child.id().to_string()]).status().unwrap().success());
+            child.wait().unwrap();
+            // A kill may leave the temporary of the file being written; never a part of a named file.
+            replaced += old_or_new(&case.path(&dir), &reference, names, false);
+        }
+        // A file size limit of 256 KiB (SIGXFSZ ignored, so the write fails with EFBIG).
+        let dir = format!("limited{k}");
+        plant_old(&case.path(&dir), names);
+        let shim = format!("trap '' XFSZ; ulimit -f 512; exec {} \"$@\"", env!("CARGO_BIN_EXE_cellmd"));
+        let out = Command::new("sh").arg("-c").arg(&shim).arg("sh").args(args(&dir)).current_dir(case.output_dir()).output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(i32::from(OUTPUT_ERROR_STATUS)), "{stderr}");
+        assert!(stderr.contains(&format!("{dir}/{}: File too large", names[0])), "{stderr}");
+        assert_eq!(old_or_new(&case.path(&dir), &reference, names, true), 0);
+        // A full disk.
+        let dir = format!("full{k}");
+        if let Some(tmpfs) = Tmpfs::mount(&case.path(&dir), "256k") {
+            plant_old(&case.path(&dir), names);
+            let out = cellmd().args(args(&dir)).current_dir(case.output_dir()).output().unwrap();
+            let stderr = String::from_utf8_lossy(&out.stderr);
+            assert_eq!(out.status.code(), Some(i32::from(OUTPUT_ERROR_STATUS)), "{stderr}");
+            assert!(stderr.contains(&format!("{dir}/{}: No space left on device", names[0])), "{stderr}");
+            assert_eq!(old_or_new(&case.path(&dir), &reference, names, true), 0);
+            drop(tmpfs);
+        } else {
+            eprintln!("NOTE: cannot mount a tmpfs here; the full disk is tested through the file size limit only");
+        }
+    }
+    eprintln!("export {:.2} s, import {:.2} s; {replaced} files replaced whole before the kills", seconds[0], seconds[1]);
+}

@@ -71,6 +71,36 @@ fn committed_crashers_are_diagnosed() {
     assert!(restart.contains("2200000000"), "{restart}");
 }
 
+/// LAMMPS input that `cellmd import-lammps` once accepted silently or
+/// refused without a place (`tests/suite/lammps_mutations.rs` found them):
+/// `tests/decks/crashers/*.lmp`, each a script reading the data file its
+/// `read_data` names, with the same `# expect:` and `# exit:` lines; the
+/// import writes nothing.
+#[test]
+fn committed_lammps_crashers_are_diagnosed() {
+    let mut scripts: Vec<_> = std::fs::read_dir("tests/decks/crashers")
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "lmp"))
+        .collect();
+    scripts.sort();
+    assert!(!scripts.is_empty());
+    let out = tempfile::tempdir().unwrap();
+    for script in scripts {
+        let text = std::fs::read_to_string(&script).unwrap();
+        let (expected, status) = (header(&text, "# expect: "), header(&text, "# exit: ").parse::<i32>().unwrap());
+        let dir = out.path().join(script.file_stem().unwrap());
+        let got = cellmd(&["import-lammps", script.to_str().unwrap(), "-o", dir.to_str().unwrap()]);
+        assert_eq!(got.status, status, "{}:\n{}", script.display(), got.stderr);
+        assert!(got.stderr.contains(expected), "{}: stderr lacks `{expected}`:\n{}", script.display(), got.stderr);
+        assert_eq!(dir.exists(), status == 0, "{}: the import wrote {}", script.display(), if status == 0 { "nothing" } else { "files" });
+        if status == 0 {
+            let check = cellmd(&["check", dir.join("system.in").to_str().unwrap()]);
+            assert_eq!(check.status, 0, "{}: the imported deck is refused:\n{}", script.display(), check.stderr);
+        }
+    }
+}
+
 /// Inputs too large (or too strange) to commit, each with the start of its
 /// expected message and exit status.
 #[test]

@@ -29,7 +29,7 @@
 //! within one edge, which pulls nodes along the surface; the shear
 //! regulariser carries that pull (at some cost in angle: it resists the
 //! spreading), where `area_conservation kl 100`, used before, let faces
-//! collapse at w/γ = 0.75. Measured (README table): |midpoint − θ_YD| ≤ 2.6°
+//! collapse at w/γ = 0.75. Measured (table in docs/src/user-guide/contact.md): |midpoint − θ_YD| ≤ 2.6°
 //! at level 2 and ≤ 1.5° at level 3, bands ≤ 2.8°, smallest face ≥ 0.40 of
 //! the mean. `cargo test --release --test suite doublet:: -- --ignored --nocapture`
 //! prints the table for levels 2 and 3.
@@ -43,7 +43,7 @@
 //!
 //! **Implicit step** (issue #6: `contact_adhesion`'s stiffness blocks). The
 //! advancing doublet at w/γ = 0.25, regularised by `area_conservation kl
-//! 100` as when the README's table was measured, relaxed by `integrator
+//! 100` as when the manual's table was measured, relaxed by `integrator
 //! implicit` at 10× the explicit dt settles within 0.5° of the explicit
 //! angle (measured 38.944° vs 38.835°; 38.948° before the blocks), and at
 //! 1000× (0.27 s) within 5° (measured +4.61°; before the blocks it did not
@@ -65,7 +65,7 @@ const TURGOR_K: f64 = 2000.0;
 /// Shear modulus of the `surface_shear` mesh regulariser, pN/µm (2γ).
 const MU: f64 = 200.0;
 /// Per-face area modulus of the `area_conservation` regulariser that the
-/// implicit-step tests keep (their README table was measured with it), pN/µm.
+/// implicit-step tests keep (their table in the manual was measured with it), pN/µm.
 const KL: f64 = 100.0;
 
 /// How the fluid surface's triangulation is kept even.

@@ -40,7 +40,7 @@
 //! and Sneddon's exact small-strain load of a sphere (Int. J. Eng. Sci. 3,
 //! 47, 1965), 0.2–1 % below Hertz for δ/R = 0.02–0.1.
 //!
-//! The refinement studies print the tables (README, *Solid bodies*):
+//! The refinement studies print the tables (docs/src/user-guide/solids.md):
 //! `cargo test --test suite hertz:: -- --ignored --nocapture`.
 
 use std::path::Path;
@@ -209,7 +209,7 @@ fn tatara_exceeds_hertz_by_the_finite_sphere_correction() {
 /// (fitted exponent within ±0.1 of Hertz's 1.5). Its amplitude is not
 /// compared: at this size the whole ball lies 2–7 % off the octant's
 /// mirror-symmetric state at δ/R = 0.06–0.08 (module docs); from
-/// `--cells 16` on they agree (README).
+/// `--cells 16` on they agree (docs/src/user-guide/solids.md).
 #[test]
 fn a_meshed_ball_loads_as_hertz_delta_to_the_three_halves() {
     let stages = sweep(8, false);
@@ -381,7 +381,7 @@ fn the_committed_block_is_what_the_builder_writes() {
 /// within ±0.1), and above Hertz (a displacement-based mesh is stiffer than
 /// the solid it approximates; Sneddon's exact sphere is 0.2–1 % below
 /// Hertz) by less than 30 % (measured: 13–24 %). Hertz within 5 % needs a
-/// finer mesh than CI affords: the study's table (README, *Solid bodies*).
+/// finer mesh than CI affords: the study's table (docs/src/user-guide/solids.md).
 #[test]
 fn a_rigid_sphere_on_a_graded_block_loads_as_hertz_from_above() {
     let stages = block_sweep(CI_BLOCK);
@@ -394,7 +394,7 @@ fn a_rigid_sphere_on_a_graded_block_loads_as_hertz_from_above() {
     assert!(excess.iter().all(|&e| e > 0.0 && e < 0.3), "F/Hertz − 1 = {excess:?}");
 }
 
-/// The meshes of the study (README, *Solid bodies*): the block at 20·R and
+/// The meshes of the study (docs/src/user-guide/solids.md): the block at 20·R and
 /// 10·R with the same spacings, the block at 20·R graded more gently, and
 /// the half-ball at the block's spacings.
 const STUDY: [Block; 4] = [

@@ -266,7 +266,7 @@ fn shell_gamma(level: u32) -> (f64, f64, usize) {
 }
 
 /// Young–Laplace through the method of planes: at level 3 (642 nodes) the
-/// estimator is within 1 % of ΔP·R/2 (the table in the README gives the
+/// estimator is within 1 % of ΔP·R/2 (the table in docs/src/user-guide/thermo.md gives the
 /// numbers), and the error falls from level 2 to level 3.
 #[test]
 fn pressurised_shell_cortical_tension_matches_young_laplace() {

@@ -44,13 +44,13 @@ fn mutants(path: &Path) -> u64 {
 /// Larger topologies are left out (their parse time, not their grammar, would dominate).
 const MAX_TOPOLOGY_BYTES: u64 = 100_000;
 /// The longest any one mutant may take before it counts as a hang.
-const HANG: Duration = Duration::from_secs(30);
+pub(crate) const HANG: Duration = Duration::from_secs(30);
 
 /// SplitMix64: small, seedable, the same on every platform.
-struct Rng(u64);
+pub(crate) struct Rng(pub(crate) u64);
 
 impl Rng {
-    fn next(&mut self) -> u64 {
+    pub(crate) fn next(&mut self) -> u64 {
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = self.0;
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
@@ -58,7 +58,7 @@ impl Rng {
         z ^ (z >> 31)
     }
 
-    fn below(&mut self, n: usize) -> usize {
+    pub(crate) fn below(&mut self, n: usize) -> usize {
         (self.next() % n.max(1) as u64) as usize
     }
 }
@@ -107,7 +107,7 @@ const WORDS: &[&str] = &[
 ];
 const CHARS: &[char] = &['\0', '\r', '\t', '"', '#', '&', '\u{7f}', 'é', '€', '\u{feff}', ' ', '\n', '$', '{', '}', ':'];
 
-fn mutate(text: &str, rng: &mut Rng) -> String {
+pub(crate) fn mutate(text: &str, rng: &mut Rng) -> String {
     let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
     for _ in 0..1 + rng.below(3) {
         if lines.is_empty() {

@@ -18,7 +18,7 @@
 //! (Storm et al., Nature 435, 191 (2005)); once stretching dominates, K
 //! grows more slowly. The band around m = 1 is twice the larger of each
 //! seed's fit error and the two seeds' difference (measured: ±0.17), and
-//! must stay below ±0.25 to tell 1 from 3/2. Measured: README, issue 6.
+//! must stay below ±0.25 to tell 1 from 3/2. Measured: docs/src/user-guide/dynamics.md, *Network shear*.
 //!
 //! `cargo test --release --test suite shear:: -- --nocapture` prints the tables.
 

@@ -10,7 +10,7 @@
 //!   `cellmd build icosphere` command (the GPU's surface kernels: tests/suite/gpu.rs).
 //!
 //! Each table is printed (`cargo test --release --test suite shells:: -- --nocapture`)
-//! and reported in the README.
+//! and reported in docs/src/user-guide/cells.md.
 
 use std::f64::consts::PI;
 

@@ -112,6 +112,45 @@ fn accepted() -> String {
     COMMANDS.iter().map(|c| c.name).collect::<Vec<_>>().join(", ")
 }
 
+/// One section per command (`## name`), the text of its reference page.
+const DOCS: &str = include_str!("commands.md");
+
+/// A deck command as its reference page shows it (`cellmd docs`).
+pub struct CommandDoc {
+    pub name: &'static str,
+    /// `FORM | FORM …`, as the argument-count errors quote it.
+    pub usage: &'static str,
+    /// `setup` (defines the system, before its first use), `block`
+    /// (structures the deck) or `command`.
+    pub kind: &'static str,
+    /// The command's section of `commands.md`, without its heading.
+    pub doc: &'static str,
+}
+
+/// Every command, in table order, with its section of `commands.md` (empty
+/// if it has none: the table's test fails then).
+pub fn command_docs() -> Vec<CommandDoc> {
+    COMMANDS
+        .iter()
+        .map(|c| {
+            let kind = match c.form {
+                Form::Block => "block",
+                Form::Setup(_) => "setup",
+                Form::Line(_) => "command",
+            };
+            CommandDoc { name: c.name, usage: c.usage, kind, doc: section(c.name).unwrap_or("") }
+        })
+        .collect()
+}
+
+/// The text under `## name` of `commands.md`, up to the next heading.
+fn section(name: &str) -> Option<&'static str> {
+    let heading = format!("\n## {name}\n");
+    let start = DOCS.find(&heading)? + heading.len();
+    let end = DOCS[start..].find("\n## ").map_or(DOCS.len(), |e| start + e);
+    Some(DOCS[start..end].trim())
+}
+
 impl Validator {
     /// Checks one command line by its parser in the table.
     pub(in crate::deck) fn command(&mut self, s: &[Token]) -> Result<(), InputError> {
@@ -154,5 +193,15 @@ mod tests {
         for word in super::super::foreign::words().chain(["fix"]) {
             assert!(!seen.contains(word), "`{word}` has a foreign-command hint but is a cellmd command");
         }
+    }
+
+    #[test]
+    fn every_command_has_one_section_of_commands_md_and_no_section_is_left_over() {
+        for c in COMMANDS {
+            assert_eq!(DOCS.matches(&format!("\n## {}\n", c.name)).count(), 1, "commands.md needs one `## {}` section", c.name);
+            assert!(!section(c.name).unwrap().is_empty(), "the `## {}` section of commands.md is empty", c.name);
+        }
+        let headings = DOCS.lines().filter(|l| l.starts_with("## ")).count();
+        assert_eq!(headings, COMMANDS.len(), "commands.md has sections for words that are not commands");
     }
 }

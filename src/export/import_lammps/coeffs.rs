@@ -333,6 +333,7 @@ struct PairCoeff {
     values: Vec<Word>,
     source: Source,
     line: usize,
+    col: usize,
     text: String,
 }
 
@@ -368,6 +369,7 @@ pub fn pairs(style: &Style, modify: &PairModify, lines: &[(Source, Line)], n: us
                             values: values.to_vec(),
                             source: source.clone(),
                             line: line.line,
+                            col: w[0].col,
                             text: line.text.clone(),
                         });
                     }
@@ -422,7 +424,7 @@ fn cutoff(c: &PairCoeff, k: usize) -> Result<f64, String> {
 /// A pair's law: `Ok(Ok(None))` for a style without forces (`zero`).
 fn pair_law(c: &PairCoeff, modify: &PairModify) -> Result<Result<Option<String>, String>, String> {
     let shift = shifted(modify, &c.sub);
-    let place = || format!("{}:{}: `{}`: ", c.source.name, c.line, clip(&c.text));
+    let place = || format!("{}:{}:{}: `{}`: ", c.source.name, c.line, c.col, clip(&c.text));
     let v = |k: usize| -> Result<f64, String> {
         let w = c.values.get(k).ok_or_else(|| format!("{}pair style `{}` needs more coefficients", place(), c.sub.name))?;
         c.source.number(w, "a coefficient")
@@ -504,7 +506,14 @@ fn mixed(modify: &PairModify, ii: Option<&Vec<PairCoeff>>, jj: Option<&Vec<PairC
     };
     // The mixed values as words of a coefficient line (exact: shortest round trip).
     let words = values.iter().map(|v| Word { text: num(*v), line: a.line, col: 1 }).collect();
-    Ok(Some(PairCoeff { sub: a.sub.clone(), values: words, source: a.source.clone(), line: a.line, text: format!("{} (mixed)", a.text) }))
+    Ok(Some(PairCoeff {
+        sub: a.sub.clone(),
+        values: words,
+        source: a.source.clone(),
+        line: a.line,
+        col: a.col,
+        text: format!("{} (mixed)", a.text),
+    }))
 }
 
 #[cfg(test)]

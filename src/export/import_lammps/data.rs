@@ -85,6 +85,16 @@ pub fn atom_columns(style: &str) -> Option<(usize, usize)> {
     }
 }
 
+/// The most types of each kind a data file may declare: every type is
+/// translated (atom types pair by pair), so a count of 4294967297 types
+/// would run for hours. Bond types are many where each bond has its own
+/// rest length (`export-lammps` writes one type per distinct length).
+const MAX_TYPES: [(&str, u64); 3] = [("atom types", 1000), ("bond types", 1_000_000), ("angle types", 1_000_000)];
+
+/// How many box lengths an atom may lie from the box (unwrapped): 2^52,
+/// beyond which a position no longer resolves a box length's fraction.
+const FARTHEST: f64 = 4_503_599_627_370_496.0;
+
 /// Reads a data file; `atom_style` is the script's (else the `Atoms`
 /// comment's, else `atomic`).
 pub fn read(source: &Source, text: &str, atom_style: Option<&str>) -> Result<Data, String> {
@@ -121,13 +131,20 @@ pub fn read(source: &Source, text: &str, atom_style: Option<&str>) -> Result<Dat
                 // `N atoms`, `N atom types`, `N extra bond per atom`, …
                 let key = rest.join(" ");
                 let n = source.count(first, &format!("the number of {key}"))?;
+                if let Some(&(_, most)) = MAX_TYPES.iter().find(|(k, _)| *k == key) {
+                    if n > most {
+                        return Err(source.error(first, format!("found {n} {key}, expected at most {most}")));
+                    }
+                }
                 counts.insert(key, n);
             }
         }
     }
     if let Some(a) = (0..3).find(|&a| !have_box[a]) {
         let axis = ["x", "y", "z"][a];
-        return Err(format!("{}: the header has no `LO HI {axis}lo {axis}hi` line, expected the box along {axis}", source.name));
+        // At the header's end: the first section's head, or the file's last line.
+        let end = lines.get(k).or(lines.last()).map_or(1, |l| l.line);
+        return Err(source.at(end, 1, format!("the header has no `LO HI {axis}lo {axis}hi` line, expected the box along {axis}")));
     }
     let count = |key: &str| counts.get(key).copied().unwrap_or(0) as usize;
     (data.atom_types, data.bond_types, data.angle_types) = (count("atom types"), count("bond types"), count("angle types"));
@@ -169,12 +186,20 @@ pub fn read(source: &Source, text: &str, atom_style: Option<&str>) -> Result<Dat
         }
     }
     if !sections.iter().any(|(h, _)| h.text == "Atoms") {
-        return Err(format!("{}: no `Atoms` section", source.name));
+        return Err(source.at(lines.last().map_or(1, |l| l.line), 1, "found no `Atoms` section, expected one"));
     }
     let ids: std::collections::BTreeSet<u64> = data.atoms.iter().map(|a| a.id).collect();
     for (what, members) in data.bonds.iter().map(|b| ("bond", b.1.to_vec())).chain(data.angles.iter().map(|a| ("angle", a.1.to_vec()))) {
         if let Some(missing) = members.iter().find(|m| !ids.contains(m)) {
-            return Err(format!("{}: a {what} names atom {missing}, which the `Atoms` section does not list", source.name));
+            // The first line of the section that names it.
+            let section = if what == "bond" { "Bonds" } else { "Angles" };
+            let body = sections.iter().filter(|(h, _)| h.text == section).flat_map(|(_, b)| b.iter());
+            let word = body.flat_map(|l| l.words.iter().skip(2)).find(|w| w.text.parse::<u64>().ok() == Some(*missing));
+            let message = format!("a {what} names atom {missing}, which the `Atoms` section does not list");
+            return Err(match word {
+                Some(w) => source.error(w, message),
+                None => source.at(1, 1, message),
+            });
         }
     }
     Ok(data)
@@ -206,8 +231,10 @@ pub fn type_of(source: &Source, w: &Word, n: usize, what: &str) -> Result<usize,
 
 fn atoms(source: &Source, head: &Line, body: &[&Line], style: &str, data: &mut Data, expected: usize) -> Result<(), String> {
     let (type_col, x_col) = atom_columns(style).ok_or_else(|| {
-        source
-            .at_line(head.line, format!("atom style `{style}` is not translated; expected atomic, bond, angle, molecular, charge or full"))
+        source.error(
+            &head.words[0],
+            format!("atom style `{style}` is not translated; expected atomic, bond, angle, molecular, charge or full"),
+        )
     })?;
     let length: Vec<f64> = (0..3).map(|a| data.hi[a] - data.lo[a]).collect();
     let charge_col = match style {
@@ -225,6 +252,9 @@ fn atoms(source: &Source, head: &Line, body: &[&Line], style: &str, data: &mut D
             ));
         }
         let id = source.count(&w[0], "an atom id")?;
+        if id == 0 {
+            return Err(source.error(&w[0], "found atom id 0, expected a positive id"));
+        }
         let t = type_of(source, &w[type_col], data.atom_types, "atom type")?;
         let mut x = [0.0; 3];
         for a in 0..3 {
@@ -236,6 +266,14 @@ fn atoms(source: &Source, head: &Line, body: &[&Line], style: &str, data: &mut D
                 None => 0,
             };
             x[a] = source.number(&w[x_col + a], "a coordinate")? + image as f64 * length[a];
+            // LAMMPS remaps an atom into a periodic box; one this far away cannot be (nor placed in a fixed one).
+            let lengths_away = ((x[a] - data.lo[a]) / length[a]).abs();
+            if lengths_away.is_nan() || lengths_away >= FARTHEST {
+                let shown = &w[x_col + a];
+                return Err(
+                    source.error(shown, format!("found atom {id} {lengths_away:e} box lengths from the box, expected at most 2^52"))
+                );
+            }
         }
         if let Some(q) = charge_col.and_then(|k| w.get(k)) {
             charged |= source.number(q, "a charge")? != 0.0;
@@ -247,7 +285,7 @@ fn atoms(source: &Source, head: &Line, body: &[&Line], style: &str, data: &mut D
     }
     if data.atoms.len() != expected {
         return Err(
-            source.at_line(head.line, format!("found {} atoms in `Atoms`, expected {expected} (the header's count)", data.atoms.len()))
+            source.error(&head.words[0], format!("found {} atoms in `Atoms`, expected {expected} (the header's count)", data.atoms.len()))
         );
     }
     Ok(())
@@ -276,7 +314,7 @@ fn terms<const N: usize>(
     }
     if out.len() != expected {
         return Err(
-            source.at_line(head.line, format!("found {} lines in `{}`, expected {expected} (the header's count)", out.len(), head.text))
+            source.error(&head.words[0], format!("found {} lines in `{}`, expected {expected} (the header's count)", out.len(), head.text))
         );
     }
     Ok(out)
@@ -311,8 +349,11 @@ mod tests {
         assert_eq!(bad("0 10 ylo", "NaN 10 ylo"), "d.data:9:1: found `NaN`, expected a box bound (a finite number)");
         assert!(bad("-1 1 zlo", "1 -1 zlo").starts_with("d.data:10:1: found the box edge [1, -1]"));
         assert_eq!(bad("2 1 2 1.5", "2 1 3 1.5"), "d.data:20:5: found `3`, expected an atom type from 1 to 2");
-        assert_eq!(bad("1 1 1 2\n", "1 1 1 7\n"), "d.data: a bond names atom 7, which the `Atoms` section does not list");
-        assert!(bad("2 1 2 1.5 0.5 0\n", "").contains("found 1 atoms in `Atoms`, expected 2"));
+        assert_eq!(bad("1 1 1 2\n", "1 1 1 7\n"), "d.data:24:7: a bond names atom 7, which the `Atoms` section does not list");
+        assert_eq!(bad("2 atom types", "1001 atom types"), "d.data:5:1: found 1001 atom types, expected at most 1000");
+        assert_eq!(bad("2 1 2 1.5 0.5 0\n", ""), "d.data:17:1: found 1 atoms in `Atoms`, expected 2 (the header's count)");
+        assert_eq!(bad("-1 1 zlo zhi", ""), "d.data:12:1: the header has no `LO HI zlo zhi` line, expected the box along z");
+        assert_eq!(bad("Atoms # molecular", "Velocities"), "d.data:24:1: found no `Atoms` section, expected one");
         assert!(bad("Atoms # molecular", "Atoms # ellipsoid").contains("atom style `ellipsoid` is not translated"));
     }
 }

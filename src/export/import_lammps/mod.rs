@@ -239,7 +239,9 @@ pub fn import(data_name: &str, data_text: &str, script_text: Option<(&str, &str)
         deck.push_str("#   (nothing)\n");
     }
     for n in &notes {
-        writeln!(deck, "#   {n}").unwrap();
+        // A control character in an untranslated line would make the comment itself bad input.
+        let printable: String = n.chars().map(|c| if c.is_control() { format!("{}", c.escape_unicode()) } else { c.to_string() }).collect();
+        writeln!(deck, "#   {printable}").unwrap();
     }
     deck.push_str("units lj\ntopology system.top\nforcefield system.ff\n");
     let w = script.special.unwrap_or([0.0; 3]);
@@ -274,29 +276,65 @@ pub fn import(data_name: &str, data_text: &str, script_text: Option<(&str, &str)
     Ok(Imported { topology: top, forcefield: ff, deck, notes })
 }
 
-/// Reads the files, translates them and writes `system.top`, `system.ff` and
-/// `system.in` into `dir`. `first` is the data file, or — alone, when it
-/// holds a `read_data` command — the input script, whose `read_data` then
-/// names the data file (relative to the script).
-pub fn import_files(first: &Path, script: Option<&Path>, dir: &Path) -> Result<Imported, String> {
-    let read = |p: &Path| std::fs::read_to_string(p).map_err(|e| format!("{}: {e}", p.display()));
-    let first_text = read(first)?;
-    let names_data = |text: &str| text.lines().any(|l| l.split_whitespace().next() == Some("read_data"));
-    let (data, script, script_text) = match script {
-        Some(s) => (first.to_path_buf(), Some(s.to_path_buf()), Some(read(s)?)),
-        None if names_data(&first_text) => {
-            let parsed = script::read(&first.display().to_string(), &first_text)?;
-            let name = parsed.read_data.ok_or_else(|| format!("{}: `read_data` names no file", first.display()))?;
-            (first.parent().unwrap_or(Path::new(".")).join(name), Some(first.to_path_buf()), Some(first_text.clone()))
-        }
-        None => (first.to_path_buf(), None, None),
+/// Reads the files and translates them. `first` is the data file, or —
+/// alone, when it holds a `read_data` command — the input script, whose
+/// `read_data` then names the data file (relative to the script). Each is
+/// read as every cellmd input is (`input::read_input_file`: a regular file
+/// of bounded size, so a FIFO or `/dev/zero` is refused at once) and must be
+/// UTF-8 (a stray byte is an error at its line and column).
+pub fn read_files(first: &Path, script: Option<&Path>) -> Result<Imported, String> {
+    let read = |p: &Path| crate::input::SourceFile::read(p, None).map(|f| f.text.clone());
+    let first_text = read(first).map_err(|e| e.to_string())?;
+    let shown = first.display().to_string();
+    let read_data = |text: &str| {
+        text.lines()
+            .enumerate()
+            .find_map(|(k, l)| Some((k + 1, l.find("read_data")? + 1)).filter(|_| l.split_whitespace().next() == Some("read_data")))
     };
-    let data_text = if script.is_some() && data == first { first_text } else { read(&data)? };
+    let (data, script, script_text, named_at) = match script {
+        Some(s) => (first.to_path_buf(), Some(s.to_path_buf()), Some(read(s).map_err(|e| e.to_string())?), None),
+        None => match read_data(&first_text) {
+            Some((line, col)) => {
+                let parsed = script::read(&shown, &first_text)?;
+                let at = |message: &str| words::Source { name: shown.clone() }.at(line, col, message);
+                let name =
+                    parsed.read_data.ok_or_else(|| at("found `read_data` with a file name cellmd cannot read, expected a literal name"))?;
+                let path = first.parent().unwrap_or(Path::new(".")).join(&name.text);
+                (path, Some(first.to_path_buf()), Some(first_text.clone()), Some(name))
+            }
+            None => (first.to_path_buf(), None, None, None),
+        },
+    };
+    let data_text = if script.is_some() && data == first {
+        first_text
+    } else {
+        // A data file the script names and cellmd cannot read is an error at its name.
+        read(&data).map_err(|e| match &named_at {
+            Some(word) if e.path == data.display().to_string() && e.message.starts_with("cannot read") => {
+                words::Source { name: shown.clone() }.error(word, &e.message)
+            }
+            _ => e.to_string(),
+        })?
+    };
     let script_name = script.as_ref().map(|p| p.display().to_string());
-    let imported = import(&data.display().to_string(), &data_text, script_name.as_deref().zip(script_text.as_deref()))?;
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    for (name, text) in [("system.top", &imported.topology), ("system.ff", &imported.forcefield), ("system.in", &imported.deck)] {
-        std::fs::write(dir.join(name), text).map_err(|e| format!("{}: {e}", dir.join(name).display()))?;
+    import(&data.display().to_string(), &data_text, script_name.as_deref().zip(script_text.as_deref()))
+}
+
+impl Imported {
+    /// Writes `system.top`, `system.ff` and last `system.in` (which names
+    /// them) into `dir`, each atomically and through no link inside `dir`
+    /// (`output::files`): a kill or a full disk leaves each name whole.
+    pub fn write(&self, dir: &Path) -> std::io::Result<()> {
+        crate::output::files::write_all_atomically(
+            dir,
+            &[("system.top", &self.topology), ("system.ff", &self.forcefield), ("system.in", &self.deck)],
+        )
     }
+}
+
+/// [`read_files`], then [`Imported::write`] into `dir`.
+pub fn import_files(first: &Path, script: Option<&Path>, dir: &Path) -> Result<Imported, String> {
+    let imported = read_files(first, script)?;
+    imported.write(dir).map_err(|e| e.to_string())?;
     Ok(imported)
 }

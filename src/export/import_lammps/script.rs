@@ -62,8 +62,8 @@ pub struct Script {
     pub skin: Option<f64>,
     pub neighbor_every: Option<u64>,
     pub neighbor_check: Option<bool>,
-    /// The data file named by `read_data`.
-    pub read_data: Option<String>,
+    /// The data file named by `read_data` (the word, for errors about it).
+    pub read_data: Option<Word>,
     pub notes: Vec<String>,
 }
 
@@ -142,7 +142,13 @@ pub fn read(name: &str, text: &str) -> Result<Script, String> {
                 s.periodic = Some(p);
             }
             "special_bonds" => special_bonds(&source, &line, &mut s)?,
-            "timestep" => s.events.push(Event::Timestep(source.number(at(1)?, "a timestep")?)),
+            "timestep" => {
+                let dt = source.number(at(1)?, "a timestep")?;
+                if dt <= 0.0 {
+                    return Err(source.error(at(1)?, format!("found timestep {dt}, expected a timestep > 0")));
+                }
+                s.events.push(Event::Timestep(dt));
+            }
             "bond_style" => s.bond_style = parse_style(&source, &w[1..])?,
             "angle_style" => s.angle_style = parse_style(&source, &w[1..])?,
             "pair_style" => s.pair_style = parse_style(&source, &w[1..])?,
@@ -188,7 +194,7 @@ pub fn read(name: &str, text: &str) -> Result<Script, String> {
                 }
             }
             "print" => s.events.push(Event::Print(w[1..].iter().map(|x| x.text.as_str()).collect::<Vec<_>>().join(" "))),
-            "read_data" => s.read_data = Some(at(1)?.text.clone()),
+            "read_data" => s.read_data = Some(at(1)?.clone()),
             "variable" => {
                 let (name, style) = (at(1)?.text.clone(), at(2)?.text.as_str());
                 let value = w.get(3).map(|v| v.text.clone());

@@ -39,7 +39,12 @@ impl Source {
         format!("{}:{}:{}: {message}", self.name, word.line, word.col)
     }
 
-    /// `file:line: message` at a line.
+    /// `file:line:col: message` at a place that is not a word (a missing line).
+    pub fn at(&self, line: usize, col: usize, message: impl std::fmt::Display) -> String {
+        format!("{}:{line}:{col}: {message}", self.name)
+    }
+
+    /// `file:line: message` at a line (for notes).
     pub fn at_line(&self, line: usize, message: impl std::fmt::Display) -> String {
         format!("{}:{line}: {message}", self.name)
     }
