@@ -21,7 +21,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::mpsc;
 
-use super::mutations::{mutate, Rng, HANG};
+use super::mutations::{mutate, watch_for_hangs, Rng};
 use cellmd::deck::validate_file;
 use cellmd::export::import_lammps::read_files;
 use cellmd::run::{RunOptions, Simulation};
@@ -258,14 +258,7 @@ fn mutants_of_the_lammps_decks_fail_at_a_place_or_import_a_deck_that_runs() {
             (failures, refused, total, kept)
         })
         .unwrap();
-    let mut current = String::from("the start");
-    loop {
-        match done.recv_timeout(HANG) {
-            Ok(Some(what)) => current = what,
-            Ok(None) => break,
-            Err(_) => panic!("{current}: no result after {HANG:?} (a hang?)"),
-        }
-    }
+    watch_for_hangs(&done);
     let (failures, refused, total, kept) = worker.join().unwrap();
     eprintln!("{refused} of {total} LAMMPS mutants refused, the others imported and ran");
     if failures.is_empty() {

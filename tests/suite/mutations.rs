@@ -46,6 +46,20 @@ const MAX_TOPOLOGY_BYTES: u64 = 100_000;
 /// The longest any one mutant may take before it counts as a hang.
 pub(crate) const HANG: Duration = Duration::from_secs(30);
 
+/// Waits for a worker's progress messages (`Some(case)` as it starts each,
+/// `None` when it is done) and panics naming the case it is stuck in when
+/// none comes within [`HANG`].
+pub(crate) fn watch_for_hangs(done: &mpsc::Receiver<Option<String>>) {
+    let mut current = String::from("the start");
+    loop {
+        match done.recv_timeout(HANG) {
+            Ok(Some(what)) => current = what,
+            Ok(None) => break,
+            Err(_) => panic!("{current}: no result after {HANG:?} (a hang?)"),
+        }
+    }
+}
+
 /// SplitMix64: small, seedable, the same on every platform.
 pub(crate) struct Rng(pub(crate) u64);
 
@@ -436,14 +450,7 @@ fn mutants_of_every_input_fail_cleanly_or_parse() {
             (failures, refused, total, seconds)
         })
         .unwrap();
-    let mut current = String::from("the start");
-    loop {
-        match done.recv_timeout(HANG) {
-            Ok(Some(what)) => current = what,
-            Ok(None) => break,
-            Err(_) => panic!("{current}: no result after {HANG:?} (a hang?)"),
-        }
-    }
+    watch_for_hangs(&done);
     let (failures, refused, total, seconds) = worker.join().unwrap();
     eprintln!("{refused} of {total} mutants refused, the others parsed; seconds by folder: {seconds:?}");
     assert!(failures.is_empty(), "{} mutants failed badly:\n{}", failures.len(), failures.join("\n"));
