@@ -126,6 +126,9 @@ pub fn overdamped_step(
             .reduce(|| 1.0, f64::min)
     });
     let root = fraction.sqrt();
+    // A fibre point's displacement is the fibre solve's (below), which
+    // draws its own noise: its Euler–Maruyama step is not computed.
+    let on_fibre = |i: usize| fibres.as_ref().is_some_and(|f| f.fibres.holds(i));
     scratch.resize(state.len(), DVec3::ZERO);
     let any_refused = scratch
         .par_iter_mut()
@@ -134,6 +137,9 @@ pub fn overdamped_step(
         .fold(
             || false,
             |bad, (i, d)| {
+                if on_fibre(i) {
+                    return bad;
+                }
                 let (a, b) = drift_and_noise(i);
                 *d = if fraction == 1.0 { a + b } else { fraction * a + root * b };
                 bad | refused(d)
