@@ -148,20 +148,25 @@ impl Constraints {
         };
         self.tension.clear();
         self.tension.resize(self.list.len(), 0.0);
-        let reference: Vec<DVec3> = self
-            .list
-            .iter()
-            .map(|c| {
-                let [i, j] = model.bonds[c.bond];
-                images.minimum_image(before[j as usize] - before[i as usize])
-            })
-            .collect();
         self.iterations = 0;
         let chained = &self.fibres.chains.chained_constraints;
         let in_chain = |k: usize| chained.len() == self.list.len() && chained[k];
+        let general = (0..self.list.len()).any(|k| !in_chain(k));
+        // The directions before the step, along which SHAKE corrects (only
+        // the constraints outside fibres need them).
+        let reference: Vec<DVec3> = if general {
+            self.list
+                .iter()
+                .map(|c| {
+                    let [i, j] = model.bonds[c.bond];
+                    images.minimum_image(before[j as usize] - before[i as usize])
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
         let x = &mut state.positions;
         let mut worst = (0, 0.0);
-        let general = (0..self.list.len()).any(|k| !in_chain(k));
         for sweep in 0..if general { self.max_iterations.max(1) } else { 0 } {
             worst = (0, 0.0);
             for (k, c) in self.list.iter().enumerate().filter(|(k, _)| !in_chain(*k)) {

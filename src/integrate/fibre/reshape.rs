@@ -47,7 +47,6 @@ pub struct Reshape {
     pub iterations: usize,
     weight: Vec<DVec3>,
     direction: Vec<DVec3>,
-    movable: Vec<bool>,
     diagonal: Vec<f64>,
     off: Vec<f64>,
     rhs: Vec<f64>,
@@ -55,23 +54,25 @@ pub struct Reshape {
 
 /// Solves the symmetric tridiagonal system (diagonal, off)·x = rhs in place
 /// (`rhs` becomes x, `off[k]` couples k and k + 1; `diagonal` is
-/// overwritten). False on a zero or non-finite pivot.
+/// overwritten with the reciprocal pivots, so each row divides once).
+/// False on a zero or non-finite pivot.
 fn thomas(diagonal: &mut [f64], off: &[f64], rhs: &mut [f64]) -> bool {
     let n = rhs.len();
-    for k in 1..n {
-        if !(diagonal[k - 1] != 0.0 && diagonal[k - 1].is_finite()) {
+    for k in 0..n {
+        if k > 0 {
+            let m = off[k - 1] * diagonal[k - 1];
+            diagonal[k] -= m * off[k - 1];
+            rhs[k] -= m * rhs[k - 1];
+        }
+        let pivot = diagonal[k];
+        if !(pivot != 0.0 && pivot.is_finite()) {
             return false;
         }
-        let m = off[k - 1] / diagonal[k - 1];
-        diagonal[k] -= m * off[k - 1];
-        rhs[k] -= m * rhs[k - 1];
+        diagonal[k] = 1.0 / pivot;
     }
-    if !(diagonal[n - 1] != 0.0 && diagonal[n - 1].is_finite()) {
-        return false;
-    }
-    rhs[n - 1] /= diagonal[n - 1];
+    rhs[n - 1] *= diagonal[n - 1];
     for k in (0..n - 1).rev() {
-        rhs[k] = (rhs[k] - off[k] * rhs[k + 1]) / diagonal[k];
+        rhs[k] = (rhs[k] - off[k] * rhs[k + 1]) * diagonal[k];
     }
     true
 }
@@ -103,41 +104,56 @@ impl Reshape {
             v.resize(segments, 0.0);
         }
         self.direction.resize(segments, DVec3::ZERO);
-        self.movable.resize(segments, false);
+        // The chain's arrays, sliced to their lengths once so the loops
+        // below index them without bounds checks.
+        let (weight, moved, target) = (&self.weight[..n], &mut self.moved[..n], &system.length[..segments]);
+        let (direction, diagonal, off, rhs, g) = (
+            &mut self.direction[..segments],
+            &mut self.diagonal[..segments],
+            &mut self.off[..segments],
+            &mut self.rhs[..segments],
+            &mut self.g[..segments],
+        );
         let mut iteration = 0;
         loop {
             let mut worst = (0, 0.0);
+            // Segment k's direction, error and row of G, and G's entry
+            // coupling it to segment k − 1.
+            let mut previous_movable = false;
             for k in 0..segments {
-                let r = images.minimum_image(self.moved[k + 1] - self.moved[k]);
+                let r = images.minimum_image(moved[k + 1] - moved[k]);
                 let length = r.length();
-                let u = r / length;
-                self.direction[k] = u;
-                let movable = ((self.weight[k] + self.weight[k + 1]) * u).length_squared() > 0.0;
-                self.movable[k] = movable;
-                let error = length - system.length[k];
-                let relative = if movable { (error / system.length[k]).abs() } else { 0.0 };
+                let u = r * (1.0 / length);
+                direction[k] = u;
+                let both = weight[k] + weight[k + 1];
+                let movable = (both * u).length_squared() > 0.0;
+                let error = length - target[k];
+                let relative = if movable { (error / target[k]).abs() } else { 0.0 };
                 if relative > worst.1 || relative.is_nan() {
                     worst = (k, relative);
                 }
-                self.rhs[k] = if movable { error } else { 0.0 };
-                self.diagonal[k] = if movable { u.dot((self.weight[k] + self.weight[k + 1]) * u) } else { 1.0 };
-            }
-            for k in 0..segments.saturating_sub(1) {
-                let coupled = self.movable[k] && self.movable[k + 1];
-                self.off[k] = if coupled { -self.direction[k].dot(self.weight[k + 1] * self.direction[k + 1]) } else { 0.0 };
+                rhs[k] = if movable { error } else { 0.0 };
+                diagonal[k] = if movable { u.dot(both * u) } else { 1.0 };
+                if k > 0 {
+                    off[k - 1] = if previous_movable && movable { -direction[k - 1].dot(weight[k] * u) } else { 0.0 };
+                }
+                previous_movable = movable;
             }
             if worst.1 <= tolerance {
                 break;
             }
-            if iteration == max_iterations || !thomas(&mut self.diagonal, &self.off, &mut self.rhs) {
+            if iteration == max_iterations || !thomas(diagonal, off, rhs) {
                 return Err(ReshapeFailure { segment: worst.0, relative_error: worst.1 });
             }
-            for i in 0..n {
-                let after = if i < segments { self.rhs[i] * self.direction[i] } else { DVec3::ZERO };
-                let before = if i > 0 { self.rhs[i - 1] * self.direction[i - 1] } else { DVec3::ZERO };
-                self.moved[i] += self.weight[i] * (after - before);
+            // Δᵢ = Wᵢ·(g_i·u_i − g_{i−1}·u_{i−1}).
+            let mut before = DVec3::ZERO;
+            for i in 0..segments {
+                let after = rhs[i] * direction[i];
+                moved[i] += weight[i] * (after - before);
+                before = after;
             }
-            self.g.iter_mut().zip(&self.rhs).for_each(|(g, d)| *g += d);
+            moved[segments] += weight[segments] * (DVec3::ZERO - before);
+            g.iter_mut().zip(rhs.iter()).for_each(|(g, d)| *g += d);
             iteration += 1;
         }
         self.iterations = iteration;
