@@ -121,3 +121,69 @@ fn the_expression_page_loops_run() {
         assert!(sim.state.step >= 2, "`{first}` ran {} steps", sim.state.step);
     }
 }
+
+/// The lines of `text` without `#` comments and blank lines.
+fn without_comments(text: &str) -> Vec<String> {
+    text.lines().map(|l| l.split('#').next().unwrap().split_whitespace().collect::<Vec<_>>().join(" ")).filter(|l| !l.is_empty()).collect()
+}
+
+/// Cells: the page's builder command writes the committed single-cell
+/// topology byte for byte, and its force field is the committed one
+/// without comments.
+#[test]
+fn the_cell_page_builds_the_committed_cell() {
+    let text = page("user-guide/cells.md");
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("topologies")).unwrap();
+    cellmd(block_after(&text, "```sh\ncellmd build icosphere", "sh").trim(), dir.path());
+    let built = std::fs::read_to_string(dir.path().join("topologies/single_cell.top")).unwrap();
+    assert_eq!(
+        built,
+        std::fs::read_to_string("topologies/single_cell.top").unwrap(),
+        "the page's command does not write the committed cell"
+    );
+    let ff = block_after(&text, "(`forcefields/single_cell.ff`, comments left out)", "text");
+    assert_eq!(without_comments(&ff), without_comments(&std::fs::read_to_string("forcefields/single_cell.ff").unwrap()));
+}
+
+/// Composed systems: the page's four `topology` lines are those of
+/// `inputs/composed_cell.in`, and the ids its comments give are where
+/// each part starts (the particle counts of the parts).
+#[test]
+fn the_composed_cell_page_names_the_committed_parts() {
+    let text = page("user-guide/composed-systems.md");
+    let shown = block_starting(&text, "topology ");
+    let deck = std::fs::read_to_string("inputs/composed_cell.in").unwrap();
+    let lines = |t: &str| without_comments(t).into_iter().filter(|l| l.starts_with("topology ")).collect::<Vec<_>>();
+    assert_eq!(lines(&shown), lines(&deck));
+    let count = |part: &str| {
+        let top = std::fs::read_to_string(format!("topologies/composed_cell/{part}.top")).unwrap();
+        let particles = top.split("[ particles ]").nth(1).unwrap().split("\n[").next().unwrap().to_string();
+        without_comments(&particles).len()
+    };
+    let membrane = count("membrane");
+    assert!(shown.contains(&format!("# ids 1 … {membrane}, body 1")), "the membrane has {membrane} particles");
+    assert!(shown.contains(&format!("# ids follow: {} …", membrane + 1)));
+}
+
+/// Force-field lines shown alone on their pages (contact, custom laws,
+/// kinetics, volume elements) are read by the force-field parser: their
+/// laws and parameters are what the code accepts.
+#[test]
+fn force_field_fragments_of_the_pages_parse() {
+    let fragments = [
+        ("user-guide/contact.md", "contact cell cell contact_barrier"),
+        ("user-guide/contact.md", "contact cell cell contact_adhesion"),
+        ("user-guide/custom.md", "bond  spring custom"),
+        ("user-guide/kinetics.md", "bond clutch harmonic"),
+        ("user-guide/solids.md", "tetra solid neo_hookean"),
+    ];
+    let dir = tempfile::tempdir().unwrap();
+    for (name, first) in fragments {
+        let path = dir.path().join("f.ff");
+        std::fs::write(&path, block_starting(&page(name), first)).unwrap();
+        let mut ff = cellmd::forcefield::ForceField::default();
+        let read = cellmd::forcefield::load_forcefield(&path, None, cellmd::units::UnitSystem::Cell, &mut ff, &mut Vec::new());
+        assert!(read.is_ok(), "{name}: `{first}…` is refused: {:?}", read.err());
+    }
+}
