@@ -30,6 +30,7 @@ mod cytosim_bench;
 mod deck_features;
 mod deck_language;
 mod docs;
+mod docs_snippets;
 mod doublet;
 mod dynamics;
 mod export_lammps;
