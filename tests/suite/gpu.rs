@@ -612,6 +612,33 @@ fn a_custom_body_term_is_refused_by_the_gpu() {
     assert_eq!(why, Some("custom surface terms of bodies (`custom` body lines) run on the CPU backend only"));
 }
 
+/// The device's steps are backward Euler: `theta` ½ (the trapezoidal rule)
+/// keeps a run on the CPU, with the reason, instead of being ignored there.
+#[test]
+fn theta_other_than_one_keeps_a_run_on_the_cpu() {
+    let top = "[ particles ]\n1 a 0.2 0.3 0.4\n2 a 1.1 1.6 2.0\n";
+    let ff = "particle a drag 1\n";
+    let deck = |integrator: &str| {
+        format!("units lj\ntopology t.top\nforcefield f.ff\nbox x 0 3 f y 0 3 f z 0 3 f\n{integrator}\ntimestep 1e-4\nrun 10\n")
+    };
+    for (integrator, refused) in
+        [("integrator implicit theta 0.5", true), ("integrator overdamped theta 0.5", true), ("integrator implicit theta 1", false)]
+    {
+        let case = common::Case::new(&[("t.top", top), ("f.ff", ff), ("deck.in", &deck(integrator))]);
+        let why = Simulation::before_first_run(&case.plan(), RunOptions::default()).unwrap().cpu_only_feature();
+        if refused {
+            assert_eq!(
+                why,
+                Some("steps with `theta` other than 1 (the device's steps are backward Euler) run on the CPU backend only"),
+                "{integrator}"
+            );
+            assert!(refused_by_the_gpu(&format!("device gpu: {}; use `device cpu` or `device auto`", why.unwrap())));
+        } else {
+            assert_eq!(why, None, "{integrator}");
+        }
+    }
+}
+
 /// A periodic box shorter than twice the pair range (pairs through several
 /// images, which the CPU's list walks) has no GPU kernel: the GPU backend
 /// and `device gpu` refuse it rather than use the minimum image alone.

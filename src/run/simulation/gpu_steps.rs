@@ -14,6 +14,9 @@ use crate::system::StepClock;
 /// Why custom surface terms of bodies keep a run (or a minimisation) on the CPU.
 const CUSTOM_SURFACE_TERMS: &str = "custom surface terms of bodies (`custom` body lines) run on the CPU backend only";
 
+/// Why `integrator … theta` other than 1 keeps a run on the CPU.
+const THETA_ON_CPU: &str = "steps with `theta` other than 1 (the device's steps are backward Euler) run on the CPU backend only";
+
 /// Why a box with periodic edges shorter than twice the pair range keeps a run on the CPU.
 const SHORT_PERIODIC_EDGES: &str =
     "pairs through several periodic images (a periodic box edge shorter than 2·(pair cutoff + skin)) run on the CPU backend only";
@@ -287,6 +290,8 @@ impl Simulation {
             Some(why)
         } else if let Some(why) = self.constraint_refusal() {
             Some(why)
+        } else if self.integrator.common().theta != 1.0 {
+            Some(THETA_ON_CPU)
         } else if self.model.has_cpu_only_surface_terms() {
             Some(CUSTOM_SURFACE_TERMS)
         } else if self.model.max_pair_cutoff() > 0.0
