@@ -115,6 +115,10 @@ impl NodalPressure {
     }
 }
 
+/// A node's Gauss–Newton weight U″(J_a)/V_a and the entries (particle,
+/// ∂v_a/∂x) of its gradient, one per element corner (merged before use).
+type Patch = (f64, Vec<(u32, DVec3)>);
+
 /// The nodal Gauss–Newton blocks U″(J_a)/V_a·∇v_a∇v_aᵀ of every node a of
 /// a nodal-pressure type at `x` (module docs), node by node in particle order.
 pub(super) fn nodal_stiffness(model: &Model, x: &[DVec3], images: &Images, blocks: &mut Vec<StiffnessBlock>) {
@@ -123,7 +127,7 @@ pub(super) fn nodal_stiffness(model: &Model, x: &[DVec3], images: &Images, block
     }
     let corners = corner_dilatations(model, x, images);
     // Per (node, nodal type): its weight and the gradient ∇v_a, entry by entry.
-    let mut patches: std::collections::BTreeMap<(u32, u32), (f64, Vec<(u32, DVec3)>)> = Default::default();
+    let mut patches: std::collections::BTreeMap<(u32, u32), Patch> = Default::default();
     for (e, c) in corners.iter().enumerate() {
         let Some(c) = c else { continue };
         let rest = &model.tetra_rest[e];

@@ -40,6 +40,12 @@
 //! and Sneddon's exact small-strain load of a sphere (Int. J. Eng. Sci. 3,
 //! 47, 1965), 0.2–1 % below Hertz for δ/R = 0.02–0.1.
 //!
+//! Volumetric locking (issue #46): at ν = 0.49 plain linear tetrahedra
+//! load the CI block 75–92 % above Hertz, the average-nodal-pressure ones
+//! (`neo_hookean_anp`) follow Hertz's ν-dependence
+//! (`average_nodal_pressure_elements_do_not_lock_at_nu_0_49`; the
+//! refinement study at ν = 0.3 … 0.499: studies/hertz_locking/).
+//!
 //! The refinement studies print the tables (docs/src/user-guide/solids.md):
 //! `cargo test --test suite hertz:: -- --ignored --nocapture`.
 
