@@ -1,6 +1,7 @@
 """Runs cellmd for a study and reads its thermo CSV: the one home of the
 run-and-read block the studies share (tissue_fracture, collagen,
-tensegrity_substrate, force_dipole, contractile_lattice, spheroid_spreading).
+tensegrity_substrate, force_dipole, contractile_lattice, spheroid_spreading,
+hertz_locking).
 
 A study script imports it after putting studies/ on sys.path:
 

@@ -21,6 +21,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
+use super::nodal_pressure::{tetra_positions, NodalPressure};
 use super::virial::{add6, outer};
 use crate::interactions::{FourBody, Kind, Radial, ThreeBody};
 use crate::system::BondState;
@@ -83,6 +84,9 @@ pub(super) struct Bonded {
     /// The volume elements whose lowest-index corner is i, likewise.
     tetra_offsets: Vec<u32>,
     owned_tetras: Vec<u32>,
+    /// The elements' averaged nodal pressures at the last force pass
+    /// ([`Self::prepare_tetras`]; empty without nodal-pressure types).
+    pub(super) nodal: NodalPressure,
 }
 
 impl Bonded {
@@ -106,6 +110,7 @@ impl Bonded {
             angle_laws: Vec::new(),
             tetra_offsets,
             owned_tetras,
+            nodal: NodalPressure::default(),
         }
     }
 
@@ -270,12 +275,18 @@ impl Bonded {
         }
     }
 
+    /// Before a force pass at `x`: the nodal volumes of the nodal-pressure
+    /// elements (src/backend/nodal_pressure.rs).
+    pub(super) fn prepare_tetras(&mut self, model: &Model, x: &[DVec3], images: &Images) {
+        self.nodal.prepare(model, x, images);
+    }
+
     /// The volume elements owned by particle `i` (lowest-index corner),
     /// ascending: calls `visit(p, f)` with each corner and its force.
     #[inline(always)]
     pub(super) fn row_tetras(&self, i: usize, model: &Model, x: &[DVec3], images: &Images, mut visit: impl FnMut(usize, DVec3)) {
         for &e in &self.owned_tetras[self.tetra_offsets[i] as usize..self.tetra_offsets[i + 1] as usize] {
-            let (_, out) = eval_tetra(model, e as usize, x, images);
+            let (_, out) = eval_tetra(model, e as usize, x, images, &self.nodal);
             for (&p, f) in model.tetras[e as usize].iter().zip(out.forces) {
                 visit(p as usize, f);
             }
@@ -311,7 +322,7 @@ impl Bonded {
         }
         let tetra_registry: Vec<usize> = model.tetra_types.iter().map(|t| registry_index(t)).collect();
         for e in 0..model.tetras.len() {
-            let (at, out) = eval_tetra(model, e, x, images);
+            let (at, out) = eval_tetra(model, e, x, images, &self.nodal);
             energy[tetra_registry[model.tetra_type[e] as usize]] += out.energy;
             for k in 1..4 {
                 add6(virial, outer(at[k] - at[0], out.forces[k]));
@@ -341,7 +352,7 @@ impl Bonded {
         }
         for (e, corners) in model.tetras.iter().enumerate() {
             if let Some(k) = corners.iter().position(|&p| p as usize == i) {
-                parts.push((Kind::Tetra, e, eval_tetra(model, e, x, images).1.forces[k]));
+                parts.push((Kind::Tetra, e, eval_tetra(model, e, x, images, &self.nodal).1.forces[k]));
             }
         }
         parts
@@ -366,14 +377,13 @@ pub(super) fn eval_angle(model: &Model, a: usize, x: &[DVec3], images: &Images) 
 }
 
 /// Volume element `e` at image-consistent positions (corners 1–3 at their
-/// minimum image around corner 0).
+/// minimum image around corner 0), with its averaged nodal pressure from
+/// `nodal` if its type has one.
 #[inline]
-pub(super) fn eval_tetra(model: &Model, e: usize, x: &[DVec3], images: &Images) -> ([DVec3; 4], FourBody) {
+pub(super) fn eval_tetra(model: &Model, e: usize, x: &[DVec3], images: &Images, nodal: &NodalPressure) -> ([DVec3; 4], FourBody) {
     let term = &model.tetra_types[model.tetra_type[e] as usize];
-    let corners = model.tetras[e];
-    let x0 = x[corners[0] as usize];
-    let at = corners.map(|p| x0 + images.minimum_image(x[p as usize] - x0));
-    (at, (term.law.0)(&term.params, &model.tetra_rest[e], at))
+    let at = tetra_positions(model, e, x, images);
+    (at, nodal.complete(model, e, at, (term.law.eval)(&term.params, &model.tetra_rest[e], at)))
 }
 
 /// Largest parameter count of a bond law (checked by a test).

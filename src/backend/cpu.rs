@@ -268,6 +268,7 @@ impl CpuBackend {
         }
         self.bonded.resolve_laws(model);
         self.bonded.gather_state(state.bonds.as_ref());
+        self.bonded.prepare_tetras(model, x, &images);
         self.surfaces.prepare(model, x, &images);
         self.contacts.prepare(model, x, &images);
         let bond_state = state.bonds.as_ref();

@@ -8,6 +8,7 @@ mod contact;
 mod contact_mesh;
 pub mod cpu;
 mod newton;
+mod nodal_pressure;
 mod pair_table;
 mod special;
 pub mod stiffness;

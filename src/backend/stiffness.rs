@@ -69,6 +69,7 @@ use glam::{DMat3, DVec3};
 
 use super::bonded::{eval_angle, eval_tetra};
 use super::cpu::CpuBackend;
+use super::nodal_pressure::nodal_stiffness;
 use super::stiffness_blocks::{push_blocks, Stiffness, StiffnessBlock};
 use crate::hessian::{finite_difference_hessian, project_psd};
 use crate::interactions::{AngleLaw, Radial, RadialLaw, TetraLaw};
@@ -131,18 +132,24 @@ impl CpuBackend {
             let AngleLaw(eval) = term.law;
             projected_term_blocks(&model.angles[a], &at, |p| eval(&term.params, [p[0], p[1], p[2]]).forces.to_vec(), &mut blocks);
         }
+        let nodal = &self.bonded().nodal;
         for e in 0..model.tetras.len() {
-            let (at, _) = eval_tetra(model, e, x, &images);
+            let (at, _) = eval_tetra(model, e, x, &images, nodal);
             let term = &model.tetra_types[model.tetra_type[e] as usize];
-            let TetraLaw(eval) = term.law;
+            let TetraLaw { eval, .. } = term.law;
             let rest = &model.tetra_rest[e];
+            // At fixed p̄_e for a nodal-pressure element (its nodal part follows).
             projected_term_blocks(
                 &model.tetras[e],
                 &at,
-                |p| eval(&term.params, rest, [p[0], p[1], p[2], p[3]]).forces.to_vec(),
+                |p| {
+                    let p = [p[0], p[1], p[2], p[3]];
+                    nodal.complete(model, e, p, eval(&term.params, rest, p)).forces.to_vec()
+                },
                 &mut blocks,
             );
         }
+        nodal_stiffness(model, x, &images, &mut blocks);
         if let Some(list) = self.neighbor_list() {
             for i in 0..model.len() {
                 // Every image of each partner (a small periodic box has several); a

@@ -95,7 +95,7 @@ impl CpuBackend {
             visit(&Term { kind: TermKind::Angle, particles: &model.angles[a], segments: &segments, bond: usize::MAX });
         }
         for e in 0..model.tetras.len() {
-            let (at, out) = eval_tetra(model, e, x, &images);
+            let (at, out) = eval_tetra(model, e, x, &images, &bonded.nodal);
             let segments = [1usize, 2, 3].map(|k| Segment { from: at[0], d: at[k] - at[0], force: out.forces[k] });
             visit(&Term { kind: TermKind::Tetra, particles: &model.tetras[e], segments: &segments, bond: usize::MAX });
         }

@@ -178,7 +178,7 @@ fn dispatch(custom: &CustomSource) -> String {
                 writeln!(area_switch, "        case {index}u: {{ return {name}_switch(p, d); }}").unwrap();
                 (&mut area_density, format!("{name}_density(p)"))
             }
-            Law::Surface { .. } => continue,
+            Law::Surface { .. } | Law::NodalTetra { .. } => continue,
         };
         writeln!(out, "        case {index}u: {{ return {call}; }}").unwrap();
     }

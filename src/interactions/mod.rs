@@ -31,6 +31,8 @@
 //! tetrahedron, W a strain-energy density of its deformation gradient F
 //! relative to its rest shape ([`TetraRest`], from the topology's initial
 //! positions); [`elastic_tetra`] turns W and its stress into corner forces.
+//! [`Law::NodalTetra`] moves the volumetric part onto the nodes (average
+//! nodal pressure, locking-free as ν → 0.5).
 //!
 //! Laws carry what later solvers need: [`Radial`] returns d²E/dr², from which
 //! the analytic pair Hessian `E''·ûûᵀ + (E'/r)(I − ûûᵀ)` follows; state that
@@ -105,6 +107,7 @@ mod indenter;
 mod linear_elastic;
 mod lj;
 mod neo_hookean;
+mod neo_hookean_anp;
 mod soft;
 mod soft_repulsion;
 mod spring;
@@ -145,6 +148,7 @@ pub static REGISTRY: &[&dyn Interaction] = &[
     &contact_barrier::ContactBarrier,
     &contact_adhesion::ContactAdhesion,
     &neo_hookean::NeoHookean,
+    &neo_hookean_anp::NeoHookeanAnp,
     &linear_elastic::LinearElastic,
     &custom::Custom,
 ];
@@ -352,6 +356,54 @@ pub enum Law {
     /// positions are image-consistent (around x_0). On the GPU its
     /// interaction's `NAME_tetra` evaluator gives W and P at F (src/gpu/tetra.rs).
     Tetra(fn(&[f64], &TetraRest, [DVec3; 4]) -> FourBody),
+    /// A volume element whose volumetric energy lives on the nodes
+    /// (average nodal pressure, `neo_hookean_anp`): `deviatoric` is the
+    /// element's own energy V_0·W(F) without it, `volumetric` U(J) of a
+    /// node's dilatation J_a = v_a/V_a (v_a, V_a: a quarter of the current
+    /// and rest volumes of the node's elements of the same type), so that
+    /// E = Σ_e V_0,e·W(F_e) + Σ_a V_a·U(J_a). The CPU backend averages the
+    /// pressures U′(J_a) onto the elements (src/backend/nodal_pressure.rs);
+    /// there is no GPU kernel ([`Law::runs_on_gpu`]).
+    NodalTetra { deviatoric: fn(&[f64], &TetraRest, [DVec3; 4]) -> FourBody, volumetric: fn(&[f64], f64) -> Volumetric },
+}
+
+/// A volumetric energy density U(J) per unit rest volume and its
+/// derivatives: `pressure` U′(J), `stiffness` U″(J).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Volumetric {
+    pub energy: f64,
+    pub pressure: f64,
+    pub stiffness: f64,
+}
+
+/// A volume element's energy and forces with the pressure `pressure` added
+/// to its `deviatoric` part: the forces −p·∂v/∂x of its current volume
+/// v = J·V_0 (Piola stress p·J·F⁻ᵀ, J·F⁻ᵀ the cofactor of F), its energy
+/// unchanged (the caller adds the volumetric energy). A flat or inverted
+/// element (J ≤ 0) has NaN forces, as in [`elastic_tetra`].
+pub fn pressured_tetra(rest: &TetraRest, x: [DVec3; 4], deviatoric: FourBody, pressure: f64) -> FourBody {
+    let f = rest.deformation_gradient(x);
+    let j = f.determinant();
+    if !(j > 0.0) {
+        return FourBody { energy: f64::NAN, forces: [DVec3::NAN; 4] };
+    }
+    let volumetric = rest.forces(pressure * j * f.inverse().transpose());
+    FourBody { energy: deviatoric.energy, forces: std::array::from_fn(|k| deviatoric.forces[k] + volumetric[k]) }
+}
+
+/// A [`Law::NodalTetra`] element alone (its nodes shared with no other
+/// element, so J_a = J at each corner): V_0·(W(F) + U(J)) and its forces.
+pub fn nodal_tetra_alone(
+    deviatoric: fn(&[f64], &TetraRest, [DVec3; 4]) -> FourBody,
+    volumetric: fn(&[f64], f64) -> Volumetric,
+    params: &[f64],
+    rest: &TetraRest,
+    x: [DVec3; 4],
+) -> FourBody {
+    let j = rest.deformation_gradient(x).determinant();
+    let u = volumetric(params, j);
+    let out = pressured_tetra(rest, x, deviatoric(params, rest, x), u.pressure);
+    FourBody { energy: out.energy + rest.volume * u.energy, ..out }
 }
 
 /// A law of one kind of term, taken out of its [`Law`] once when the term
@@ -394,9 +446,13 @@ pub enum ContactLaw {
     Area { switch: fn(&[f64], f64) -> Radial, density: fn(&[f64]) -> f64, range: fn(&[f64]) -> f64 },
 }
 
-/// E(x_0 … x_3) of a volume element ([`Law::Tetra`]).
+/// E(x_0 … x_3) of a volume element ([`Law::Tetra`]), or its deviatoric
+/// part and the nodal volumetric U(J) of a [`Law::NodalTetra`].
 #[derive(Clone, Copy, Debug)]
-pub struct TetraLaw(pub fn(&[f64], &TetraRest, [DVec3; 4]) -> FourBody);
+pub struct TetraLaw {
+    pub eval: fn(&[f64], &TetraRest, [DVec3; 4]) -> FourBody,
+    pub volumetric: Option<fn(&[f64], f64) -> Volumetric>,
+}
 
 impl KindLaw for RadialLaw {
     fn from_law(law: Law) -> Option<Self> {
@@ -456,7 +512,8 @@ impl ContactLaw {
 impl KindLaw for TetraLaw {
     fn from_law(law: Law) -> Option<Self> {
         match law {
-            Law::Tetra(eval) => Some(TetraLaw(eval)),
+            Law::Tetra(eval) => Some(TetraLaw { eval, volumetric: None }),
+            Law::NodalTetra { deviatoric, volumetric } => Some(TetraLaw { eval: deviatoric, volumetric: Some(volumetric) }),
             _ => None,
         }
     }
@@ -465,10 +522,12 @@ impl KindLaw for TetraLaw {
 impl Law {
     /// Whether the GPU backend has a kernel for this law (and so its
     /// interaction a `shaders/interactions/NAME.wgsl` evaluator): every law
-    /// but the surface laws without a GPU form (custom body terms).
+    /// but the surface laws without a GPU form (custom body terms) and the
+    /// nodal-pressure volume elements.
     pub fn runs_on_gpu(&self) -> bool {
         match self {
             Law::Surface { gpu, .. } => *gpu != SurfaceGpu::None,
+            Law::NodalTetra { .. } => false,
             _ => true,
         }
     }
@@ -574,7 +633,7 @@ mod tests {
                 | (Kind::External, Law::OneBody(_))
                 | (Kind::Body, Law::Surface { .. })
                 | (Kind::Contact, Law::Contact { .. } | Law::ContactArea { .. })
-                | (Kind::Tetra, Law::Tetra(_)) => {}
+                | (Kind::Tetra, Law::Tetra(_) | Law::NodalTetra { .. }) => {}
                 _ => panic!("{}: kind and law disagree", i.name()),
             }
         }

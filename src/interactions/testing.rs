@@ -26,7 +26,7 @@
 use glam::{DMat3, DVec3};
 
 pub use super::{Entry, Interaction};
-use super::{Law, SurfaceHessian, SurfaceMesh, TetraRest};
+use super::{FourBody, Law, SurfaceHessian, SurfaceMesh, TetraRest};
 use crate::hessian::project_psd;
 use faer::{Col, Mat};
 
@@ -55,7 +55,7 @@ pub fn evaluate(law: Law, params: &[f64], positions: &[DVec3]) -> (f64, Vec<DVec
         }
         Law::Surface { .. } => panic!("a surface law needs its mesh: use evaluate_surface"),
         Law::ContactArea { .. } => panic!("an area-weighted contact law needs whole bodies: use assert_checks_of on the engine"),
-        Law::Tetra(_) => panic!("a volume law needs its rest shape: use assert_tetra_checks"),
+        Law::Tetra(_) | Law::NodalTetra { .. } => panic!("a volume law needs its rest shape: use assert_tetra_checks"),
     }
 }
 
@@ -406,10 +406,22 @@ pub fn deformed_tetrahedra() -> Vec<([DVec3; 4], [DVec3; 4])> {
     out
 }
 
+/// A volume law's energy and forces of one element alone (a
+/// [`Law::NodalTetra`] with its nodal volumes those of the element:
+/// [`nodal_tetra_alone`](super::nodal_tetra_alone)).
+pub fn element_law(interaction: &dyn Interaction) -> impl Fn(&[f64], &TetraRest, [DVec3; 4]) -> FourBody {
+    let law = interaction.law();
+    move |p, rest, x| match law {
+        Law::Tetra(eval) => eval(p, rest, x),
+        Law::NodalTetra { deviatoric, volumetric } => super::nodal_tetra_alone(deviatoric, volumetric, p, rest, x),
+        _ => panic!("not a volume law"),
+    }
+}
+
 /// F = −∇E, Σf = 0, Σ r×f = 0 and rigid-motion invariance of a volume law on
 /// one element with rest corners `rest` at corners `x`, and zero force at rest.
 pub fn assert_tetra_checks(interaction: &dyn Interaction, params: &[f64], rest: [DVec3; 4], x: [DVec3; 4], h: f64, force_floor: f64) {
-    let Law::Tetra(eval) = interaction.law() else { panic!("{} is not a volume law", interaction.name()) };
+    let eval = element_law(interaction);
     let shape = TetraRest::new(rest).unwrap();
     let element = |p: &[DVec3]| {
         let out = eval(params, &shape, [p[0], p[1], p[2], p[3]]);
@@ -424,7 +436,7 @@ pub fn assert_tetra_checks(interaction: &dyn Interaction, params: &[f64], rest: 
 /// found by bisection where the lateral stress vanishes, gives the nominal
 /// stress P₁₁ = E·ε and t = 1 − ν·ε (relative 10⁻³ for E, 10⁻³ for ν).
 pub fn assert_small_strain_moduli(interaction: &dyn Interaction, params: &[f64]) {
-    let Law::Tetra(eval) = interaction.law() else { panic!("{} is not a volume law", interaction.name()) };
+    let eval = element_law(interaction);
     let (e, nu) = (params[0], params[1]);
     let (rest, eps) = (unit_tetra_rest(), 1e-5);
     let lateral = |t: f64| eval(params, &rest, stretched_unit_tetra(1.0 + eps, t)).forces[2].y;

@@ -384,6 +384,12 @@ impl Model {
         (0..self.bodies.len()).any(|b| self.rules_of_body(b).any(|r| !self.body_rules[r].interaction.law().runs_on_gpu()))
     }
 
+    /// Whether any volume element carries its volumetric energy on the nodes
+    /// ([`crate::interactions::Law::NodalTetra`]; CPU backend only).
+    pub fn has_nodal_pressure_tetras(&self) -> bool {
+        self.tetra_types.iter().any(|t| t.law.volumetric.is_some())
+    }
+
     /// Whether any contact term acts between bodies.
     pub fn has_contact_terms(&self) -> bool {
         !self.contact_rules.is_empty()

@@ -53,6 +53,7 @@ mod kinetics;
 mod lammps_mutations;
 mod measure;
 mod mutations;
+mod nodal_pressure;
 mod protocols;
 mod readme;
 mod reproducibility;

@@ -17,6 +17,9 @@ const CUSTOM_SURFACE_TERMS: &str = "custom surface terms of bodies (`custom` bod
 /// Why `integrator … theta` other than 1 keeps a run on the CPU.
 const THETA_ON_CPU: &str = "steps with `theta` other than 1 (the device's steps are backward Euler) run on the CPU backend only";
 
+/// Why average-nodal-pressure volume elements keep a run on the CPU.
+const NODAL_PRESSURE_TETRA: &str = "average-nodal-pressure volume elements (`neo_hookean_anp`) run on the CPU backend only";
+
 /// Why a box with periodic edges shorter than twice the pair range keeps a run on the CPU.
 const SHORT_PERIODIC_EDGES: &str =
     "pairs through several periodic images (a periodic box edge shorter than 2·(pair cutoff + skin)) run on the CPU backend only";
@@ -294,6 +297,8 @@ impl Simulation {
             Some(THETA_ON_CPU)
         } else if self.model.has_cpu_only_surface_terms() {
             Some(CUSTOM_SURFACE_TERMS)
+        } else if self.model.has_nodal_pressure_tetras() {
+            Some(NODAL_PRESSURE_TETRA)
         } else if self.model.max_pair_cutoff() > 0.0
             && crate::neighbor::ImageShifts::has_short_edges(&self.sim_box, self.model.max_pair_cutoff() + self.neighbor.skin)
         {
@@ -326,6 +331,10 @@ impl Simulation {
         // Only what the forces need decides (not the integrator's or the constraints' refusals).
         if self.model.has_cpu_only_surface_terms() {
             self.say(&format!("minimize on the CPU: {CUSTOM_SURFACE_TERMS}"));
+            return Ok(None);
+        }
+        if self.model.has_nodal_pressure_tetras() {
+            self.say(&format!("minimize on the CPU: {NODAL_PRESSURE_TETRA}"));
             return Ok(None);
         }
         let Some(context) = self.open_gpu(device)? else { return Ok(None) };
