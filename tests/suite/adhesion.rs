@@ -13,9 +13,7 @@
 //!   translations and rotations in its null space;
 //! - runs are bit-identical on 1 and 2 threads; the GPU refuses the term.
 
-use std::cell::RefCell;
-
-use crate::common::{position_bits, two_cells, Case};
+use crate::common::{cpu_energy_and_forces, jitter, position_bits, two_cells, Case};
 use cellmd::backend::{CpuBackend, Forces};
 use cellmd::deck::Plan;
 use cellmd::interactions::testing::assert_checks_of;
@@ -38,28 +36,7 @@ const BARRIER: &str = "contact cell cell contact_barrier dhat 0.1 kappa 5\n";
 /// The topology's positions, each node moved by a deterministic offset of up
 /// to 0.03 µm (a generic configuration: no symmetric ties).
 fn jittered(plan: &Plan) -> Vec<DVec3> {
-    plan.positions
-        .iter()
-        .enumerate()
-        .map(|(k, p)| {
-            let k = k as f64;
-            *p + 0.02 * DVec3::new((12.9898 * k).sin(), (78.233 * k + 1.0).sin(), (37.719 * k + 2.0).sin())
-        })
-        .collect()
-}
-
-/// The backend's total energy and forces as a function of all positions.
-fn engine(plan: &Plan) -> impl Fn(&[DVec3]) -> (f64, Vec<DVec3>) + '_ {
-    let state = RefCell::new(State::new(plan.positions.clone()));
-    let backend = RefCell::new(CpuBackend::new(&plan.model, &state.borrow(), &plan.sim_box, 0.0).unwrap());
-    move |x: &[DVec3]| {
-        let (mut state, mut backend) = (state.borrow_mut(), backend.borrow_mut());
-        state.positions.copy_from_slice(x);
-        backend.update_contacts(&plan.model, &state, &plan.sim_box).unwrap();
-        let mut out = Forces::default();
-        backend.compute(&plan.model, &state, &plan.sim_box, &mut out);
-        (out.total_energy(), out.forces)
-    }
+    plan.positions.iter().enumerate().map(|(k, p)| *p + 0.02 * jitter(k)).collect()
 }
 
 /// Nodes of body `a` by their distance to body `b`: (in full contact, in the switch zone).
@@ -93,7 +70,7 @@ fn adhesion_forces_are_minus_the_gradient_of_the_engine_energy() {
         // Generic: nodes in full contact, in the switch zone and beyond it.
         let (full, switching) = zones(&plan, &x, 0, 1, 0.14, 0.45);
         assert!(full >= 1 && switching >= 10, "{full} nodes in contact, {switching} in the switch zone");
-        let eval = engine(&plan);
+        let eval = cpu_energy_and_forces(&plan);
         let (energy, forces) = eval(&x);
         assert!(energy < 0.0 && forces.iter().any(|f| f.length() > 0.1), "E = {energy}");
         assert_checks_of("contact_adhesion (engine)", &eval, &x, 1e-6, 0.0);
@@ -108,7 +85,7 @@ fn adhesion_energy_is_minus_w_times_the_area_in_contact() {
     let case = cells_case(ADHESION, "timestep 1e-3\nrun 0\n");
     let plan = case.plan();
     let x = jittered(&plan);
-    let (energy, _) = engine(&plan)(&x);
+    let (energy, _) = cpu_energy_and_forces(&plan)(&x);
     let switch = quintic(on, off);
     let mut expected = 0.0;
     for (a, b) in [(0, 1), (1, 0)] {

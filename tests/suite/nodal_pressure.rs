@@ -14,9 +14,7 @@
 //!
 //! Hertz indentation, where the formulation removes locking: tests/suite/hertz.rs.
 
-use std::cell::RefCell;
-
-use crate::common::Case;
+use crate::common::{cpu_energy_and_forces, jitter, Case};
 use cellmd::backend::{CpuBackend, Forces};
 use cellmd::build::{ball, BallArgs};
 use cellmd::deck::Plan;
@@ -40,34 +38,14 @@ fn ball_case() -> Case {
 /// The rest positions squeezed by 10 % along z and moved by a deterministic
 /// jitter of up to 0.05 µm (a generic configuration: no symmetric ties).
 fn deformed(plan: &Plan) -> Vec<DVec3> {
-    plan.positions
-        .iter()
-        .enumerate()
-        .map(|(k, p)| {
-            let k = k as f64;
-            DVec3::new(p.x, p.y, 0.9 * p.z) + 0.05 * DVec3::new((12.9898 * k).sin(), (78.233 * k + 1.0).sin(), (37.719 * k + 2.0).sin())
-        })
-        .collect()
-}
-
-/// The backend's total energy and forces as a function of all positions.
-fn engine(plan: &Plan) -> impl Fn(&[DVec3]) -> (f64, Vec<DVec3>) + '_ {
-    let state = RefCell::new(State::new(plan.positions.clone()));
-    let backend = RefCell::new(CpuBackend::new(&plan.model, &state.borrow(), &plan.sim_box, 0.0).unwrap());
-    move |x: &[DVec3]| {
-        let (mut state, mut backend) = (state.borrow_mut(), backend.borrow_mut());
-        state.positions.copy_from_slice(x);
-        let mut out = Forces::default();
-        backend.compute(&plan.model, &state, &plan.sim_box, &mut out);
-        (out.total_energy(), out.forces)
-    }
+    plan.positions.iter().enumerate().map(|(k, p)| DVec3::new(p.x, p.y, 0.9 * p.z) + 0.05 * jitter(k)).collect()
 }
 
 #[test]
 fn nodal_pressure_forces_are_minus_the_gradient_of_the_engine_energy() {
     let plan = ball_case().plan();
     let x = deformed(&plan);
-    let eval = engine(&plan);
+    let eval = cpu_energy_and_forces(&plan);
     let (energy, forces) = eval(&x);
     assert!(energy > 0.0 && forces.iter().any(|f| f.length() > 1.0), "E = {energy}");
     assert_checks_of("neo_hookean_anp (engine)", &eval, &x, 1e-6, 0.0);
@@ -95,7 +73,7 @@ fn nodal_pressure_energy_is_its_definition() {
         let j = w / v;
         expected += v * 0.25 * kappa * (j * j - 1.0 - 2.0 * j.ln());
     }
-    let (energy, _) = engine(&plan)(&x);
+    let (energy, _) = cpu_energy_and_forces(&plan)(&x);
     assert!((energy - expected).abs() < 1e-12 * expected, "engine {energy}, definition {expected}");
 }
 
@@ -117,7 +95,7 @@ fn nodal_pressure_stiffness_at_rest_is_the_hessian() {
             }
         }
     }
-    let eval = engine(&plan);
+    let eval = cpu_energy_and_forces(&plan);
     let h = finite_difference_hessian(&plan.positions, |p| eval(p).1);
     let scale = (0..3 * n).map(|d| h[(d, d)].abs()).fold(0.0, f64::max);
     let worst = (0..3 * n).flat_map(|r| (0..3 * n).map(move |c| (r, c))).map(|(r, c)| (k[(r, c)] - h[(r, c)]).abs()).fold(0.0, f64::max);

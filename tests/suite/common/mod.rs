@@ -413,3 +413,27 @@ pub fn assert_complete_csv(path: &Path) -> usize {
     }
     rows
 }
+
+/// A deterministic direction-like jitter of particle `k` (components in
+/// [−1, 1], no symmetric ties between particles) for generic test configurations.
+pub fn jitter(k: usize) -> glam::DVec3 {
+    let k = k as f64;
+    glam::DVec3::new((12.9898 * k).sin(), (78.233 * k + 1.0).sin(), (37.719 * k + 2.0).sin())
+}
+
+/// The CPU backend's total energy and forces as a function of all
+/// positions (contacts found again at each call), for F = −∇E checks.
+pub fn cpu_energy_and_forces(plan: &Plan) -> impl Fn(&[glam::DVec3]) -> (f64, Vec<glam::DVec3>) + '_ {
+    use cellmd::backend::{CpuBackend, Forces};
+    use cellmd::system::State;
+    let state = std::cell::RefCell::new(State::new(plan.positions.clone()));
+    let backend = std::cell::RefCell::new(CpuBackend::new(&plan.model, &state.borrow(), &plan.sim_box, 0.0).unwrap());
+    move |x: &[glam::DVec3]| {
+        let (mut state, mut backend) = (state.borrow_mut(), backend.borrow_mut());
+        state.positions.copy_from_slice(x);
+        backend.update_contacts(&plan.model, &state, &plan.sim_box).unwrap();
+        let mut out = Forces::default();
+        backend.compute(&plan.model, &state, &plan.sim_box, &mut out);
+        (out.total_energy(), out.forces)
+    }
+}
