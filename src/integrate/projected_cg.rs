@@ -218,11 +218,17 @@ pub(super) fn projected_cg(
         )));
     }
     // The defect AΔx − b = −Jᵀλ gives the multipliers: the general ones by
-    // the projection, the fibres' by their solve of b − AΔx.
-    product(&x, &mut fibres, &mut ap);
+    // the projection, the fibres' by their solve of b − AΔx. Without an
+    // iteration (free fibres: the starting point is the answer) `ap` is
+    // still A·x and, without general constraints, the residual's solve
+    // above was that of b − AΔx, so the fibres hold their multipliers.
+    let settled = iterations == 0 && general.schur.is_none();
+    if iterations > 0 {
+        product(&x, &mut fibres, &mut ap);
+    }
     let defect: Vec<f64> = ap.iter().zip(rhs).map(|(a, b)| a - b).collect();
     let lambda = general.multipliers(&dinv, &defect);
-    if fibres.is_some() {
+    if fibres.is_some() && !settled {
         let minus: Vec<f64> = defect.iter().map(|d| -d).collect();
         precondition(&minus, false, &mut fibres, &mut z);
     }

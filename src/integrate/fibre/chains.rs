@@ -52,7 +52,9 @@ pub struct Chains {
     pub chains: Vec<Chain>,
     /// For each particle: its chain and point index, or `None`.
     pub place: Vec<Option<(u32, u32)>>,
-    /// Bonds whose stiffness a chain's block carries (the generic stiffness skips them).
+    /// Bonds whose stiffness a chain's block carries, or whose length its
+    /// constraint rows hold (the generic stiffness skips them: along an
+    /// inextensible segment a bond's law is replaced by the constraint).
     pub owned_bonds: Vec<bool>,
     /// Angles whose stiffness a chain's block carries.
     pub owned_angles: Vec<bool>,
@@ -162,12 +164,8 @@ impl Chains {
             for (m, &p) in points.iter().enumerate() {
                 place[p as usize] = Some((c as u32, m as u32));
             }
-            let constraints = if constrained {
-                bonds.iter().map(|&b| list_index[b as usize]).collect()
-            } else {
-                bonds.iter().for_each(|&b| owned_bonds[b as usize] = true);
-                Vec::new()
-            };
+            bonds.iter().for_each(|&b| owned_bonds[b as usize] = true);
+            let constraints = if constrained { bonds.iter().map(|&b| list_index[b as usize]).collect() } else { Vec::new() };
             for &k in &constraints {
                 chained_constraints[k as usize] = true;
             }
@@ -218,6 +216,8 @@ mod tests {
         assert_eq!(chain.constraints, vec![0, 1, 2]);
         assert_eq!(chain.joints, vec![(1, 0), (2, 1)]);
         assert_eq!(chains.owned_angles, vec![true, true, false]);
+        // The chain's segment bonds are held by its constraints, not by the generic stiffness.
+        assert_eq!(chains.owned_bonds, [vec![true; 3], vec![false; 6]].concat());
         assert_eq!(chains.chained_constraints.iter().filter(|&&c| c).count(), 3);
         assert_eq!(chains.place[2], Some((0, 2)));
         assert_eq!(chains.place[4], None);
@@ -233,7 +233,7 @@ mod tests {
         let points: Vec<_> = chains.chains.iter().map(|c| c.points.clone()).collect();
         assert_eq!(points, vec![vec![0, 1, 2], vec![3, 4, 5]]);
         assert!(chains.chains[0].is_constrained() && !chains.chains[1].is_constrained());
-        assert_eq!(chains.owned_bonds, vec![false, false, true, true, false]);
+        assert_eq!(chains.owned_bonds, vec![true, true, true, true, false]);
         // Without elastic chains only the constrained one.
         assert_eq!(Chains::find(&m, &[0, 1], true, false, |_| None).chains.len(), 1);
         // Constrained bonds solved elsewhere (SHAKE) are in no chain, elastic or not.
