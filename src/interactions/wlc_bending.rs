@@ -18,13 +18,14 @@ fn eval(p: &[f64], [ri, rj, rk]: [DVec3; 3]) -> ThreeBody {
     let strength = strength(p);
     let a = rj - ri;
     let b = rk - rj;
-    let (la, lb) = (a.length(), b.length());
-    let t1 = a / la;
-    let t2 = b / lb;
+    // Two divisions, not twelve (this is the inner loop of a fibre's step).
+    let (ia, ib) = (1.0 / a.length(), 1.0 / b.length());
+    let t1 = a * ia;
+    let t2 = b * ib;
     let c = t1.dot(t2);
     // ∂c/∂a and ∂c/∂b for c = t1·t2.
-    let dc_da = (t2 - c * t1) / la;
-    let dc_db = (t1 - c * t2) / lb;
+    let dc_da = (t2 - c * t1) * ia;
+    let dc_db = (t1 - c * t2) * ib;
     // E = (κ/ℓ)(1 − c); a = rj − ri, b = rk − rj.
     let fi = -strength * dc_da;
     let fk = strength * dc_db;

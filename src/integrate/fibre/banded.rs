@@ -7,7 +7,8 @@
 //! Then every inner loop — the factorisation's update of a row, the
 //! solves' products — runs over contiguous slots in increasing order (and
 //! vectorises). The factorisation overwrites the band with the unit lower
-//! factor L (below the diagonal) and D (on it): A = L·D·Lᵀ, right-looking, b(b + 1)/2
+//! factor L (below the diagonal) and D⁻¹ (on it, so the solve multiplies
+//! where it would divide): A = L·D·Lᵀ, right-looking, b(b + 1)/2
 //! multiply–adds per column. Without pivoting it needs every leading
 //! principal minor to be non-zero, which holds for the fibre systems in
 //! their interleaved ordering: each multiplier follows the positions it
@@ -89,7 +90,7 @@ impl Banded {
         }
     }
 
-    /// Factorises in place into L·D·Lᵀ (right-looking: column j's
+    /// Factorises in place into L and D⁻¹ (right-looking: column j's
     /// multipliers l = a_·j/d_j update the trailing triangle). Fails,
     /// naming the row, on a zero or non-finite pivot.
     pub fn factorize(&mut self) -> Result<(), usize> {
@@ -98,8 +99,10 @@ impl Banded {
             if d == 0.0 || !d.is_finite() {
                 return Err(j);
             }
+            let inverse = 1.0 / d;
+            self.rows[j][B] = inverse;
             let below: &mut [[f64; W]; B] = (&mut self.rows[j + 1..j + 1 + B]).try_into().expect("a full band");
-            eliminate(d, below);
+            eliminate(inverse, below);
         }
         Ok(())
     }
@@ -128,7 +131,7 @@ impl Banded {
             x[i] = s;
         }
         for (xi, row) in x[..n].iter_mut().zip(&self.rows) {
-            *xi /= row[B];
+            *xi *= row[B];
         }
         // Lᵀ·x = D⁻¹·y.
         for i in (0..n).rev() {
@@ -148,14 +151,13 @@ impl Banded {
     }
 }
 
-/// Eliminates column j (pivot d) from the B rows below it, `below[t − 1]`
-/// being row j + t (see [`update_row`]). Each row is its own instance of
-/// the update, so every loop has a fixed trip count and unrolls.
+/// Eliminates column j (reciprocal pivot `inverse`) from the B rows below
+/// it, `below[t − 1]` being row j + t (see [`update_row`]). Each row is its
+/// own instance of the update, so every loop has a fixed trip count and unrolls.
 #[inline(always)]
-fn eliminate(d: f64, below: &mut [[f64; W]; B]) {
+fn eliminate(inverse: f64, below: &mut [[f64; W]; B]) {
     // c[s] = a_{j+s, j}.
     let c: [f64; W] = std::array::from_fn(|s| if s == 0 { 0.0 } else { below[s - 1][B - s] });
-    let inverse = 1.0 / d;
     const { assert!(B == 8, "one update per row below") };
     update_row::<1>(&mut below[0], &c, inverse);
     update_row::<2>(&mut below[1], &c, inverse);

@@ -60,6 +60,7 @@ fn mobile(drag: &[f64], held: &[[bool; 3]], i: usize, a: usize) -> bool {
 }
 
 /// Which of a system's banded matrices.
+#[derive(Clone, Copy)]
 enum Which {
     Matrix,
     Factor,
@@ -104,7 +105,12 @@ pub struct ChainSystem {
     constrained: bool,
     /// Whether each segment's multiplier row is a constraint (else λ = 0).
     active: Vec<bool>,
+    /// The operator γ/dt + θK, built from the data fields on the first
+    /// [`ChainSystem::times`] after an assembly (the explicit step never needs it).
     matrix: Banded,
+    matrix_current: bool,
+    /// (dt, θ) of the last assembly.
+    step: (f64, f64),
     factor: Banded,
     work: Vec<f64>,
     product: Vec<f64>,
@@ -125,6 +131,8 @@ impl ChainSystem {
             constrained,
             active: vec![false; segments],
             matrix: Banded::zeros(order),
+            matrix_current: false,
+            step: (0.0, 0.0),
             factor: Banded::zeros(order),
             work: vec![0.0; order],
             product: vec![0.0; order],
@@ -158,8 +166,27 @@ impl ChainSystem {
     /// Assembles and factorises γ/dt + θK with the constraint rows from the
     /// data fields. Fails naming the row of a singular pivot.
     pub fn assemble(&mut self, dt: f64, theta: f64) -> Result<(), usize> {
+        self.step = (dt, theta);
+        self.matrix_current = false;
+        self.fill(Which::Factor);
+        if !self.constrained {
+            // An elastic chain's operator keeps the bending's exact Hessian
+            // (in the generic stiffness); its factor, the preconditioner, the isotropic one.
+            add_bending(&mut self.factor, &self.strength, &self.length, theta);
+            self.isolate_fixed(Which::Factor);
+        }
+        self.factor.factorize()
+    }
+
+    /// Writes γ/dt + θK (without an elastic chain's bending) with the
+    /// constraint rows into `which`, at the last assembly's (dt, θ).
+    fn fill(&mut self, which: Which) {
         let n = self.points();
-        let m = &mut self.matrix;
+        let (dt, theta) = self.step;
+        let m = match which {
+            Which::Matrix => &mut self.matrix,
+            Which::Factor => &mut self.factor,
+        };
         m.clear();
         for i in 0..n {
             let diagonal = self.drag[i] / dt;
@@ -200,15 +227,7 @@ impl ChainSystem {
                 m.isolate(multiplier(k));
             }
         }
-        self.isolate_fixed(Which::Matrix);
-        self.factor.clone_from(&self.matrix);
-        if !self.constrained {
-            // An elastic chain's operator keeps the bending's exact Hessian
-            // (in the generic stiffness); its factor, the preconditioner, the isotropic one.
-            add_bending(&mut self.factor, &self.strength, &self.length, theta);
-            self.isolate_fixed(Which::Factor);
-        }
-        self.factor.factorize()
+        self.isolate_fixed(which);
     }
 
     /// Solves the factorised system for right-hand sides `force` (per point)
@@ -265,6 +284,10 @@ impl ChainSystem {
             }
         }
         self.work[DUMMY] = 0.0;
+        if !self.matrix_current {
+            self.fill(Which::Matrix);
+            self.matrix_current = true;
+        }
         self.matrix.times(&self.work, &mut self.product);
         for (i, yi) in y.iter_mut().enumerate().take(n) {
             *yi = DVec3::new(self.product[var(i, 0)], self.product[var(i, 1)], self.product[var(i, 2)]);

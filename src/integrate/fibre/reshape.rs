@@ -46,6 +46,9 @@ pub struct Reshape {
     /// Iterations the last reshape took.
     pub iterations: usize,
     weight: Vec<DVec3>,
+    /// W_k + W_{k+1} and 1/ℓ_k per segment, fixed over the iterations.
+    both: Vec<DVec3>,
+    inverse_length: Vec<f64>,
     direction: Vec<DVec3>,
     diagonal: Vec<f64>,
     off: Vec<f64>,
@@ -104,9 +107,14 @@ impl Reshape {
             v.resize(segments, 0.0);
         }
         self.direction.resize(segments, DVec3::ZERO);
+        self.both.clear();
+        self.both.extend(self.weight.windows(2).map(|w| w[0] + w[1]));
+        self.inverse_length.clear();
+        self.inverse_length.extend(system.length[..segments].iter().map(|l| 1.0 / l));
         // The chain's arrays, sliced to their lengths once so the loops
         // below index them without bounds checks.
         let (weight, moved, target) = (&self.weight[..n], &mut self.moved[..n], &system.length[..segments]);
+        let (both, inverse_length) = (&self.both[..segments], &self.inverse_length[..segments]);
         let (direction, diagonal, off, rhs, g) = (
             &mut self.direction[..segments],
             &mut self.diagonal[..segments],
@@ -125,15 +133,15 @@ impl Reshape {
                 let length = r.length();
                 let u = r * (1.0 / length);
                 direction[k] = u;
-                let both = weight[k] + weight[k + 1];
-                let movable = (both * u).length_squared() > 0.0;
+                let mobility = u.dot(both[k] * u);
+                let movable = mobility > 0.0;
                 let error = length - target[k];
-                let relative = if movable { (error / target[k]).abs() } else { 0.0 };
+                let relative = if movable { (error * inverse_length[k]).abs() } else { 0.0 };
                 if relative > worst.1 || relative.is_nan() {
                     worst = (k, relative);
                 }
                 rhs[k] = if movable { error } else { 0.0 };
-                diagonal[k] = if movable { u.dot(both * u) } else { 1.0 };
+                diagonal[k] = if movable { mobility } else { 1.0 };
                 if k > 0 {
                     off[k - 1] = if previous_movable && movable { -direction[k - 1].dot(weight[k] * u) } else { 0.0 };
                 }
