@@ -22,10 +22,15 @@ fn run(chains: usize, segments: usize, a: f64, integrator: &str, dt: f64, steps:
     let top = common::worm_like_chains(chains, segments, a, 0x9E3779B97F4A7C15);
     let bend = if a > 0.0 { format!("angle bend wlc_bending kappa {a} l0 1\n") } else { String::new() };
     let ff = format!("particle bead drag 1\nbond rod harmonic k 100 r0 1\n{bend}");
+    // The chains start 10 apart on a 10 × 10 grid of layers; the box
+    // (fixed axes) leaves each room for its length.
+    let margin = 10 + segments;
     let deck = format!(
-        "units lj\ntopology t.top\nforcefield f.ff\nbox x -10 110 f y -10 110 f z -10 {} f\ntemperature 1\nseed 7\n\
+        "units lj\ntopology t.top\nforcefield f.ff\nbox x -{margin} {} f y -{margin} {} f z -{margin} {} f\ntemperature 1\nseed 7\n\
          constrain rod\n{integrator}\ntimestep {dt}\nrun {steps}\n",
-        10.0 * (chains / 100 + 1) as f64
+        100 + margin,
+        100 + margin,
+        10 * (chains / 100 + 1) + margin
     );
     let case = Case::new(&[("t.top", &top), ("f.ff", &ff), ("deck.in", &deck)]);
     Simulation::execute(case.plan(), RunOptions { output_dir: case.output_dir().to_path_buf(), ..Default::default() }).unwrap()
@@ -122,4 +127,35 @@ fn freely_jointed_fibres_keep_uniform_joints() {
     println!("⟨cos θ⟩ = {mean:.4} ± {error:.4} (0); ⟨cos²θ⟩ = {mean2:.4} ± {error2:.4} (1/3)");
     assert!(mean.abs() < 2.0 * error, "⟨cos θ⟩ = {mean} ± {error}");
     assert!((mean2 - 1.0 / 3.0).abs() < 2.0 * error2, "⟨cos²θ⟩ = {mean2} ± {error2}");
+}
+
+/// Fibres of 10, 50 and 500 segments, and a network-sized population of
+/// 2 000 fibres, at the steps Cytosim users take: D·dt/ℓ² = 0.0025 and
+/// 0.025 are 1 ms and 10 ms for actin's 0.1 µm segments in 1 Pa·s, and
+/// a = κ/(ℓkT) = 180 is actin's bending (κ = 0.075 pN·µm², kT = 4.1e-3
+/// pN·µm), on both integrators: every segment stays at its length to
+/// 1e-10 (the default `constrain` tolerance; issue #39 asks for 1e-6)
+/// after 200 steps and the fibres move (a thermal step is not frozen).
+/// Stiff springs blow up within a step here and SHAKE on the same
+/// constraints failed at step 1 on 50-segment fibres at 1 ms.
+#[test]
+fn inextensible_fibres_hold_their_lengths_at_one_and_ten_millisecond_steps() {
+    for (chains, segments) in [(2000, 10), (40, 50), (2, 500)] {
+        let start = run(chains, segments, 180.0, "integrator overdamped", 1e-12, 0);
+        let before = start.state.positions.clone();
+        for integrator in ["integrator overdamped", "integrator implicit"] {
+            for dt in [0.0025, 0.025] {
+                let sim = run(chains, segments, 180.0, integrator, dt, 200);
+                let t = tangents(&sim, chains, segments);
+                let worst = worst_length_error(&t);
+                let moved = sim.state.positions.iter().zip(&before).map(|(x, x0)| (*x - *x0).length()).sum::<f64>() / before.len() as f64;
+                println!(
+                    "{chains} × {segments} segments, {integrator}, dt {dt}: worst |r − ℓ|/ℓ {worst:.1e}, mean displacement {moved:.3}"
+                );
+                assert!(worst < 1e-10, "{chains} × {segments}, {integrator}, dt {dt}: a segment is off its length by {worst:e}");
+                // A free point would diffuse by √(6·D·t) = 1.7–5.5 here; a fibre's points, moving together, by 0.4–1.9 (measured).
+                assert!(moved > 0.1, "{chains} × {segments}, {integrator}, dt {dt}: the points moved by {moved} on average");
+            }
+        }
+    }
 }
