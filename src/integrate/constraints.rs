@@ -19,8 +19,11 @@
 //! Cytosim — are not swept: each chain is solved exactly by the fibre
 //! solver ([`super::fibre`]), whose step keeps the lengths to first order
 //! and whose reshape restores them to the tolerance by Newton's method on
-//! one multiplier per segment. SHAKE handles the rest (branched or
-//! crosslinked constraint graphs).
+//! one multiplier per segment. Where other constraints join fibres (a
+//! constrained crosslink, a branch), the fibres' and those constraints'
+//! lengths are restored together by one Newton projection of the whole
+//! graph ([`super::fibre::coupled`]); SHAKE handles the constraints that
+//! touch no fibre.
 //!
 //! The GPU backend projects on the device with the same equation, the
 //! constraints swept colour by colour (src/gpu/shake.rs).
@@ -28,6 +31,7 @@
 use glam::DVec3;
 
 use super::context::StepContext;
+use super::fibre::coupled::Coupling;
 use super::fibre::{FibreInputs, Fibres};
 use crate::system::{Model, SimBox, State};
 
@@ -152,6 +156,36 @@ impl Constraints {
         let chained = &self.fibres.chains.chained_constraints;
         let in_chain = |k: usize| chained.len() == self.list.len() && chained[k];
         let general = (0..self.list.len()).any(|k| !in_chain(k));
+        let on_fibre = |k: usize| model.bonds[self.list[k].bond].iter().any(|&p| self.fibres.holds(p as usize));
+        if general && (0..self.list.len()).any(|k| !in_chain(k) && on_fibre(k)) {
+            // Constraints joined to fibres: one projection of the whole graph.
+            let couplings: Vec<Coupling> = (0..self.list.len())
+                .filter(|&k| !in_chain(k))
+                .map(|k| Coupling { entry: k, ends: model.bonds[self.list[k].bond], length: self.list[k].length })
+                .collect();
+            let x = &mut state.positions;
+            let coordinates = |i: usize| DVec3::splat(mobility(i));
+            let outcome = self.fibres.reshape_coupled(
+                x,
+                &images,
+                dt,
+                self.tolerance,
+                self.max_iterations,
+                &couplings,
+                &coordinates,
+                &mut self.tension,
+            );
+            for (x, image) in x.iter_mut().zip(state.images.iter_mut()) {
+                sim_box.wrap(x, image);
+            }
+            return match outcome {
+                Ok(iterations) => {
+                    self.iterations = iterations;
+                    Ok(())
+                }
+                Err((constraint, relative_error)) => Err(ConstraintFailure { bond: self.list[constraint].bond, relative_error }),
+            };
+        }
         // The directions before the step, along which SHAKE corrects (only
         // the constraints outside fibres need them).
         let reference: Vec<DVec3> = if general {

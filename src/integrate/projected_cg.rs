@@ -52,6 +52,7 @@ impl GeneralConstraints {
     fn new(
         constrained: &ConstrainedBonds,
         chained: &[bool],
+        on_fibre: &[bool],
         mobile: &[bool],
         dinv: &[f64],
         positions: &[DVec3],
@@ -65,8 +66,15 @@ impl GeneralConstraints {
                 (i as usize, j as usize, images.minimum_image(positions[j as usize] - positions[i as usize]).normalize_or_zero())
             })
             .collect();
-        let active: Vec<bool> =
-            rows.iter().enumerate().map(|(k, &(i, j, _))| (mobile[i] || mobile[j]) && !chained.get(k).copied().unwrap_or(false)).collect();
+        // A constraint on a fibre's point that is not one of its segments (a
+        // constrained crosslink) is left to the projection after the step,
+        // which restores it with the fibres (`integrate::fibre::coupled`):
+        // the fibre's solve, not D⁻¹, moves that point.
+        let active: Vec<bool> = rows
+            .iter()
+            .enumerate()
+            .map(|(k, &(i, j, _))| (mobile[i] || mobile[j]) && !chained.get(k).copied().unwrap_or(false) && !on_fibre[i] && !on_fibre[j])
+            .collect();
         let m = rows.len();
         if !active.iter().any(|&a| a) {
             return Ok(Self { rows, active, schur: None });
@@ -153,7 +161,7 @@ pub(super) fn projected_cg(
     let free = |k: usize| mobile[k / 3] && !held.get(k).copied().unwrap_or(false);
     let dinv: Vec<f64> = (0..dim).map(|k| if free(k) && !on_fibre[k / 3] { 1.0 / diagonal[k] } else { 0.0 }).collect();
     let chained = fibres.as_ref().map_or(&[][..], |f| &f.chains.chained_constraints[..]);
-    let general = GeneralConstraints::new(constrained, chained, mobile, &dinv, positions, sim_box)?;
+    let general = GeneralConstraints::new(constrained, chained, &on_fibre, mobile, &dinv, positions, sim_box)?;
     // z = M⁻¹ r: projected Jacobi off the fibres (after the residual update), each fibre's own solve on them.
     let precondition = |r: &[f64], restore: bool, fibres: &mut Option<&mut Fibres>, z: &mut [f64]| {
         z.iter_mut().zip(r).zip(&dinv).for_each(|((z, r), d)| *z = d * r);

@@ -4,10 +4,14 @@
 //!
 //! A **constrained chain** is a connected component of the constrained
 //! bonds (`constrain`) that is a simple path: every particle on at most two
-//! of them, no cycle, no two bonds on one pair. A component that is not a
-//! path (a branch point, a ring, a crosslink that is itself constrained)
-//! stays with the general projection (SHAKE after the explicit step,
-//! projected conjugate gradients in the implicit one). An **elastic chain**
+//! of them, no cycle, no two bonds on one pair. In a component that is not
+//! a path (fibres joined by constrained crosslinks, a branch point), the
+//! simple paths of one bond type are chains too, the longest first, each
+//! through particles no chain holds yet; its other constraints are the
+//! couplings restored with the chains after the step ([`super::coupled`]).
+//! What touches no chain (a ring, a branched graph of one type) stays with
+//! the general projection (SHAKE after the explicit step, projected
+//! conjugate gradients in the implicit one). An **elastic chain**
 //! is a path of at least two bonds of one unconstrained bond type through
 //! particles no other chain holds: the implicit step solves its bonds and
 //! bending in the same banded block (stiff harmonic segments of a filament).
@@ -53,8 +57,9 @@ pub struct Chains {
     /// For each particle: its chain and point index, or `None`.
     pub place: Vec<Option<(u32, u32)>>,
     /// Bonds whose stiffness a chain's block carries, or whose length its
-    /// constraint rows hold (the generic stiffness skips them: along an
-    /// inextensible segment a bond's law is replaced by the constraint).
+    /// constraint rows or the coupled projection hold (the generic stiffness
+    /// skips them: along an inextensible bond its law is replaced by the
+    /// constraint).
     pub owned_bonds: Vec<bool>,
     /// Angles whose stiffness a chain's block carries.
     pub owned_angles: Vec<bool>,
@@ -147,6 +152,25 @@ impl Chains {
         for (points, _, _) in &groups {
             points.iter().for_each(|&p| taken[p as usize] = true);
         }
+        // A constraint graph that is no path (fibres joined by constrained
+        // crosslinks, a branched fibre) still holds fibres: the paths of one
+        // bond type each, the longest first, the rest its couplings.
+        let mut in_chain = vec![false; model.bonds.len()];
+        groups.iter().flat_map(|(_, bonds, _)| bonds).for_each(|&b| in_chain[b as usize] = true);
+        let mut typed: Vec<(Vec<u32>, Vec<u32>)> = (0..model.bond_types.len() as u32)
+            .flat_map(|t| {
+                let edges: Vec<u32> =
+                    edges.iter().copied().filter(|&b| model.bond_type[b as usize] == t && !in_chain[b as usize]).collect();
+                paths(model, &edges, &taken)
+            })
+            .collect();
+        typed.sort_by_key(|(_, bonds)| std::cmp::Reverse(bonds.len()));
+        for (points, bonds) in typed {
+            if points.iter().all(|&p| !taken[p as usize]) {
+                points.iter().for_each(|&p| taken[p as usize] = true);
+                groups.push((points, bonds, true));
+            }
+        }
         if elastic {
             let is_constrained: Vec<bool> = (0..model.bonds.len()).map(|b| list_index[b] != u32::MAX).collect();
             for t in 0..model.bond_types.len() as u32 {
@@ -170,6 +194,16 @@ impl Chains {
                 chained_constraints[k as usize] = true;
             }
             chains.push(Chain { points, bonds, constraints, joints: Vec::new() });
+        }
+        // A constrained bond on a chain's point outside the chains (a
+        // constrained crosslink) is held by the projection after the step
+        // (`super::coupled`), which the implicit step leaves it to: its law's
+        // stiffness along it would otherwise resist that step.
+        for &b in &edges {
+            let [i, j] = model.bonds[b as usize];
+            if !owned_bonds[b as usize] && (place[i as usize].is_some() || place[j as usize].is_some()) {
+                owned_bonds[b as usize] = true;
+            }
         }
         let mut owned_angles = vec![false; model.angles.len()];
         for (a, &[i, j, k]) in model.angles.iter().enumerate() {

@@ -55,6 +55,7 @@
 
 pub mod banded;
 pub mod chains;
+pub mod coupled;
 pub mod kkt;
 pub mod reshape;
 

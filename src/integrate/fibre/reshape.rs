@@ -50,22 +50,22 @@ pub struct Reshape {
     both: Vec<DVec3>,
     inverse_length: Vec<f64>,
     direction: Vec<DVec3>,
+    /// Whether each segment's ends can move along it (else its row of G is the identity).
+    movable: Vec<bool>,
     diagonal: Vec<f64>,
     off: Vec<f64>,
     rhs: Vec<f64>,
 }
 
-/// Solves the symmetric tridiagonal system (diagonal, off)·x = rhs in place
-/// (`rhs` becomes x, `off[k]` couples k and k + 1; `diagonal` is
-/// overwritten with the reciprocal pivots, so each row divides once).
-/// False on a zero or non-finite pivot.
-fn thomas(diagonal: &mut [f64], off: &[f64], rhs: &mut [f64]) -> bool {
-    let n = rhs.len();
-    for k in 0..n {
+/// Factorises the symmetric tridiagonal matrix (diagonal, off) in place
+/// (`off[k]` couples k and k + 1): `diagonal` becomes the reciprocal
+/// pivots, so each row of a solve divides once. False on a zero or
+/// non-finite pivot.
+fn thomas_factor(diagonal: &mut [f64], off: &[f64]) -> bool {
+    for k in 0..diagonal.len() {
         if k > 0 {
             let m = off[k - 1] * diagonal[k - 1];
             diagonal[k] -= m * off[k - 1];
-            rhs[k] -= m * rhs[k - 1];
         }
         let pivot = diagonal[k];
         if !(pivot != 0.0 && pivot.is_finite()) {
@@ -73,11 +73,20 @@ fn thomas(diagonal: &mut [f64], off: &[f64], rhs: &mut [f64]) -> bool {
         }
         diagonal[k] = 1.0 / pivot;
     }
-    rhs[n - 1] *= diagonal[n - 1];
-    for k in (0..n - 1).rev() {
-        rhs[k] = (rhs[k] - off[k] * rhs[k + 1]) * diagonal[k];
-    }
     true
+}
+
+/// Solves (diagonal, off)·x = rhs in place with the factor of [`thomas_factor`].
+fn thomas_solve(reciprocal: &[f64], off: &[f64], rhs: &mut [f64]) {
+    let n = rhs.len();
+    for k in 1..n {
+        let m = off[k - 1] * reciprocal[k - 1];
+        rhs[k] -= m * rhs[k - 1];
+    }
+    rhs[n - 1] *= reciprocal[n - 1];
+    for k in (0..n - 1).rev() {
+        rhs[k] = (rhs[k] - off[k] * rhs[k + 1]) * reciprocal[k];
+    }
 }
 
 impl Reshape {
@@ -92,6 +101,30 @@ impl Reshape {
         tolerance: f64,
         max_iterations: usize,
     ) -> Result<(), ReshapeFailure> {
+        self.begin(system, at);
+        let mut iteration = 0;
+        loop {
+            let (segment, relative_error) = self.linearise(system, images);
+            if relative_error <= tolerance {
+                break;
+            }
+            if iteration == max_iterations || !self.factor() {
+                return Err(ReshapeFailure { segment, relative_error });
+            }
+            let mut g = std::mem::take(&mut self.rhs);
+            self.solve(&mut g);
+            self.apply(&g);
+            self.rhs = g;
+            iteration += 1;
+        }
+        self.iterations = iteration;
+        Ok(())
+    }
+
+    /// Sizes the scratch for `system`, takes the mobilities Wᵢ (0 on fixed
+    /// points and held coordinates) and the starting points from `at`, and
+    /// zeroes the multipliers' sum.
+    pub(super) fn begin(&mut self, system: &ChainSystem, at: impl Fn(usize) -> DVec3) {
         let n = system.points();
         let segments = n - 1;
         self.weight.clear();
@@ -107,65 +140,100 @@ impl Reshape {
             v.resize(segments, 0.0);
         }
         self.direction.resize(segments, DVec3::ZERO);
+        self.movable.resize(segments, false);
         self.both.clear();
         self.both.extend(self.weight.windows(2).map(|w| w[0] + w[1]));
         self.inverse_length.clear();
         self.inverse_length.extend(system.length[..segments].iter().map(|l| 1.0 / l));
-        // The chain's arrays, sliced to their lengths once so the loops
-        // below index them without bounds checks.
-        let (weight, moved, target) = (&self.weight[..n], &mut self.moved[..n], &system.length[..segments]);
+    }
+
+    /// At the current `moved`: each segment's direction u_k, its error
+    /// e_k = |r_k| − ℓ_k into `rhs` (0 where its ends cannot move along
+    /// it) and G's rows. Returns the worst segment and its |e_k|/ℓ_k.
+    pub(super) fn linearise(&mut self, system: &ChainSystem, images: &Images) -> (usize, f64) {
+        let segments = self.direction.len();
+        // The chain's arrays, sliced to their lengths once so the loop
+        // below indexes them without bounds checks.
+        let (weight, moved, target) = (&self.weight[..segments + 1], &self.moved[..segments + 1], &system.length[..segments]);
         let (both, inverse_length) = (&self.both[..segments], &self.inverse_length[..segments]);
-        let (direction, diagonal, off, rhs, g) = (
+        let (direction, diagonal, off, rhs, movable) = (
             &mut self.direction[..segments],
             &mut self.diagonal[..segments],
             &mut self.off[..segments],
             &mut self.rhs[..segments],
-            &mut self.g[..segments],
+            &mut self.movable[..segments],
         );
-        let mut iteration = 0;
-        loop {
-            let mut worst = (0, 0.0);
-            // Segment k's direction, error and row of G, and G's entry
-            // coupling it to segment k − 1.
-            let mut previous_movable = false;
-            for k in 0..segments {
-                let r = images.minimum_image(moved[k + 1] - moved[k]);
-                let length = r.length();
-                let u = r * (1.0 / length);
-                direction[k] = u;
-                let mobility = u.dot(both[k] * u);
-                let movable = mobility > 0.0;
-                let error = length - target[k];
-                let relative = if movable { (error * inverse_length[k]).abs() } else { 0.0 };
-                if relative > worst.1 || relative.is_nan() {
-                    worst = (k, relative);
-                }
-                rhs[k] = if movable { error } else { 0.0 };
-                diagonal[k] = if movable { mobility } else { 1.0 };
-                if k > 0 {
-                    off[k - 1] = if previous_movable && movable { -direction[k - 1].dot(weight[k] * u) } else { 0.0 };
-                }
-                previous_movable = movable;
+        let mut worst = (0, 0.0);
+        // Segment k's direction, error and row of G, and G's entry
+        // coupling it to segment k − 1.
+        for k in 0..segments {
+            let r = images.minimum_image(moved[k + 1] - moved[k]);
+            let length = r.length();
+            let u = r * (1.0 / length);
+            direction[k] = u;
+            let mobility = u.dot(both[k] * u);
+            movable[k] = mobility > 0.0;
+            let error = length - target[k];
+            let relative = if movable[k] { (error * inverse_length[k]).abs() } else { 0.0 };
+            if relative > worst.1 || relative.is_nan() {
+                worst = (k, relative);
             }
-            if worst.1 <= tolerance {
-                break;
+            rhs[k] = if movable[k] { error } else { 0.0 };
+            diagonal[k] = if movable[k] { mobility } else { 1.0 };
+            if k > 0 {
+                off[k - 1] = if movable[k - 1] && movable[k] { -direction[k - 1].dot(weight[k] * u) } else { 0.0 };
             }
-            if iteration == max_iterations || !thomas(diagonal, off, rhs) {
-                return Err(ReshapeFailure { segment: worst.0, relative_error: worst.1 });
-            }
-            // Δᵢ = Wᵢ·(g_i·u_i − g_{i−1}·u_{i−1}).
-            let mut before = DVec3::ZERO;
-            for i in 0..segments {
-                let after = rhs[i] * direction[i];
-                moved[i] += weight[i] * (after - before);
-                before = after;
-            }
-            moved[segments] += weight[segments] * (DVec3::ZERO - before);
-            g.iter_mut().zip(rhs.iter()).for_each(|(g, d)| *g += d);
-            iteration += 1;
         }
-        self.iterations = iteration;
-        Ok(())
+        worst
+    }
+
+    /// The errors of the last [`Reshape::linearise`], by segment.
+    pub(super) fn errors(&self) -> &[f64] {
+        &self.rhs
+    }
+
+    /// Factorises G = J·W·Jᵀ of the last [`Reshape::linearise`]; false on a singular pivot.
+    pub(super) fn factor(&mut self) -> bool {
+        thomas_factor(&mut self.diagonal, &self.off)
+    }
+
+    /// v ← G⁻¹·v with the factor of [`Reshape::factor`].
+    pub(super) fn solve(&self, v: &mut [f64]) {
+        thomas_solve(&self.diagonal, &self.off, v);
+    }
+
+    /// out_k = u_k·(δ_{k+1} − δ_k), J·δ for the chain's displacements δ
+    /// (0 on segments whose ends cannot move along them).
+    pub(super) fn segment_changes(&self, delta: impl Fn(usize) -> DVec3, out: &mut [f64]) {
+        for (k, out) in out.iter_mut().enumerate() {
+            *out = if self.movable[k] { self.direction[k].dot(delta(k + 1) - delta(k)) } else { 0.0 };
+        }
+    }
+
+    /// Wᵢ·(g_i·u_i − g_{i−1}·u_{i−1}) of point i, the displacement −W·Jᵀg of multipliers g.
+    pub(super) fn displacement(&self, g: &[f64], i: usize) -> DVec3 {
+        let after = if i < g.len() { g[i] * self.direction[i] } else { DVec3::ZERO };
+        let before = if i > 0 { g[i - 1] * self.direction[i - 1] } else { DVec3::ZERO };
+        self.weight[i] * (after - before)
+    }
+
+    /// The mobility Wᵢ of point i (per coordinate).
+    pub(super) fn weight(&self, i: usize) -> DVec3 {
+        self.weight[i]
+    }
+
+    /// Moves the points by Δᵢ = Wᵢ·(g_i·u_i − g_{i−1}·u_{i−1}) and adds g to the multipliers' sum.
+    pub(super) fn apply(&mut self, g: &[f64]) {
+        let segments = self.direction.len();
+        let (weight, moved, direction) = (&self.weight[..segments + 1], &mut self.moved[..segments + 1], &self.direction[..segments]);
+        let mut before = DVec3::ZERO;
+        for i in 0..segments {
+            let after = g[i] * direction[i];
+            moved[i] += weight[i] * (after - before);
+            before = after;
+        }
+        moved[segments] += weight[segments] * (DVec3::ZERO - before);
+        self.g.iter_mut().zip(g).for_each(|(s, d)| *s += d);
     }
 }
 
@@ -183,7 +251,8 @@ mod tests {
             .map(|k| diagonal[k] * x[k] + if k > 0 { off[k - 1] * x[k - 1] } else { 0.0 } + if k < 3 { off[k] * x[k + 1] } else { 0.0 })
             .collect();
         let mut d = diagonal;
-        assert!(thomas(&mut d, &off, &mut rhs));
+        assert!(thomas_factor(&mut d, &off));
+        thomas_solve(&d, &off, &mut rhs);
         for (a, b) in rhs.iter().zip(x) {
             assert!((a - b).abs() < 1e-14);
         }
