@@ -150,22 +150,23 @@ pub struct FibreStep<'a> {
     pub theta: f64,
 }
 
-impl FibreStep<'_> {
+impl<'a> FibreStep<'a> {
+    /// What the fibres read at `positions`.
+    fn inputs<'b>(&self, model: &'b Model, positions: &'b [DVec3], images: &'b Images) -> FibreInputs<'b>
+    where
+        'a: 'b,
+    {
+        FibreInputs { model, positions, images, constraint_length: self.constraint_length, held: self.held, bond_block: self.bond_block }
+    }
+
     /// Assembles every fibre's system at `positions` for a step of length `dt`.
     pub fn assemble(&mut self, model: &Model, positions: &[DVec3], images: &Images, dt: f64) -> Result<(), SingularFibre> {
-        let inputs = FibreInputs {
-            model,
-            positions,
-            images,
-            constraint_length: self.constraint_length,
-            held: self.held,
-            bond_block: self.bond_block,
-        };
+        let inputs = self.inputs(model, positions, images);
         self.fibres.assemble(&inputs, dt, self.theta)
     }
 
     /// The displacement of every fibre point in a step of length `dt` from
-    /// `positions`, into `out` (see [`Fibres::displacements`]).
+    /// `positions`, into `out` (see [`Fibres::step`]).
     #[allow(clippy::too_many_arguments)]
     pub fn displace(
         &mut self,
@@ -177,9 +178,8 @@ impl FibreStep<'_> {
         dt: f64,
         out: &mut [DVec3],
     ) -> Result<(), SingularFibre> {
-        self.assemble(model, positions, images, dt)?;
-        self.fibres.displacements(forces, ctx, dt, out);
-        Ok(())
+        let inputs = self.inputs(model, positions, images);
+        self.fibres.step(&inputs, forces, ctx, dt, self.theta, out)
     }
 }
 
@@ -236,12 +236,26 @@ impl Fibres {
     }
 
     /// The displacement of every fibre point in one step of the context's
-    /// kT and noise and length `dt`, with `forces` from the force pass,
-    /// into `out` (by particle): the solve of each assembled system with
-    /// the right-hand side F + √(2kTγ/dt)·ξ.
-    pub fn displacements(&mut self, forces: &[DVec3], ctx: &StepContext, dt: f64, out: &mut [DVec3]) {
+    /// kT and noise and length `dt` from the inputs' positions, with
+    /// `forces` from the force pass, into `out` (by particle): each fibre's
+    /// system assembled (stiffness weight `theta`) and solved with the
+    /// right-hand side F + √(2kTγ/dt)·ξ, in one parallel pass (a pass per
+    /// phase left the pool's second thread asleep between them).
+    pub fn step(
+        &mut self,
+        inputs: &FibreInputs,
+        forces: &[DVec3],
+        ctx: &StepContext,
+        dt: f64,
+        theta: f64,
+        out: &mut [DVec3],
+    ) -> Result<(), SingularFibre> {
         let StepContext { kt, seed, noise, step, .. } = *ctx;
-        self.work.par_iter_mut().zip(self.chains.chains.par_iter()).for_each(|(work, chain)| {
+        self.work.par_iter_mut().zip(self.chains.chains.par_iter()).try_for_each(|(work, chain)| {
+            work.load(chain, inputs);
+            work.system
+                .assemble(dt, theta)
+                .map_err(|row| SingularFibre { particle: chain.points[(row / 4).min(chain.points.len() - 1)] })?;
             let FibreWork { system, step: displacement, tension, deficit, rhs, .. } = work;
             for (m, &p) in chain.points.iter().enumerate() {
                 let gamma = system.drag[m];
@@ -252,12 +266,14 @@ impl Fibres {
             }
             let lengths = chain.is_constrained().then_some(&deficit[..]);
             system.solve(|m| rhs[m], lengths, displacement, tension);
-        });
+            Ok(())
+        })?;
         for (work, chain) in self.work.iter().zip(&self.chains.chains) {
             for (m, &p) in chain.points.iter().enumerate() {
                 out[p as usize] = work.step[m];
             }
         }
+        Ok(())
     }
 
     /// Whether particle `i` is a point of a fibre.
