@@ -68,29 +68,19 @@ impl Simulation {
     pub(super) fn with_thermo_inputs<R>(&mut self, read: impl FnOnce(&Thermo, &ThermoInputs) -> R) -> Result<R, RunError> {
         self.ensure_forces()?;
         let context = self.step_context();
-        let min_contact_distance = self.min_contact_distance();
         let Simulation { backend, model, state, sim_box, outputs, kinetics, reports, constraints, settings, .. } = self;
         let Backends { cpu, forces, .. } = backend;
         let backend: &CpuBackend = cpu.get(model, state, sim_box, settings.neighbor.skin)?;
-        let (bond_tension, _) = backend.bond_tension_and_length();
         let inputs = ThermoInputs {
             model,
-            bonds: state.bonds.as_ref(),
-            bond_tension,
-            kinetics: &kinetics.engine,
-            forces,
-            n_particles: model.len(),
-            context,
-            volume: sim_box.volume(),
-            neighbor_builds: backend.neighbor_builds(),
-            solve: reports.last_solve,
-            constraints,
-            positions: &state.positions,
-            images: sim_box.images(),
-            backend,
             state,
             sim_box,
-            min_contact_distance,
+            backend,
+            forces,
+            context,
+            kinetics: &kinetics.engine,
+            solve: reports.last_solve,
+            constraints,
             contact_clamps: reports.contact_clamps,
         };
         Ok(read(&outputs.thermo, &inputs))
