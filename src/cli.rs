@@ -516,7 +516,7 @@ fn profile_gpu(plan: &crate::deck::Plan, repetitions: u32, rebuild_rate: Option<
             true => GpuBackend::with_device_kinetics(&context, &sim.model, &sim.state, &sim.sim_box, &settings, &[])?,
             false => GpuBackend::new(&context, &sim.model, &sim.state, &sim.sim_box, &settings)?,
         };
-        if let crate::integrate::Integrator::Implicit(_, implicit) = &sim.integrator {
+        if let crate::integrate::Integrator::Implicit(_, implicit) = &sim.settings.integrator {
             gpu.step_implicitly(&context, &sim.model, &settings, implicit, &constrained)?;
         }
         if !constrained.is_empty() {

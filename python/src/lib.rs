@@ -289,7 +289,7 @@ impl PySimulation {
     /// Whether the last minimisation converged (None before any).
     #[getter]
     fn minimize_converged(&self) -> Option<bool> {
-        self.sim.last_minimize.as_ref().map(|r| r.converged)
+        self.sim.reports.last_minimize.as_ref().map(|r| r.converged)
     }
 
     /// Steps taken since the deck started.

@@ -129,6 +129,34 @@ pub struct CollagenArgs {
     /// Longest bond along a fibre (µm): fibres are split between crosslinks into bonds no longer than this.
     #[arg(allow_negative_numbers = true, long)]
     pub node_spacing: f64,
+    #[command(flatten)]
+    pub types: CollagenTypes,
+    #[command(flatten)]
+    pub common: Common,
+}
+
+impl Default for CollagenArgs {
+    fn default() -> Self {
+        Self {
+            layout: CellLayout::Pair,
+            cells: None,
+            separation: 60.0,
+            cell_radius: 10.0,
+            ring_nodes: 83,
+            size: vec![120.0, 80.0],
+            density: 0.6,
+            fibre_length: 20.0,
+            node_spacing: 3.0,
+            types: CollagenTypes::default(),
+            common: Common { seed: 1, output: "collagen.top".into(), rest_from_geometry: false },
+        }
+    }
+}
+
+/// The particle, bond and angle types of `cellmd build collagen`'s fibre
+/// nodes, anchors, cell rings, hubs, fibres, cortices, spokes and bends.
+#[derive(clap::Args, Clone, Debug)]
+pub struct CollagenTypes {
     /// Particle type of the fibre nodes (crosslinks and the nodes between them).
     #[arg(long, default_value = "node")]
     pub node_type: String,
@@ -153,22 +181,11 @@ pub struct CollagenArgs {
     /// Angle type along each fibre where it runs straight (bending; vertex in the middle).
     #[arg(long, default_value = "bend")]
     pub angle_type: String,
-    #[command(flatten)]
-    pub common: Common,
 }
 
-impl Default for CollagenArgs {
+impl Default for CollagenTypes {
     fn default() -> Self {
         Self {
-            layout: CellLayout::Pair,
-            cells: None,
-            separation: 60.0,
-            cell_radius: 10.0,
-            ring_nodes: 83,
-            size: vec![120.0, 80.0],
-            density: 0.6,
-            fibre_length: 20.0,
-            node_spacing: 3.0,
             node_type: "node".into(),
             anchor_type: "anchor".into(),
             ring_type: "ring".into(),
@@ -177,7 +194,6 @@ impl Default for CollagenArgs {
             cortex_bond_type: "cortex".into(),
             spoke_bond_type: "spoke".into(),
             angle_type: "bend".into(),
-            common: Common { seed: 1, output: "collagen.top".into(), rest_from_geometry: false },
         }
     }
 }
@@ -417,21 +433,21 @@ pub fn collagen(a: &CollagenArgs) -> Result<Built, String> {
     // Write: per cell its hub and ring, then the network nodes.
     let mut wr = Writer::new(1);
     wr.set_rest_from_geometry(a.common.rest_from_geometry);
-    wr.set_own_rest(&a.fibre_bond_type);
+    wr.set_own_rest(&a.types.fibre_bond_type);
     let at = |x: DVec2| DVec3::new(x.x, x.y, 0.0);
     let mut id = vec![0u64; g.nodes.len()];
     let mut hubs = Vec::new();
     for (c, &centre) in cells.iter().enumerate() {
-        hubs.push(wr.particle(&a.hub_type, at(centre), None));
+        hubs.push(wr.particle(&a.types.hub_type, at(centre), None));
         for k in 0..n_ring {
-            id[c * n_ring + k] = wr.particle(&a.ring_type, at(g.nodes[c * n_ring + k].0), None);
+            id[c * n_ring + k] = wr.particle(&a.types.ring_type, at(g.nodes[c * n_ring + k].0), None);
         }
     }
     let (mut nodes, mut anchors) = (0, 0);
     for (k, &(x, kind)) in g.nodes.iter().enumerate().skip(cells.len() * n_ring) {
         if keep[k] {
             let anchor = kind == Kind::Anchor;
-            id[k] = wr.particle(if anchor { &a.anchor_type } else { &a.node_type }, at(x), None);
+            id[k] = wr.particle(if anchor { &a.types.anchor_type } else { &a.types.node_type }, at(x), None);
             (nodes, anchors) = (nodes + usize::from(!anchor), anchors + usize::from(anchor));
         }
     }
@@ -439,22 +455,22 @@ pub fn collagen(a: &CollagenArgs) -> Result<Built, String> {
     for c in 0..cells.len() {
         let ring = &id[c * n_ring..(c + 1) * n_ring];
         for k in 0..n_ring {
-            wr.bond(&a.cortex_bond_type, ring[k], ring[(k + 1) % n_ring]);
+            wr.bond(&a.types.cortex_bond_type, ring[k], ring[(k + 1) % n_ring]);
         }
     }
     for c in 0..cells.len() {
         for k in 0..n_ring {
-            wr.bond(&a.spoke_bond_type, hubs[c], id[c * n_ring + k]);
+            wr.bond(&a.types.spoke_bond_type, hubs[c], id[c * n_ring + k]);
         }
     }
     let mut lengths = Vec::new();
     for (&[p, q], _) in g.edges.iter().zip(&keep_edge).filter(|(_, &k)| k) {
         lengths.push((g.nodes[q].0 - g.nodes[p].0).length());
-        wr.bond(&a.fibre_bond_type, id[p], id[q]);
+        wr.bond(&a.types.fibre_bond_type, id[p], id[q]);
     }
     let mut angles = 0;
     for t in g.angles.iter().filter(|t| t.iter().all(|&k| keep[k])) {
-        wr.angle(&a.angle_type, id[t[0]], id[t[1]], id[t[2]]);
+        wr.angle(&a.types.angle_type, id[t[0]], id[t[1]], id[t[2]]);
         angles += 1;
     }
     let attached = g.edges.iter().zip(&keep_edge).filter(|(e, &k)| k && e.iter().any(|&v| g.nodes[v].1 == Kind::Ring)).count();
@@ -470,10 +486,10 @@ pub fn collagen(a: &CollagenArgs) -> Result<Built, String> {
         ),
         format!(
             "each cell a hub `{}` and a ring of {n_ring} nodes `{}`: cortex `{}` length {cortex:.12e}, spoke `{}` length {r:.12e} (for r0); cell c (from 0) has ids c·{} + 1 (hub) … (c + 1)·{}",
-            a.hub_type,
-            a.ring_type,
-            a.cortex_bond_type,
-            a.spoke_bond_type,
+            a.types.hub_type,
+            a.types.ring_type,
+            a.types.cortex_bond_type,
+            a.types.spoke_bond_type,
             n_ring + 1,
             n_ring + 1
         ),
@@ -483,14 +499,14 @@ pub fn collagen(a: &CollagenArgs) -> Result<Built, String> {
         ),
         format!(
             "network as written: {nodes} nodes `{}`, {anchors} anchors `{}` at the edge, {} fibre bonds `{}` ({attached} attached to rings), fibre length per area outside the holes {:.6e} µm⁻¹",
-            a.node_type,
-            a.anchor_type,
+            a.types.node_type,
+            a.types.anchor_type,
             lengths.len(),
-            a.fibre_bond_type,
+            a.types.fibre_bond_type,
             lengths.iter().sum::<f64>() / area
         ),
         format!("fibre bond length min {lo:.6e} mean {mean:.6e} max {hi:.6e} (node spacing {ell:?}); each fibre bond line ends with its own r0"),
-        format!("{angles} angles `{}` along the fibres, at every node where a fibre runs straight on (θ = 180° as built)", a.angle_type),
+        format!("{angles} angles `{}` along the fibres, at every node where a fibre runs straight on (θ = 180° as built)", a.types.angle_type),
     ];
     let title =
         format!("Collagen network: {} cells, fibres of length {len:?} at density {rho:?} µm⁻¹, seed {}", cells.len(), a.common.seed);

@@ -142,24 +142,8 @@ pub struct TensegrityArgs {
     /// Cables per stress fibre (with one bead fewer between them).
     #[arg(long, default_value_t = 4)]
     pub fibre_segments: u32,
-    /// Bond type of the microtubule struts.
-    #[arg(long, default_value = "microtubule")]
-    pub strut_type: String,
-    /// Bond type of the actin cables from cortex to nucleus.
-    #[arg(long, default_value = "actin")]
-    pub cable_type: String,
-    /// Bond type of the stress-fibre cables.
-    #[arg(long, default_value = "stress_fibre")]
-    pub stress_fibre_type: String,
-    /// Particle type of the beads inside stress fibres.
-    #[arg(long, default_value = "fibre_bead")]
-    pub fibre_bead_type: String,
-    /// Particle type of the focal adhesions.
-    #[arg(long, default_value = "focal_adhesion")]
-    pub adhesion_type: String,
-    /// Particle type of the centrosome node (without --nucleus).
-    #[arg(long, default_value = "centrosome")]
-    pub centrosome_type: String,
+    #[command(flatten)]
+    pub types: TensegrityTypes,
     // `--substrate flat|R` and its options: a rigid substrate under the cell.
     #[command(flatten)]
     pub substrate: SubstrateOptions,
@@ -182,15 +166,47 @@ impl Default for TensegrityArgs {
             spread: None,
             focal_adhesions: 0,
             fibre_segments: 4,
+            types: TensegrityTypes::default(),
+            substrate: SubstrateOptions::default(),
+            box_half_width: None,
+            common: Common { seed: 1, output: "tensegrity.top".into(), rest_from_geometry: false },
+        }
+    }
+}
+
+/// The bond and particle types of `cellmd build tensegrity`'s struts, cables,
+/// stress fibres, focal adhesions and centrosome.
+#[derive(clap::Args, Clone, Debug)]
+pub struct TensegrityTypes {
+    /// Bond type of the microtubule struts.
+    #[arg(long, default_value = "microtubule")]
+    pub strut_type: String,
+    /// Bond type of the actin cables from cortex to nucleus.
+    #[arg(long, default_value = "actin")]
+    pub cable_type: String,
+    /// Bond type of the stress-fibre cables.
+    #[arg(long, default_value = "stress_fibre")]
+    pub stress_fibre_type: String,
+    /// Particle type of the beads inside stress fibres.
+    #[arg(long, default_value = "fibre_bead")]
+    pub fibre_bead_type: String,
+    /// Particle type of the focal adhesions.
+    #[arg(long, default_value = "focal_adhesion")]
+    pub adhesion_type: String,
+    /// Particle type of the centrosome node (without --nucleus).
+    #[arg(long, default_value = "centrosome")]
+    pub centrosome_type: String,
+}
+
+impl Default for TensegrityTypes {
+    fn default() -> Self {
+        Self {
             strut_type: "microtubule".into(),
             cable_type: "actin".into(),
             stress_fibre_type: "stress_fibre".into(),
             fibre_bead_type: "fibre_bead".into(),
             adhesion_type: "focal_adhesion".into(),
             centrosome_type: "centrosome".into(),
-            substrate: SubstrateOptions::default(),
-            box_half_width: None,
-            common: Common { seed: 1, output: "tensegrity.top".into(), rest_from_geometry: false },
         }
     }
 }
@@ -293,8 +309,8 @@ pub fn tensegrity(a: &TensegrityArgs) -> Result<Built, String> {
             (first..first + rays as u64).collect()
         }
         None => {
-            lines.push(format!("no nucleus: the rays meet at a centrosome node `{}` at the centre", a.centrosome_type));
-            vec![w.particle(&a.centrosome_type, centre, None); rays]
+            lines.push(format!("no nucleus: the rays meet at a centrosome node `{}` at the centre", a.types.centrosome_type));
+            vec![w.particle(&a.types.centrosome_type, centre, None); rays]
         }
     };
     let length = radius - nucleus.as_ref().map_or(0.0, |n| n.radius);
@@ -302,16 +318,16 @@ pub fn tensegrity(a: &TensegrityArgs) -> Result<Built, String> {
     for k in 0..rays {
         let outer = k as u64 + 1;
         if strut[k] {
-            w.bond(&a.strut_type, inner[k], outer);
+            w.bond(&a.types.strut_type, inner[k], outer);
         }
         if fibre[k] {
-            w.set_type(outer, &a.adhesion_type);
+            w.set_type(outer, &a.types.adhesion_type);
             let (from, to) = (w.position(outer), w.position(inner[k]));
             let mut chain = vec![outer];
-            chain.extend((1..m).map(|s| w.particle(&a.fibre_bead_type, from.lerp(to, s as f64 / m as f64), None)));
+            chain.extend((1..m).map(|s| w.particle(&a.types.fibre_bead_type, from.lerp(to, s as f64 / m as f64), None)));
             chain.push(inner[k]);
             for pair in chain.windows(2) {
-                w.bond(&a.stress_fibre_type, pair[0], pair[1]);
+                w.bond(&a.types.stress_fibre_type, pair[0], pair[1]);
             }
         }
     }
@@ -322,7 +338,7 @@ pub fn tensegrity(a: &TensegrityArgs) -> Result<Built, String> {
             for (outer, towards_inner) in [(i, j), (j, i)] {
                 let (x, y) = (outer as u64 + 1, inner[towards_inner]);
                 actin.push((w.position(y) - w.position(x)).length());
-                w.bond(&a.cable_type, x, y);
+                w.bond(&a.types.cable_type, x, y);
             }
         }
     }
@@ -333,17 +349,17 @@ pub fn tensegrity(a: &TensegrityArgs) -> Result<Built, String> {
     }
     lines.push(format!(
         "radial elements of length L = {length:?} (r0): {struts} microtubule struts `{}`, {adhesions} stress fibres `{}` of {m} cables of L/{m} = {:?} (r0) from the focal adhesions `{}` (the {adhesions} cortex nodes lowest in z)",
-        a.strut_type,
-        a.stress_fibre_type,
+        a.types.strut_type,
+        a.types.stress_fibre_type,
         length / m as f64,
-        a.adhesion_type
+        a.types.adhesion_type
     ));
     if !actin.is_empty() {
         let [lo, mean, hi] = min_mean_max(&actin);
         lines.push(format!(
             "{} actin cables `{}` from each cortex node to the nucleus nodes of its neighbours' rays: length min {lo:.6e} mean {mean:.6e} max {hi:.6e} (for r0)",
             actin.len(),
-            a.cable_type
+            a.types.cable_type
         ));
     }
     let struts_cos: Vec<f64> = (0..rays).filter(|&k| strut[k]).map(|k| unit[k].dot(towards)).collect();
@@ -358,7 +374,7 @@ pub fn tensegrity(a: &TensegrityArgs) -> Result<Built, String> {
     ));
     lines.push(format!(
         "self-stress: cables (`{}`, `{}`, `{}`) with pre-strain tau > 0 put the struts `{}` (spring law) in compression",
-        a.shell.bond_type, a.cable_type, a.stress_fibre_type, a.strut_type
+        a.shell.bond_type, a.types.cable_type, a.types.stress_fibre_type, a.types.strut_type
     ));
     let title = format!("Tensegrity cell: radius {radius:?}, icosphere level {}, seed {}", a.level, a.common.seed);
     Ok(w.finish(&title, "tensegrity", lines))

@@ -59,7 +59,7 @@ fn snapshot(sim: &mut Simulation) -> Result<Snapshot, String> {
     sim.current_forces().map_err(|e| e.to_string())?;
     let mut order: Vec<usize> = (0..sim.model.len()).collect();
     order.sort_by_key(|&i| sim.model.ids[i]);
-    let f = &sim.forces;
+    let f = &sim.backend.forces;
     let energies = REGISTRY
         .iter()
         .enumerate()

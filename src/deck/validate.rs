@@ -35,36 +35,58 @@ pub use self::commands::{command_docs, CommandDoc};
 pub(super) struct Validator {
     deck_dir: PathBuf,
     pub(super) vars: Variables,
-    units: UnitSystem,
-    /// Shared, as the system below: a branch is validated on a copy of the
-    /// validator, which must not copy a 10⁵-term system each time.
-    topology: Option<Arc<Topology>>,
-    forcefield: ForceField,
-    forcefield_seen: bool,
-    box_axes: Option<[BoxAxis; 3]>,
-    special_bonds: SpecialBonds,
+    /// The setup commands seen so far.
+    setup: Setup,
     /// The system as first built (the plan's starting point).
-    initial_model: Option<Arc<Model>>,
+    initial: Initial,
     /// A working copy that `coeff` edits, so each edit is validated against
     /// the parameter values in force at that point of the deck.
     model: Option<Model>,
-    positions: Vec<DVec3>,
-    sim_box: Option<SimBox>,
     groups: HashMap<String, Group>,
-    dumps: HashMap<String, PathBuf>,
-    /// Every output file named so far, by kind (one file, one writer).
-    output_names: output_names::OutputNames,
+    /// The output files named so far.
+    outputs: Outputs,
     externals: HashSet<String>,
-    states_written: HashSet<PathBuf>,
     timestep_set: bool,
     pub(super) actions: Vec<Action>,
-    allow_outside: bool,
     /// Ramps waiting for a run, moving and frozen groups, reset rest lengths.
     protocols: protocols::Protocols,
     pub(super) control: ControlState,
     /// The last command validated (where a deck-level error is reported).
     pub(super) last: Option<Token>,
     warnings: Vec<String>,
+}
+
+/// The setup commands seen so far (`units`, `topology`, `forcefield`,
+/// `box`, `special_bonds`), from which the system is built at its first use.
+#[derive(Clone)]
+struct Setup {
+    units: UnitSystem,
+    /// Shared, as the system built from it: a branch is validated on a copy
+    /// of the validator, which must not copy a 10⁵-term system each time.
+    topology: Option<Arc<Topology>>,
+    forcefield: ForceField,
+    forcefield_seen: bool,
+    box_axes: Option<[BoxAxis; 3]>,
+    special_bonds: SpecialBonds,
+}
+
+/// The system as first built: the plan's model, positions and box.
+#[derive(Clone, Default)]
+struct Initial {
+    model: Option<Arc<Model>>,
+    positions: Vec<DVec3>,
+    sim_box: Option<SimBox>,
+}
+
+/// The output files the deck names: which paths it may write, its open
+/// dumps, every output file by kind, and the states it writes.
+#[derive(Clone)]
+struct Outputs {
+    allow_outside: bool,
+    dumps: HashMap<String, PathBuf>,
+    /// Every output file named so far, by kind (one file, one writer).
+    names: output_names::OutputNames,
+    states_written: HashSet<PathBuf>,
 }
 
 /// How a deck is validated.
@@ -146,31 +168,9 @@ impl Validator {
         }
     }
 
-    /// An output path (relative to the output directory): refused when it
-    /// would leave that directory, unless outside paths are allowed.
-    fn output_file(&self, token: &Token) -> Result<PathBuf, InputError> {
-        let path = PathBuf::from(&token.text);
-        let escapes = path.is_absolute() || path.components().any(|c| matches!(c, std::path::Component::ParentDir));
-        if escapes && !self.allow_outside {
-            return Err(token.error(format!(
-                "found output path `{}` outside the output directory; expected a relative path without `..` \
-                 (or `cellmd run --allow-outside`)",
-                token.text
-            )));
-        }
-        Ok(path)
-    }
-
-    /// [`Self::output_file`], claimed for a writer of `kind` (see `output_names`).
-    fn output_of(&mut self, token: &Token, kind: output_names::OutputKind) -> Result<PathBuf, InputError> {
-        let path = self.output_file(token)?;
-        self.output_names.claim(token, &path, kind)?;
-        Ok(path)
-    }
-
     /// The output names `other` (a copy that validated a branch) claimed.
     pub(super) fn take_output_names(&mut self, other: &Validator) {
-        self.output_names = other.output_names.clone();
+        self.outputs.names = other.outputs.names.clone();
     }
 
     /// The group a token names (`all` or one a `group` command defined before).
@@ -183,34 +183,62 @@ impl Validator {
     /// The model, built on first use from the setup commands seen so far.
     pub(super) fn model(&mut self, at: &Token) -> Result<&mut Model, InputError> {
         if self.model.is_none() {
-            let topology = self
-                .topology
-                .as_ref()
-                .ok_or_else(|| at.error(format!("`{}` needs a system; expected a `topology FILE` command before it", at.text)))?;
-            if !self.forcefield_seen {
-                return Err(at.error(format!("`{}` needs a force field; expected a `forcefield FILE` command before it", at.text)));
-            }
-            let axes = self.box_axes.clone().or_else(|| topology.box_axes.clone()).ok_or_else(|| {
-                at.error(format!(
-                    "no simulation box: expected a `box` command before `{}` or a [ box ] section in {}",
-                    at.text, topology.path
-                ))
-            })?;
-            let sim_box = SimBox::new(
-                DVec3::new(axes[0].lo, axes[1].lo, axes[2].lo),
-                DVec3::new(axes[0].hi, axes[1].hi, axes[2].hi),
-                [axes[0].periodic, axes[1].periodic, axes[2].periodic],
-            );
-            let model = Model::build(topology, &self.forcefield, self.units, self.special_bonds)?;
-            check_placement(topology, &model, &sim_box)?;
-            check_outward(&model, topology, &sim_box)?;
-            self.positions = topology.positions.clone();
-            self.sim_box = Some(sim_box);
+            let (model, positions, sim_box) = self.setup.build(at)?;
+            self.initial = Initial { model: Some(Arc::new(model.clone())), positions, sim_box: Some(sim_box) };
             self.groups.insert("all".into(), Group { name: "all".into(), members: (0..model.len() as u32).collect() });
-            self.initial_model = Some(Arc::new(model.clone()));
             self.model = Some(model);
         }
         Ok(self.model.as_mut().unwrap())
+    }
+}
+
+impl Setup {
+    /// The system the setup commands define (the model, its positions and
+    /// box), checked; `at` is the command that first needs it.
+    fn build(&self, at: &Token) -> Result<(Model, Vec<DVec3>, SimBox), InputError> {
+        let topology = self
+            .topology
+            .as_ref()
+            .ok_or_else(|| at.error(format!("`{}` needs a system; expected a `topology FILE` command before it", at.text)))?;
+        if !self.forcefield_seen {
+            return Err(at.error(format!("`{}` needs a force field; expected a `forcefield FILE` command before it", at.text)));
+        }
+        let axes = self.box_axes.clone().or_else(|| topology.box_axes.clone()).ok_or_else(|| {
+            at.error(format!("no simulation box: expected a `box` command before `{}` or a [ box ] section in {}", at.text, topology.path))
+        })?;
+        let sim_box = SimBox::new(
+            DVec3::new(axes[0].lo, axes[1].lo, axes[2].lo),
+            DVec3::new(axes[0].hi, axes[1].hi, axes[2].hi),
+            [axes[0].periodic, axes[1].periodic, axes[2].periodic],
+        );
+        let model = Model::build(topology, &self.forcefield, self.units, self.special_bonds)?;
+        check_placement(topology, &model, &sim_box)?;
+        check_outward(&model, topology, &sim_box)?;
+        Ok((model, topology.positions.clone(), sim_box))
+    }
+}
+
+impl Outputs {
+    /// An output path (relative to the output directory): refused when it
+    /// would leave that directory, unless outside paths are allowed.
+    fn file(&self, token: &Token) -> Result<PathBuf, InputError> {
+        let path = PathBuf::from(&token.text);
+        let escapes = path.is_absolute() || path.components().any(|c| matches!(c, std::path::Component::ParentDir));
+        if escapes && !self.allow_outside {
+            return Err(token.error(format!(
+                "found output path `{}` outside the output directory; expected a relative path without `..` \
+                 (or `cellmd run --allow-outside`)",
+                token.text
+            )));
+        }
+        Ok(path)
+    }
+
+    /// [`Self::file`], claimed for a writer of `kind` (see `output_names`).
+    fn claim(&mut self, token: &Token, kind: output_names::OutputKind) -> Result<PathBuf, InputError> {
+        let path = self.file(token)?;
+        self.names.claim(token, &path, kind)?;
+        Ok(path)
     }
 }
 
@@ -240,24 +268,24 @@ pub fn validate_with(
 
 /// Validates a deck with a fresh `v`, which then holds the deck's context.
 pub(super) fn validate_in(v: &mut Validator, file: &std::sync::Arc<SourceFile>) -> Result<Plan, InputError> {
-    v.output_names.reserve_for_deck(&file.path);
+    v.outputs.names.reserve_for_deck(&file.path);
     let last = v.statements(file)?;
     let Some(last) = last else {
         return Err(InputError::in_file(&file.path, "the deck is empty; expected at least `topology`, `forcefield`, `timestep` and `run`"));
     };
     v.model(&last)?;
     v.protocols.finish()?;
-    let model = v.initial_model.as_ref().expect("built above");
+    let model = v.initial.model.as_ref().expect("built above");
     let externals: Vec<_> = v.actions.iter().filter_map(|a| if let Action::External(e) = a { Some(e) } else { None }).collect();
-    let sim_box = v.sim_box.as_ref().expect("built with the model");
-    v.warnings.extend(crate::system::custom_warnings(model, &externals, &v.positions, sim_box));
+    let sim_box = v.initial.sim_box.as_ref().expect("built with the model");
+    v.warnings.extend(crate::system::custom_warnings(model, &externals, &v.initial.positions, sim_box));
     Ok(Plan {
         deck_path: PathBuf::from(&file.path),
-        model: Arc::unwrap_or_clone(v.initial_model.take().expect("built above")),
-        sim_box: v.sim_box.expect("built with the model"),
+        model: Arc::unwrap_or_clone(v.initial.model.take().expect("built above")),
+        sim_box: v.initial.sim_box.expect("built with the model"),
         // Kept by the validator too: commands validated later (an `OpenDeck`) check
         // expressions at the initial positions.
-        positions: v.positions.clone(),
+        positions: v.initial.positions.clone(),
         actions: std::mem::take(&mut v.actions),
         inputs: DeckInputs::default(),
         warnings: std::mem::take(&mut v.warnings),
@@ -269,24 +297,26 @@ impl Validator {
         Validator {
             deck_dir: deck_dir.to_path_buf(),
             vars: Variables::with_overrides(overrides),
-            units: UnitSystem::Cell,
-            topology: None,
-            forcefield: ForceField::default(),
-            forcefield_seen: false,
-            box_axes: None,
-            special_bonds: SpecialBonds::default(),
-            initial_model: None,
+            setup: Setup {
+                units: UnitSystem::Cell,
+                topology: None,
+                forcefield: ForceField::default(),
+                forcefield_seen: false,
+                box_axes: None,
+                special_bonds: SpecialBonds::default(),
+            },
+            initial: Initial::default(),
             model: None,
-            positions: Vec::new(),
-            sim_box: None,
             groups: HashMap::new(),
-            dumps: HashMap::new(),
-            output_names: Default::default(),
+            outputs: Outputs {
+                allow_outside: options.allow_outside,
+                dumps: HashMap::new(),
+                names: Default::default(),
+                states_written: HashSet::new(),
+            },
             externals: HashSet::new(),
-            states_written: HashSet::new(),
             timestep_set: false,
             actions: Vec::new(),
-            allow_outside: options.allow_outside,
             protocols: protocols::Protocols::default(),
             control: ControlState::default(),
             last: None,

@@ -315,13 +315,17 @@ enum Solve {
     Split(SplitSolve),
 }
 
+/// A per-term block kernel of the implicit step and the terms it runs over.
+struct TermBlocks {
+    kernel: wgpu::ComputePipeline,
+    count: u32,
+}
+
 /// The device's implicit solver: its buffers, bind group (group 1) and kernels.
 pub(super) struct ImplicitSolver {
     pub(super) group: wgpu::BindGroup,
-    angles: wgpu::ComputePipeline,
-    tetras: wgpu::ComputePipeline,
-    faces: wgpu::ComputePipeline,
-    nodes: wgpu::ComputePipeline,
+    /// The block kernels of the angles, volume elements, faces and curvature nodes.
+    terms: [TermBlocks; 4],
     blocks: wgpu::ComputePipeline,
     solve: Solve,
     moves: wgpu::ComputePipeline,
@@ -331,10 +335,6 @@ pub(super) struct ImplicitSolver {
     particles: u32,
     /// Curvature nodes and bodies of the surface terms (the split solve's body dots).
     body_items: u32,
-    angle_count: u32,
-    tetra_count: u32,
-    face_count: u32,
-    node_count: u32,
     /// Constrained bonds, and the byte offset of their entries in `imp`.
     pub(super) constraints: usize,
     pub(super) constraints_at: u64,
@@ -458,10 +458,13 @@ impl ImplicitSolver {
             Solve::One(side.pipeline(ctx, if constrained.is_empty() { "implicit_solve" } else { "implicit_solve_constrained" }))
         };
         Ok(Self {
-            angles: side.pipeline(ctx, "implicit_angles"),
-            tetras: side.pipeline(ctx, "implicit_tetras"),
-            faces: side.pipeline(ctx, "implicit_faces"),
-            nodes: side.pipeline(ctx, "implicit_nodes"),
+            terms: [
+                ("implicit_angles", model.angles.len()),
+                ("implicit_tetras", model.tetras.len()),
+                ("implicit_faces", faces),
+                ("implicit_nodes", body_nodes),
+            ]
+            .map(|(kernel, count)| TermBlocks { kernel: side.pipeline(ctx, kernel), count: count as u32 }),
             blocks: side.pipeline(ctx, "implicit_blocks"),
             solve,
             moves: side.pipeline(ctx, "implicit_move"),
@@ -470,10 +473,6 @@ impl ImplicitSolver {
             report_at: 16 * report as u64,
             particles: n as u32,
             body_items: body_nodes.max(bodies) as u32,
-            angle_count: model.angles.len() as u32,
-            tetra_count: model.tetras.len() as u32,
-            face_count: faces as u32,
-            node_count: body_nodes as u32,
             constraints: constrained.len(),
             constraints_at: 16 * (report + 1) as u64,
             tolerance,
@@ -486,14 +485,7 @@ impl ImplicitSolver {
     /// curvature nodes), the per-particle blocks, the solve and the move.
     pub(super) fn step_passes(&self) -> Vec<(&wgpu::ComputePipeline, u32)> {
         let particles = self.particles.div_ceil(WORKGROUP);
-        let terms = [
-            (&self.angles, self.angle_count),
-            (&self.tetras, self.tetra_count),
-            (&self.faces, self.face_count),
-            (&self.nodes, self.node_count),
-        ];
-        let mut passes: Vec<_> =
-            terms.into_iter().filter(|&(_, count)| count > 0).map(|(kernel, count)| (kernel, count.div_ceil(WORKGROUP))).collect();
+        let mut passes: Vec<_> = self.terms.iter().filter(|t| t.count > 0).map(|t| (&t.kernel, t.count.div_ceil(WORKGROUP))).collect();
         passes.push((&self.blocks, particles));
         match &self.solve {
             Solve::One(kernel) => passes.push((kernel, 1)),

@@ -37,35 +37,15 @@ use crate::system::{Model, SimBox};
 
 pub use super::prelude::pack::PARAM_SLOTS;
 
-/// The uniform block (must match `Params` in layout.wgsl).
+/// The uniform block (must match `Params` in layout.wgsl, which names the
+/// words of each group below one by one, in the same order: the
+/// `params_match_the_wgsl_layout` test checks the sizes and offsets).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct Params {
-    pub box_len_h: [u32; 4],
-    pub box_len_f: [u32; 4],
-    pub box_lo_h: [u32; 4],
-    pub box_lo_f: [u32; 4],
-    pub periodic: [u32; 4],
-    pub grid: [u32; 4],
-    pub cell_inv_width: [f32; 4],
-    pub box_len: [f32; 4],
-    pub n: u32,
-    pub nlist_cap: u32,
-    pub n_types: u32,
-    pub steps_wanted: u32,
-    pub range2: f32,
-    pub half_skin2: f32,
-    pub max_disp2: f32,
-    pub neighbor_every: u32,
-    pub seed_lo: u32,
-    pub seed_hi: u32,
-    pub step_lo: u32,
-    pub step_hi: u32,
-    pub neighbor_check: u32,
-    pub scan_blocks: u32,
-    pub groups_x: u32,
-    /// 1 for `noise gaussian`.
-    pub gaussian: u32,
+    pub frame: BoxFrame,
+    pub sizes: Sizes,
+    pub step: StepWords,
     /// Offsets of the `topo` sections, in layout.wgsl's order (the last: of
     /// the term scales in `fparams`).
     pub topo_offsets: [u32; 12],
@@ -77,11 +57,7 @@ pub struct Params {
     pub surface_offsets: [u32; 16],
     /// Node–face contact: layout.wgsl's `off_cfaces` … (src/gpu/contact.rs).
     pub contact: [u32; 16],
-    /// Bond kinetics on the device (src/gpu/kinetics.rs): its bonds, their first term, event capacity, bond types.
-    pub kin_bonds: u32,
-    pub kin_first_term: u32,
-    pub kin_capacity: u32,
-    pub kin_types: u32,
+    pub kinetics: KineticsWords,
     /// Volume elements (tetra.wgsl): `topo` elements, `fparams` rest shapes,
     /// `topo` slot CSR (offsets, slots), first `surf` slot, count, 2 × padding.
     pub tetra_offsets: [u32; 8],
@@ -93,6 +69,66 @@ pub struct Params {
     pub adhesion: [u32; 8],
     /// Protocols (protocol.wgsl): held words present, ramped slots, the ramp table's first step, `protocol` offsets, 2 × padding.
     pub protocol: [u32; 8],
+}
+
+/// The box and the cell grid of [`Params`]: edge lengths and lower corner
+/// in the 64-bit fixed point ([`FixedPoint`]: integer and fraction words),
+/// periodic axes, cells along x, y, z (w: in all), cells per unit length,
+/// and the edge lengths in f32 (w: the fixed-point unit q).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct BoxFrame {
+    pub box_len_h: [u32; 4],
+    pub box_len_f: [u32; 4],
+    pub box_lo_h: [u32; 4],
+    pub box_lo_f: [u32; 4],
+    pub periodic: [u32; 4],
+    pub grid: [u32; 4],
+    pub cell_inv_width: [f32; 4],
+    pub box_len: [f32; 4],
+}
+
+/// The sizes of [`Params`]: particles, neighbour-list capacity per particle,
+/// particle types, and the steps this call takes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct Sizes {
+    pub n: u32,
+    pub nlist_cap: u32,
+    pub n_types: u32,
+    pub steps_wanted: u32,
+}
+
+/// The step's words of [`Params`]: (cutoff + skin)², (skin/2)², max
+/// displacement², the neighbour list's `every`, the seed and the first
+/// step (low and high words), the list's `check`, scan blocks over cells,
+/// the dispatch width (workgroups along x) and 1 for `noise gaussian`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct StepWords {
+    pub range2: f32,
+    pub half_skin2: f32,
+    pub max_disp2: f32,
+    pub neighbor_every: u32,
+    pub seed_lo: u32,
+    pub seed_hi: u32,
+    pub step_lo: u32,
+    pub step_hi: u32,
+    pub neighbor_check: u32,
+    pub scan_blocks: u32,
+    pub groups_x: u32,
+    pub gaussian: u32,
+}
+
+/// Bond kinetics on the device of [`Params`] (src/gpu/kinetics.rs): its
+/// bonds, their first term, the event capacity and the bond types.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct KineticsWords {
+    pub kin_bonds: u32,
+    pub kin_first_term: u32,
+    pub kin_capacity: u32,
+    pub kin_types: u32,
 }
 
 /// The GPU's 64-bit fixed point (layout.wgsl): a length x is the integer
@@ -344,4 +380,67 @@ pub fn cell_grid(sim_box: &SimBox, range: f64, n: usize) -> ([u32; 3], [f32; 3])
     }
     let inv = [0, 1, 2].map(|a| if lengths[a] > 0.0 { (counts[a] as f64 / lengths[a]) as f32 } else { 0.0 });
     (counts, inv)
+}
+
+#[cfg(test)]
+mod tests {
+    use std::mem::{offset_of, size_of};
+
+    use super::*;
+
+    /// `Params` here and in layout.wgsl are the same bytes: the same size,
+    /// and each word of the Rust groups at the offset of the WGSL member of
+    /// its name (an array at the offset of the WGSL member that starts it).
+    #[test]
+    fn params_match_the_wgsl_layout() {
+        let module = naga::front::wgsl::parse_str(&super::super::shader::compose()).expect("the composed program parses");
+        let params = module.types.iter().find(|(_, t)| t.name.as_deref() == Some("Params")).expect("layout.wgsl declares Params");
+        let naga::TypeInner::Struct { members, span } = &params.1.inner else { panic!("Params is a struct") };
+        assert_eq!(*span as usize, size_of::<Params>(), "the sizes of Params in layout.wgsl and in Rust");
+        let (frame, sizes, step, kinetics) =
+            (offset_of!(Params, frame), offset_of!(Params, sizes), offset_of!(Params, step), offset_of!(Params, kinetics));
+        let words = [
+            ("box_len_h", frame + offset_of!(BoxFrame, box_len_h)),
+            ("box_len_f", frame + offset_of!(BoxFrame, box_len_f)),
+            ("box_lo_h", frame + offset_of!(BoxFrame, box_lo_h)),
+            ("box_lo_f", frame + offset_of!(BoxFrame, box_lo_f)),
+            ("periodic", frame + offset_of!(BoxFrame, periodic)),
+            ("grid", frame + offset_of!(BoxFrame, grid)),
+            ("cell_inv_width", frame + offset_of!(BoxFrame, cell_inv_width)),
+            ("box_len", frame + offset_of!(BoxFrame, box_len)),
+            ("n", sizes + offset_of!(Sizes, n)),
+            ("nlist_cap", sizes + offset_of!(Sizes, nlist_cap)),
+            ("n_types", sizes + offset_of!(Sizes, n_types)),
+            ("steps_wanted", sizes + offset_of!(Sizes, steps_wanted)),
+            ("range2", step + offset_of!(StepWords, range2)),
+            ("half_skin2", step + offset_of!(StepWords, half_skin2)),
+            ("max_disp2", step + offset_of!(StepWords, max_disp2)),
+            ("neighbor_every", step + offset_of!(StepWords, neighbor_every)),
+            ("seed_lo", step + offset_of!(StepWords, seed_lo)),
+            ("seed_hi", step + offset_of!(StepWords, seed_hi)),
+            ("step_lo", step + offset_of!(StepWords, step_lo)),
+            ("step_hi", step + offset_of!(StepWords, step_hi)),
+            ("neighbor_check", step + offset_of!(StepWords, neighbor_check)),
+            ("scan_blocks", step + offset_of!(StepWords, scan_blocks)),
+            ("groups_x", step + offset_of!(StepWords, groups_x)),
+            ("gaussian", step + offset_of!(StepWords, gaussian)),
+            ("off_term_kind", offset_of!(Params, topo_offsets)),
+            ("off_params", offset_of!(Params, fparam_offsets)),
+            ("off_faces", offset_of!(Params, surface_offsets)),
+            ("off_cfaces", offset_of!(Params, contact)),
+            ("kin_bonds", kinetics + offset_of!(KineticsWords, kin_bonds)),
+            ("kin_first_term", kinetics + offset_of!(KineticsWords, kin_first_term)),
+            ("kin_capacity", kinetics + offset_of!(KineticsWords, kin_capacity)),
+            ("kin_types", kinetics + offset_of!(KineticsWords, kin_types)),
+            ("off_tetras", offset_of!(Params, tetra_offsets)),
+            ("time_hi", offset_of!(Params, clock)),
+            ("off_special_offsets", offset_of!(Params, special_offsets)),
+            ("off_arule_start", offset_of!(Params, adhesion)),
+            ("protocol_held", offset_of!(Params, protocol)),
+        ];
+        for (name, offset) in words {
+            let member = members.iter().find(|m| m.name.as_deref() == Some(name)).unwrap_or_else(|| panic!("layout.wgsl has no `{name}`"));
+            assert_eq!(member.offset as usize, offset, "the offset of `{name}` in layout.wgsl and in Rust");
+        }
+    }
 }

@@ -71,11 +71,11 @@ impl Dispatcher<'_> {
     /// chunk bound (chunk 0 is bound again afterwards).
     pub(super) fn dispatch(&self, pass: &mut wgpu::ComputePass, pipeline: &wgpu::ComputePipeline, over: Over) {
         pass.set_pipeline(pipeline);
-        let width = self.params.groups_x;
+        let width = self.params.step.groups_x;
         let direct = |pass: &mut wgpu::ComputePass, groups: u32| pass.dispatch_workgroups(groups.min(width), groups.div_ceil(width), 1);
         match over {
             Over::Groups(groups) => direct(pass, groups),
-            Over::Particles => direct(pass, self.params.n.div_ceil(WORKGROUP)),
+            Over::Particles => direct(pass, self.params.sizes.n.div_ceil(WORKGROUP)),
             Over::Chunks => self.per_chunk(pass, |pass| direct(pass, self.list.per_chunk.div_ceil(WORKGROUP))),
         }
     }

@@ -177,29 +177,29 @@ fn mcap_err(e: mcap::McapError) -> io::Error {
 /// Writes an MCAP trajectory (see the module docs for the channels).
 pub struct McapWriter {
     sink: Sink,
-    channel_topology: u16,
-    channel_frame: u16,
-    channel_bond_state: u16,
-    channel_scene: u16,
-    channel_events: u16,
+    channels: Channels,
     /// Stamp of the previous frame (ns).
     last_frame_ns: Option<u64>,
     scene: Scene,
     scene_enabled: bool,
-    encoding: Encoding,
-    units: &'static str,
-    ids: Vec<u64>,
-    types: Vec<u32>,
-    type_names: Vec<String>,
-    type_radius: Vec<f64>,
-    bonds: Vec<[u32; 2]>,
-    angles: Vec<[u32; 3]>,
-    triangles: Vec<[u32; 3]>,
+    /// The `/topology` message, written with the first frame.
+    topology: proto::Topology,
 }
 
-/// The MCAP writer with per-channel sequence numbers and a reused buffer.
+/// The channel ids of the topics (see the module docs).
+struct Channels {
+    topology: u16,
+    frame: u16,
+    bond_state: u16,
+    scene: u16,
+    events: u16,
+}
+
+/// The MCAP writer with its message encoding, per-channel sequence numbers
+/// and a reused buffer.
 struct Sink {
     writer: mcap::Writer<RecordFile>,
+    encoding: Encoding,
     sequence: BTreeMap<u16, u32>,
     buffer: Vec<u8>,
     /// When the oldest message not yet in a written chunk was published.
@@ -207,10 +207,10 @@ struct Sink {
 }
 
 impl Sink {
-    /// Publishes `message` in `encoding`.
-    fn publish(&mut self, channel_id: u16, ns: u64, encoding: Encoding, message: &(impl prost::Message + JsonForm)) -> io::Result<()> {
+    /// Publishes `message` in the sink's encoding.
+    fn publish(&mut self, channel_id: u16, ns: u64, message: &(impl prost::Message + JsonForm)) -> io::Result<()> {
         self.buffer.clear();
-        match encoding {
+        match self.encoding {
             Encoding::Protobuf => message.encode(&mut self.buffer).map_err(io::Error::other)?,
             Encoding::Json => serde_json::to_writer(&mut self.buffer, &message.to_json()).map_err(io::Error::other)?,
         }
@@ -280,30 +280,23 @@ impl McapWriter {
                 [own[0], own[1], own[2], own[3], scene]
             }
         };
-        let [channel_topology, channel_frame, channel_bond_state, channel_events, channel_scene] = channels;
-        let mut sink = Sink { writer, sequence: BTreeMap::new(), buffer: Vec::new(), unwritten_since: None };
+        let [topology_channel, frame, bond_state, events, scene] = channels;
+        let mut sink = Sink { writer, encoding, sequence: BTreeMap::new(), buffer: Vec::new(), unwritten_since: None };
         // The header and a first chunk with the schemas and channels.
         sink.end_chunk()?;
         Ok(Self {
             sink,
-            channel_topology,
-            channel_frame,
-            channel_bond_state,
-            channel_scene,
-            channel_events,
+            channels: Channels { topology: topology_channel, frame, bond_state, scene, events },
             last_frame_ns: None,
             scene: Scene::new(topology),
             scene_enabled: true,
-            encoding,
-            units: units_keyword(topology.units),
-            ids: topology.ids.to_vec(),
-            types: topology.types.to_vec(),
-            type_names: topology.type_names.to_vec(),
-            type_radius: topology.type_radius.to_vec(),
-            bonds: topology.bonds.to_vec(),
-            angles: topology.angles.to_vec(),
-            triangles: topology.triangles.to_vec(),
+            topology: topology_message(topology),
         })
+    }
+
+    /// The number of bonds of the topology.
+    fn bond_count(&self) -> usize {
+        self.topology.bonds.len() / 2
     }
 
     /// Turns the `/scene` channel on (the default) or off for later frames.
@@ -317,41 +310,41 @@ impl McapWriter {
     /// calls this after each batch of binding/unbinding events. The stamp is
     /// `round(time·10⁹)` ns, not forced monotone.
     pub fn write_bond_state(&mut self, step: u64, time: f64, bound: &[bool]) -> io::Result<()> {
-        if bound.len() != self.bonds.len() {
-            return Err(invalid_input(format!("bond state at step {step} has {} flags for {} bonds", bound.len(), self.bonds.len())));
+        if bound.len() != self.bond_count() {
+            return Err(invalid_input(format!("bond state at step {step} has {} flags for {} bonds", bound.len(), self.bond_count())));
         }
         self.publish_bond_state(time_ns(time), step, time, bound)
     }
 
     fn publish_bond_state(&mut self, ns: u64, step: u64, time: f64, bound: &[bool]) -> io::Result<()> {
-        self.sink.publish(self.channel_bond_state, ns, self.encoding, &proto::BondState { step, time, bound: bound.to_vec() })
-    }
-
-    fn write_topology(&mut self, ns: u64) -> io::Result<()> {
-        let ids = &self.ids;
-        let message = proto::Topology {
-            units: self.units.to_string(),
-            ids: ids.clone(),
-            type_names: self.type_names.clone(),
-            types: self.types.clone(),
-            type_radius: self.type_radius.clone(),
-            radii: self.types.iter().map(|&t| self.type_radius.get(t as usize).copied().unwrap_or(0.0)).collect(),
-            bonds: self.bonds.iter().flat_map(|b| b.map(|i| ids[i as usize])).collect(),
-            angles: self.angles.iter().flat_map(|a| a.map(|i| ids[i as usize])).collect(),
-            triangles: self.triangles.iter().flat_map(|t| t.map(|i| ids[i as usize])).collect(),
-        };
-        self.sink.publish(self.channel_topology, ns, self.encoding, &message)
+        self.sink.publish(self.channels.bond_state, ns, &proto::BondState { step, time, bound: bound.to_vec() })
     }
 
     fn write_scene(&mut self, ns: u64, frame: &FrameView) -> io::Result<()> {
         let update = self.scene.update(frame, ns);
-        self.sink.publish(self.channel_scene, ns, self.encoding, &update)
+        self.sink.publish(self.channels.scene, ns, &update)
+    }
+}
+
+/// The `/topology` message of `topology` (its terms by particle id).
+fn topology_message(topology: &TopologyView) -> proto::Topology {
+    let ids = topology.ids;
+    proto::Topology {
+        units: units_keyword(topology.units).to_string(),
+        ids: ids.to_vec(),
+        type_names: topology.type_names.to_vec(),
+        types: topology.types.to_vec(),
+        type_radius: topology.type_radius.to_vec(),
+        radii: topology.types.iter().map(|&t| topology.type_radius.get(t as usize).copied().unwrap_or(0.0)).collect(),
+        bonds: topology.bonds.iter().flat_map(|b| b.map(|i| ids[i as usize])).collect(),
+        angles: topology.angles.iter().flat_map(|a| a.map(|i| ids[i as usize])).collect(),
+        triangles: topology.triangles.iter().flat_map(|t| t.map(|i| ids[i as usize])).collect(),
     }
 }
 
 impl TrajectoryWriter for McapWriter {
     fn write_frame(&mut self, frame: &FrameView) -> io::Result<()> {
-        check_frame(self.ids.len(), frame)?;
+        check_frame(self.topology.ids.len(), frame)?;
         let mut ns = time_ns(frame.time);
         let first = self.last_frame_ns.is_none();
         if let Some(last) = self.last_frame_ns {
@@ -361,8 +354,8 @@ impl TrajectoryWriter for McapWriter {
         }
         self.last_frame_ns = Some(ns);
         if first {
-            self.write_topology(ns)?;
-            let bound: Vec<bool> = (0..self.bonds.len()).map(|k| frame.is_bound(k)).collect();
+            self.sink.publish(self.channels.topology, ns, &self.topology)?;
+            let bound: Vec<bool> = (0..self.bond_count()).map(|k| frame.is_bound(k)).collect();
             self.publish_bond_state(ns, frame.step, frame.time, &bound)?;
         }
         let b = frame.sim_box;
@@ -373,7 +366,7 @@ impl TrajectoryWriter for McapWriter {
             positions: frame.positions.iter().flat_map(|x| x.to_array()).collect(),
             images: (0..frame.positions.len()).flat_map(|i| frame.images.get(i).copied().unwrap_or([0; 3])).collect(),
         };
-        self.sink.publish(self.channel_frame, ns, self.encoding, &message)?;
+        self.sink.publish(self.channels.frame, ns, &message)?;
         if self.scene_enabled {
             self.write_scene(ns, frame)?;
         }
@@ -384,8 +377,8 @@ impl TrajectoryWriter for McapWriter {
     fn write_bond_events(&mut self, events: &[crate::kinetics_engine::Event], bound: &[bool]) -> io::Result<()> {
         let Some(first) = events.first() else { return Ok(()) };
         let message = proto::BondEvents { step: first.step, time: first.time, events: events.iter().map(proto::BondEvent::from).collect() };
-        self.sink.publish(self.channel_events, time_ns(first.time), self.encoding, &message)?;
-        if bound.len() == self.bonds.len() {
+        self.sink.publish(self.channels.events, time_ns(first.time), &message)?;
+        if bound.len() == self.bond_count() {
             self.write_bond_state(first.step, first.time, bound)?;
         }
         Ok(())

@@ -9,5 +9,5 @@ mod stop;
 pub mod thermo;
 
 pub use self::blowup::{RunError, OUTPUT_ERROR_STATUS};
-pub use self::simulation::{ActiveRun, BondTable, RunOptions, Simulation};
+pub use self::simulation::{ActiveRun, Backends, BondTable, KineticsState, Reports, RunOptions, Settings, Simulation};
 pub use self::stop::{StopReason, StopSignal, STOPPED_STATUS};

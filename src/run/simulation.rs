@@ -1,6 +1,9 @@
 //! A live simulation: the actions of a plan applied to a system.
 //!
-//! [`Simulation`] orchestrates; each responsibility has its own file:
+//! [`Simulation`] orchestrates; its state is the system (model, state,
+//! box), the constraints, the protocols and the sub-states of `parts`
+//! (settings, backends, kinetics, reports, outputs, deck progress), and
+//! each responsibility has its own file:
 //! `step_loop` (the one loop of a `run` over a `Stepper`), `cpu_steps` and
 //! `gpu_steps` (the two steppers), `reference` (the CPU backend as the
 //! reference for forces, thermo and measurements), `outputs`, `restarts`
@@ -16,31 +19,29 @@ use super::blowup::RunError;
 use super::protocol::{reset_rest, Protocols};
 use super::stop::StopSignal;
 use super::thermo::Thermo;
-use crate::backend::Forces;
-use crate::deck::{Action, CoeffTarget, NeighborSettings, Plan, Protocol};
-use crate::gpu::{DevicePreference, GpuContext};
+use crate::deck::{Action, CoeffTarget, Plan, Protocol};
+use crate::gpu::DevicePreference;
 use crate::input::DeckInputs;
 use crate::integrate::constraints::{Constraint, Constraints};
-use crate::integrate::fire::FireReport;
-use crate::integrate::implicit::SolveReport;
-use crate::integrate::Integrator;
-use crate::kinetics_engine::{initial_bond_state, Formation, Kinetics};
+use crate::kinetics_engine::{initial_bond_state, Formation};
 use crate::output::open_writer;
 use crate::output::restart::{read_state, write_state, RestartData};
-use crate::output::run_log::{LogHeader, PhaseTimes, RunLog};
-use crate::output::{EventLog, LifetimeTable};
+use crate::output::run_log::LogHeader;
+use crate::output::EventLog;
 use crate::system::{Model, SimBox, State};
 
 mod cpu_steps;
 mod gpu_steps;
 mod outputs;
+mod parts;
 mod reference;
 mod restarts;
 mod step_loop;
 mod stepping;
 
 use self::outputs::ActiveDump;
-use self::reference::Reference;
+pub use self::parts::{Backends, KineticsState, Reports, Settings};
+use self::parts::{DeckProgress, Outputs};
 use self::restarts::{with_step, Checkpoints};
 pub use self::stepping::{ActiveRun, BondTable};
 
@@ -68,73 +69,46 @@ impl Default for RunOptions {
     }
 }
 
-/// A live simulation.
+impl RunOptions {
+    /// Prints `message` on stdout when the options echo (a closed stdout requests a stop).
+    fn say(&self, message: &str) {
+        if self.echo {
+            self.stop.say(message);
+        }
+    }
+
+    /// `path` resolved against the output directory.
+    fn output_path(&self, path: &Path) -> PathBuf {
+        if path.is_absolute() {
+            path.to_path_buf()
+        } else {
+            self.output_dir.join(path)
+        }
+    }
+}
+
+/// A live simulation: the system (model, state, box) and the sub-states of
+/// the run that steps it (src/run/simulation/parts.rs).
 pub struct Simulation {
     pub model: Model,
     pub state: State,
     pub sim_box: SimBox,
-    pub forces: Forces,
-    pub kt: f64,
-    pub dt: f64,
-    pub seed: u64,
-    pub integrator: Integrator,
-    pub neighbor: NeighborSettings,
-    /// The CPU backend (the reference for thermo and measurements).
-    cpu: Reference,
-    forces_current: bool,
-    /// Whether `forces` also holds the energies and virial of the current state.
-    energies_current: bool,
-    thermo: Thermo,
-    dumps: Vec<ActiveDump>,
-    /// Bond kinetics: event counts and the CSV event log.
-    pub kinetics: Kinetics,
-    /// Bond formation (when the force field has `bind` rules).
-    formation: Option<Formation>,
-    event_log: Option<(EventLog, PathBuf)>,
-    /// Lifetimes of broken bonds and where the deck wants their table.
-    lifetimes: LifetimeTable,
-    lifetime_file: Option<PathBuf>,
-    options: RunOptions,
-    deck_stem: String,
-    scratch: Vec<DVec3>,
-    /// Per-particle displacement limits of the contact step clamp.
-    step_limits: Vec<f64>,
-    /// Explicit steps shortened by the contact step clamp.
-    pub contact_clamps: u64,
-    /// GPU steps whose `bind` formation the device left to the host (its
-    /// bond pool, slots, candidate list or neighbour list ran out of room,
-    /// src/gpu/bind.rs), this run.
-    pub host_formations: u64,
-    /// The last minimisation's outcome.
-    pub last_minimize: Option<FireReport>,
-    /// The deck's `device` setting.
-    pub device: DevicePreference,
-    /// The last implicit step's linear solve.
-    pub last_solve: SolveReport,
+    /// The deck's settings in force.
+    pub settings: Settings,
     /// Constrained (inextensible) bonds.
     pub constraints: Constraints,
-    /// Constraint tensions of the last implicit step's solve (added to SHAKE's).
-    implicit_tension: Vec<f64>,
-    /// The opened GPU (kept across `run` commands), or why it could not be used.
-    gpu: Option<Result<GpuContext, String>>,
-    /// Bond type labels, for outputs.
-    bond_type_names: Vec<String>,
-    /// The deck and its inputs as read, carried by every restart written.
-    inputs: DeckInputs,
-    /// Index of the deck action being applied.
-    action: usize,
-    /// The last step of the `run` in progress.
-    run_end: Option<u64>,
-    checkpoints: Option<Checkpoints>,
-    /// Wall time by phase of the step loop (for the run log).
-    pub times: PhaseTimes,
-    log: Option<RunLog>,
     /// Ramps, moved and frozen groups in force.
     protocols: Protocols,
-    /// The thermo values each run-time `if` (by its place in the deck, so
-    /// across the iterations of a loop) read at its last decision, for its
-    /// `previous(…)`.
-    decisions: HashMap<String, Vec<f64>>,
+    /// Bond kinetics: event counts and bond formation.
+    pub kinetics: KineticsState,
+    /// The backends and the forces they computed.
+    pub backend: Backends,
+    /// Counters and the last solves of the run.
+    pub reports: Reports,
+    outputs: Outputs,
+    /// Where the run stands in its deck.
+    deck: DeckProgress,
+    options: RunOptions,
 }
 
 impl Simulation {
@@ -153,46 +127,21 @@ impl Simulation {
         state.bonds = initial_bond_state(&model);
         let deck_stem = deck_path.file_stem().map_or("cellmd".into(), |s| s.to_string_lossy().into_owned());
         Self {
-            thermo: Thermo::new(&model),
-            formation: (!model.bind_rules.is_empty()).then(|| Formation::new(&model, &sim_box)),
-            bond_type_names: model.bond_types.iter().map(|t| t.label.text.clone()).collect(),
+            kinetics: KineticsState {
+                formation: (!model.bind_rules.is_empty()).then(|| Formation::new(&model, &sim_box)),
+                ..KineticsState::default()
+            },
+            outputs: Outputs::new(Thermo::new(&model), model.bond_types.iter().map(|t| t.label.text.clone()).collect(), deck_stem),
             model,
             state,
             sim_box,
-            forces: Forces::default(),
-            kt: 0.0,
-            dt: 0.0,
-            seed: 1,
-            integrator: Integrator::default(),
-            neighbor: NeighborSettings::default(),
-            cpu: Reference::default(),
-            forces_current: false,
-            energies_current: false,
-            dumps: Vec::new(),
-            kinetics: Kinetics::default(),
-            event_log: None,
-            lifetimes: LifetimeTable::default(),
-            lifetime_file: None,
-            options,
-            deck_stem,
-            scratch: Vec::new(),
-            step_limits: Vec::new(),
-            contact_clamps: 0,
-            host_formations: 0,
-            last_minimize: None,
-            device: DevicePreference::Cpu,
-            last_solve: SolveReport::default(),
+            settings: Settings::default(),
             constraints: Constraints::default(),
-            implicit_tension: Vec::new(),
-            gpu: None,
-            inputs,
-            action: 0,
-            run_end: None,
-            checkpoints: None,
-            times: PhaseTimes::default(),
-            log: None,
             protocols: Protocols::default(),
-            decisions: HashMap::new(),
+            backend: Backends::default(),
+            reports: Reports::default(),
+            deck: DeckProgress { inputs, action: 0, run_end: None, decisions: HashMap::new() },
+            options,
         }
     }
 
@@ -230,14 +179,14 @@ impl Simulation {
                 )));
             }
             for (k, action) in before.iter().enumerate().filter(|(_, a)| a.replays_on_continue()) {
-                sim.action = k;
+                sim.deck.action = k;
                 sim.apply(action)?;
             }
             sim.load_restart(data, restart)?;
-            sim.say(&format!("continuing {} from step {} ({})", sim.inputs.deck, sim.state.step, restart.display()));
+            sim.options.say(&format!("continuing {} from step {} ({})", sim.deck.inputs.deck, sim.state.step, restart.display()));
             let next = match resume.run_end {
                 Some(end) if end > sim.state.step => {
-                    sim.action = resume.action;
+                    sim.deck.action = resume.action;
                     sim.run(end - sim.state.step)?;
                     resume.action + 1
                 }
@@ -255,13 +204,13 @@ impl Simulation {
     fn perform(&mut self, actions: &[Action], from: usize) -> Result<(), RunError> {
         let mut next = from;
         while let Some(action) = actions.get(next) {
-            self.action = next;
+            self.deck.action = next;
             self.stop_if_requested()?;
             next += 1 + match action {
                 Action::Branch { condition, skip } => {
-                    let mut last = self.decisions.remove(condition.place()).unwrap_or_default();
+                    let mut last = self.deck.decisions.remove(condition.place()).unwrap_or_default();
                     let holds = condition.holds(&mut |c| self.thermo_value(c).map_err(|e| e.to_string()), &mut last);
-                    self.decisions.insert(condition.place().to_string(), last);
+                    self.deck.decisions.insert(condition.place().to_string(), last);
                     let holds = holds.map_err(RunError::Setup)?;
                     if holds {
                         0
@@ -283,15 +232,15 @@ impl Simulation {
     /// run log ends with the outcome and the time by phase.
     fn finish(mut self, result: Result<(), RunError>) -> Result<Simulation, RunError> {
         let mut closed = self.close_outputs();
-        if let Some(mut log) = self.log.take() {
+        if let Some(mut log) = self.outputs.log.take() {
             let outcome = match &result {
                 Ok(()) => format!("finished at step {}", self.state.step),
                 Err(e) => format!("ended at step {}: {e}", self.state.step),
             };
             let text = format!(
                 "\n{outcome}\nloop time {:.3} s by section (CPU step loop):\n{}",
-                self.times.total.as_secs_f64(),
-                self.times.table()
+                self.reports.times.total.as_secs_f64(),
+                self.reports.times.table()
             );
             if let Err(e) = log.section(&text) {
                 closed = closed.and(Err(self.output_error(&log.path, e)));
@@ -323,68 +272,68 @@ impl Simulation {
             Action::Branch { .. } | Action::Skip(_) => {
                 return Err(RunError::Setup("a jump of an `if` decided during the run is applied with its plan".into()))
             }
-            Action::Temperature(kt) => self.kt = *kt,
-            Action::Timestep(dt) => self.dt = *dt,
-            Action::Seed(seed) => self.seed = *seed,
-            Action::Device(device) => self.device = *device,
-            Action::Integrator(settings) => self.integrator = *settings,
+            Action::Temperature(kt) => self.settings.kt = *kt,
+            Action::Timestep(dt) => self.settings.dt = *dt,
+            Action::Seed(seed) => self.settings.seed = *seed,
+            Action::Device(device) => self.settings.device = *device,
+            Action::Integrator(settings) => self.settings.integrator = *settings,
             Action::Neighbor(settings) => {
-                self.neighbor = *settings;
-                self.cpu.invalidate();
+                self.settings.neighbor = *settings;
+                self.backend.cpu.invalidate();
             }
             Action::Thermo { every, columns } => {
-                self.thermo.every = *every;
-                self.thermo.set_columns(columns.clone(), &self.model);
+                self.outputs.thermo.every = *every;
+                self.outputs.thermo.set_columns(columns.clone(), &self.model);
             }
             Action::EventFile(path) => {
-                let path = self.output_path(path);
+                let path = self.options.output_path(path);
                 let file = self.create_output(&path)?;
                 let log = EventLog::create(file, self.model.units).map_err(|e| self.output_error(&path, e))?;
-                if let Some((old, old_path)) = self.event_log.replace((log, path)) {
+                if let Some((old, old_path)) = self.outputs.event_log.replace((log, path)) {
                     old.finish().map_err(|e| self.output_error(&old_path, e))?;
                 }
             }
-            Action::LifetimeFile(path) => self.lifetime_file = Some(self.output_path(path)),
+            Action::LifetimeFile(path) => self.outputs.lifetime_file = Some(self.options.output_path(path)),
             Action::ThermoFile(path) => {
-                let path = self.output_path(path);
+                let path = self.options.output_path(path);
                 let file = self.create_output(&path)?;
-                self.thermo.set_file(file, path).map_err(|(path, e)| self.output_error(&path, e))?;
+                self.outputs.thermo.set_file(file, path).map_err(|(path, e)| self.output_error(&path, e))?;
             }
             Action::Dump(spec) => {
-                let path = self.output_path(&spec.path);
+                let path = self.options.output_path(&spec.path);
                 let file = self.create_output(&path)?;
                 let writer =
                     open_writer(spec.format, file, &self.topology_view(), &spec.options).map_err(|e| self.output_error(&path, e))?;
-                self.dumps.push(ActiveDump { spec: spec.clone(), path, writer, last_step: None });
+                self.outputs.dumps.push(ActiveDump { spec: spec.clone(), path, writer, last_step: None });
             }
             Action::Undump(name) => {
-                if let Some(k) = self.dumps.iter().position(|d| d.spec.name == *name) {
-                    let dump = self.dumps.remove(k);
+                if let Some(k) = self.outputs.dumps.iter().position(|d| d.spec.name == *name) {
+                    let dump = self.outputs.dumps.remove(k);
                     dump.writer.finish().map_err(|e| self.output_error(&dump.path, e))?;
                 }
             }
             Action::External(external) => {
                 self.model.externals.retain(|e| e.term.label.text != external.term.label.text);
                 self.model.externals.push(external.clone());
-                self.forces_current = false;
+                self.backend.forces_current = false;
             }
             Action::Unexternal(name) => {
                 self.model.externals.retain(|e| e.term.label.text != *name);
                 self.protocols.forget_drive(name);
-                self.forces_current = false;
+                self.backend.forces_current = false;
             }
             Action::Displace { group, delta } => self.displace(&group.members, *delta)?,
             Action::Coeff { target, param, value } => {
                 if let CoeffTarget::PairRule(_) = target {
-                    self.cpu.invalidate(); // the cutoff may change
+                    self.backend.cpu.invalidate(); // the cutoff may change
                 }
                 target.set(&mut self.model, *param, *value);
-                self.forces_current = false;
+                self.backend.forces_current = false;
             }
             Action::Protocol(Protocol::ResetRest(bond_types)) => {
                 reset_rest(&mut self.model, &mut self.state, &self.sim_box, bond_types);
-                self.cpu.invalidate(); // bonds now carry state
-                self.forces_current = false;
+                self.backend.cpu.invalidate(); // bonds now carry state
+                self.backend.forces_current = false;
             }
             Action::Protocol(protocol) => self.protocols.apply(protocol),
             Action::Constrain { bond_type, tolerance, max_iterations, reshape, method } => {
@@ -409,19 +358,19 @@ impl Simulation {
             Action::Minimize(settings) => self.minimize(settings)?,
             Action::Run(steps) => self.run(*steps)?,
             Action::WriteState(path) => {
-                let path = self.output_path(&with_step(path, self.state.step));
+                let path = self.options.output_path(&with_step(path, self.state.step));
                 write_state(&self.options.output_dir, &path, &self.restart_data()).map_err(|e| self.output_error(&path, e))?;
-                self.say(&format!("wrote state at step {} to {}", self.state.step, path.display()));
+                self.options.say(&format!("wrote state at step {} to {}", self.state.step, path.display()));
             }
             Action::Checkpoint(spec) => {
-                self.checkpoints = Some(Checkpoints { spec: spec.clone(), last_step: None, written: Default::default() })
+                self.outputs.checkpoints = Some(Checkpoints { spec: spec.clone(), last_step: None, written: Default::default() })
             }
             Action::ReadState(path) => {
-                let path = if path.exists() { path.clone() } else { self.output_path(path) };
+                let path = if path.exists() { path.clone() } else { self.options.output_path(path) };
                 let data = read_state(&path).map_err(RunError::Setup)?;
                 self.load_restart(data, &path)?;
             }
-            Action::Print(text) => self.say(text),
+            Action::Print(text) => self.options.say(text),
         }
         Ok(())
     }
@@ -436,10 +385,10 @@ impl Simulation {
             self.sim_box.wrap(&mut self.state.positions[i], &mut self.state.images[i]);
         }
         self.check_in_box()?;
-        if let Some(backend) = self.cpu.built_mut() {
+        if let Some(backend) = self.backend.cpu.built_mut() {
             backend.update_neighbors(&self.state, &self.sim_box, true).map_err(RunError::Setup)?;
         }
-        self.forces_current = false;
+        self.backend.forces_current = false;
         Ok(())
     }
 }

@@ -46,36 +46,28 @@ use crate::output::records::RecordFile;
 use crate::units::{Dim, UnitSystem};
 use glam::DVec2;
 
-/// Values a thermo row is made from.
+/// What a thermo row reads: the system and the CPU backend after a force
+/// evaluation at its state, with the run's counters and last solve. Values
+/// that follow from these (the bond state, the box's volume and images,
+/// the backend's tensions and neighbour-list builds) are read from them.
 pub struct ThermoInputs<'a> {
     pub model: &'a crate::system::Model,
-    pub bonds: Option<&'a crate::system::BondState>,
-    /// Per-bond tension of the last force pass.
-    pub bond_tension: &'a [f64],
-    pub kinetics: &'a crate::kinetics_engine::Kinetics,
+    pub state: &'a crate::system::State,
+    pub sim_box: &'a crate::system::SimBox,
+    /// The backend after a force evaluation at `state` (for measurements
+    /// that read the force terms).
+    pub backend: &'a crate::backend::CpuBackend,
+    pub forces: &'a Forces,
     /// The context of the next step: its index and start time are the
     /// current state's, with the kT in force.
     pub context: crate::integrate::context::StepContext,
-    pub forces: &'a Forces,
-    pub n_particles: usize,
-    pub volume: f64,
-    pub neighbor_builds: u64,
+    pub kinetics: &'a crate::kinetics_engine::Kinetics,
     /// The last implicit step's linear solve.
     pub solve: crate::integrate::implicit::SolveReport,
     /// The constrained bonds and their last tensions.
     pub constraints: &'a crate::integrate::constraints::Constraints,
-    /// Positions (wrapped) and the box's images, for body volumes and areas.
-    pub positions: &'a [glam::DVec3],
-    pub images: crate::system::Images,
-    /// Smallest node–face distance between bodies at the last force pass.
-    pub min_contact_distance: f64,
     /// Steps shortened by the contact step clamp so far.
     pub contact_clamps: u64,
-    /// The backend after a force evaluation at `state` (for measurements
-    /// that read the force terms).
-    pub backend: &'a crate::backend::CpuBackend,
-    pub state: &'a crate::system::State,
-    pub sim_box: &'a crate::system::SimBox,
 }
 
 /// A column's header name (bond-type columns name their type).
@@ -149,15 +141,17 @@ pub fn column_unit(c: &ThermoColumn, units: UnitSystem) -> &'static str {
 
 /// Sum over the bodies of type `body_type` of `pick((volume, area))`.
 fn body_sum(t: &ThermoInputs, body_type: usize, pick: impl Fn((f64, f64)) -> f64) -> f64 {
+    let images = t.sim_box.images();
     (0..t.model.bodies.len())
         .filter(|&b| t.model.bodies[b].body_type as usize == body_type)
-        .map(|b| pick(t.model.body_volume_and_area(b, t.positions, &t.images)))
+        .map(|b| pick(t.model.body_volume_and_area(b, &t.state.positions, &images)))
         .sum()
 }
 
 /// A column's value; integers are returned as exact f64.
 pub fn column_value(c: &ThermoColumn, t: &ThermoInputs) -> f64 {
-    let ideal = t.n_particles as f64 * t.context.kt / t.volume;
+    let volume = t.sim_box.volume();
+    let ideal = t.model.len() as f64 * t.context.kt / volume;
     let w = &t.forces.virial;
     match c {
         ThermoColumn::Step => t.context.step as f64,
@@ -169,15 +163,16 @@ pub fn column_value(c: &ThermoColumn, t: &ThermoInputs) -> f64 {
         ThermoColumn::PeOf(k) => t.forces.energy_by_interaction[*k],
         ThermoColumn::Fmax => t.forces.max_force().0,
         ThermoColumn::Fnorm => t.forces.forces.iter().map(|f| f.length_squared()).sum::<f64>().sqrt(),
-        ThermoColumn::Press => ideal + (w[0] + w[1] + w[2]) / (3.0 * t.volume),
-        ThermoColumn::Pressure(k) => (if *k < 3 { ideal } else { 0.0 }) + w[*k] / t.volume,
-        ThermoColumn::Nbuild => t.neighbor_builds as f64,
+        ThermoColumn::Press => ideal + (w[0] + w[1] + w[2]) / (3.0 * volume),
+        ThermoColumn::Pressure(k) => (if *k < 3 { ideal } else { 0.0 }) + w[*k] / volume,
+        ThermoColumn::Nbuild => t.backend.neighbor_builds() as f64,
         ThermoColumn::Events(kind) => t.kinetics.count(*kind) as f64,
         ThermoColumn::Bound(ty) => bonds_of_type(t, *ty).count() as f64,
         ThermoColumn::Tension(ty) => {
             // The backend keeps per-bond tensions only for kinetic bonds; compute them otherwise.
-            if t.bond_tension.len() == t.model.bonds.len() {
-                bonds_of_type(t, *ty).map(|b| t.bond_tension[b]).sum()
+            let (bond_tension, _) = t.backend.bond_tension_and_length();
+            if bond_tension.len() == t.model.bonds.len() {
+                bonds_of_type(t, *ty).map(|b| bond_tension[b]).sum()
             } else {
                 let (tension, _) = t.backend.bond_tensions_at(t.model, t.state, t.sim_box);
                 bonds_of_type(t, *ty).map(|b| tension[b]).sum()
@@ -191,21 +186,21 @@ pub fn column_value(c: &ThermoColumn, t: &ThermoInputs) -> f64 {
         }
         ThermoColumn::BodyVolume(k) => body_sum(t, *k, |(v, _)| v),
         ThermoColumn::BodyArea(k) => body_sum(t, *k, |(_, a)| a),
-        ThermoColumn::MinDistance => t.min_contact_distance,
+        ThermoColumn::MinDistance => t.backend.min_contact_distance(),
         ThermoColumn::ContactClamps => t.contact_clamps as f64,
         ThermoColumn::PlaneTension { axis, pos } => planes::plane_tension(t.backend, t.model, t.state, t.sim_box, *axis, *pos),
         ThermoColumn::CorticalTension(k) => planes::cortical_tension(t.backend, t.model, t.state, t.sim_box, *k),
-        ThermoColumn::EndToEnd(ty) => filaments::end_to_end(&filaments::chains(t.model, *ty), t.positions, t.sim_box),
+        ThermoColumn::EndToEnd(ty) => filaments::end_to_end(&filaments::chains(t.model, *ty), &t.state.positions, t.sim_box),
         ThermoColumn::TangentCorrelation { bond_type, lag } => {
-            filaments::tangent_correlation(&filaments::chains(t.model, *bond_type), t.positions, t.sim_box, *lag)
+            filaments::tangent_correlation(&filaments::chains(t.model, *bond_type), &t.state.positions, t.sim_box, *lag)
         }
         ThermoColumn::Fracture { bond_type, quantity } => {
-            fracture::fracture(t.model, t.bonds.map(|s| s.bound.as_slice()), *bond_type).value(*quantity)
+            fracture::fracture(t.model, t.state.bonds.as_ref().map(|s| s.bound.as_slice()), *bond_type).value(*quantity)
         }
         ThermoColumn::Group { group, quantity } => group_value(t, &group.members, *quantity),
         ThermoColumn::Clustering { bond_type, a, b } => clustering::ratio(&clustering::profile(
             t.model,
-            t.bonds.map(|s| s.bound.as_slice()),
+            t.state.bonds.as_ref().map(|s| s.bound.as_slice()),
             t.state,
             t.sim_box,
             *bond_type,
@@ -277,7 +272,7 @@ fn external_sums(t: &ThermoInputs, name: &str) -> (glam::DVec3, f64) {
 
 /// Indices of the bound bonds of a bond type.
 fn bonds_of_type<'a>(t: &'a ThermoInputs, ty: usize) -> impl Iterator<Item = usize> + 'a {
-    (0..t.model.bonds.len()).filter(move |&b| t.model.bond_type[b] as usize == ty && t.bonds.is_none_or(|s| s.bound[b]))
+    (0..t.model.bonds.len()).filter(move |&b| t.model.bond_type[b] as usize == ty && t.state.bonds.as_ref().is_none_or(|s| s.bound[b]))
 }
 
 fn is_integer(c: &ThermoColumn) -> bool {

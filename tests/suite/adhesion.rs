@@ -225,8 +225,8 @@ fn adhesion_runs_are_bit_identical_on_one_and_two_threads() {
     );
     let (one, two) = (case.run_with_threads(1), case.run_with_threads(2));
     assert_eq!(position_bits(&one), position_bits(&two));
-    assert_eq!(one.forces.total_energy().to_bits(), two.forces.total_energy().to_bits());
-    assert_eq!(one.forces.virial.map(f64::to_bits), two.forces.virial.map(f64::to_bits));
+    assert_eq!(one.backend.forces.total_energy().to_bits(), two.backend.forces.total_energy().to_bits());
+    assert_eq!(one.backend.forces.virial.map(f64::to_bits), two.backend.forces.virial.map(f64::to_bits));
     let index = REGISTRY.iter().position(|i| i.name() == "contact_adhesion").unwrap();
-    assert!(one.forces.energy_by_interaction[index] < 0.0, "the cells never adhered");
+    assert!(one.backend.forces.energy_by_interaction[index] < 0.0, "the cells never adhered");
 }

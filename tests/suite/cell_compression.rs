@@ -66,7 +66,7 @@ fn compress(level: u32, stages: u32, dstrain: f64) -> Vec<Stage> {
     for action in &plan.actions {
         sim.apply(action).unwrap_or_else(|e| panic!("{e}"));
         if let Action::Minimize(_) = action {
-            let report = sim.last_minimize.as_ref().unwrap();
+            let report = sim.reports.last_minimize.as_ref().unwrap();
             assert!(report.converged, "FIRE did not converge: {report:?}");
         }
         if !matches!(action, Action::Run(0)) {

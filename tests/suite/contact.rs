@@ -119,10 +119,10 @@ fn pressed_cells_flatten_against_each_other_without_touching() {
             .count()
     };
     let (patch, width) = (near(0, 1).min(near(1, 0)), width_along_x(&sim, 0));
-    println!("smallest distance {smallest:.4e} µm, final {:.4e} µm, contact patch {patch} nodes, width {width0:.4} → {width:.4} µm, {} clamped steps", sim.min_contact_distance(), sim.contact_clamps);
+    println!("smallest distance {smallest:.4e} µm, final {:.4e} µm, contact patch {patch} nodes, width {width0:.4} → {width:.4} µm, {} clamped steps", sim.min_contact_distance(), sim.reports.contact_clamps);
     assert!(patch >= 7, "no flat contact patch: {patch} nodes within d̂");
     assert!(width < width0 - 0.05, "the cell did not flatten: width {width0} → {width}");
-    assert!(sim.forces.energy_by_interaction.iter().sum::<f64>().is_finite());
+    assert!(sim.backend.forces.energy_by_interaction.iter().sum::<f64>().is_finite());
 }
 
 #[test]
@@ -133,8 +133,8 @@ fn the_step_clamp_keeps_a_too_large_step_from_jumping_through() {
     let mut sim =
         Simulation::before_first_run(&plan, RunOptions { output_dir: case.output_dir().to_path_buf(), ..Default::default() }).unwrap();
     let smallest = run_checking_every_step(&mut sim, 200, 0.1);
-    println!("smallest distance {smallest:.4e} µm, {} of 200 steps clamped, time {:.4e} s", sim.contact_clamps, sim.state.time);
-    assert!(sim.contact_clamps > 0, "the clamp never acted");
+    println!("smallest distance {smallest:.4e} µm, {} of 200 steps clamped, time {:.4e} s", sim.reports.contact_clamps, sim.state.time);
+    assert!(sim.reports.contact_clamps > 0, "the clamp never acted");
     assert!(sim.state.time < 200.0 * 1e-2, "clamped steps advance time by less than dt");
 }
 
@@ -155,7 +155,7 @@ fn clamped_steps_age_bonds_and_stamp_events_by_their_actual_length() {
     let settings = "temperature 0.0041\nseed 7\ntimestep 1e-2\nevents events.csv\nthermo 1 step time\nthermo_file thermo.csv\nrun 200\n";
     let case = case_on(&top, &ff, 50.0, settings);
     let sim = case.run();
-    assert!(sim.contact_clamps > 0, "the clamp never acted");
+    assert!(sim.reports.contact_clamps > 0, "the clamp never acted");
     assert!(sim.state.time < 200.0 * 1e-2, "clamped steps advance time by less than dt");
     let bonds = sim.state.bonds.as_ref().unwrap();
     let is_slow = |b: usize| sim.model.bond_types[sim.model.bond_type[b] as usize].label.text == "slow";
@@ -181,7 +181,7 @@ fn clamped_steps_age_bonds_and_stamp_events_by_their_actual_length() {
         assert_eq!(time, thermo[&step], "event at step {step}: time {time}, thermo time {}", thermo[&step]);
         events += 1;
     }
-    println!("{} of 200 steps clamped, {events} events", sim.contact_clamps);
+    println!("{} of 200 steps clamped, {events} events", sim.reports.contact_clamps);
     assert!(events > 50, "too few events to test: {events}");
 }
 
@@ -190,8 +190,8 @@ fn contact_runs_are_bit_identical_on_one_and_two_threads() {
     let case = pressed_case(5.0, "temperature 0.0041\nseed 3\ntimestep 1e-3\nthermo 100 step pe mindist nclamp\nrun 300\n");
     let (one, two) = (case.run_with_threads(1), case.run_with_threads(2));
     assert_eq!(position_bits(&one), position_bits(&two));
-    assert_eq!(one.forces.total_energy().to_bits(), two.forces.total_energy().to_bits());
-    assert_eq!(one.forces.virial.map(f64::to_bits), two.forces.virial.map(f64::to_bits));
+    assert_eq!(one.backend.forces.total_energy().to_bits(), two.backend.forces.total_energy().to_bits());
+    assert_eq!(one.backend.forces.virial.map(f64::to_bits), two.backend.forces.virial.map(f64::to_bits));
     assert!(one.min_contact_distance() < 0.1, "the cells never came into contact");
 }
 
@@ -207,7 +207,7 @@ fn implicit_squeeze(dt: f64) -> (f64, u64, f64) {
     let mut sim = simulation(&squeezed_cells(&format!("integrator implicit\ntemperature 0\ntimestep {dt}\nrun 0\n")));
     let smallest = run_checking_every_step(&mut sim, (2.4 / dt).round() as u64, 0.1);
     assert!(sim.min_contact_distance() < 0.1, "dt = {dt}: the barrier never acted");
-    (smallest, sim.contact_clamps, sim.forces.forces.iter().map(|f| f.length()).fold(0.0, f64::max))
+    (smallest, sim.reports.contact_clamps, sim.backend.forces.forces.iter().map(|f| f.length()).fold(0.0, f64::max))
 }
 
 #[test]
@@ -236,7 +236,7 @@ fn implicit_squeeze_time_step_table() {
 fn fire_relaxes_squeezed_cells_without_interpenetration() {
     let mut sim = simulation(&squeezed_cells("temperature 0\ntimestep 1e-3\nrun 0\n"));
     sim.minimize(&FireSettings { ftol: 1e-2, max_iterations: 30_000, dmax: 0.05, ..Default::default() }).unwrap();
-    let report = sim.last_minimize.clone().unwrap();
+    let report = sim.reports.last_minimize.clone().unwrap();
     let exact = brute_force_min_distance(&sim);
     println!("FIRE: {report:?}, min distance {exact:.4e} µm");
     assert!(report.converged, "{report:?}");

@@ -157,11 +157,11 @@ fn fire_converges_a_stretched_network() {
     let deck = "units lj\ntopology t.top\nforcefield f.ff\nbox x -20 20 f y -20 20 f z -20 20 f\nneighbor skin 0.3\ntimestep 0.01\nminimize ftol 1e-8 maxiter 20000\n";
     let case = Case::new(&[("t.top", &top), ("f.ff", ff), ("deck.in", deck)]);
     let mut sim = case.run();
-    let report = sim.last_minimize.clone().unwrap();
+    let report = sim.reports.last_minimize.clone().unwrap();
     assert!(report.converged, "{report:?}");
     // Independently recompute the forces at the final state.
     sim.apply(&cellmd::deck::Action::Run(0)).unwrap();
-    let (fmax, _) = sim.forces.max_force();
+    let (fmax, _) = sim.backend.forces.max_force();
     assert!(fmax < 1e-8, "max |F| = {fmax}");
     // A stretched network that is free relaxes to (nearly) unstretched bonds.
     let mean_bond: f64 =

@@ -760,7 +760,7 @@ fn implicit_condition_bound(sim: &Simulation) -> f64 {
             *row += (0..3).map(|c| b.block.col(c)[r].abs()).sum::<f64>();
         }
     }
-    let drag = model.types.iter().map(|&t| model.type_drag[t as usize] / sim.dt).filter(|d| d.is_finite());
+    let drag = model.types.iter().map(|&t| model.type_drag[t as usize] / sim.settings.dt).filter(|d| d.is_finite());
     let (lo, hi) = drag.fold((f64::INFINITY, 0.0f64), |(lo, hi), d| (lo.min(d), hi.max(d)));
     (hi + rows.iter().copied().fold(0.0, f64::max)) / lo
 }
@@ -822,7 +822,7 @@ fn every_input_deck_runs_on_the_gpu_like_on_the_cpu() {
         // the whole test took 37 min on the loaded 2-core machine with 10⁴ for all.
         // An implicit step's f32 solve is exact to about κ(A)·(its tolerance + 8ε_f32)
         // relative (src/gpu/implicit.rs), its explicit steps to the 1e-5 below.
-        let bound = match setup.integrator {
+        let bound = match setup.settings.integrator {
             Integrator::Implicit(..) => (implicit_condition_bound(&setup) * (F32_TOLERANCE + 8.0 * f32::EPSILON as f64)).max(1e-5),
             Integrator::Overdamped(_) => 1e-5,
         };
@@ -834,7 +834,7 @@ fn every_input_deck_runs_on_the_gpu_like_on_the_cpu() {
         // hertz_block's 5 stages 36 s; `cargo test --release`, llvmpipe, 2 cores).
         // Implicit decks of more than 1 000 particles (0.7–2 s a step on
         // llvmpipe) are compared over 10 steps.
-        let horizon = match setup.integrator {
+        let horizon = match setup.settings.integrator {
             Integrator::Implicit(..) if bound >= 1.0 => 1,
             Integrator::Implicit(..) if setup.model.len() > 1000 => 10,
             Integrator::Implicit(..) => 100,
@@ -1503,8 +1503,11 @@ fn the_contact_step_clamp_runs_on_the_gpu_like_on_the_cpu() {
     let (_, a) = run(DevicePreference::Gpu, 0.0041, 60);
     let (_, b) = run(DevicePreference::Gpu, 0.0041, 60);
     let bits = |s: &Simulation| s.state.positions.iter().map(|x| x.to_array().map(f64::to_bits)).collect::<Vec<_>>();
-    assert!(bits(&a) == bits(&b) && a.state.time == b.state.time && a.contact_clamps == b.contact_clamps, "two GPU runs differ");
-    assert!(a.contact_clamps > 0);
+    assert!(
+        bits(&a) == bits(&b) && a.state.time == b.state.time && a.reports.contact_clamps == b.reports.contact_clamps,
+        "two GPU runs differ"
+    );
+    assert!(a.reports.contact_clamps > 0);
 }
 
 /// A GPU blow-up near a contact names the step, the particle and the
@@ -1647,7 +1650,10 @@ fn adhesion_runs_on_the_gpu_like_on_the_cpu_and_twice_alike() {
     let (_, a) = run(DevicePreference::Gpu, 0.0041, 40);
     let (_, b) = run(DevicePreference::Gpu, 0.0041, 40);
     let bits = |s: &Simulation| s.state.positions.iter().map(|x| x.to_array().map(f64::to_bits)).collect::<Vec<_>>();
-    assert!(bits(&a) == bits(&b) && a.state.time == b.state.time && a.contact_clamps == b.contact_clamps, "two GPU runs differ");
+    assert!(
+        bits(&a) == bits(&b) && a.state.time == b.state.time && a.reports.contact_clamps == b.reports.contact_clamps,
+        "two GPU runs differ"
+    );
 }
 
 /// Runs `deck` (with topology `top` and force field `ff`) on `device`;
@@ -1792,10 +1798,10 @@ fn formulas_of_t_see_the_clamped_clock_inside_a_gpu_chunk() {
     let deviation = (0..start.len()).map(|i| (unwrap(&cpu.state, i) - unwrap(&gpu.state, i)).length()).fold(0.0, f64::max);
     println!(
         "{} clamped steps, t = {:.4e} s (whole steps: 0.1 s); GPU − CPU {deviation:.3e} after {travelled:.3e}",
-        cpu.contact_clamps, cpu.state.time
+        cpu.reports.contact_clamps, cpu.state.time
     );
     assert!(cpu.state.time < 0.05, "the clamp shortened the steps too little for the test: t = {}", cpu.state.time);
-    assert_eq!(gpu.contact_clamps, cpu.contact_clamps);
+    assert_eq!(gpu.reports.contact_clamps, cpu.reports.contact_clamps);
     assert!(deviation <= CONTACT_GPU_EPSILON * travelled, "GPU − CPU {deviation:e} > {CONTACT_GPU_EPSILON:e} × {travelled:e}");
 }
 

@@ -65,10 +65,10 @@ fn bind_forms_the_cpus_bonds_on_the_device() {
     println!(
         "{forms} forms, {breaks} breaks, {rebinds} rebinds on the CPU; {} events on the GPU, {} steps' formation on the host",
         gpu_rows.len(),
-        gpu.host_formations
+        gpu.kinetics.host_formations
     );
     assert!(forms > 1000 && breaks > 1000 && rebinds > 500, "too little churn to compare");
-    assert!(gpu.host_formations > 0, "no step's formation fell to the host: the path is not tested");
+    assert!(gpu.kinetics.host_formations > 0, "no step's formation fell to the host: the path is not tested");
     assert_eq!(cpu_rows.len(), gpu_rows.len(), "event counts");
     for (c, g) in cpu_rows.iter().zip(&gpu_rows) {
         assert_eq!((&c[..7], &c[9]), (&g[..7], &g[9]), "event {c:?} on the CPU, {g:?} on the GPU");

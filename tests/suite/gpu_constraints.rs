@@ -138,8 +138,8 @@ fn the_constrained_implicit_step_runs_on_the_gpu_like_on_the_cpu() {
         "implicit cantilever: tip moved {path:.4e} µm; GPU − CPU {apart:.3e} µm (bound {bound:.2e}); worst |r − r0|/r0 GPU {:.2e}; \
          last solve GPU {} iterations, CPU {}",
         worst_length_error(&gpu),
-        gpu.last_solve.iterations,
-        cpu.last_solve.iterations
+        gpu.reports.last_solve.iterations,
+        cpu.reports.last_solve.iterations
     );
     assert!(path > 0.05, "the load barely bent the filament ({path:e} µm)");
     assert!(apart < bound, "GPU and CPU equilibria part by {apart:e} µm (bound {bound:e})");

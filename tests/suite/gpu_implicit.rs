@@ -202,7 +202,7 @@ fn one_implicit_step_with_contact_matches_the_cpu() {
     let ff = format!("{CONTACT_SHELLS}{CONTACT_BARRIER}{CONTACT_ADHESION}");
     let case = contact_case(&ff, 0.06, 1.0, "integrator implicit\ntimestep 2e-4\nrun 1\n");
     let gpu = one_step_matches(&case);
-    assert_eq!(gpu.contact_clamps, 0, "a clamped step would test the clamp, not the blocks");
+    assert_eq!(gpu.reports.contact_clamps, 0, "a clamped step would test the clamp, not the blocks");
 }
 
 /// The implicit step's contact clamp on the device: the cells of
@@ -250,7 +250,7 @@ fn the_split_solve_matches_the_cpu() {
     };
     let filament_step = one_step_matches(&split(filament(1, 0.0)));
     // The filament's step outran the first budget: it was taken again with a larger one.
-    assert!(filament_step.last_solve.iterations > 32, "{} iterations", filament_step.last_solve.iterations);
+    assert!(filament_step.reports.last_solve.iterations > 32, "{} iterations", filament_step.reports.last_solve.iterations);
     clamped_contact_runs_agree("integrator implicit gpu_workgroups all");
     let thermal = split(filament(30, 4.1e-3));
     let (a, b) = (run(&thermal, DevicePreference::Gpu), run(&thermal, DevicePreference::Gpu));
@@ -318,12 +318,12 @@ fn one_step_matches(case: &common::Case) -> Simulation {
     println!(
         "|Δx| {:.4e}, GPU − CPU {error:.3e} (bound {bound:.3e}, κ ≤ {kappa:.0}); iterations GPU {} CPU {}, residual GPU {:.2e}",
         norm(&dc),
-        gpu.last_solve.iterations,
-        cpu.last_solve.iterations,
-        gpu.last_solve.relative_residual
+        gpu.reports.last_solve.iterations,
+        cpu.reports.last_solve.iterations,
+        gpu.reports.last_solve.relative_residual
     );
     assert!(norm(&dc) > 1e-3, "the step moved nothing: {:e}", norm(&dc));
-    assert!(gpu.last_solve.iterations > 1 && gpu.last_solve.relative_residual <= F32_TOLERANCE);
+    assert!(gpu.reports.last_solve.iterations > 1 && gpu.reports.last_solve.relative_residual <= F32_TOLERANCE);
     assert!(error <= bound, "GPU − CPU {error:e} > {bound:e}");
     gpu
 }
@@ -468,7 +468,7 @@ fn newton_steps_of_a_cholesky_deck_reach_the_cpu_equilibrium_on_the_gpu() {
     println!(
         "dipole {dipole:.4} pN, moved {moved:.4e} µm; GPU end: f64 residual {residual:.3e} pN (bound {residual_bound:.3e}), \
          GPU − CPU {apart:.3e} µm; iterations GPU {} CPU {}",
-        gpu.last_solve.iterations, cpu.last_solve.iterations
+        gpu.reports.last_solve.iterations, cpu.reports.last_solve.iterations
     );
     assert!(moved > 1e-3, "the dipole moved nothing: {moved:e}");
     assert!(residual <= residual_bound, "the GPU's end state is not an equilibrium: |F| {residual:e} > {residual_bound:e}");
@@ -489,7 +489,7 @@ fn buckling_filament_timing() {
         let started = std::time::Instant::now();
         let sim = Simulation::execute(plan, options).unwrap();
         let seconds = started.elapsed().as_secs_f64();
-        println!("{device:?}: {} steps in {seconds:.2} s, last solve {} iterations", sim.state.step, sim.last_solve.iterations);
+        println!("{device:?}: {} steps in {seconds:.2} s, last solve {} iterations", sim.state.step, sim.reports.last_solve.iterations);
     }
 }
 

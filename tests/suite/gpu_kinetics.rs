@@ -96,7 +96,7 @@ fn device_breaks_follow_the_catch_slip_rate() {
     let (sim, settings) = sweep();
     let steps = 1000;
     let (decided, _, _) = run_on_device(&sim, &settings, steps);
-    let kt = sim.kt;
+    let kt = sim.settings.kt;
     let rate = |f: f64| 10.0 * (-f * 0.002 / kt).exp() + 0.05 * (f * 0.001 / kt).exp();
     let held = |b: usize| {
         let [i, j] = sim.model.bonds[b];

@@ -45,7 +45,7 @@ fn springs() -> common::Case {
 #[test]
 fn fire_on_the_gpu_reaches_the_analytic_minima_and_keeps_held_axes() {
     let gpu = run(&springs(), DevicePreference::Gpu);
-    let report = gpu.last_minimize.clone().expect("a minimisation");
+    let report = gpu.reports.last_minimize.clone().expect("a minimisation");
     println!("{report:?}");
     assert!(report.converged, "{report:?}");
     let x = &gpu.state.positions;
@@ -82,7 +82,7 @@ fn the_same_gpu_minimisation_twice_gives_the_same_bits() {
     let case = springs();
     let (first, second) = (run(&case, DevicePreference::Gpu), run(&case, DevicePreference::Gpu));
     assert_eq!(common::position_bits(&first), common::position_bits(&second));
-    assert_eq!(first.last_minimize.map(|r| r.iterations), second.last_minimize.map(|r| r.iterations));
+    assert_eq!(first.reports.last_minimize.map(|r| r.iterations), second.reports.last_minimize.map(|r| r.iterations));
 }
 
 /// The tensegrity cell on its substrate (inputs/tensegrity_substrate.in),
@@ -109,7 +109,7 @@ fn the_tensegrity_stage_relaxes_on_the_gpu_like_on_the_cpu() {
     };
     let cpu = first_minimize(DevicePreference::Cpu);
     let gpu = first_minimize(DevicePreference::Gpu);
-    let (c, g) = (cpu.last_minimize.clone().unwrap(), gpu.last_minimize.clone().unwrap());
+    let (c, g) = (cpu.reports.last_minimize.clone().unwrap(), gpu.reports.last_minimize.clone().unwrap());
     let apart = cpu.state.positions.iter().zip(&gpu.state.positions).map(|(a, b)| (*a - *b).length()).fold(0.0, f64::max);
     println!("CPU {c:?}\nGPU {g:?}\nlargest position difference {apart:.3e} µm, energy difference {:.3e}", (g.energy / c.energy - 1.0));
     assert!(c.converged && g.converged);
@@ -123,7 +123,9 @@ fn the_tensegrity_stage_relaxes_on_the_gpu_like_on_the_cpu() {
     // (the forces are the CPU's f64 ones at both ends; a fixed particle or a
     // held axis has Δx = 0): asserted within twice the sum of its terms' sizes.
     let first_order: f64 = (0..cpu.state.len())
-        .map(|i| (0.5 * (cpu.forces.forces[i] + gpu.forces.forces[i]).dot(gpu.state.positions[i] - cpu.state.positions[i])).abs())
+        .map(|i| {
+            (0.5 * (cpu.backend.forces.forces[i] + gpu.backend.forces.forces[i]).dot(gpu.state.positions[i] - cpu.state.positions[i])).abs()
+        })
         .sum();
     println!("|ΔE| {:.3e} pN·µm, bound {:.3e}", (g.energy - c.energy).abs(), 2.0 * first_order);
     assert!((g.energy - c.energy).abs() < 2.0 * first_order, "energies part by {:e}", g.energy - c.energy);
@@ -140,7 +142,7 @@ fn minimize_runs_on_the_gpu_whatever_the_integrator() {
     let deck = std::fs::read_to_string(case.path("deck.in")).unwrap();
     std::fs::write(case.path("deck.in"), deck.replace("timestep 1e-3\n", "timestep 1e-3\nintegrator implicit solver cholesky\n")).unwrap();
     let cholesky = run(&case, DevicePreference::Gpu);
-    assert!(cholesky.last_minimize.as_ref().is_some_and(|r| r.converged));
+    assert!(cholesky.reports.last_minimize.as_ref().is_some_and(|r| r.converged));
     assert_eq!(common::position_bits(&plain), common::position_bits(&cholesky));
 }
 
@@ -156,7 +158,7 @@ fn minimize_runs_on_the_gpu_whatever_the_integrator() {
 fn fire_with_contact_relaxes_on_the_gpu_like_on_the_cpu() {
     let case = common::squeezed_cells("temperature 0\ntimestep 1e-3\nminimize ftol 1e-2 maxiter 30000 dmax 0.05\n");
     let (cpu, gpu) = (run(&case, DevicePreference::Cpu), run(&case, DevicePreference::Gpu));
-    let (c, g) = (cpu.last_minimize.clone().unwrap(), gpu.last_minimize.clone().unwrap());
+    let (c, g) = (cpu.reports.last_minimize.clone().unwrap(), gpu.reports.last_minimize.clone().unwrap());
     let images = cpu.sim_box.images();
     let apart =
         cpu.state.positions.iter().zip(&gpu.state.positions).map(|(a, b)| images.minimum_image(*a - *b).length()).fold(0.0, f64::max);
@@ -171,7 +173,7 @@ fn fire_with_contact_relaxes_on_the_gpu_like_on_the_cpu() {
     let first_order: f64 = (0..cpu.state.len())
         .map(|i| {
             let dx = images.minimum_image(gpu.state.positions[i] - cpu.state.positions[i]);
-            (0.5 * (cpu.forces.forces[i] + gpu.forces.forces[i]).dot(dx)).abs()
+            (0.5 * (cpu.backend.forces.forces[i] + gpu.backend.forces.forces[i]).dot(dx)).abs()
         })
         .sum();
     println!("|ΔE| {:.3e} pN·µm, bound {:.3e}", (g.energy - c.energy).abs(), 2.0 * first_order);

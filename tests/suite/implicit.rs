@@ -62,7 +62,7 @@ fn implicit_and_explicit_reach_the_same_cantilever_equilibrium() {
         "tip deflection {deflection:.8} µm; implicit − explicit {:.2e} µm, cholesky − cg {:.2e} µm; last CG solve {:?}",
         worst(&implicit, &explicit),
         worst(&cholesky, &implicit),
-        implicit.last_solve
+        implicit.reports.last_solve
     );
     assert!(deflection > 0.01, "the load bent the filament by only {deflection} µm");
     assert!(worst(&implicit, &explicit) < 1e-6, "implicit and explicit equilibria differ by {:e} µm", worst(&implicit, &explicit));
@@ -85,7 +85,7 @@ fn conjugate_gradients_take_newton_steps_like_cholesky() {
     let cholesky = run(&cantilever("integrator implicit solver cholesky", 1e6, 4)).unwrap();
     let worst = cg.state.positions.iter().zip(&cholesky.state.positions).map(|(x, y)| (*x - *y).length()).fold(0.0, f64::max);
     let deflection = cholesky.state.positions[10].y;
-    println!("tip deflection {deflection:.6} µm; cg − cholesky {worst:.2e} µm; last CG solve {:?}", cg.last_solve);
+    println!("tip deflection {deflection:.6} µm; cg − cholesky {worst:.2e} µm; last CG solve {:?}", cg.reports.last_solve);
     assert!(deflection > 0.01, "the load bent the filament by only {deflection} µm");
     assert!(worst < 1e-9, "CG and Cholesky Newton steps differ by {worst:e} µm");
 }
@@ -141,7 +141,7 @@ fn implicit_error_is_first_order_in_dt() {
         let steps = (t / dt).round() as u64;
         let sim = run(&cantilever("integrator implicit tolerance 1e-12", dt, steps)).unwrap();
         let error = (sim.state.positions[10] - tip_ref).length();
-        println!("| {factor} | {steps} | {error:.3e} | {} |", sim.last_solve.iterations);
+        println!("| {factor} | {steps} | {error:.3e} | {} |", sim.reports.last_solve.iterations);
         errors.push(error);
     }
     for w in errors.windows(2) {
@@ -170,7 +170,7 @@ fn deformed_cell(integrator: &str, dt: f64) -> Simulation {
 fn relax(mut sim: Simulation) -> Simulation {
     loop {
         sim.run(50).unwrap();
-        if sim.forces.forces.iter().map(|f| f.length()).fold(0.0, f64::max) < 1e-9 {
+        if sim.backend.forces.forces.iter().map(|f| f.length()).fold(0.0, f64::max) < 1e-9 {
             return sim;
         }
         assert!(sim.state.step < 200_000, "not relaxed after {} steps", sim.state.step);

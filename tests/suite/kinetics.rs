@@ -80,7 +80,7 @@ fn lifetime_sweep(rule: &str, kt: f64, forces: &[f64], rate: impl Fn(f64) -> f64
         &format!("temperature {kt}\ntimestep {dt}\nseed {seed}\nevents events.csv\nlifetimes lifetimes.csv\nrun {steps}\n"),
     );
     let sim = c.run();
-    assert_eq!(sim.kinetics.breaks as usize, per_force * forces.len(), "some bonds never broke");
+    assert_eq!(sim.kinetics.engine.breaks as usize, per_force * forces.len(), "some bonds never broke");
     let table = std::fs::read_to_string(c.path("lifetimes.csv")).unwrap();
     let mut rows = table.lines();
     assert_eq!(rows.next(), Some("type,breaks,surviving,force[ε/σ],tau[τ],stderr[τ],tau_censored[τ]"));
@@ -196,7 +196,7 @@ fn slip_bonds_under_a_force_ramp_rupture_at_the_bell_evans_force() {
     let bond = format!("bond b harmonic k {k_bond} r0 1 kinetics motor v0 {v0} fs 1e12 kinetics slip k0 {k0} x_beta {x_beta}");
     let c = case(&fixed_pairs(n, &[1.0]), &bond, &format!("temperature {kt}\ntimestep {dt}\nseed 5\nevents events.csv\nrun {steps}\n"));
     let sim = c.run();
-    assert_eq!(sim.kinetics.breaks as usize, n);
+    assert_eq!(sim.kinetics.engine.breaks as usize, n);
     let mut forces: Vec<f64> = events(&c).iter().map(|e| e.3).collect();
     forces.sort_by(f64::total_cmp);
     // Kolmogorov–Smirnov against the exact CDF 1 − exp(−(k0/r)(e^(F/Fβ) − 1)·Fβ).
@@ -422,7 +422,7 @@ fn kinetics_runs_are_bit_identical_across_thread_counts() {
         let c = Case::new(&[("t.top", &top), ("f.ff", ff), ("deck.in", deck)]);
         let sim = c.run_with_threads(threads);
         let log = std::fs::read(c.path("events.csv")).unwrap();
-        (common::position_bits(&sim), sim.state.bonds.clone().unwrap(), log, sim.kinetics.breaks, sim.kinetics.forms)
+        (common::position_bits(&sim), sim.state.bonds.clone().unwrap(), log, sim.kinetics.engine.breaks, sim.kinetics.engine.forms)
     };
     let (one, two) = (run(1), run(2));
     assert!(one.3 > 100, "too few events to test: {}", one.3);
@@ -459,8 +459,8 @@ fn bond_formation_reaches_the_steady_state_and_reuses_bonds() {
     let c = Case::new(&[("t.top", &top), ("f.ff", &ff), ("deck.in", &deck)]);
     let sim = c.run();
     assert_eq!(sim.model.bonds.len(), n, "one bond per pair, reused");
-    assert_eq!(sim.kinetics.forms as usize, n);
-    assert!(sim.kinetics.rebinds > 10 * n as u64);
+    assert_eq!(sim.kinetics.engine.forms as usize, n);
+    assert!(sim.kinetics.engine.rebinds > 10 * n as u64);
     let rows: Vec<f64> =
         std::fs::read_to_string(c.path("t.csv")).unwrap().lines().skip(1).map(|l| l.split(',').nth(1).unwrap().parse().unwrap()).collect();
     let samples = &rows[10..];
@@ -534,7 +534,7 @@ fn restart_resumes_formed_bonds_bit_identically() {
     let (_, whole) = run("run 400\nrun 400\n", None);
     let (first, _) = run("run 400\nwrite_state half.state\n", None);
     let (_, resumed) = run("read_state half.state\nrun 400\n", Some(&first));
-    assert!(whole.kinetics.forms > 50, "too few bonds formed: {}", whole.kinetics.forms);
+    assert!(whole.kinetics.engine.forms > 50, "too few bonds formed: {}", whole.kinetics.engine.forms);
     assert_eq!(whole.model.bonds, resumed.model.bonds);
     assert_eq!(whole.state.bonds, resumed.state.bonds);
     let bits = |s: &cellmd::run::Simulation| s.state.positions.iter().map(|x| x.to_array().map(f64::to_bits)).collect::<Vec<_>>();

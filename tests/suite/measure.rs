@@ -256,7 +256,7 @@ fn shell_gamma(level: u32) -> (f64, f64, usize) {
                 minimize ftol 1e-7 maxiter 200000\n";
     let case = Case::new(&[("cell.top", &cell.text), ("cell.ff", &ff), ("deck.in", deck)]);
     let mut sim = case.run();
-    assert!(sim.last_minimize.as_ref().unwrap().converged, "FIRE did not converge");
+    assert!(sim.reports.last_minimize.as_ref().unwrap().converged, "FIRE did not converge");
     let v = sim.thermo_value(&ThermoColumn::BodyVolume(0)).unwrap();
     let dp = 100.0 + 200.0 * (cell.shells[0].volume - v) / cell.shells[0].volume;
     let (_, r) = cellmd::measure::planes::body_centre_and_radius(&sim.model, 0, &sim.state.positions, &sim.sim_box);

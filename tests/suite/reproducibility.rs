@@ -36,8 +36,8 @@ fn one_and_two_threads_give_identical_bits() {
     let two = case.run_with_threads(2);
     assert_eq!(position_bits(&one), position_bits(&two));
     assert_eq!(one.state.images, two.state.images);
-    assert_eq!(one.forces.total_energy().to_bits(), two.forces.total_energy().to_bits());
-    assert_eq!(one.forces.virial.map(f64::to_bits), two.forces.virial.map(f64::to_bits));
+    assert_eq!(one.backend.forces.total_energy().to_bits(), two.backend.forces.total_energy().to_bits());
+    assert_eq!(one.backend.forces.virial.map(f64::to_bits), two.backend.forces.virial.map(f64::to_bits));
     // The particles did move, across periodic boundaries.
     assert!(one.state.images.iter().any(|i| *i != [0, 0, 0]) || one.state.step == 500);
 }
@@ -102,8 +102,8 @@ fn many_blocks_give_identical_bits_on_one_and_two_threads_and_across_a_restart()
     let two = whole.run_with_threads(2);
     assert!(one.model.len() > 2 * 4096);
     assert_eq!(position_bits(&one), position_bits(&two));
-    assert_eq!(one.forces.total_energy().to_bits(), two.forces.total_energy().to_bits());
-    assert_eq!(one.forces.virial.map(f64::to_bits), two.forces.virial.map(f64::to_bits));
+    assert_eq!(one.backend.forces.total_energy().to_bits(), two.backend.forces.total_energy().to_bits());
+    assert_eq!(one.backend.forces.virial.map(f64::to_bits), two.backend.forces.virial.map(f64::to_bits));
     let first = network_case("run 40\nwrite_state half.state\n");
     first.run_with_threads(2);
     let second = network_case("read_state half.state\nrun 40\n");

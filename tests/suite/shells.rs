@@ -79,7 +79,7 @@ fn young_laplace_radius_converges_with_refinement() {
         let ff = format!("body cell turgor k {k} v0 {v0:?}\nbody cell surface_tension gamma {gamma}\n");
         let case = cell_case(level, r0, &ff, "timestep 3e-3\nminimize ftol 1e-5 maxiter 200000 dmax 0.01\n");
         let sim = case.run();
-        let report = sim.last_minimize.clone().unwrap();
+        let report = sim.reports.last_minimize.clone().unwrap();
         assert!(report.converged, "level {level}: FIRE did not converge: {report:?}");
         let (v, area) = volume_and_area(&sim);
         let r_v = (3.0 * v / (4.0 * PI)).cbrt();
@@ -331,7 +331,7 @@ fn junctions_bind_only_across_cells_and_break_when_pulled_apart() {
         formed += (f[2] == "form") as u32;
     }
     assert!(formed >= 3, "only {formed} junctions formed");
-    assert!(sim.kinetics.breaks >= formed as u64, "{} of {formed} junctions broke", sim.kinetics.breaks);
+    assert!(sim.kinetics.engine.breaks >= formed as u64, "{} of {formed} junctions broke", sim.kinetics.engine.breaks);
     let bound = sim.state.bonds.as_ref().unwrap().bound[sim.model.topology_bonds..].iter().filter(|&&b| b).count();
     assert_eq!(bound, 0, "junctions still bound after the pull");
     let centre = |lo: usize, hi: usize| sim.state.positions[lo..hi].iter().fold(DVec3::ZERO, |s, x| s + *x) / (hi - lo) as f64;

@@ -157,7 +157,7 @@ fn newton_and_fire_relax_the_spreading_cell_to_the_same_state() {
     let fire = spread("flat", &fixed);
     let newton = spread("flat", &[fixed[0].clone(), fixed[1].clone(), ("min_style", "newton".to_string())]);
     let (a, b) = (fire.spread.last().unwrap(), newton.spread.last().unwrap());
-    let (fire_report, newton_report) = (fire.sim.last_minimize.clone().unwrap(), newton.sim.last_minimize.clone().unwrap());
+    let (fire_report, newton_report) = (fire.sim.reports.last_minimize.clone().unwrap(), newton.sim.reports.last_minimize.clone().unwrap());
     let free = fire.sim.model.types.iter().filter(|&&t| fire.sim.model.type_drag[t as usize].is_finite()).count() as f64;
     let bound = free * 0.05;
     println!(

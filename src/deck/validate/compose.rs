@@ -17,9 +17,9 @@ impl Validator {
         };
         let file = SourceFile::read(&self.input_path(&s[1]), Some(&s[1]))?;
         let parsed = parse_topology(&file)?;
-        let mut top = match self.topology.take() {
+        let mut top = match self.setup.topology.take() {
             None if offset.unwrap_or(0) == 0 => {
-                self.topology = Some(Arc::new(parsed));
+                self.setup.topology = Some(Arc::new(parsed));
                 return Ok(());
             }
             previous => previous.map(Arc::unwrap_or_clone).unwrap_or_default(),
@@ -30,7 +30,7 @@ impl Validator {
                 c.id, s[1].text, c.offset, c.used
             ))
         })?;
-        self.topology = Some(Arc::new(top));
+        self.setup.topology = Some(Arc::new(top));
         Ok(())
     }
 }

@@ -84,7 +84,7 @@ impl Validator {
         let kw = &s[0];
         expect_len(s, 3..=usize::MAX, usage)?;
         self.protocols.check_external_kept(&s[1])?;
-        let units = self.units;
+        let units = self.setup.units;
         self.model(kw)?;
         let group = self.group_named(&s[2])?.clone();
         let (term, expressions) = if s[3].text == "custom" {
@@ -162,12 +162,12 @@ impl Validator {
         if !reshape {
             let model = self.model.as_ref().expect("built above");
             let type_r0 = model.bond_types[bond_type].params[r0];
-            let images = self.sim_box.as_ref().expect("built with the model").images();
+            let images = self.initial.sim_box.as_ref().expect("built with the model").images();
             let worst = (0..model.topology_bonds)
                 .filter(|&b| model.bond_type[b] as usize == bond_type)
                 .map(|b| {
                     let [i, j] = model.bonds[b];
-                    let length = images.minimum_image(self.positions[j as usize] - self.positions[i as usize]).length();
+                    let length = images.minimum_image(self.initial.positions[j as usize] - self.initial.positions[i as usize]).length();
                     let rest = model.bond_rest[b].unwrap_or(type_r0);
                     (b, length, rest, ((length - rest) / rest).abs())
                 })
@@ -207,7 +207,7 @@ impl Validator {
 
     pub(super) fn coeff(&mut self, s: &[Token], usage: &str) -> Result<(), InputError> {
         expect_len(s, 3..=usize::MAX, usage)?;
-        let units = self.units;
+        let units = self.setup.units;
         let (targets, start) = self.coeff_targets(s, usage)?;
         if !(s.len() - start).is_multiple_of(2) || s.len() == start {
             return Err(s.last().unwrap().error("expected `PARAM VALUE` pairs"));
@@ -238,7 +238,7 @@ impl Validator {
             }
             let expr = self.position_expression(&pairs[k])?;
             let first = group.members.first().copied().unwrap_or(0);
-            let x = self.positions[first as usize];
+            let x = self.initial.positions[first as usize];
             let value = expr.expr.eval(&mut |r| position_or_time(r, x, 0.0)).map_err(|e| self.at_particle(&expr, &e, first))?;
             values[k] = pairs[k].with_text(format!("{value}"));
             expressions.push((pairs[k - 1].clone(), expr));
@@ -274,7 +274,7 @@ impl Validator {
             .map(|(name, expr)| (param_index(term.interaction, &name.text).expect("checked by parse_params"), expr))
             .collect();
         for &m in &group.members {
-            let x = self.positions[m as usize];
+            let x = self.initial.positions[m as usize];
             let mut params = term.params.clone();
             for (k, expr) in &indexed {
                 params[*k] = expr.expr.eval(&mut |r| position_or_time(r, x, 0.0)).map_err(|e| self.at_particle(expr, &e, m))?;
@@ -295,7 +295,7 @@ impl Validator {
     pub(super) fn at_particle(&self, expr: &DeckExpr, e: &ExprError, m: u32) -> InputError {
         let mut located = expr.error(e);
         let id = self.model.as_ref().expect("built").ids[m as usize];
-        located.message = format!("at particle {id} (x = {}) and t = 0: {}", self.positions[m as usize], located.message);
+        located.message = format!("at particle {id} (x = {}) and t = 0: {}", self.initial.positions[m as usize], located.message);
         located
     }
 }

@@ -31,21 +31,21 @@ impl Validator {
 
     pub(super) fn thermo_file(&mut self, s: &[Token], usage: &str) -> Result<(), InputError> {
         expect_len(s, 1..=1, usage)?;
-        let path = self.output_of(&s[1], OutputKind::ThermoFile)?;
+        let path = self.outputs.claim(&s[1], OutputKind::ThermoFile)?;
         self.actions.push(Action::ThermoFile(path));
         Ok(())
     }
 
     pub(super) fn events(&mut self, s: &[Token], usage: &str) -> Result<(), InputError> {
         expect_len(s, 1..=1, usage)?;
-        let path = self.output_of(&s[1], OutputKind::Events)?;
+        let path = self.outputs.claim(&s[1], OutputKind::Events)?;
         self.actions.push(Action::EventFile(path));
         Ok(())
     }
 
     pub(super) fn lifetimes(&mut self, s: &[Token], usage: &str) -> Result<(), InputError> {
         expect_len(s, 1..=1, usage)?;
-        let path = self.output_of(&s[1], OutputKind::Lifetimes)?;
+        let path = self.outputs.claim(&s[1], OutputKind::Lifetimes)?;
         self.actions.push(Action::LifetimeFile(path));
         Ok(())
     }
@@ -63,22 +63,22 @@ impl Validator {
             let names: Vec<String> = DumpFormat::ALL.iter().map(|f| format!("`{}`", f.keyword())).collect();
             s[4].error(format!("found format `{}`, expected one of {}", s[4].text, names.join(", ")))
         })?;
-        let path = self.output_of(&s[5], OutputKind::Dump)?;
+        let path = self.outputs.claim(&s[5], OutputKind::Dump)?;
         let options = self.dump_options(format, &s[6..], usage)?;
-        if self.dumps.contains_key(&s[1].text) {
+        if self.outputs.dumps.contains_key(&s[1].text) {
             return Err(s[1].error(format!("dump `{}` is already active; expected a new name or `undump {}` first", s[1].text, s[1].text)));
         }
-        if self.dumps.values().any(|p| *p == path) {
+        if self.outputs.dumps.values().any(|p| *p == path) {
             return Err(s[5].error(format!("`{}` is already written by another dump; expected a different file", s[5].text)));
         }
-        self.dumps.insert(s[1].text.clone(), path.clone());
+        self.outputs.dumps.insert(s[1].text.clone(), path.clone());
         self.actions.push(Action::Dump(DumpSpec { name: s[1].text.clone(), every, format, path, options }));
         Ok(())
     }
 
     pub(super) fn undump(&mut self, s: &[Token], usage: &str) -> Result<(), InputError> {
         expect_len(s, 1..=1, usage)?;
-        if self.dumps.remove(&s[1].text).is_none() {
+        if self.outputs.dumps.remove(&s[1].text).is_none() {
             return Err(s[1].error(format!("found `{}`, expected the name of an active dump", s[1].text)));
         }
         self.actions.push(Action::Undump(s[1].text.clone()));
@@ -90,9 +90,9 @@ impl Validator {
         expect_len(s, 1..=1, usage)?;
         self.model(kw)?;
         let written = PathBuf::from(&s[1].text);
-        let path = if self.states_written.contains(&written) { written } else { self.input_path(&s[1]) };
+        let path = if self.outputs.states_written.contains(&written) { written } else { self.input_path(&s[1]) };
         // A continued run starts after this point from its own restart.
-        if !self.states_written.contains(&path) && !is_replaying() {
+        if !self.outputs.states_written.contains(&path) && !is_replaying() {
             if !path.exists() {
                 return Err(
                     s[1].error(format!("cannot read `{}`: no such file; expected a restart file written by `write_state`", path.display()))
@@ -101,7 +101,7 @@ impl Validator {
             check_input_file(&path).map_err(|why| s[1].error(format!("cannot read `{}`: {why}", path.display())))?;
             // Checked now against the system, so a bad restart fails `check`, before any output exists.
             let data = read_state(&path).map_err(|e| s[1].error(e))?;
-            let periodic = self.sim_box.as_ref().expect("built with the model").periodic;
+            let periodic = self.initial.sim_box.as_ref().expect("built with the model").periodic;
             let model = self.model(kw)?;
             data.check_against(model, periodic).map_err(|e| s[1].error(format!("{}: {e}", path.display())))?;
         }
@@ -114,9 +114,9 @@ impl Validator {
     pub(super) fn write_state(&mut self, s: &[Token], usage: &str) -> Result<(), InputError> {
         expect_len(s, 1..=5, usage)?;
         self.model(&s[0])?;
-        let path = self.output_of(&s[1], OutputKind::Restart)?;
+        let path = self.outputs.claim(&s[1], OutputKind::Restart)?;
         if s.len() == 2 {
-            self.states_written.insert(path.clone());
+            self.outputs.states_written.insert(path.clone());
             self.actions.push(Action::WriteState(path));
             return Ok(());
         }
@@ -156,13 +156,13 @@ impl Validator {
         const FIXED: &str =
             "step, time, pe, work, pe/NAME, pe/EXTERNAL, fmax, fnorm, press, pxx, pyy, pzz, pxy, pxz, pyz, nbuild, solver_iterations, solver_residual, ctension/BONDTYPE, breaks, rebinds, forms, resets, nbound/BONDTYPE, tension/BONDTYPE, volume/BODYTYPE, area/BODYTYPE, planetension/AXIS/POS, gamma/BODYTYPE, e2e/BONDTYPE, tcorr/BONDTYPE/LAG, fracture/BONDTYPE/QUANTITY, clustering/BONDTYPE/GROUP_A/GROUP_B, fx/GROUP, fy/GROUP, fz/GROUP, fx/EXTERNAL, fy/EXTERNAL, fz/EXTERNAL, xu/GROUP, yu/GROUP, zu/GROUP, xspan/GROUP, yspan/GROUP, zspan/GROUP, fabs/GROUP, hullarea/GROUP, load/INDENTER, depth/INDENTER, mindist, nclamp";
         let bond_type = |t: &Token, name: &str| {
-            self.forcefield.bond_types.iter().position(|b| b.label.text == name).ok_or_else(|| {
-                let names: Vec<&str> = self.forcefield.bond_types.iter().map(|b| b.label.text.as_str()).collect();
+            self.setup.forcefield.bond_types.iter().position(|b| b.label.text == name).ok_or_else(|| {
+                let names: Vec<&str> = self.setup.forcefield.bond_types.iter().map(|b| b.label.text.as_str()).collect();
                 t.error(format!("found bond type `{name}`, expected one defined in the force field ({})", names.join(", ")))
             })
         };
         let body_type = |t: &Token, name: &str| {
-            let names = self.forcefield.body_type_names();
+            let names = self.setup.forcefield.body_type_names();
             names.iter().position(|n| *n == name).ok_or_else(|| {
                 t.error(format!(
                     "found body type `{name}`, expected one that `body` or `contact` lines of the force field name ({})",
@@ -194,7 +194,7 @@ impl Validator {
                     "rebinds" => ThermoColumn::Events(EventKind::Rebind),
                     "forms" => ThermoColumn::Events(EventKind::Form),
                     "resets" => ThermoColumn::Events(EventKind::Reset),
-                    "mindist" | "nclamp" if self.forcefield.contact_rules.is_empty() => {
+                    "mindist" | "nclamp" if self.setup.forcefield.contact_rules.is_empty() => {
                         return Err(t.error(format!("found `{}`, which needs `contact` lines in the force field; expected {FIXED}", t.text)))
                     }
                     "mindist" => ThermoColumn::MinDistance,

@@ -113,7 +113,7 @@ impl Validator {
             let param = self.target_param(&target, name)?;
             let interaction = target.term(self.model(name)?).interaction;
             let spec = &interaction.params()[param];
-            let what = |end: &str| format!("the {end} value of `{}` in {}", spec.name, self.units.label(spec.dim));
+            let what = |end: &str| format!("the {end} value of `{}` in {}", spec.name, self.setup.units.label(spec.dim));
             let from = parse_f64(from_token, &what("start"))?;
             let to = parse_f64(to_token, &what("end"))?;
             let cutoff = self.pair_cutoff(&target, name)?;
@@ -151,7 +151,7 @@ impl Validator {
         expect_len(s, 5..=5, usage)?;
         self.model(&s[0])?;
         let group = self.group_named(&s[1])?.clone();
-        let unit = self.units.label(crate::units::Dim::Velocity);
+        let unit = self.setup.units.label(crate::units::Dim::Velocity);
         let components = s[3..].iter().zip(["VX", "VY", "VZ"]);
         let velocity = match s[2].text.as_str() {
             "linear" => {
@@ -164,7 +164,7 @@ impl Validator {
             "velocity" => {
                 let exprs = components.map(|(t, _)| self.position_expression(t)).collect::<Result<Vec<_>, _>>()?;
                 for &m in &group.members {
-                    let x = self.positions[m as usize];
+                    let x = self.initial.positions[m as usize];
                     for expr in &exprs {
                         let value = expr.expr.eval(&mut |r| position_or_time(r, x, 0.0)).map_err(|e| self.at_particle(expr, &e, m))?;
                         if !value.is_finite() {
@@ -289,7 +289,7 @@ impl Validator {
                 if s.len() != 6 && s.len() != 8 {
                     expect_len(s, 5..=5, usage)?;
                 }
-                let unit = self.units.label(crate::units::Dim::Velocity);
+                let unit = self.setup.units.label(crate::units::Dim::Velocity);
                 let mut velocity = DVec3::ZERO;
                 for (a, (t, name)) in s[3..6].iter().zip(["VX", "VY", "VZ"]).enumerate() {
                     velocity[a] = parse_f64(t, &format!("a velocity {name} in {unit}"))?;
@@ -297,7 +297,7 @@ impl Validator {
                 let until = match s.get(6) {
                     None => None,
                     Some(t) if t.text == "until" => {
-                        let load = positive(&s[7], &format!("a load in {}", self.units.label(crate::units::Dim::Force)))?;
+                        let load = positive(&s[7], &format!("a load in {}", self.setup.units.label(crate::units::Dim::Force)))?;
                         Some(load)
                     }
                     Some(t) => return Err(t.error(format!("found `{}`, expected `until` or the end of the line (`{usage}`)", t.text))),

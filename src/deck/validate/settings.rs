@@ -16,21 +16,21 @@ use crate::units::UnitSystem;
 impl Validator {
     pub(super) fn temperature(&mut self, s: &[Token], usage: &str) -> Result<(), InputError> {
         expect_len(s, 1..=1, usage)?;
-        let what = match self.units {
+        let what = match self.setup.units {
             UnitSystem::Cell => "a temperature in K",
             UnitSystem::Lj => "a reduced temperature kT",
         };
         let t = non_negative(&s[1], what)?;
-        if self.units == UnitSystem::Cell && t > 0.0 && t < 1.0 {
+        if self.setup.units == UnitSystem::Cell && t > 0.0 && t < 1.0 {
             self.warnings.push(format!(
                 "{}:{}:{}: warning: temperature {t} K; did you mean kT? temperature is in kelvin (kT = {:.3e} pN·µm at 300 K)",
                 s[1].file.path,
                 s[1].line,
                 s[1].col,
-                self.units.kt(300.0)
+                self.setup.units.kt(300.0)
             ));
         }
-        self.actions.push(Action::Temperature(self.units.kt(t)));
+        self.actions.push(Action::Temperature(self.setup.units.kt(t)));
         Ok(())
     }
 

@@ -11,10 +11,10 @@ use crate::units::UnitSystem;
 impl Validator {
     pub(super) fn units(&mut self, s: &[Token], usage: &str) -> Result<(), InputError> {
         expect_len(s, 1..=1, usage)?;
-        if self.topology.is_some() || self.forcefield_seen {
+        if self.setup.topology.is_some() || self.setup.forcefield_seen {
             return Err(s[0].error("`units` must come before `topology` and `forcefield`"));
         }
-        self.units = UnitSystem::from_keyword(&s[1].text)
+        self.setup.units = UnitSystem::from_keyword(&s[1].text)
             .ok_or_else(|| s[1].error(format!("found `{}`, expected `cell` (µm, s, pN) or `lj`", s[1].text)))?;
         Ok(())
     }
@@ -22,8 +22,8 @@ impl Validator {
     pub(super) fn forcefield(&mut self, s: &[Token], usage: &str) -> Result<(), InputError> {
         expect_len(s, 1..=1, usage)?;
         let path = self.input_path(&s[1]);
-        load_forcefield(&path, Some(&s[1]), self.units, &mut self.forcefield, &mut Vec::new())?;
-        self.forcefield_seen = true;
+        load_forcefield(&path, Some(&s[1]), self.setup.units, &mut self.setup.forcefield, &mut Vec::new())?;
+        self.setup.forcefield_seen = true;
         Ok(())
     }
 
@@ -38,7 +38,7 @@ impl Validator {
             }
             seen[index] = true;
         }
-        self.box_axes = Some(axes);
+        self.setup.box_axes = Some(axes);
         Ok(())
     }
 
@@ -53,7 +53,7 @@ impl Validator {
                 return Err(t.error(format!("found weight {}, expected a weight from 0 (pair left out) to 1 (pair in full)", weights[k])));
             }
         }
-        self.special_bonds = SpecialBonds { weights };
+        self.setup.special_bonds = SpecialBonds { weights };
         Ok(())
     }
 }

@@ -127,12 +127,12 @@ pub fn import(data_name: &str, data_text: &str, script_text: Option<(&str, &str)
     let mut drag: BTreeMap<usize, f64> = BTreeMap::new();
     let mut temperature: Option<f64> = None;
     let mut gaussian = false;
-    let has_langevin = script.dynamics.iter().any(|(_, d)| matches!(d, Dynamics::Langevin { .. }));
-    if !script.nve.is_empty() && !has_langevin {
+    let has_langevin = script.fixes.dynamics.iter().any(|(_, d)| matches!(d, Dynamics::Langevin { .. }));
+    if !script.fixes.nve.is_empty() && !has_langevin {
         let name = script.source.as_ref().map_or("INPUT", |s| s.name.as_str());
-        notes.push(format!("{name}:{}: `fix … nve` without `fix … langevin` (inertial dynamics) is not translated", script.nve[0]));
+        notes.push(format!("{name}:{}: `fix … nve` without `fix … langevin` (inertial dynamics) is not translated", script.fixes.nve[0]));
     }
-    for (line, d) in &script.dynamics {
+    for (line, d) in &script.fixes.dynamics {
         let name = script.source.as_ref().map_or("INPUT", |s| s.name.as_str());
         let (group, t) = match d {
             Dynamics::Brownian { group, temperature, rng, .. } => {
@@ -208,12 +208,12 @@ pub fn import(data_name: &str, data_text: &str, script_text: Option<(&str, &str)
         }
     }
     let bond_lines: Vec<_> =
-        data_coeffs(&data_source, &data, "Bond Coeffs", "bond_coeff").into_iter().chain(script.bond_coeffs.iter().cloned()).collect();
+        data_coeffs(&data_source, &data, "Bond Coeffs", "bond_coeff").into_iter().chain(script.bond.coeffs.iter().cloned()).collect();
     let angle_lines: Vec<_> =
-        data_coeffs(&data_source, &data, "Angle Coeffs", "angle_coeff").into_iter().chain(script.angle_coeffs.iter().cloned()).collect();
+        data_coeffs(&data_source, &data, "Angle Coeffs", "angle_coeff").into_iter().chain(script.angle.coeffs.iter().cloned()).collect();
     for (kind, style, lines, count, used) in [
-        ("bond", &script.bond_style, &bond_lines, data.bond_types, !data.bonds.is_empty()),
-        ("angle", &script.angle_style, &angle_lines, data.angle_types, !data.angles.is_empty()),
+        ("bond", &script.bond.style, &bond_lines, data.bond_types, !data.bonds.is_empty()),
+        ("angle", &script.angle.style, &angle_lines, data.angle_types, !data.angles.is_empty()),
     ] {
         let laws = coeffs::bonded(kind, style, lines, count)?;
         for t in 1..=count {
@@ -226,8 +226,8 @@ pub fn import(data_name: &str, data_text: &str, script_text: Option<(&str, &str)
         }
     }
     let pair_lines: Vec<_> =
-        data_coeffs(&data_source, &data, "Pair Coeffs", "pair_coeff").into_iter().chain(script.pair_coeffs.iter().cloned()).collect();
-    let (pairs, pair_notes) = coeffs::pairs(&script.pair_style, &script.pair_modify, &pair_lines, n)?;
+        data_coeffs(&data_source, &data, "Pair Coeffs", "pair_coeff").into_iter().chain(script.pair.coeffs.iter().cloned()).collect();
+    let (pairs, pair_notes) = coeffs::pairs(&script.pair.style, &script.pair_modify, &pair_lines, n)?;
     notes.extend(pair_notes);
     for (i, j, law) in &pairs {
         writeln!(ff, "pair {} {} {law}", names[i], names[j]).unwrap();
@@ -246,13 +246,13 @@ pub fn import(data_name: &str, data_text: &str, script_text: Option<(&str, &str)
     deck.push_str("units lj\ntopology system.top\nforcefield system.ff\n");
     let w = script.special.unwrap_or([0.0; 3]);
     writeln!(deck, "special_bonds {} {} {}", num(w[0]), num(w[1]), num(w[2])).unwrap();
-    if script.skin.is_some() || script.neighbor_every.is_some() || script.neighbor_check.is_some() {
+    if script.neighbor.skin.is_some() || script.neighbor.every.is_some() || script.neighbor.check.is_some() {
         // LAMMPS' default skin in lj units is 0.3σ.
-        let mut line = format!("neighbor skin {}", num(script.skin.unwrap_or(0.3)));
-        if let Some(every) = script.neighbor_every {
+        let mut line = format!("neighbor skin {}", num(script.neighbor.skin.unwrap_or(0.3)));
+        if let Some(every) = script.neighbor.every {
             write!(line, " every {}", every.max(1)).unwrap();
         }
-        if let Some(check) = script.neighbor_check {
+        if let Some(check) = script.neighbor.check {
             write!(line, " check {}", if check { "yes" } else { "no" }).unwrap();
         }
         writeln!(deck, "{line}").unwrap();

@@ -43,28 +43,47 @@ pub struct Script {
     pub atom_style: Option<String>,
     pub periodic: Option<[bool; 3]>,
     pub special: Option<[f64; 3]>,
-    pub bond_style: Style,
-    pub angle_style: Style,
-    pub pair_style: Style,
-    pub bond_coeffs: Vec<(Source, Line)>,
-    pub angle_coeffs: Vec<(Source, Line)>,
-    pub pair_coeffs: Vec<(Source, Line)>,
+    /// `bond_style` and the `bond_coeff` lines.
+    pub bond: Terms,
+    /// `angle_style` and the `angle_coeff` lines.
+    pub angle: Terms,
+    /// `pair_style` and the `pair_coeff` lines.
+    pub pair: Terms,
     pub pair_modify: PairModify,
     /// `mass` commands: (type range word, mass).
     pub masses: Vec<(Word, f64)>,
     /// `group NAME type …`: the type words.
     pub groups: BTreeMap<String, Vec<Word>>,
-    pub dynamics: Vec<(usize, Dynamics)>,
-    /// `fix … nve` ids (with a langevin fix, the pair is overdamped dynamics).
-    pub nve: Vec<usize>,
+    pub fixes: Fixes,
     pub events: Vec<Event>,
-    /// `neighbor SKIN` and `neigh_modify every N check yes|no`.
-    pub skin: Option<f64>,
-    pub neighbor_every: Option<u64>,
-    pub neighbor_check: Option<bool>,
+    pub neighbor: Neighbor,
     /// The data file named by `read_data` (the word, for errors about it).
     pub read_data: Option<Word>,
     pub notes: Vec<String>,
+}
+
+/// A kind's style and its coefficient lines (in script order).
+#[derive(Clone, Debug, Default)]
+pub struct Terms {
+    pub style: Style,
+    pub coeffs: Vec<(Source, Line)>,
+}
+
+/// The `fix` commands of the dynamics that are in force, by fix id.
+#[derive(Clone, Debug, Default)]
+pub struct Fixes {
+    /// `fix … brownian` and `fix … langevin`.
+    pub dynamics: Vec<(usize, Dynamics)>,
+    /// `fix … nve` ids (with a langevin fix, the pair is overdamped dynamics).
+    pub nve: Vec<usize>,
+}
+
+/// `neighbor SKIN` and `neigh_modify every N check yes|no`.
+#[derive(Clone, Debug, Default)]
+pub struct Neighbor {
+    pub skin: Option<f64>,
+    pub every: Option<u64>,
+    pub check: Option<bool>,
 }
 
 /// Commands that change no result of a run (parallel settings, LAMMPS' own output).
@@ -149,12 +168,12 @@ pub fn read(name: &str, text: &str) -> Result<Script, String> {
                 }
                 s.events.push(Event::Timestep(dt));
             }
-            "bond_style" => s.bond_style = parse_style(&source, &w[1..])?,
-            "angle_style" => s.angle_style = parse_style(&source, &w[1..])?,
-            "pair_style" => s.pair_style = parse_style(&source, &w[1..])?,
-            "bond_coeff" => s.bond_coeffs.push((source.clone(), line.clone())),
-            "angle_coeff" => s.angle_coeffs.push((source.clone(), line.clone())),
-            "pair_coeff" => s.pair_coeffs.push((source.clone(), line.clone())),
+            "bond_style" => s.bond.style = parse_style(&source, &w[1..])?,
+            "angle_style" => s.angle.style = parse_style(&source, &w[1..])?,
+            "pair_style" => s.pair.style = parse_style(&source, &w[1..])?,
+            "bond_coeff" => s.bond.coeffs.push((source.clone(), line.clone())),
+            "angle_coeff" => s.angle.coeffs.push((source.clone(), line.clone())),
+            "pair_coeff" => s.pair.coeffs.push((source.clone(), line.clone())),
             "pair_modify" => pair_modify(&source, &line, &mut s)?,
             "mass" => s.masses.push((at(1)?.clone(), source.number(at(2)?, "a mass")?)),
             "group" if w.get(2).is_some_and(|k| k.text == "type") => {
@@ -163,8 +182,8 @@ pub fn read(name: &str, text: &str) -> Result<Script, String> {
             "fix" => fix(&source, &line, &mut s, &mut fix_ids)?,
             "unfix" => {
                 if let Some(k) = fix_ids.remove(&at(1)?.text) {
-                    s.dynamics.retain(|(id, _)| *id != k);
-                    s.nve.retain(|id| *id != k);
+                    s.fixes.dynamics.retain(|(id, _)| *id != k);
+                    s.fixes.nve.retain(|id| *id != k);
                     if s.events.iter().any(|e| matches!(e, Event::Run(_))) {
                         note(&mut s, "a fix removed after a run: the deck runs every `run` with the fixes defined before the first");
                     }
@@ -183,12 +202,12 @@ pub fn read(name: &str, text: &str) -> Result<Script, String> {
                 }
             }
             "thermo" => s.events.push(Event::Thermo(source.count(at(1)?, "a thermo interval")?)),
-            "neighbor" => s.skin = Some(source.number(at(1)?, "a skin")?),
+            "neighbor" => s.neighbor.skin = Some(source.number(at(1)?, "a skin")?),
             "neigh_modify" => {
                 for pair in w[1..].windows(2) {
                     match pair[0].text.as_str() {
-                        "every" => s.neighbor_every = Some(source.count(&pair[1], "a rebuild interval")?),
-                        "check" => s.neighbor_check = Some(pair[1].text == "yes"),
+                        "every" => s.neighbor.every = Some(source.count(&pair[1], "a rebuild interval")?),
+                        "check" => s.neighbor.check = Some(pair[1].text == "yes"),
                         _ => {}
                     }
                 }
@@ -342,7 +361,7 @@ fn fix(source: &Source, line: &Line, s: &mut Script, ids: &mut BTreeMap<String, 
             let gamma = keyword("gamma_t").ok_or_else(|| source.error(&w[3], "`fix brownian` without `gamma_t` is not translated"))?;
             let gamma = source.number(gamma, "a drag gamma_t")?;
             let rng = keyword("rng").map_or("uniform".to_string(), |r| r.text.clone());
-            s.dynamics.push((k, Dynamics::Brownian { group, temperature, gamma, rng }));
+            s.fixes.dynamics.push((k, Dynamics::Brownian { group, temperature, gamma, rng }));
         }
         "langevin" => {
             let (t0, t1) = (source.number(at(4)?, "a start temperature")?, source.number(at(5)?, "a stop temperature")?);
@@ -365,9 +384,9 @@ fn fix(source: &Source, line: &Line, s: &mut Script, ids: &mut BTreeMap<String, 
                 k,
                 format!("`{}`: translated in the overdamped limit (drag m/damp per type); LAMMPS' inertial dynamics agrees where damp = {damp} is short against the times of interest", clip(&line.text)),
             ));
-            s.dynamics.push((k, Dynamics::Langevin { group, temperature: t0, damp, scale }));
+            s.fixes.dynamics.push((k, Dynamics::Langevin { group, temperature: t0, damp, scale }));
         }
-        "nve" => s.nve.push(k),
+        "nve" => s.fixes.nve.push(k),
         _ => s.notes.push(source.at_line(k, format!("`{}`: not translated", clip(&line.text)))),
     }
     Ok(())

@@ -12,7 +12,7 @@ use crate::gpu::forces::ForcePasses;
 use crate::gpu::kinetics::{DeviceKinetics, KinKernels, KinLayout};
 use crate::gpu::neighbours::{DispatchArgs, NeighbourList};
 use crate::gpu::nlist::NeighbourStorage;
-use crate::gpu::pack::{cell_grid, pack, FixedPoint, Packed, Params};
+use crate::gpu::pack::{cell_grid, pack, BoxFrame, FixedPoint, KineticsWords, Packed, Params, Sizes, StepWords};
 use crate::gpu::prelude::status::STATUS_WORDS;
 use crate::gpu::protocol::{DeviceProtocol, PackedTerms, ProtocolKernels, ProtocolPack};
 use crate::gpu::shader;
@@ -92,38 +92,46 @@ impl GpuBackend {
         let lo_fixed = [0, 1, 2].map(|a| fixed.encode(sim_box.lo[a]));
         let groups_x = ctx.limits.max_compute_workgroups_per_dimension.min(65_535);
         let params = Params {
-            box_len_h: [box_fixed[0].0, box_fixed[1].0, box_fixed[2].0, 0],
-            box_len_f: [box_fixed[0].1, box_fixed[1].1, box_fixed[2].1, 0],
-            box_len: [lengths.x as f32, lengths.y as f32, lengths.z as f32, fixed.q as f32],
-            box_lo_h: [lo_fixed[0].0, lo_fixed[1].0, lo_fixed[2].0, 0],
-            box_lo_f: [lo_fixed[0].1, lo_fixed[1].1, lo_fixed[2].1, 0],
-            periodic: [sim_box.periodic[0] as u32, sim_box.periodic[1] as u32, sim_box.periodic[2] as u32, 0],
-            grid: [grid[0], grid[1], grid[2], cells],
-            cell_inv_width: [inv_width[0], inv_width[1], inv_width[2], 0.0],
-            n: n as u32,
-            nlist_cap: initial_capacity(n, sim_box, range, has_pairs),
-            n_types: model.type_names.len() as u32,
-            steps_wanted: 0,
-            range2: (range * range) as f32,
-            half_skin2: (0.25 * skin * skin) as f32,
-            max_disp2: (settings.context.max_displacement * settings.context.max_displacement) as f32,
-            neighbor_every: settings.neighbor_every.max(1) as u32,
-            seed_lo: settings.context.seed as u32,
-            seed_hi: (settings.context.seed >> 32) as u32,
-            step_lo: 0,
-            step_hi: 0,
-            neighbor_check: settings.neighbor_check as u32,
-            scan_blocks,
-            groups_x,
-            gaussian: (settings.context.noise == crate::rng::Noise::Gaussian) as u32,
+            frame: BoxFrame {
+                box_len_h: [box_fixed[0].0, box_fixed[1].0, box_fixed[2].0, 0],
+                box_len_f: [box_fixed[0].1, box_fixed[1].1, box_fixed[2].1, 0],
+                box_lo_h: [lo_fixed[0].0, lo_fixed[1].0, lo_fixed[2].0, 0],
+                box_lo_f: [lo_fixed[0].1, lo_fixed[1].1, lo_fixed[2].1, 0],
+                periodic: [sim_box.periodic[0] as u32, sim_box.periodic[1] as u32, sim_box.periodic[2] as u32, 0],
+                grid: [grid[0], grid[1], grid[2], cells],
+                cell_inv_width: [inv_width[0], inv_width[1], inv_width[2], 0.0],
+                box_len: [lengths.x as f32, lengths.y as f32, lengths.z as f32, fixed.q as f32],
+            },
+            sizes: Sizes {
+                n: n as u32,
+                nlist_cap: initial_capacity(n, sim_box, range, has_pairs),
+                n_types: model.type_names.len() as u32,
+                steps_wanted: 0,
+            },
+            step: StepWords {
+                range2: (range * range) as f32,
+                half_skin2: (0.25 * skin * skin) as f32,
+                max_disp2: (settings.context.max_displacement * settings.context.max_displacement) as f32,
+                neighbor_every: settings.neighbor_every.max(1) as u32,
+                seed_lo: settings.context.seed as u32,
+                seed_hi: (settings.context.seed >> 32) as u32,
+                step_lo: 0,
+                step_hi: 0,
+                neighbor_check: settings.neighbor_check as u32,
+                scan_blocks,
+                groups_x,
+                gaussian: (settings.context.noise == crate::rng::Noise::Gaussian) as u32,
+            },
             topo_offsets: packed.topo_offsets,
             fparam_offsets: packed.fparam_offsets,
             surface_offsets: packed.surface_offsets,
             contact: contact_fields,
-            kin_bonds: kin_words.as_ref().map_or(0, |(_, l)| l.bonds()),
-            kin_first_term: kin_words.as_ref().map_or(0, |(_, l)| l.first_term),
-            kin_capacity: kin_words.as_ref().map_or(0, |(_, l)| l.capacity),
-            kin_types: model.bond_types.len() as u32,
+            kinetics: KineticsWords {
+                kin_bonds: kin_words.as_ref().map_or(0, |(_, l)| l.bonds()),
+                kin_first_term: kin_words.as_ref().map_or(0, |(_, l)| l.first_term),
+                kin_capacity: kin_words.as_ref().map_or(0, |(_, l)| l.capacity),
+                kin_types: model.bond_types.len() as u32,
+            },
             tetra_offsets: packed.tetra_offsets,
             clock: [0.0, 0.0, settings.context.dt as f32, 0.0],
             special_offsets: packed.special_offsets,
@@ -152,7 +160,7 @@ impl GpuBackend {
         let cell_count = zeros("cell_count", 4 * cells as u64, rw);
         let cell_data = zeros("cell_data", 4 * (cells as u64 + 1 + scan_blocks as u64 + n as u64), rw);
         let nlist_binding_limit = ctx.limits.max_storage_buffer_binding_size.min(ctx.limits.max_buffer_size);
-        let nlist = NeighbourStorage::new(ctx, n as u32, params.nlist_cap, nlist_binding_limit)?;
+        let nlist = NeighbourStorage::new(ctx, n as u32, params.sizes.nlist_cap, nlist_binding_limit)?;
         let force = zeros("force", 16 * n as u64, rw);
         let status = zeros("status", 4 * STATUS_WORDS as u64, rw);
         let surf_bytes = 16 * (packed.surf_entries + contact.surf_entries(n as u32) + adhesion.surf_entries(n as u32));

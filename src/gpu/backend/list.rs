@@ -17,7 +17,7 @@ impl GpuBackend {
 
     /// Neighbour-list capacity per particle.
     pub fn neighbor_capacity(&self) -> u32 {
-        self.params.nlist_cap
+        self.params.sizes.nlist_cap
     }
 
     /// Chunks the neighbour list is bound in (1 unless it exceeds one binding).
@@ -30,7 +30,7 @@ impl GpuBackend {
     /// chunked list on small systems. An error when 64 particles' rows do not fit.
     pub fn limit_neighbor_binding(&mut self, bytes: u64) -> Result<(), String> {
         self.list.binding_limit = bytes.min(self.list.binding_limit);
-        self.list.resize(&self.ctx, self.params.n, self.params.nlist_cap)?;
+        self.list.resize(&self.ctx, self.params.sizes.n, self.params.sizes.nlist_cap)?;
         self.bindings.main = self.bind_main();
         Ok(())
     }
@@ -48,13 +48,13 @@ impl GpuBackend {
     /// Grows the neighbour list to hold `need` neighbours per particle (with
     /// a quarter's margin); nothing if it does. The list is rebuilt before the next step.
     pub fn reserve_neighbors(&mut self, need: u32) -> Result<(), String> {
-        if need <= self.params.nlist_cap {
+        if need <= self.params.sizes.nlist_cap {
             return Ok(());
         }
         let need = need as u64;
         let cap = (need + need / 4 + 8).next_multiple_of(8) as u32;
-        self.list.resize(&self.ctx, self.params.n, cap)?;
-        self.params.nlist_cap = cap;
+        self.list.resize(&self.ctx, self.params.sizes.n, cap)?;
+        self.params.sizes.nlist_cap = cap;
         self.bindings.main = self.bind_main();
         self.list.grown += 1;
         self.implicit_list_check()
@@ -68,7 +68,7 @@ impl GpuBackend {
             return Err(format!(
                 "integrator implicit with pair terms: the neighbour list ({} particles × {} neighbours) needs {} bindings on {}; \
                  the device's implicit solve reads it from one (use `device cpu`)",
-                self.params.n, self.params.nlist_cap, self.list.storage.chunks, self.ctx.info.name
+                self.params.sizes.n, self.params.sizes.nlist_cap, self.list.storage.chunks, self.ctx.info.name
             ));
         }
         Ok(())
@@ -79,6 +79,6 @@ impl GpuBackend {
     /// halts with [`GpuHalt::Formation`](super::GpuHalt::Formation), src/gpu/bind.rs), so a backend
     /// built anew can [`Self::reserve_neighbors`] them.
     pub fn neighbors_met(&self) -> u32 {
-        self.params.nlist_cap.max(self.list.overflow_met)
+        self.params.sizes.nlist_cap.max(self.list.overflow_met)
     }
 }

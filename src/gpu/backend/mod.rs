@@ -290,7 +290,7 @@ impl GpuBackend {
     /// 65 535, by default); wider dispatches are split along y. Lowering it
     /// exercises the split on small systems.
     pub fn limit_dispatch_width(&mut self, groups: u32) {
-        self.params.groups_x = groups.clamp(1, self.params.groups_x);
+        self.params.step.groups_x = groups.clamp(1, self.params.step.groups_x);
     }
 
     fn reset_status(&self, force_rebuild: bool) {
@@ -470,9 +470,9 @@ impl GpuBackend {
                 }
                 self.params.protocol = pack.fields;
             }
-            self.params.step_lo = step as u32;
-            self.params.step_hi = (step >> 32) as u32;
-            self.params.steps_wanted = chunk as u32;
+            self.params.step.step_lo = step as u32;
+            self.params.step.step_hi = (step >> 32) as u32;
+            self.params.sizes.steps_wanted = chunk as u32;
             self.set_clock(self.time + self.elapsed(done));
             self.write_params();
             self.reset_status(force_rebuild);

@@ -35,7 +35,7 @@ impl GpuBackend {
     /// is left as it was (integration is timed on a copy of the positions).
     pub fn profile(&mut self, repetitions: u32) -> Result<PhaseTimes, String> {
         self.evaluate()?;
-        let saved = self.read(&self.buffers.state, 48 * self.params.n as u64);
+        let saved = self.read(&self.buffers.state, 48 * self.params.sizes.n as u64);
         let particles = Over::Particles;
         let at = self.dispatcher();
         // `group`: the bind group 1 the kernels read (the neighbour decision's
@@ -68,7 +68,7 @@ impl GpuBackend {
         let (check, neighbor_build) = match self.list.active {
             true => {
                 let (passes, args) = self.list.check_passes();
-                (time(&passes, Some(args)), time(&self.list.build_passes(self.params.grid[3]), None))
+                (time(&passes, Some(args)), time(&self.list.build_passes(self.params.frame.grid[3]), None))
             }
             false => (0.0, 0.0),
         };
@@ -92,7 +92,7 @@ impl GpuBackend {
         let kinetics = self.features.kinetics.as_ref().map_or(0.0, |kinetics| time(&kinetics.profiled(), None));
         let started = std::time::Instant::now();
         for _ in 0..repetitions {
-            self.read(&self.buffers.state, 48 * self.params.n as u64);
+            self.read(&self.buffers.state, 48 * self.params.sizes.n as u64);
         }
         let readback = started.elapsed().as_secs_f64() / repetitions as f64;
         self.ctx.queue.write_buffer(&self.buffers.state, 0, &saved);

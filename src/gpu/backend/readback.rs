@@ -62,15 +62,15 @@ impl GpuBackend {
 
     /// Forces (f32, widened) and per-particle energy shares from the last force pass.
     pub fn forces_and_energies(&self) -> Vec<(DVec3, f64)> {
-        let n = self.params.n as u64;
+        let n = self.params.sizes.n as u64;
         let data: Vec<[f32; 4]> = bytemuck::cast_slice(&self.read(&self.buffers.force, 16 * n)).to_vec();
         data.iter().map(|f| (DVec3::new(f[0] as f64, f[1] as f64, f[2] as f64), f[3] as f64)).collect()
     }
 
     /// The neighbour list of the last build, each particle's list sorted.
     pub fn neighbor_lists(&self) -> Vec<Vec<u32>> {
-        let n = self.params.n as usize;
-        let cap = self.params.nlist_cap as usize;
+        let n = self.params.sizes.n as usize;
+        let cap = self.params.sizes.nlist_cap as usize;
         let data: Vec<u32> = bytemuck::cast_slice(&self.read(&self.list.storage.list, 4 * (n * (1 + cap)) as u64)).to_vec();
         (0..n)
             .map(|i| {

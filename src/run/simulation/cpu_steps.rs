@@ -34,7 +34,7 @@ pub(super) struct CpuSteps {
 impl CpuSteps {
     fn lap(&mut self, sim: &mut Simulation, phase: Phase) {
         if let Some(clock) = &mut self.clock {
-            clock.lap(&mut sim.times, phase);
+            clock.lap(&mut sim.reports.times, phase);
         }
     }
 }
@@ -42,17 +42,17 @@ impl CpuSteps {
 impl Stepper for CpuSteps {
     fn take(&mut self, sim: &mut Simulation, _until: u64, _last: u64) -> Result<Taken, RunError> {
         sim.stop_if_requested()?;
-        self.clock = Some(sim.times.clock());
+        self.clock = Some(sim.reports.times.clock());
         let ctx = sim.step_context();
         if !sim.constraints.list.is_empty() {
             self.before.clone_from(&sim.state.positions);
         }
-        sim.protocols.before_step(&mut sim.forces.forces, &sim.state);
-        let moved = match sim.integrator {
+        sim.protocols.before_step(&mut sim.backend.forces.forces, &sim.state);
+        let moved = match sim.settings.integrator {
             Integrator::Implicit(settings, implicit) => sim.implicit_step(&ctx, &settings, &implicit)?,
             Integrator::Overdamped(settings) => {
                 let n = sim.model.len();
-                let limited = sim.cpu.built().is_some_and(|b| b.contact_step_limits(n, &mut sim.step_limits));
+                let limited = sim.backend.cpu.built().is_some_and(|b| b.contact_step_limits(n, &mut sim.backend.step_limits));
                 let held = sim.protocols.held_coordinates(n);
                 let Constraints { list, fibres, method, .. } = &mut sim.constraints;
                 fibres.prepare(&sim.model, list.iter().map(|c| c.bond), *method == ConstraintMethod::Fibre, false);
@@ -67,25 +67,25 @@ impl Stepper for CpuSteps {
                 overdamped_step(
                     &sim.model,
                     &mut sim.state,
-                    &sim.forces.forces,
+                    &sim.backend.forces.forces,
                     &sim.sim_box,
                     &ctx,
-                    limited.then_some(sim.step_limits.as_slice()),
-                    &mut sim.scratch,
+                    limited.then_some(sim.backend.step_limits.as_slice()),
+                    &mut sim.backend.scratch,
                     fibres,
                 )
-                .inspect(|&fraction| sim.contact_clamps += u64::from(fraction < 1.0))
+                .inspect(|&fraction| sim.reports.contact_clamps += u64::from(fraction < 1.0))
             }
         };
-        sim.protocols.restore_forces(&mut sim.forces.forces);
+        sim.protocols.restore_forces(&mut sim.backend.forces.forces);
         let clock = match moved {
             Ok(fraction) => ctx.advance(&mut sim.state, fraction),
-            Err(Blowup { particle, displacement }) => return Err(sim.blowup(particle, sim.displacement_message(displacement))),
+            Err(Blowup { particle, displacement }) => return Err(sim.blowup(particle, sim.settings.displacement_message(displacement))),
         };
         if !sim.constraints.list.is_empty() {
             let projected = sim.constraints.project(&sim.model, &self.before, &mut sim.state, &sim.sim_box, &ctx);
-            if sim.implicit_tension.len() == sim.constraints.tension.len() {
-                sim.constraints.tension.iter_mut().zip(&sim.implicit_tension).for_each(|(t, extra)| *t += extra);
+            if sim.backend.implicit_tension.len() == sim.constraints.tension.len() {
+                sim.constraints.tension.iter_mut().zip(&sim.backend.implicit_tension).for_each(|(t, extra)| *t += extra);
             }
             if let Err(failure) = projected {
                 let c = &sim.constraints;
@@ -113,10 +113,10 @@ impl Stepper for CpuSteps {
         sim.protocols.advance_drives(&mut sim.model, &ctx);
         sim.protocols.set_ramps(&mut sim.model, sim.state.step);
         let final_step = sim.state.step == last;
-        if sim.cpu.is_built() {
-            if sim.state.step.is_multiple_of(sim.neighbor.every) {
-                let backend = sim.cpu.get(&sim.model, &sim.state, &sim.sim_box, sim.neighbor.skin)?;
-                backend.update_neighbors(&sim.state, &sim.sim_box, sim.neighbor.check).map_err(RunError::Setup)?;
+        if sim.backend.cpu.is_built() {
+            if sim.state.step.is_multiple_of(sim.settings.neighbor.every) {
+                let backend = sim.backend.cpu.get(&sim.model, &sim.state, &sim.sim_box, sim.settings.neighbor.skin)?;
+                backend.update_neighbors(&sim.state, &sim.sim_box, sim.settings.neighbor.check).map_err(RunError::Setup)?;
                 self.lap(sim, Phase::Neighbor);
             }
             sim.compute_forces(due || final_step)?;
@@ -144,10 +144,10 @@ impl Simulation {
         settings: &OverdampedSettings,
         implicit: &ImplicitSettings,
     ) -> Result<Result<f64, Blowup>, RunError> {
-        let backend = self.cpu.get(&self.model, &self.state, &self.sim_box, self.neighbor.skin)?;
-        let limited = backend.contact_step_limits(self.model.len(), &mut self.step_limits);
+        let backend = self.backend.cpu.get(&self.model, &self.state, &self.sim_box, self.settings.neighbor.skin)?;
+        let limited = backend.contact_step_limits(self.model.len(), &mut self.backend.step_limits);
         let backend = &*backend;
-        let (model, forces, sim_box) = (&self.model, &self.forces.forces, &self.sim_box);
+        let (model, forces, sim_box) = (&self.model, &self.backend.forces.forces, &self.sim_box);
         let held = self.protocols.held_coordinates(model.len());
         let mut constrained = ConstrainedBonds { pairs: self.constraints.pairs(model), tension: Vec::new() };
         let Constraints { list, fibres, method, .. } = &mut self.constraints;
@@ -177,15 +177,15 @@ impl Simulation {
             settings.theta,
             &mut constrained,
             fibres,
-            limited.then_some(self.step_limits.as_slice()),
+            limited.then_some(self.backend.step_limits.as_slice()),
             &held,
         );
-        self.implicit_tension = constrained.tension;
+        self.backend.implicit_tension = constrained.tension;
         match outcome {
             Ok(report) => {
                 let fraction = report.step_fraction;
-                self.contact_clamps += u64::from(fraction < 1.0);
-                self.last_solve = report;
+                self.reports.contact_clamps += u64::from(fraction < 1.0);
+                self.reports.last_solve = report;
                 Ok(Ok(fraction))
             }
             Err(ImplicitError::Blowup(blowup)) => Ok(Err(blowup)),
@@ -200,12 +200,8 @@ impl Simulation {
             let ends = self.model.bonds[failure.bond].map(|p| self.model.ids[p as usize]);
             return Err(RunError::Setup(failure_message(ends, c.max_iterations, self.state.step, failure.relative_error, c.tolerance)));
         }
-        self.forces_current = false;
+        self.backend.forces_current = false;
         Ok(())
-    }
-
-    fn displacement_message(&self, displacement: f64) -> String {
-        format!("displacement {displacement:e} in one step exceeds max_displacement {:e}", self.integrator.common().max_displacement)
     }
 
     /// `minimize`: FIRE to max |F| < ftol, on the device where the run
@@ -220,7 +216,7 @@ impl Simulation {
                 None => self.minimize_on_cpu(settings)?,
             },
         };
-        if let Some(i) = self.forces.forces.iter().position(|f| !finite_force(*f)) {
+        if let Some(i) = self.backend.forces.forces.iter().position(|f| !finite_force(*f)) {
             return Err(self.blowup(i, "non-finite force during minimisation".into()));
         }
         self.check_in_box()?;
@@ -229,7 +225,7 @@ impl Simulation {
             MinimizeStyle::Fire => "FIRE",
             MinimizeStyle::Newton => "Newton, on the CPU",
         };
-        self.say(&format!(
+        self.options.say(&format!(
             "minimize ({style}): {verdict} after {} iterations: max |F| = {:e} (ftol {:e}), pe = {:e}{}",
             report.iterations,
             report.max_force,
@@ -237,14 +233,14 @@ impl Simulation {
             report.energy,
             if report.clamped > 0 { format!(", {} moves shortened by the contact step clamp", report.clamped) } else { String::new() }
         ));
-        self.contact_clamps += report.clamped;
-        self.last_minimize = Some(report);
+        self.reports.contact_clamps += report.clamped;
+        self.reports.last_minimize = Some(report);
         Ok(())
     }
 
     /// FIRE's fictitious masses γ·Δt per particle (infinite for a fixed one).
     pub(super) fn fire_masses(&self) -> Vec<f64> {
-        self.model.types.iter().map(|&t| self.model.type_drag[t as usize] * self.dt).collect()
+        self.model.types.iter().map(|&t| self.model.type_drag[t as usize] * self.settings.dt).collect()
     }
 
     /// FIRE on the CPU backend, from current forces.
@@ -252,14 +248,14 @@ impl Simulation {
         let ctx = self.step_context();
         let mass = self.fire_masses();
         let mut state = self.state.clone();
-        let backend = self.cpu.get(&self.model, &self.state, &self.sim_box, self.neighbor.skin)?;
-        let (model, sim_box, forces, protocols) = (&self.model, &self.sim_box, &mut self.forces, &self.protocols);
+        let backend = self.backend.cpu.get(&self.model, &self.state, &self.sim_box, self.settings.neighbor.skin)?;
+        let (model, sim_box, forces, protocols) = (&self.model, &self.sim_box, &mut self.backend.forces, &self.protocols);
         let report = fire_minimize(&mut state, sim_box, &mass, &ctx, settings, |s, f, limits, energy| {
             minimizer_forces(backend, model, sim_box, protocols, forces, s, f, limits, energy)
         })?;
         self.state = state;
-        self.forces_current = true;
-        self.energies_current = true;
+        self.backend.forces_current = true;
+        self.backend.energies_current = true;
         Ok(report)
     }
 
@@ -268,8 +264,8 @@ impl Simulation {
         let mass = self.fire_masses();
         let held = self.protocols.held_coordinates(self.model.len());
         let mut state = self.state.clone();
-        let backend = self.cpu.get(&self.model, &self.state, &self.sim_box, self.neighbor.skin)?;
-        let (model, sim_box, forces, protocols) = (&self.model, &self.sim_box, &mut self.forces, &self.protocols);
+        let backend = self.backend.cpu.get(&self.model, &self.state, &self.sim_box, self.settings.neighbor.skin)?;
+        let (model, sim_box, forces, protocols) = (&self.model, &self.sim_box, &mut self.backend.forces, &self.protocols);
         // The backend is borrowed by both closures: the forces', then K̃'s at the state taken.
         let backend = std::cell::RefCell::new(backend);
         let report = newton_minimize(
@@ -283,7 +279,7 @@ impl Simulation {
             |why| RunError::Setup(format!("minimize style newton: {why}")),
         )?;
         self.state = state;
-        self.forces_current = false;
+        self.backend.forces_current = false;
         self.ensure_forces()?;
         Ok(report)
     }

@@ -69,19 +69,19 @@ impl GpuSteps {
         let device_kinetics = sim.model.has_kinetics() && crate::gpu::kinetics::refusal(&sim.model).is_none();
         let (model, state, sim_box) = (&sim.model, &sim.state, &sim.sim_box);
         let protocol = sim.protocols.for_device(model);
-        let warned = device_kinetics.then(|| sim.kinetics.warned(model));
+        let warned = device_kinetics.then(|| sim.kinetics.engine.warned(model));
         let mut gpu =
             GpuBackend::with_protocol(context, model, state, sim_box, &settings, warned.as_deref(), &protocol).map_err(RunError::Setup)?;
-        if let Integrator::Implicit(_, implicit) = &sim.integrator {
+        if let Integrator::Implicit(_, implicit) = &sim.settings.integrator {
             // The implicit step on the device (src/gpu/implicit.rs): f32 CG has a tolerance floor.
             if implicit.solver == crate::integrate::implicit::LinearSolver::Cholesky {
-                sim.say(&format!(
+                sim.options.say(&format!(
                     "device gpu: integrator implicit solver cholesky has no device form: its steps are solved by f32 conjugate \
                      gradients to relative residual {:e}, and reach the same equilibrium",
                     crate::gpu::implicit::F32_TOLERANCE
                 ));
             } else if implicit.tolerance < crate::gpu::implicit::F32_TOLERANCE {
-                sim.say(&format!(
+                sim.options.say(&format!(
                     "device gpu: integrator implicit solves to relative residual {:e} in f32 (the deck asks for {:e})",
                     crate::gpu::implicit::F32_TOLERANCE,
                     implicit.tolerance
@@ -89,7 +89,7 @@ impl GpuSteps {
             }
             gpu.step_implicitly(context, model, &settings, implicit, &sim.constraints.pairs(model)).map_err(RunError::Setup)?;
             if gpu.implicit_is_split() {
-                sim.say(&format!(
+                sim.options.say(&format!(
                     "device gpu: integrator implicit: conjugate gradients split over every workgroup ({} particles; gpu_workgroups one keeps them in one)",
                     model.len()
                 ));
@@ -99,7 +99,7 @@ impl GpuSteps {
             // The constraints' projection on the device (src/gpu/shake.rs): f32 lengths have a tolerance floor.
             let tolerance = gpu.constrain_bonds(context, model, &sim.constraints).map_err(RunError::Setup)?;
             if tolerance > sim.constraints.tolerance {
-                sim.say(&format!(
+                sim.options.say(&format!(
                     "device gpu: constraints are projected to |r − r0|/r0 ≤ {tolerance:e} in f32 (the deck asks for {:e})",
                     sim.constraints.tolerance
                 ));
@@ -114,13 +114,13 @@ impl Stepper for GpuSteps {
     fn take(&mut self, sim: &mut Simulation, until: u64, last: u64) -> Result<Taken, RunError> {
         // Bond kinetics decided on the host: one step per segment.
         let kinetics = sim.model.has_kinetics() && !self.device_kinetics;
-        let next_output = sim.next_output_step(last).min(sim.state.step + GPU_SYNC_STEPS).min(until);
+        let next_output = sim.outputs.next_due(sim.state.step, last).min(sim.state.step + GPU_SYNC_STEPS).min(until);
         let steps = if kinetics { 1 } else { next_output - sim.state.step };
         self.gpu.set_time(sim.state.time);
         if sim.protocols.has_ramps() {
             self.gpu.set_ramps(sim.state.step, sim.protocols.ramp_rows(sim.state.step, steps));
         }
-        let centres = sim.protocols.drive_centres(&sim.model, sim.dt, steps);
+        let centres = sim.protocols.drive_centres(&sim.model, sim.settings.dt, steps);
         self.gpu.set_drives(centres.clone());
         let outcome = self.gpu.run(sim.state.step, steps);
         sim.protocols.follow_device_drives(&mut sim.model, &centres, &self.gpu.drive_states());
@@ -133,12 +133,12 @@ impl Stepper for GpuSteps {
         // Each step took s·dt: below 1 where the contact step clamp shortened it (src/gpu/contact.rs).
         let mut taken = Taken { steps: done, last: None };
         if let Some(report) = self.gpu.implicit_report() {
-            sim.last_solve = report;
+            sim.reports.last_solve = report;
         }
         let mut clocks = Vec::new();
         for k in 0..done {
             let fraction = self.gpu.step_fraction(k);
-            sim.contact_clamps += u64::from(fraction < 1.0);
+            sim.reports.contact_clamps += u64::from(fraction < 1.0);
             let clock = sim.step_context().advance(&mut sim.state, fraction);
             clocks.extend(Some(clock).filter(|_| self.device_kinetics));
             taken.last = Some(clock);
@@ -148,15 +148,13 @@ impl Stepper for GpuSteps {
         }
         // The outputs here see the ramps' values of this step, as on the CPU.
         sim.protocols.set_ramps(&mut sim.model, sim.state.step);
-        sim.forces_current = false;
+        sim.backend.forces_current = false;
         let segment_end = sim.state.step == until;
-        let thermo_due = sim.thermo.every > 0 && sim.state.step.is_multiple_of(sim.thermo.every);
-        let dump_due = sim.dumps.iter().any(|d| sim.state.step.is_multiple_of(d.spec.every));
         // Positions come back only when something reads them; between
         // outputs the sync only reads the GPU's status words.
-        let checkpoint_due = sim.checkpoints.as_ref().is_some_and(|c| sim.state.step.is_multiple_of(c.spec.every));
+        let output_due = sim.outputs.reads_positions_at(sim.state.step);
         self.stopping = sim.options.stop.requested().is_some();
-        let read_back = segment_end || thermo_due || dump_due || checkpoint_due || self.stopping || outcome.is_err() || kinetics;
+        let read_back = segment_end || output_due || self.stopping || outcome.is_err() || kinetics;
         if read_back {
             self.gpu.download(&mut sim.state);
             if let Some(bonds) = sim.state.bonds.as_mut() {
@@ -178,10 +176,10 @@ impl Stepper for GpuSteps {
             // The device left the last step's `bind` formation to the host
             // (src/gpu/bind.rs): decided here from the state read back, then
             // a backend with the formed bonds in its rows and an empty pool.
-            sim.host_formations += 1;
+            sim.kinetics.host_formations += 1;
             let (events, _) = sim.bind_on_host(clock)?;
             sim.record_events(&events, clock.length)?;
-            sim.cpu.invalidate();
+            sim.backend.cpu.invalidate();
             // The new backend keeps the neighbour capacity this one needed.
             let met = self.gpu.neighbors_met();
             *self = GpuSteps::new(sim, &self.context)?;
@@ -195,8 +193,8 @@ impl Stepper for GpuSteps {
             sim.refresh_cpu_forces(false)?;
             let what = format!(
                 "its GPU step was non-finite or longer than max_displacement {:e} (force here {:e})",
-                sim.integrator.common().max_displacement,
-                sim.forces.forces[particle].length()
+                sim.settings.integrator.common().max_displacement,
+                sim.backend.forces.forces[particle].length()
             );
             return Err(sim.blowup(particle, what));
         }
@@ -206,21 +204,21 @@ impl Stepper for GpuSteps {
         // As on the CPU, bond kinetics (one step per segment) are decided from
         // the tensions before the step (measured at the end of the previous
         // one), then measured again at the new positions with the new bond state.
-        self.resets = sim.kinetics.resets;
+        self.resets = sim.kinetics.engine.resets;
         Ok(taken)
     }
 
     fn bonds_changed(&mut self, sim: &mut Simulation, changed: bool) -> Result<(), RunError> {
-        if !sim.cpu.is_built() {
+        if !sim.backend.cpu.is_built() {
             // Bonds formed: both backends are rebuilt for the new bond list.
             sim.ensure_forces()?;
             let (model, state, sim_box) = (&sim.model, &sim.state, &sim.sim_box);
             self.gpu = GpuBackend::with_protocol(&self.context, model, state, sim_box, &self.settings, None, &self.protocol)
                 .map_err(RunError::Setup)?;
-        } else if changed || self.evolving || sim.kinetics.resets != self.resets {
+        } else if changed || self.evolving || sim.kinetics.engine.resets != self.resets {
             self.gpu.update_bonds(&sim.model, &sim.state, changed).map_err(RunError::Setup)?;
         }
-        let backend = sim.cpu.get(&sim.model, &sim.state, &sim.sim_box, sim.neighbor.skin)?;
+        let backend = sim.backend.cpu.get(&sim.model, &sim.state, &sim.sim_box, sim.settings.neighbor.skin)?;
         backend.measure_bonds(&sim.model, &sim.state, &sim.sim_box);
         Ok(())
     }
@@ -253,7 +251,7 @@ impl GpuSteps {
     fn record_device_kinetics(&mut self, sim: &mut Simulation, clocks: &[StepClock]) -> Result<(), RunError> {
         let decided = self.gpu.drain_kinetics();
         for &(t, step, rate_dt) in &decided.coarse {
-            if let Some(warning) = sim.kinetics.warn_coarse(&sim.model, t, step, rate_dt) {
+            if let Some(warning) = sim.kinetics.engine.warn_coarse(&sim.model, t, step, rate_dt) {
                 eprintln!("{warning}");
             }
         }
@@ -267,18 +265,18 @@ impl GpuSteps {
                     Some((t, particles)) => {
                         formed = true;
                         let (model, state) = (&mut sim.model, &mut sim.state);
-                        sim.kinetics.apply_formed(model, state, e.bond, t, particles, clock, e.length).map_err(RunError::Setup)?
+                        sim.kinetics.engine.apply_formed(model, state, e.bond, t, particles, clock, e.length).map_err(RunError::Setup)?
                     }
-                    None => sim.kinetics.apply_decided(&sim.model, &mut sim.state, e.bond, e.kind, clock, e.force, e.length, e.age),
+                    None => sim.kinetics.engine.apply_decided(&sim.model, &mut sim.state, e.bond, e.kind, clock, e.force, e.length, e.age),
                 });
             }
             sim.record_events(&events, clock.length)?;
         }
         if formed {
             // New bonds: the CPU backend is built anew where it is next needed.
-            sim.cpu.invalidate();
+            sim.backend.cpu.invalidate();
         } else if !decided.events.is_empty() {
-            let backend = sim.cpu.get(&sim.model, &sim.state, &sim.sim_box, sim.neighbor.skin)?;
+            let backend = sim.backend.cpu.get(&sim.model, &sim.state, &sim.sim_box, sim.settings.neighbor.skin)?;
             backend.bonds_changed(&sim.model, &sim.state, &sim.sim_box).map_err(RunError::Setup)?;
         }
         Ok(())
@@ -293,14 +291,14 @@ impl Simulation {
             Some(why)
         } else if let Some(why) = self.constraint_refusal() {
             Some(why)
-        } else if self.integrator.common().theta != 1.0 {
+        } else if self.settings.integrator.common().theta != 1.0 {
             Some(THETA_ON_CPU)
         } else if self.model.has_cpu_only_surface_terms() {
             Some(CUSTOM_SURFACE_TERMS)
         } else if self.model.has_nodal_pressure_tetras() {
             Some(NODAL_PRESSURE_TETRA)
         } else if self.model.max_pair_cutoff() > 0.0
-            && crate::neighbor::ImageShifts::has_short_edges(&self.sim_box, self.model.max_pair_cutoff() + self.neighbor.skin)
+            && crate::neighbor::ImageShifts::has_short_edges(&self.sim_box, self.model.max_pair_cutoff() + self.settings.neighbor.skin)
         {
             Some(SHORT_PERIODIC_EDGES)
         } else {
@@ -312,9 +310,9 @@ impl Simulation {
     pub fn step_settings(&self) -> StepSettings {
         StepSettings {
             context: self.step_context(),
-            skin: self.neighbor.skin,
-            neighbor_every: self.neighbor.every,
-            neighbor_check: self.neighbor.check,
+            skin: self.settings.neighbor.skin,
+            neighbor_every: self.settings.neighbor.every,
+            neighbor_check: self.settings.neighbor.check,
         }
     }
 
@@ -324,17 +322,17 @@ impl Simulation {
     /// |F| and energy from the CPU's f64 forces there (masked as the CPU's
     /// FIRE masks them). None: the CPU minimises.
     pub(super) fn minimize_on_gpu(&mut self, settings: &FireSettings) -> Result<Option<FireReport>, RunError> {
-        let device = self.options.device.unwrap_or(self.device);
+        let device = self.options.device.unwrap_or(self.settings.device);
         if device == DevicePreference::Cpu {
             return Ok(None);
         }
         // Only what the forces need decides (not the integrator's or the constraints' refusals).
         if self.model.has_cpu_only_surface_terms() {
-            self.say(&format!("minimize on the CPU: {CUSTOM_SURFACE_TERMS}"));
+            self.options.say(&format!("minimize on the CPU: {CUSTOM_SURFACE_TERMS}"));
             return Ok(None);
         }
         if self.model.has_nodal_pressure_tetras() {
-            self.say(&format!("minimize on the CPU: {NODAL_PRESSURE_TETRA}"));
+            self.options.say(&format!("minimize on the CPU: {NODAL_PRESSURE_TETRA}"));
             return Ok(None);
         }
         let Some(context) = self.open_gpu(device)? else { return Ok(None) };
@@ -359,7 +357,7 @@ impl Simulation {
                 }
                 Err(GpuHalt::Blowup { particle, .. }) => {
                     gpu.download(&mut self.state);
-                    self.forces_current = false;
+                    self.backend.forces_current = false;
                     return Err(self.blowup(particle, "non-finite FIRE move on the GPU during minimisation".into()));
                 }
                 Err(GpuHalt::Capacity { message, .. }) => return Err(RunError::Setup(format!("device gpu: minimize: {message}"))),
@@ -368,12 +366,12 @@ impl Simulation {
             }
         }
         gpu.download(&mut self.state);
-        self.forces_current = false;
+        self.backend.forces_current = false;
         self.ensure_forces()?;
-        let mut forces = self.forces.forces.clone();
+        let mut forces = self.backend.forces.forces.clone();
         self.protocols.mask(&mut forces);
         let max_force = max_residual_force(&forces, &self.fire_masses());
-        let energy = self.forces.total_energy();
+        let energy = self.backend.forces.total_energy();
         Ok(Some(FireReport { converged: max_force < settings.ftol, iterations, energy, max_force, clamped }))
     }
 
@@ -387,7 +385,7 @@ impl Simulation {
         let (model, state, sim_box) = (&self.model, &self.state, &self.sim_box);
         let mut gpu =
             GpuBackend::with_protocol(context, model, state, sim_box, &self.step_settings(), None, &protocol).map_err(RunError::Setup)?;
-        gpu.minimize_with_fire(context, model, settings, self.dt).map_err(RunError::Setup)?;
+        gpu.minimize_with_fire(context, model, settings, self.settings.dt).map_err(RunError::Setup)?;
         Ok(gpu)
     }
 
@@ -398,7 +396,7 @@ impl Simulation {
 
     /// Why the implicit step cannot run on the device (src/gpu/implicit.rs).
     fn implicit_refusal(&self) -> Option<&'static str> {
-        match &self.integrator {
+        match &self.settings.integrator {
             Integrator::Implicit(..) => crate::gpu::implicit::refusal(&self.model),
             Integrator::Overdamped(_) => None,
         }
@@ -407,7 +405,7 @@ impl Simulation {
     /// The GPU to run on, per the effective `device` setting (None: the CPU).
     /// The adapter is opened once and announced.
     pub(super) fn gpu_for_run(&mut self) -> Result<Option<GpuContext>, RunError> {
-        let device = self.options.device.unwrap_or(self.device);
+        let device = self.options.device.unwrap_or(self.settings.device);
         if device == DevicePreference::Cpu {
             return Ok(None);
         }
@@ -415,7 +413,7 @@ impl Simulation {
             return match device {
                 DevicePreference::Gpu => Err(RunError::Setup(format!("device gpu: {why}; use `device cpu` or `device auto`"))),
                 _ => {
-                    self.say(&format!("device auto: {why}; running on the CPU"));
+                    self.options.say(&format!("device auto: {why}; running on the CPU"));
                     Ok(None)
                 }
             };
@@ -426,19 +424,19 @@ impl Simulation {
     /// The adapter of `device` (gpu or auto), opened once and announced;
     /// None where `device auto` found no hardware adapter.
     fn open_gpu(&mut self, device: DevicePreference) -> Result<Option<GpuContext>, RunError> {
-        let opened = match self.gpu.take() {
+        let opened = match self.backend.gpu.take() {
             Some(opened) => opened,
             None => {
                 let opened = GpuContext::open(device == DevicePreference::Auto);
                 match &opened {
-                    Ok(context) => self.say(&format!("device: GPU {}", context.describe())),
-                    Err(e) if device == DevicePreference::Auto => self.say(&format!("device auto: {e}; running on the CPU")),
+                    Ok(context) => self.options.say(&format!("device: GPU {}", context.describe())),
+                    Err(e) if device == DevicePreference::Auto => self.options.say(&format!("device auto: {e}; running on the CPU")),
                     Err(_) => {}
                 }
                 opened
             }
         };
-        match self.gpu.insert(opened) {
+        match self.backend.gpu.insert(opened) {
             Ok(context) => Ok(Some(context.clone())),
             Err(_) if device == DevicePreference::Auto => Ok(None),
             Err(e) => Err(RunError::Setup(format!("device gpu: {e}"))),

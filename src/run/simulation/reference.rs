@@ -5,7 +5,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::Simulation;
+use super::{Backends, Simulation};
 use crate::backend::{CpuBackend, Forces};
 use crate::deck::ThermoColumn;
 use crate::run::thermo::{column_value, Thermo, ThermoInputs};
@@ -53,14 +53,14 @@ impl Simulation {
     /// The smallest node–face distance between different bodies at the last
     /// force evaluation (∞ without `contact` lines or before the first one).
     pub fn min_contact_distance(&self) -> f64 {
-        self.cpu.built().map_or(f64::INFINITY, |b| b.min_contact_distance())
+        self.backend.cpu.built().map_or(f64::INFINITY, |b| b.min_contact_distance())
     }
 
     /// Forces, energies by interaction and virial at the current state
     /// (computed now if stale).
     pub fn current_forces(&mut self) -> Result<&Forces, RunError> {
         self.ensure_forces()?;
-        Ok(&self.forces)
+        Ok(&self.backend.forces)
     }
 
     /// Calls `read` with the thermo settings and what thermo columns read at
@@ -68,32 +68,22 @@ impl Simulation {
     pub(super) fn with_thermo_inputs<R>(&mut self, read: impl FnOnce(&Thermo, &ThermoInputs) -> R) -> Result<R, RunError> {
         self.ensure_forces()?;
         let context = self.step_context();
-        let min_contact_distance = self.min_contact_distance();
-        let Simulation { cpu, model, state, sim_box, forces, thermo, kinetics, last_solve, constraints, contact_clamps, neighbor, .. } =
-            self;
-        let backend: &CpuBackend = cpu.get(model, state, sim_box, neighbor.skin)?;
-        let (bond_tension, _) = backend.bond_tension_and_length();
+        let Simulation { backend, model, state, sim_box, outputs, kinetics, reports, constraints, settings, .. } = self;
+        let Backends { cpu, forces, .. } = backend;
+        let backend: &CpuBackend = cpu.get(model, state, sim_box, settings.neighbor.skin)?;
         let inputs = ThermoInputs {
             model,
-            bonds: state.bonds.as_ref(),
-            bond_tension,
-            kinetics,
-            forces,
-            n_particles: model.len(),
-            context,
-            volume: sim_box.volume(),
-            neighbor_builds: backend.neighbor_builds(),
-            solve: *last_solve,
-            constraints,
-            positions: &state.positions,
-            images: sim_box.images(),
-            backend,
             state,
             sim_box,
-            min_contact_distance,
-            contact_clamps: *contact_clamps,
+            backend,
+            forces,
+            context,
+            kinetics: &kinetics.engine,
+            solve: reports.last_solve,
+            constraints,
+            contact_clamps: reports.contact_clamps,
         };
-        Ok(read(thermo, &inputs))
+        Ok(read(&outputs.thermo, &inputs))
     }
 
     /// The value of a thermo column at the current state (forces, energies
@@ -105,24 +95,24 @@ impl Simulation {
     /// The per-particle virial W_i at the current state (see [`crate::measure::stress`]).
     pub fn particle_virial(&mut self) -> Result<Vec<[f64; 6]>, RunError> {
         self.ensure_forces()?;
-        let backend = self.cpu.get(&self.model, &self.state, &self.sim_box, self.neighbor.skin)?;
+        let backend = self.backend.cpu.get(&self.model, &self.state, &self.sim_box, self.settings.neighbor.skin)?;
         Ok(crate::measure::per_particle_virial(backend, &self.model, &self.state, &self.sim_box))
     }
 
     /// Tension (dE/dr, positive when stretched) and length of every bond at the current state.
     pub fn bond_tensions(&mut self) -> Result<(Vec<f64>, Vec<f64>), RunError> {
         self.ensure_forces()?;
-        let backend = self.cpu.get(&self.model, &self.state, &self.sim_box, self.neighbor.skin)?;
+        let backend = self.backend.cpu.get(&self.model, &self.state, &self.sim_box, self.settings.neighbor.skin)?;
         Ok(backend.bond_tensions_at(&self.model, &self.state, &self.sim_box))
     }
 
     /// Ensures a backend with a fresh neighbour list and forces at the current state.
     pub(super) fn ensure_forces(&mut self) -> Result<(), RunError> {
-        if !self.cpu.is_built() {
-            self.cpu.get(&self.model, &self.state, &self.sim_box, self.neighbor.skin)?;
-            self.forces_current = false;
+        if !self.backend.cpu.is_built() {
+            self.backend.cpu.get(&self.model, &self.state, &self.sim_box, self.settings.neighbor.skin)?;
+            self.backend.forces_current = false;
         }
-        if !self.forces_current || !self.energies_current {
+        if !self.backend.forces_current || !self.backend.energies_current {
             self.compute_forces(true)?;
         }
         Ok(())
@@ -130,16 +120,16 @@ impl Simulation {
 
     /// Forces at the current state, with energies and virial if `energies`.
     pub(super) fn compute_forces(&mut self, energies: bool) -> Result<(), RunError> {
-        let backend = self.cpu.get(&self.model, &self.state, &self.sim_box, self.neighbor.skin)?;
+        let backend = self.backend.cpu.get(&self.model, &self.state, &self.sim_box, self.settings.neighbor.skin)?;
         backend.update_contacts(&self.model, &self.state, &self.sim_box).map_err(RunError::Setup)?;
         if energies {
-            backend.compute(&self.model, &self.state, &self.sim_box, &mut self.forces);
+            backend.compute(&self.model, &self.state, &self.sim_box, &mut self.backend.forces);
         } else {
-            backend.compute_forces(&self.model, &self.state, &self.sim_box, &mut self.forces);
+            backend.compute_forces(&self.model, &self.state, &self.sim_box, &mut self.backend.forces);
         }
-        self.forces_current = true;
-        self.energies_current = energies;
-        if let Some(i) = self.forces.forces.par_iter().with_min_len(4096).position_first(|f| !finite_force(*f)) {
+        self.backend.forces_current = true;
+        self.backend.energies_current = energies;
+        if let Some(i) = self.backend.forces.forces.par_iter().with_min_len(4096).position_first(|f| !finite_force(*f)) {
             return Err(self.blowup(i, "non-finite force".into()));
         }
         Ok(())
@@ -147,7 +137,7 @@ impl Simulation {
 
     /// CPU forces (and energies) at the current state, after a GPU segment.
     pub(super) fn refresh_cpu_forces(&mut self, energies: bool) -> Result<(), RunError> {
-        let backend = self.cpu.get(&self.model, &self.state, &self.sim_box, self.neighbor.skin)?;
+        let backend = self.backend.cpu.get(&self.model, &self.state, &self.sim_box, self.settings.neighbor.skin)?;
         backend.update_neighbors(&self.state, &self.sim_box, true).map_err(RunError::Setup)?;
         self.compute_forces(energies)
     }

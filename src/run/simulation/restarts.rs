@@ -10,7 +10,7 @@ use super::Simulation;
 use crate::deck::{Action, CheckpointSpec, Plan};
 use crate::kinetics_engine::{initial_bond_state, Formation};
 use crate::output::files;
-use crate::output::restart::{write_state, Counters, RestartData, Resume};
+use crate::output::restart::{write_state, Counters, RestartData};
 use crate::run::blowup::culprit;
 use crate::run::RunError;
 
@@ -60,7 +60,7 @@ impl Simulation {
     /// [`RunError::Stopped`]; the caller's error path closes the outputs.
     pub(super) fn stop_if_requested(&mut self) -> Result<(), RunError> {
         let Some(reason) = self.options.stop.requested() else { return Ok(()) };
-        let restart = self.output_path(Path::new(&format!("{}.restart", self.deck_stem)));
+        let restart = self.options.output_path(Path::new(&format!("{}.restart", self.outputs.deck_stem)));
         self.write_lifetimes()?;
         write_state(&self.options.output_dir, &restart, &self.restart_data()).map_err(|e| self.output_error(&restart, e))?;
         Err(RunError::Stopped { step: self.state.step, reason: reason.to_string(), restart: restart.display().to_string() })
@@ -71,25 +71,25 @@ impl Simulation {
     pub(super) fn restart_data(&self) -> RestartData {
         let mut data = RestartData::from_state(self.model.units, &self.state, &self.sim_box, &self.model.ids);
         data.counters = Counters {
-            breaks: self.kinetics.breaks,
-            rebinds: self.kinetics.rebinds,
-            forms: self.kinetics.forms,
-            resets: self.kinetics.resets,
-            contact_clamps: self.contact_clamps,
+            breaks: self.kinetics.engine.breaks,
+            rebinds: self.kinetics.engine.rebinds,
+            forms: self.kinetics.engine.forms,
+            resets: self.kinetics.engine.resets,
+            contact_clamps: self.reports.contact_clamps,
         };
-        data.resume = Some(Resume { inputs: self.inputs.clone(), action: self.action, run_end: self.run_end });
+        data.resume = Some(self.deck.resume());
         data
     }
 
     /// A periodic checkpoint when one is due at this step.
     pub(super) fn checkpoint(&mut self) -> Result<(), RunError> {
         let step = self.state.step;
-        let Some(due) = self.checkpoints.as_ref().filter(|c| step.is_multiple_of(c.spec.every) && c.last_step != Some(step)) else {
+        let Some(due) = self.outputs.checkpoints.as_ref().filter(|c| step.is_multiple_of(c.spec.every) && c.last_step != Some(step)) else {
             return Ok(());
         };
-        let path = self.output_path(&with_step(&due.spec.path, step));
+        let path = self.options.output_path(&with_step(&due.spec.path, step));
         write_state(&self.options.output_dir, &path, &self.restart_data()).map_err(|e| self.output_error(&path, e))?;
-        let checkpoints = self.checkpoints.as_mut().expect("due above");
+        let checkpoints = self.outputs.checkpoints.as_mut().expect("due above");
         checkpoints.last_step = Some(step);
         let mut stale = Vec::new();
         if let Some(keep) = checkpoints.spec.keep {
@@ -109,22 +109,22 @@ impl Simulation {
     pub(super) fn load_restart(&mut self, data: RestartData, path: &Path) -> Result<(), RunError> {
         data.check_against(&self.model, self.sim_box.periodic).map_err(|e| RunError::Setup(format!("{}: {e}", path.display())))?;
         let counters = data.counters;
-        self.kinetics.breaks = counters.breaks;
-        self.kinetics.rebinds = counters.rebinds;
-        self.kinetics.forms = counters.forms;
-        self.kinetics.resets = counters.resets;
-        self.contact_clamps = counters.contact_clamps;
+        self.kinetics.engine.breaks = counters.breaks;
+        self.kinetics.engine.rebinds = counters.rebinds;
+        self.kinetics.engine.forms = counters.forms;
+        self.kinetics.engine.resets = counters.resets;
+        self.reports.contact_clamps = counters.contact_clamps;
         self.sim_box = data.sim_box;
-        if self.formation.is_some() {
-            self.formation = Some(Formation::new(&self.model, &self.sim_box));
+        if self.kinetics.formation.is_some() {
+            self.kinetics.formation = Some(Formation::new(&self.model, &self.sim_box));
         }
         self.state = data.to_state();
         match &self.state.bonds {
             Some(bonds) => self.model.set_formed_bonds(&bonds.formed),
             None => self.state.bonds = initial_bond_state(&self.model),
         }
-        self.cpu.invalidate();
-        self.forces_current = false;
+        self.backend.cpu.invalidate();
+        self.backend.forces_current = false;
         self.check_in_box()
     }
 
@@ -147,18 +147,18 @@ impl Simulation {
 
     /// Builds the blow-up report and writes the last good frame.
     pub(super) fn blowup(&mut self, particle: usize, what: String) -> RunError {
-        let parts = match self.cpu.built() {
+        let parts = match self.backend.cpu.built() {
             Some(b) => b.breakdown(&self.model, &self.state, &self.sim_box, particle),
             None => Vec::new(),
         };
         let mut last_good = Vec::new();
         let step = self.state.step;
-        for i in 0..self.dumps.len() {
-            if self.dumps[i].last_step != Some(step) && self.write_dump(i).is_ok() {
-                last_good.push(self.dumps[i].path.display().to_string());
+        for i in 0..self.outputs.dumps.len() {
+            if self.outputs.dumps[i].last_step != Some(step) && self.write_dump(i).is_ok() {
+                last_good.push(self.outputs.dumps[i].path.display().to_string());
             }
         }
-        let restart = self.output_path(Path::new(&format!("{}.lastgood.restart", self.deck_stem)));
+        let restart = self.options.output_path(Path::new(&format!("{}.lastgood.restart", self.outputs.deck_stem)));
         if write_state(&self.options.output_dir, &restart, &self.restart_data()).is_ok() {
             last_good.push(restart.display().to_string());
         }

@@ -71,10 +71,10 @@ impl Simulation {
     /// header and the outputs of the first step.
     pub fn begin_run(&mut self, steps: u64) -> Result<ActiveRun, RunError> {
         self.check_kinetics_temperature()?;
-        self.host_formations = 0;
+        self.kinetics.host_formations = 0;
         self.protocols.begin_run(self.state.step, self.state.step + steps);
         if self.protocols.set_ramps(&mut self.model, self.state.step) {
-            self.forces_current = false;
+            self.backend.forces_current = false;
         }
         self.ensure_forces()?;
         self.protocols.check_drives(&self.model, &self.state, &self.sim_box);
@@ -84,13 +84,13 @@ impl Simulation {
             bar.set_style(ProgressStyle::with_template("{bar:40} {pos}/{len} steps  {per_sec}  ETA {eta}").expect("valid template"));
             bar
         });
-        let header = self.thermo.header();
+        let header = self.outputs.thermo.header();
         match &bar {
             Some(b) => b.println(header),
-            None => self.say(&header),
+            None => self.options.say(&header),
         }
         let last = self.state.step + steps;
-        self.run_end = Some(last);
+        self.deck.run_end = Some(last);
         self.log_run(steps, if gpu.is_some() { "the GPU" } else { "the CPU" })?;
         self.outputs_at_step(&bar, true)?;
         Ok(ActiveRun { steps, last, gpu, bar, started: std::time::Instant::now() })
@@ -101,7 +101,7 @@ impl Simulation {
     /// segments; forces are recomputed first if the system changed since.
     pub fn advance(&mut self, run: &ActiveRun, until: u64) -> Result<(), RunError> {
         let until = until.min(run.last);
-        if !self.cpu.is_built() || !self.forces_current {
+        if !self.backend.cpu.is_built() || !self.backend.forces_current {
             self.ensure_forces()?;
         }
         let started = std::time::Instant::now();
@@ -109,7 +109,7 @@ impl Simulation {
             Some(context) => GpuSteps::new(self, context).and_then(|mut gpu| self.step_loop(&mut gpu, until, run.last, &run.bar)),
             None => self.step_loop(&mut CpuSteps::default(), until, run.last, &run.bar),
         };
-        self.times.total += started.elapsed();
+        self.reports.times.total += started.elapsed();
         looped
     }
 
@@ -126,7 +126,7 @@ impl Simulation {
                 stepper.bonds_changed(self, changed)?;
             }
             let final_step = self.state.step == last;
-            let thermo_due = self.thermo.every > 0 && self.state.step.is_multiple_of(self.thermo.every);
+            let thermo_due = self.outputs.thermo_due(self.state.step);
             stepper.before_outputs(self, until, last, thermo_due)?;
             self.outputs_at_step(bar, final_step && !thermo_due)?;
             stepper.after_outputs(self)?;
@@ -142,18 +142,18 @@ impl Simulation {
         if let Some(b) = run.bar {
             b.finish_and_clear();
         }
-        self.run_end = None;
+        self.deck.run_end = None;
         self.protocols.end_run();
         self.write_lifetimes()?;
         let seconds = run.started.elapsed().as_secs_f64();
-        if self.host_formations > 0 {
-            self.say(&format!(
+        if self.kinetics.host_formations > 0 {
+            self.options.say(&format!(
                 "device gpu: the `bind` formation of {} steps was decided on the host (the device's bond pool, slots, candidate list \
                  or neighbour list ran out of room; each rebuilt the GPU backend)",
-                self.host_formations
+                self.kinetics.host_formations
             ));
         }
-        self.say(&format!(
+        self.options.say(&format!(
             "loop time {seconds:.6} s for {} steps with {} particles: {:.6e} particle-steps/s",
             run.steps,
             self.model.len(),
@@ -164,40 +164,16 @@ impl Simulation {
 
     /// The context of the next step: the deck's settings in force and the state's clock.
     pub fn step_context(&self) -> StepContext {
-        StepContext {
-            dt: self.dt,
-            kt: self.kt,
-            seed: self.seed,
-            noise: self.integrator.common().noise,
-            max_displacement: self.integrator.common().max_displacement,
-            step: self.state.step,
-            time: self.state.time,
-        }
-    }
-
-    /// The first step after the current one at which thermo or a dump is due (or `last`).
-    pub(super) fn next_output_step(&self, last: u64) -> u64 {
-        let after = |every: u64| (self.state.step / every + 1) * every;
-        let mut next = last;
-        if self.thermo.every > 0 {
-            next = next.min(after(self.thermo.every));
-        }
-        for dump in &self.dumps {
-            next = next.min(after(dump.spec.every));
-        }
-        if let Some(c) = &self.checkpoints {
-            next = next.min(after(c.spec.every));
-        }
-        next
+        self.settings.step_context(&self.state)
     }
 
     /// Bond kinetics of the step just integrated, decided from the tensions of
     /// its force pass; a break or rebind updates the pair exclusions.
     /// Returns whether a bond broke, bound or formed.
     pub(super) fn kinetics_step(&mut self, clock: StepClock) -> Result<bool, RunError> {
-        let backend = self.cpu.get(&self.model, &self.state, &self.sim_box, self.neighbor.skin)?;
+        let backend = self.backend.cpu.get(&self.model, &self.state, &self.sim_box, self.settings.neighbor.skin)?;
         let (tension, length) = backend.bond_tension_and_length();
-        let mut report = self.kinetics.step(&self.model, &mut self.state, tension, length, clock);
+        let mut report = self.kinetics.engine.step(&self.model, &mut self.state, tension, length, clock);
         for warning in &report.warnings {
             eprintln!("{warning}");
         }
@@ -207,9 +183,9 @@ impl Simulation {
         self.record_events(&report.events, clock.length)?;
         if formed_any {
             // New bonds change every per-bond buffer: rebuild the backend.
-            self.cpu.invalidate();
+            self.backend.cpu.invalidate();
         } else if report.bonds_changed {
-            let backend = self.cpu.get(&self.model, &self.state, &self.sim_box, self.neighbor.skin)?;
+            let backend = self.backend.cpu.get(&self.model, &self.state, &self.sim_box, self.settings.neighbor.skin)?;
             backend.bonds_changed(&self.model, &self.state, &self.sim_box).map_err(RunError::Setup)?;
         }
         Ok(report.bonds_changed)
@@ -219,10 +195,10 @@ impl Simulation {
     /// rebinds), decided and applied on the host (src/kinetics_engine/formation.rs):
     /// their events, and whether new bonds formed.
     pub(super) fn bind_on_host(&mut self, clock: StepClock) -> Result<(Vec<Event>, bool), RunError> {
-        let Some(formation) = &mut self.formation else { return Ok((Vec::new(), false)) };
+        let Some(formation) = &mut self.kinetics.formation else { return Ok((Vec::new(), false)) };
         let bindings = formation.decide(&self.model, &self.state, &self.sim_box, clock).map_err(RunError::Setup)?;
         let formed_any = bindings.iter().any(|b| matches!(b, Binding::New(..)));
-        Ok((self.kinetics.apply_bindings(&mut self.model, &mut self.state, &self.sim_box, bindings, clock), formed_any))
+        Ok((self.kinetics.engine.apply_bindings(&mut self.model, &mut self.state, &self.sim_box, bindings, clock), formed_any))
     }
 
     /// The events of one step (`dt` long; none: nothing) into the lifetime
@@ -231,15 +207,16 @@ impl Simulation {
         if events.is_empty() {
             return Ok(());
         }
-        self.lifetimes.record(&self.model, events, dt);
-        if let Some((log, path)) = &mut self.event_log {
+        self.outputs.lifetimes.record(&self.model, events, dt);
+        if let Some((log, path)) = &mut self.outputs.event_log {
             if let Err(e) = log.write(events) {
                 let path = path.clone();
                 return Err(self.output_error(&path, e));
             }
         }
         let bound = &self.state.bonds.as_ref().expect("kinetics has bond state").bound;
-        let failed = self.dumps.iter_mut().find_map(|d| d.writer.write_bond_events(events, bound).err().map(|e| (d.path.clone(), e)));
+        let failed =
+            self.outputs.dumps.iter_mut().find_map(|d| d.writer.write_bond_events(events, bound).err().map(|e| (d.path.clone(), e)));
         if let Some((path, e)) = failed {
             return Err(self.output_error(&path, e));
         }
@@ -248,7 +225,7 @@ impl Simulation {
 
     /// Rules whose rates depend on kT refuse to run at T = 0.
     fn check_kinetics_temperature(&self) -> Result<(), RunError> {
-        if self.kt > 0.0 {
+        if self.settings.kt > 0.0 {
             return Ok(());
         }
         for (t, kinetics) in self.model.bond_kinetics.iter().enumerate() {

@@ -101,21 +101,21 @@ impl Simulation {
             *x = *new;
             self.sim_box.wrap(x, image);
         }
-        if let Some(backend) = self.cpu.built_mut() {
+        if let Some(backend) = self.backend.cpu.built_mut() {
             backend.update_neighbors(&self.state, &self.sim_box, true).map_err(RunError::Setup)?;
         }
-        self.forces_current = false;
+        self.backend.forces_current = false;
         Ok(())
     }
 
     /// Keeps every thermo row in memory from now on (see [`Self::thermo_log`]).
     pub fn record_thermo(&mut self) {
-        self.thermo.record = true;
+        self.outputs.thermo.record = true;
     }
 
     /// The thermo columns' labels and the rows recorded since recording
     /// began or the columns last changed.
     pub fn thermo_log(&self) -> (&[String], &[Vec<f64>]) {
-        (&self.thermo.labels, &self.thermo.log)
+        (&self.outputs.thermo.labels, &self.outputs.thermo.log)
     }
 }

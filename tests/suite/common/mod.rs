@@ -249,7 +249,7 @@ pub fn run_deck_on_lattice(deck: &str, args: &cellmd::build::LatticeArgs, vars: 
     let plan = validate_file(Path::new(deck), &all).unwrap_or_else(|e| panic!("{e}"));
     let sim = Simulation::execute(plan, RunOptions { output_dir: dir.path().to_path_buf(), ..Default::default() })
         .unwrap_or_else(|e| panic!("{e}"));
-    if let Some(report) = &sim.last_minimize {
+    if let Some(report) = &sim.reports.last_minimize {
         assert!(report.converged, "FIRE did not converge: {report:?}");
     }
     (sim, built)
@@ -318,10 +318,10 @@ pub fn assert_clamped_runs_agree(start: &cellmd::system::State, cpu: &Simulation
     let deviation = (0..start.len()).map(|i| (unwrap(&cpu.state, i) - unwrap(&gpu.state, i)).length()).fold(0.0, f64::max);
     println!(
         "CPU: {} clamped steps, t = {:.6e} s, mindist {:.4e}; GPU: {} clamped, t = {:.6e} s, mindist {:.4e}; GPU − CPU {deviation:.3e} after {travelled:.3e}",
-        cpu.contact_clamps, cpu.state.time, cpu.min_contact_distance(), gpu.contact_clamps, gpu.state.time, gpu.min_contact_distance()
+        cpu.reports.contact_clamps, cpu.state.time, cpu.min_contact_distance(), gpu.reports.contact_clamps, gpu.state.time, gpu.min_contact_distance()
     );
-    assert!(cpu.contact_clamps >= min_clamps, "the clamp hardly acted: {} steps", cpu.contact_clamps);
-    assert_eq!(gpu.contact_clamps, cpu.contact_clamps);
+    assert!(cpu.reports.contact_clamps >= min_clamps, "the clamp hardly acted: {} steps", cpu.reports.contact_clamps);
+    assert_eq!(gpu.reports.contact_clamps, cpu.reports.contact_clamps);
     let (t_cpu, t_gpu) = (cpu.state.time, gpu.state.time);
     assert!((t_gpu - t_cpu).abs() <= CONTACT_GPU_EPSILON * t_cpu, "{t_gpu} vs {t_cpu}");
     assert!(deviation <= CONTACT_GPU_EPSILON * travelled, "GPU − CPU {deviation:e} > {CONTACT_GPU_EPSILON:e} × {travelled:e}");
