@@ -427,7 +427,13 @@ impl ScatterTerms<'_> {
             let mut near = Near::new();
             for i in range {
                 if let Some(pairs) = self.pairs {
-                    pairs.row_forces::<ENERGY>(i, self.geometry, &mut near, energy, virial, |j, f| scatter.pair(i, j, f));
+                    // The row's own force stays in a register (Scatter::own).
+                    let mut fi = scatter.own(i);
+                    pairs.row_forces::<ENERGY>(i, self.geometry, &mut near, energy, virial, |j, f| {
+                        fi += f;
+                        scatter.partner(j, f);
+                    });
+                    scatter.set_own(i, fi);
                 }
                 self.bonded.row_bonds(i, self.model, x, images, |j, f| scatter.pair(i, j, f));
                 self.bonded.row_angles(i, self.model, x, images, |p, f| scatter.add(p, f));

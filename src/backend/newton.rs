@@ -68,6 +68,27 @@ impl Scatter<'_> {
     #[inline(always)]
     pub(super) fn pair(&mut self, i: usize, j: usize, f: DVec3) {
         self.local[i - self.start] += f;
+        self.partner(j, f);
+    }
+
+    /// The force so far on particle `i` (in this block). A row of pairs
+    /// (i, j > i) adds to i in a register, [`Self::own`] then each f, then
+    /// [`Self::set_own`]: the same additions in the same order as
+    /// [`Self::pair`] per pair, since no partner j is i.
+    #[inline(always)]
+    pub(super) fn own(&self, i: usize) -> DVec3 {
+        self.local[i - self.start]
+    }
+
+    /// Stores the force on particle `i` (in this block) back (see [`Self::own`]).
+    #[inline(always)]
+    pub(super) fn set_own(&mut self, i: usize, f: DVec3) {
+        self.local[i - self.start] = f;
+    }
+
+    /// Adds −f to particle `j` (anywhere): the partner's half of a pair.
+    #[inline(always)]
+    pub(super) fn partner(&mut self, j: usize, f: DVec3) {
         match self.local.get_mut(j.wrapping_sub(self.start)) {
             Some(fj) => *fj -= f,
             None => self.spill[j / BLOCK].push((j as u32, -f)),

@@ -33,7 +33,7 @@ use rayon::prelude::*;
 
 use super::context::StepContext;
 use super::fibre::FibreStep;
-use crate::rng::{noise3, Noise};
+use crate::rng::{noise3, noise3_x4, Noise};
 use crate::system::{Model, SimBox, State};
 
 /// Options of `integrator overdamped`, which `integrator implicit` shares.
@@ -103,15 +103,14 @@ pub fn overdamped_step(
 ) -> Result<f64, Blowup> {
     let StepContext { dt, kt, seed, noise, step, .. } = *ctx;
     let refused = |d: &DVec3| !d.is_finite() || d.length() > ctx.max_displacement;
-    // Drift a = dt·F/γ and noise b = √(2kT·dt/γ)·ξ of particle i; a `fixed`
-    // particle never moves (and draws no noise).
-    let drift_and_noise = |i: usize| {
+    // Drift a = dt·F/γ and noise b = √(2kT·dt/γ)·ξ of particle i, with ξ
+    // its draw; a `fixed` particle never moves (and its draw is unused).
+    let drift_and_noise = |i: usize, xi: [f64; 3]| {
         let gamma = model.type_drag[model.types[i] as usize];
         if gamma.is_infinite() {
             return (DVec3::ZERO, DVec3::ZERO);
         }
-        let noise =
-            if kt > 0.0 { (2.0 * kt * dt / gamma).sqrt() * DVec3::from_array(noise3(seed, step, i as u32, noise)) } else { DVec3::ZERO };
+        let noise = if kt > 0.0 { (2.0 * kt * dt / gamma).sqrt() * DVec3::from_array(xi) } else { DVec3::ZERO };
         (forces[i] * (dt / gamma), noise)
     };
     // The minimum is exact, so s does not depend on the thread count.
@@ -120,7 +119,8 @@ pub fn overdamped_step(
             .into_par_iter()
             .with_min_len(1024)
             .map(|i| {
-                let (a, b) = drift_and_noise(i);
+                let xi = if kt > 0.0 { noise3(seed, step, i as u32, noise) } else { [0.0; 3] };
+                let (a, b) = drift_and_noise(i, xi);
                 step_fraction(a.length(), b.length(), limits[i])
             })
             .reduce(|| 1.0, f64::min)
@@ -130,19 +130,26 @@ pub fn overdamped_step(
     // draws its own noise: its Euler–Maruyama step is not computed.
     let on_fibre = |i: usize| fibres.as_ref().is_some_and(|f| f.fibres.holds(i));
     scratch.resize(state.len(), DVec3::ZERO);
+    // Four particles at a time: their noise is drawn in one call (noise3_x4,
+    // the same bits as four).
     let any_refused = scratch
-        .par_iter_mut()
+        .par_chunks_mut(4)
         .enumerate()
-        .with_min_len(1024)
+        .with_min_len(256)
         .fold(
             || false,
-            |bad, (i, d)| {
-                if on_fibre(i) {
-                    return bad;
+            |mut bad, (c, four)| {
+                let xi = if kt > 0.0 { noise3_x4(seed, step, 4 * c as u32, noise) } else { [[0.0; 3]; 4] };
+                for (l, d) in four.iter_mut().enumerate() {
+                    let i = 4 * c + l;
+                    if on_fibre(i) {
+                        continue;
+                    }
+                    let (a, b) = drift_and_noise(i, xi[l]);
+                    *d = if fraction == 1.0 { a + b } else { fraction * a + root * b };
+                    bad |= refused(d);
                 }
-                let (a, b) = drift_and_noise(i);
-                *d = if fraction == 1.0 { a + b } else { fraction * a + root * b };
-                bad | refused(d)
+                bad
             },
         )
         .reduce(|| false, |a, b| a | b);
