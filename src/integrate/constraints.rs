@@ -156,39 +156,18 @@ impl Constraints {
         let chained = &self.fibres.chains.chained_constraints;
         let in_chain = |k: usize| chained.len() == self.list.len() && chained[k];
         let general = (0..self.list.len()).any(|k| !in_chain(k));
+        // Constraints joined to fibres are restored with them, in one
+        // projection of the whole graph; SHAKE sweeps the others.
         let on_fibre = |k: usize| model.bonds[self.list[k].bond].iter().any(|&p| self.fibres.holds(p as usize));
-        if general && (0..self.list.len()).any(|k| !in_chain(k) && on_fibre(k)) {
-            // Constraints joined to fibres: one projection of the whole graph.
-            let couplings: Vec<Coupling> = (0..self.list.len())
-                .filter(|&k| !in_chain(k))
-                .map(|k| Coupling { entry: k, ends: model.bonds[self.list[k].bond], length: self.list[k].length })
-                .collect();
-            let x = &mut state.positions;
-            let coordinates = |i: usize| DVec3::splat(mobility(i));
-            let outcome = self.fibres.reshape_coupled(
-                x,
-                &images,
-                dt,
-                self.tolerance,
-                self.max_iterations,
-                &couplings,
-                &coordinates,
-                &mut self.tension,
-            );
-            for (x, image) in x.iter_mut().zip(state.images.iter_mut()) {
-                sim_box.wrap(x, image);
-            }
-            return match outcome {
-                Ok(iterations) => {
-                    self.iterations = iterations;
-                    Ok(())
-                }
-                Err((constraint, relative_error)) => Err(ConstraintFailure { bond: self.list[constraint].bond, relative_error }),
-            };
-        }
+        let coupled = general && (0..self.list.len()).any(|k| !in_chain(k) && on_fibre(k));
+        let couplings: Vec<Coupling> = (0..self.list.len())
+            .filter(|&k| coupled && !in_chain(k))
+            .map(|k| Coupling { entry: k, ends: model.bonds[self.list[k].bond], length: self.list[k].length })
+            .collect();
+        let swept = general && !coupled;
         // The directions before the step, along which SHAKE corrects (only
-        // the constraints outside fibres need them).
-        let reference: Vec<DVec3> = if general {
+        // the constraints it sweeps need them).
+        let reference: Vec<DVec3> = if swept {
             self.list
                 .iter()
                 .map(|c| {
@@ -201,7 +180,7 @@ impl Constraints {
         };
         let x = &mut state.positions;
         let mut worst = (0, 0.0);
-        for sweep in 0..if general { self.max_iterations.max(1) } else { 0 } {
+        for sweep in 0..if swept { self.max_iterations.max(1) } else { 0 } {
             worst = (0, 0.0);
             for (k, c) in self.list.iter().enumerate().filter(|(k, _)| !in_chain(*k)) {
                 let [i, j] = model.bonds[c.bond];
@@ -230,7 +209,22 @@ impl Constraints {
             }
         }
         if !self.fibres.is_empty() {
-            match self.fibres.reshape(x, &images, dt, self.tolerance, self.max_iterations, &mut self.tension) {
+            let restored = if coupled {
+                let coordinates = |i: usize| DVec3::splat(mobility(i));
+                self.fibres.reshape_coupled(
+                    x,
+                    &images,
+                    dt,
+                    self.tolerance,
+                    self.max_iterations,
+                    &couplings,
+                    &coordinates,
+                    &mut self.tension,
+                )
+            } else {
+                self.fibres.reshape(x, &images, dt, self.tolerance, self.max_iterations, &mut self.tension)
+            };
+            match restored {
                 Ok(iterations) => self.iterations = self.iterations.max(iterations),
                 Err((constraint, relative_error)) => return Err(ConstraintFailure { bond: self.list[constraint].bond, relative_error }),
             }

@@ -112,6 +112,13 @@ impl FibreWork {
         }
     }
 
+    /// Loads the chain at the inputs' positions, then assembles and
+    /// factorises its system; a singular pivot names its particle.
+    fn prepare(&mut self, chain: &Chain, inputs: &FibreInputs, dt: f64, theta: f64) -> Result<(), SingularFibre> {
+        self.load(chain, inputs);
+        self.system.assemble(dt, theta).map_err(|row| SingularFibre { particle: chain.points[(row / 4).min(chain.points.len() - 1)] })
+    }
+
     fn new(points: usize, constrained: bool) -> Self {
         let segments = points - 1;
         Self {
@@ -223,10 +230,7 @@ impl Fibres {
     /// Assembles and factorises every fibre's system at the step's start,
     /// with step length `dt` and stiffness weight `theta`.
     pub fn assemble(&mut self, inputs: &FibreInputs, dt: f64, theta: f64) -> Result<(), SingularFibre> {
-        self.work.par_iter_mut().zip(self.chains.chains.par_iter()).try_for_each(|(work, chain)| {
-            work.load(chain, inputs);
-            work.system.assemble(dt, theta).map_err(|row| SingularFibre { particle: chain.points[(row / 4).min(chain.points.len() - 1)] })
-        })
+        self.work.par_iter_mut().zip(self.chains.chains.par_iter()).try_for_each(|(work, chain)| work.prepare(chain, inputs, dt, theta))
     }
 
     /// Reads every fibre's geometry, drags, held coordinates and lengths
@@ -252,10 +256,7 @@ impl Fibres {
     ) -> Result<(), SingularFibre> {
         let StepContext { kt, seed, noise, step, .. } = *ctx;
         self.work.par_iter_mut().zip(self.chains.chains.par_iter()).try_for_each(|(work, chain)| {
-            work.load(chain, inputs);
-            work.system
-                .assemble(dt, theta)
-                .map_err(|row| SingularFibre { particle: chain.points[(row / 4).min(chain.points.len() - 1)] })?;
+            work.prepare(chain, inputs, dt, theta)?;
             let FibreWork { system, step: displacement, tension, deficit, rhs, .. } = work;
             for (m, &p) in chain.points.iter().enumerate() {
                 let gamma = system.drag[m];
@@ -359,9 +360,22 @@ impl Fibres {
             let chain = &self.chains.chains[c];
             return Err((chain.constraints[failure.segment] as usize, failure.relative_error));
         }
-        let mut iterations = 0;
+        self.write_back(positions, dt, tension);
+        Ok(self
+            .work
+            .iter()
+            .zip(&self.chains.chains)
+            .filter(|(_, c)| c.is_constrained())
+            .map(|(w, _)| w.reshape.iterations)
+            .max()
+            .unwrap_or(0))
+    }
+
+    /// Writes every inextensible fibre's reshaped points into `positions`
+    /// and adds each segment's tension λ + Σg/dt (the step's multiplier and
+    /// the reshape's) to `tension` (by constraint-list entry).
+    fn write_back(&self, positions: &mut [DVec3], dt: f64, tension: &mut [f64]) {
         for (work, chain) in self.work.iter().zip(&self.chains.chains).filter(|(_, c)| c.is_constrained()) {
-            iterations = iterations.max(work.reshape.iterations);
             for (m, &p) in chain.points.iter().enumerate() {
                 positions[p as usize] = work.reshape.moved[m];
             }
@@ -369,7 +383,6 @@ impl Fibres {
                 tension[entry as usize] += work.tension[k] + work.reshape.g[k] / dt;
             }
         }
-        Ok(iterations)
     }
 }
 

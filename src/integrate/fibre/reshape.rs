@@ -89,6 +89,15 @@ fn thomas_solve(reciprocal: &[f64], off: &[f64], rhs: &mut [f64]) {
     }
 }
 
+/// Wᵢ·(g_i·u_i − g_{i−1}·u_{i−1}): point i's displacement by the
+/// multipliers g of segments with directions u (−W·Jᵀg; 0 past the ends).
+#[inline(always)]
+fn displacement(weight: &[DVec3], direction: &[DVec3], g: &[f64], i: usize) -> DVec3 {
+    let after = if i < g.len() { g[i] * direction[i] } else { DVec3::ZERO };
+    let before = if i > 0 { g[i - 1] * direction[i - 1] } else { DVec3::ZERO };
+    weight[i] * (after - before)
+}
+
 impl Reshape {
     /// Moves the chain's points (after the step, as `at` reads them) onto
     /// the lengths of `system` (with its drags and held coordinates), into
@@ -212,9 +221,7 @@ impl Reshape {
 
     /// Wᵢ·(g_i·u_i − g_{i−1}·u_{i−1}) of point i, the displacement −W·Jᵀg of multipliers g.
     pub(super) fn displacement(&self, g: &[f64], i: usize) -> DVec3 {
-        let after = if i < g.len() { g[i] * self.direction[i] } else { DVec3::ZERO };
-        let before = if i > 0 { g[i - 1] * self.direction[i - 1] } else { DVec3::ZERO };
-        self.weight[i] * (after - before)
+        displacement(&self.weight, &self.direction, g, i)
     }
 
     /// The mobility Wᵢ of point i (per coordinate).
@@ -224,15 +231,9 @@ impl Reshape {
 
     /// Moves the points by Δᵢ = Wᵢ·(g_i·u_i − g_{i−1}·u_{i−1}) and adds g to the multipliers' sum.
     pub(super) fn apply(&mut self, g: &[f64]) {
-        let segments = self.direction.len();
-        let (weight, moved, direction) = (&self.weight[..segments + 1], &mut self.moved[..segments + 1], &self.direction[..segments]);
-        let mut before = DVec3::ZERO;
-        for i in 0..segments {
-            let after = g[i] * direction[i];
-            moved[i] += weight[i] * (after - before);
-            before = after;
+        for (i, x) in self.moved.iter_mut().enumerate() {
+            *x += displacement(&self.weight, &self.direction, g, i);
         }
-        moved[segments] += weight[segments] * (DVec3::ZERO - before);
         self.g.iter_mut().zip(g).for_each(|(s, d)| *s += d);
     }
 }
